@@ -1,0 +1,32 @@
+"""orbits: N-body orbital mechanics with astropy units and compiled integrators.
+
+>>> import astropy.units as u
+>>> import orbits
+>>> bodies = orbits.scenes.outer_solar_system()
+>>> sim = orbits.Simulation(bodies, integrator="leapfrog", dt=10 * u.day)
+>>> result = sim.run(until=1000 * u.yr, outputs=100, progress=False)
+>>> print(result.summary())                               # doctest: +SKIP
+"""
+
+from importlib.metadata import PackageNotFoundError, version as _version
+
+from . import errors, integrators, monitors, scenes
+from .bodies import BodySet
+from .custom import Trajectory, integrate
+from .errors import (BodyError, BodyUnitsError, CloseEncounter, ElementsError, Escape,
+                     IntegratorOptionError, NonFiniteState, OrbitsError, StepSizeUnderflow,
+                     UnknownIntegratorError)
+from .result import Result
+from .simulation import Simulation
+from .units import UnitSystem
+
+try:
+    __version__ = _version("orbits")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0+unknown"
+
+__all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajectory",
+           "scenes", "integrators", "monitors", "errors", "OrbitsError", "BodyError",
+           "BodyUnitsError", "ElementsError", "IntegratorOptionError",
+           "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow",
+           "CloseEncounter", "Escape", "__version__"]

@@ -1,0 +1,91 @@
+"""Every numba option the package uses, in one place.
+
+Kernels import :func:`njit` from here instead of from numba so that the
+compilation options are the same everywhere and can be changed once.
+
+* ``cache=True``: compiled code is written next to the module, so a new
+  process loads it instead of compiling again.
+* ``error_model="numpy"``: division by zero gives inf/nan as in numpy instead
+  of raising; the Python error model puts a branch before every division and
+  stops LLVM from vectorising the pair loops.  Non-finite states are caught
+  explicitly by the stepping loops instead.
+* ``fastmath`` is off: results must be reproducible and comparable bit for bit.
+  The one exception is the parallel gravity kernel, which allows
+  re-association of its inner sums so that they vectorise (see there).
+"""
+
+import hashlib
+import pathlib
+import types
+
+import numba
+
+__all__ = ["njit", "njit_parallel", "specialize", "KERNEL_STAMP", "NUMBA_OPTIONS"]
+
+NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
+
+
+def njit(func=None, **overrides):
+    """``numba.njit`` with the package's options; usable bare or with overrides."""
+    options = dict(NUMBA_OPTIONS, **overrides)
+    if func is None:
+        return lambda f: numba.njit(**options)(f)
+    return numba.njit(**options)(func)
+
+
+def njit_parallel(func=None, **overrides):
+    """Like :func:`njit` but with ``parallel=True`` (threads over ``prange``)."""
+    return njit(func, parallel=True, **overrides)
+
+
+def _stamp():
+    # numba only invalidates a cached function when its own file changes, not
+    # when a kernel it calls does.  Specialised loops carry a hash of every
+    # kernel source in their name, so editing any kernel gives fresh cache keys.
+    h = hashlib.sha1()
+    for path in sorted(pathlib.Path(__file__).parent.glob("*.py")):
+        h.update(path.read_bytes())
+    return h.hexdigest()[:10]
+
+
+KERNEL_STAMP = _stamp()
+
+_SPECIALISED = {}
+
+
+def specialize(template, suffix, jit=True, cache=True, **bindings):
+    """Compile a copy of ``template`` whose global names are bound to ``bindings``.
+
+    A stepping loop is written once, with the force (or another kernel) as a
+    global name.  Each scene's loop is a copy of that code with the name bound
+    to the kernel it needs, compiled and cached under its own name, so a scene
+    compiles only the kernels it uses.  (Passing the kernel as an argument
+    would defeat numba's on-disk cache; closures do too.)
+
+    Parameters
+    ----------
+    template : function
+        Plain Python function (not yet jitted) written against global names.
+    suffix : str
+        Distinguishes this copy in the cache; use the names of the bindings.
+    jit : bool
+        False returns the plain Python copy (for a user's Python force).
+    cache : bool
+        False when a binding cannot be cached on disk (a user's function).
+    **bindings
+        Global names to replace, typically jitted kernels.
+    """
+    key = (template, suffix, jit, cache)
+    if key in _SPECIALISED:
+        return _SPECIALISED[key]
+    glob = dict(template.__globals__)
+    glob.update(bindings)
+    name = f"{template.__name__}__{suffix}__{KERNEL_STAMP}"
+    func = types.FunctionType(template.__code__, glob, name,
+                              template.__defaults__, template.__closure__)
+    func.__qualname__ = name
+    func.__module__ = template.__module__
+    func.__doc__ = template.__doc__
+    result = numba.njit(**dict(NUMBA_OPTIONS, cache=cache))(func) if jit else func
+    _SPECIALISED[key] = result
+    return result

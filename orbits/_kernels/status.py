@@ -1,0 +1,18 @@
+"""Status codes returned by the compiled loops.
+
+numba compiles members of an ``IntEnum`` as integer constants, so kernels and
+Python share one set of names.  ``Simulation`` turns a non-OK status into the
+matching exception of :mod:`orbits.errors`.
+"""
+
+from enum import IntEnum
+
+__all__ = ["Status"]
+
+
+class Status(IntEnum):
+    OK = 0
+    NON_FINITE = 1
+    STEP_UNDERFLOW = 2
+    CLOSE_ENCOUNTER = 3
+    ESCAPE = 4

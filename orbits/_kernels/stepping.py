@@ -1,0 +1,198 @@
+"""The compiled loops that advance a state many steps.
+
+For a few bodies the cost of a step is dominated by getting in and out of
+Python, so the whole loop over steps is compiled, not only the force.  Each
+loop is written once as a plain function over a global name ``force`` and
+compiled per force by :func:`orbits._kernels._jit.specialize`; a scene compiles
+only the loop and force it uses.
+
+Forces have the signature ``force(x, v, t, fargs, acc)`` and write the
+accelerations into ``acc``; ``fargs`` is a tuple of whatever the force needs.
+
+Every loop returns ``(status, steps_done, n_monitor_rows)``.  After each
+step it checks that the state is finite; on failure it returns at once with
+``Status.NON_FINITE`` and ``steps_done`` the number of good steps before the
+bad one.  The caller keeps a copy of the state it passed in, so it can
+recompute the last good state exactly (the loops are deterministic) without
+the loop paying for a copy every step.
+
+Monitors (energy, angular momentum, ...) are recorded every ``every`` steps,
+counted from the start of the simulation (``step0``), into ``mon_t`` and
+``mon_out``; ``every = 0`` switches them off and costs one branch a step.
+"""
+
+import math
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from ._jit import njit, specialize
+from .gravity import accelerate_pairwise, accelerate_pairwise_parallel
+from .invariants import monitor_row
+from .status import Status
+
+__all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
+           "user_force", "state_is_finite", "ForceKernel"]
+
+#: operator codes of a splitting table
+DRIFT = 0
+KICK = 1
+
+
+@njit
+def state_is_finite(x, v):
+    """True if every position and velocity component is finite."""
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += x[i, 0] + x[i, 1] + x[i, 2] + v[i, 0] + v[i, 1] + v[i, 2]
+    # a sum with a NaN or an inf term is itself NaN or inf
+    return math.isfinite(s)
+
+
+@njit
+def _record(x, v, t, mon, n_mon, mon_t, mon_out):
+    every, which, m, G, n_active, eps2 = mon
+    mon_t[n_mon] = t
+    monitor_row(x, v, m, G, n_active, eps2, which, mon_out[n_mon])
+
+
+# -- forces ------------------------------------------------------------------------
+
+def _gravity_force(x, v, t, fargs, acc):
+    gm, n_active, eps2 = fargs
+    pair_kernel(x, gm, n_active, eps2, acc)  # noqa: F821 - bound by specialize
+
+
+def _user_force(x, v, t, fargs, acc):
+    # the user's arrays (any shape, ``size`` values) fill the (rows, 3) state
+    # arrays in order; the padding stays zero
+    size, shape = fargs
+    xu = x.ravel()[:size].reshape(shape)
+    vu = v.ravel()[:size].reshape(shape)
+    a = np.asarray(user_accel(xu, vu, t)).ravel()  # noqa: F821 - bound by specialize
+    flat = acc.ravel()
+    for i in range(size):
+        flat[i] = a[i]
+
+
+class ForceKernel(NamedTuple):
+    """A force function and how loops that call it are compiled."""
+
+    kernel: Callable
+    key: str       # names the loops compiled for it
+    jit: bool      # False: everything runs as plain Python (a user's Python function)
+    cache: bool    # False where the force cannot be cached on disk (a user's function)
+
+
+def gravity_force(parallel):
+    """The pairwise-gravity force, serial or threaded."""
+    if parallel:
+        key, pair = "gravity_parallel", accelerate_pairwise_parallel
+    else:
+        key, pair = "gravity_serial", accelerate_pairwise
+    return ForceKernel(specialize(_gravity_force, key, pair_kernel=pair), key, True, True)
+
+
+def user_force(accel, jit):
+    """A force from a user's ``accel(x, v, t)``; compiled if ``accel`` is a numba function."""
+    key = f"user{id(accel)}"
+    kernel = specialize(_user_force, key, jit=jit, cache=False, user_accel=accel)
+    return ForceKernel(kernel, key, jit, False)
+
+
+# -- splitting methods --------------------------------------------------------------
+
+def _splitting_loop(x, v, t, dt, nsteps, kinds, coefs, acc, cache, fargs,
+                    velocity_dependent, mon, step0, mon_t, mon_out):
+    # A splitting step is a sequence of drifts (x += c dt v) and kicks
+    # (v += c dt a(x)).  The acceleration depends only on positions (unless
+    # velocity_dependent), so it is recomputed only after a drift: velocity
+    # Verlet's closing kick and the next step's opening kick share one force
+    # evaluation.  cache[0] is 1 while acc belongs to the current positions.
+    n = x.shape[0]
+    n_ops = kinds.shape[0]
+    every = mon[0]
+    n_mon = 0
+    for k in range(nsteps):
+        tx = t + k * dt
+        for op in range(n_ops):
+            h = coefs[op] * dt
+            if kinds[op] == DRIFT:
+                for i in range(n):
+                    x[i, 0] += h * v[i, 0]
+                    x[i, 1] += h * v[i, 1]
+                    x[i, 2] += h * v[i, 2]
+                tx += h
+                cache[0] = 0
+            else:
+                if cache[0] == 0:
+                    force(x, v, tx, fargs, acc)  # noqa: F821 - bound by specialize
+                    cache[0] = 1
+                for i in range(n):
+                    v[i, 0] += h * acc[i, 0]
+                    v[i, 1] += h * acc[i, 1]
+                    v[i, 2] += h * acc[i, 2]
+                if velocity_dependent:
+                    cache[0] = 0
+        if not state_is_finite(x, v):
+            return Status.NON_FINITE, k, n_mon
+        if every > 0 and (step0 + k + 1) % every == 0:
+            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
+            n_mon += 1
+    return Status.OK, nsteps, n_mon
+
+
+def splitting_loop(force):
+    """The splitting loop compiled for a :class:`ForceKernel`."""
+    return specialize(_splitting_loop, force.key, jit=force.jit, cache=force.cache,
+                      force=force.kernel)
+
+
+# -- explicit Runge-Kutta ---------------------------------------------------------------
+
+def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, step0,
+                      mon_t, mon_out):
+    # y = (x, v), y' = (v, a(x, v, t)); stage s has state
+    # y + dt sum_j A[s, j] k_j and derivative k_s.  kx[s] = stage velocity,
+    # kv[s] = stage acceleration.
+    n = x.shape[0]
+    n_stages = b.shape[0]
+    every = mon[0]
+    n_mon = 0
+    for k in range(nsteps):
+        tk = t + k * dt
+        for s in range(n_stages):
+            for i in range(n):
+                for d in range(3):
+                    xi = x[i, d]
+                    vi = v[i, d]
+                    for j in range(s):
+                        a_sj = A[s, j]
+                        if a_sj != 0.0:
+                            xi += dt * a_sj * kx[j, i, d]
+                            vi += dt * a_sj * kv[j, i, d]
+                    xs[i, d] = xi
+                    vs[i, d] = vi
+                    kx[s, i, d] = vi
+            force(xs, vs, tk + c[s] * dt, fargs, kv[s])  # noqa: F821 - bound by specialize
+        for i in range(n):
+            for d in range(3):
+                dx = 0.0
+                dv = 0.0
+                for s in range(n_stages):
+                    dx += b[s] * kx[s, i, d]
+                    dv += b[s] * kv[s, i, d]
+                x[i, d] += dt * dx
+                v[i, d] += dt * dv
+        if not state_is_finite(x, v):
+            return Status.NON_FINITE, k, n_mon
+        if every > 0 and (step0 + k + 1) % every == 0:
+            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
+            n_mon += 1
+    return Status.OK, nsteps, n_mon
+
+
+def runge_kutta_loop(force):
+    """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`."""
+    return specialize(_runge_kutta_loop, force.key, jit=force.jit, cache=force.cache,
+                      force=force.kernel)

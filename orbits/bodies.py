@@ -1,0 +1,421 @@
+"""Body sets: names, masses and states, with astropy units at the edge.
+
+A :class:`BodySet` stores its numbers as float64 arrays in its
+:class:`~orbits.units.UnitSystem`; its public properties give Quantities.
+Bodies enter by Cartesian state (:meth:`BodySet.add` with ``position`` and
+``velocity``), by orbital elements about a primary (:meth:`BodySet.add` with
+``a``, ``e``, ...), or all at once from arrays (:meth:`BodySet.from_arrays`).
+Every value is checked where it enters; a bad one raises a
+:class:`~orbits.errors.BodyError` naming the body and the field.
+"""
+
+import copy as _copy
+import math
+
+import astropy.units as u
+import numpy as np
+
+from ._kernels import kepler as _kepler
+from .errors import (BodyError, BodyUnitsError, CoincidentBodiesError, DuplicateBodyError,
+                     ElementsError, NoMassiveBodyError, UnknownBodyError)
+from .units import UnitSystem
+
+__all__ = ["BodySet"]
+
+_ELEMENT_NAMES = ("a", "e", "inc", "Omega", "omega", "f", "M")
+
+
+class BodySet:
+    """An ordered set of named point masses with positions and velocities.
+
+    Parameters
+    ----------
+    units : UnitSystem, optional
+        The unit system in which the set stores its numbers.  Default:
+        au, solar masses and days with astropy's G.  When a unit system is given
+        explicitly, plain numbers are accepted everywhere and read in it.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> bodies = orbits.BodySet()
+    >>> bodies.add("Sun", mass=1 * u.Msun)
+    >>> bodies.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.048,
+    ...            inc=1.3 * u.deg)
+    >>> bodies.move_to_com()
+    >>> len(bodies)
+    2
+    """
+
+    def __init__(self, units=None):
+        if units is not None and not isinstance(units, UnitSystem):
+            raise TypeError(f"units must be a UnitSystem, got {type(units).__name__}")
+        self.units = units if units is not None else UnitSystem.default()
+        self._bare_ok = units is not None
+        self._names = []
+        self._m = np.zeros(0)
+        self._x = np.zeros((0, 3))
+        self._v = np.zeros((0, 3))
+        self.history = []  # how the bodies were made, recorded with results
+
+    # -- construction -----------------------------------------------------------
+    def add(self, name, mass, *, position=None, velocity=None, primary=None, a=None,
+            e=None, inc=None, Omega=None, omega=None, f=None, M=None):
+        """Add one body, by Cartesian state or by orbital elements.
+
+        Parameters
+        ----------
+        name : str
+            Unique name.
+        mass : Quantity, scalar, mass
+            Must be finite and >= 0.  A massless body feels gravity but exerts none.
+        position, velocity : Quantity, shape (3,), length and velocity
+            Cartesian state in the frame of the set.  Both default to zero (a
+            body at rest at the origin, as a central star is usually given).
+        primary : str, optional
+            With elements: the body the orbit is about.  Default: the centre of
+            mass of all bodies added before (Jacobi-like, as for hierarchical
+            systems).
+        a : Quantity, length
+            Semi-major axis; negative for a hyperbolic orbit (e > 1).
+        e : float
+            Eccentricity, >= 0; default 0.  Parabolic orbits (e = 1) cannot be
+            given by ``a``: give a Cartesian state instead.
+        inc, Omega, omega : Quantity, angle
+            Inclination, longitude of the ascending node, argument of pericentre.
+            Default 0.
+        f, M : Quantity, angle
+            True or mean anomaly (give at most one).  Default ``f = 0``.
+
+        Notes
+        -----
+        The orbit about the primary uses ``mu = G (m_primary + m_body)``, so a
+        massive body on a circular orbit given this way stays circular in the
+        two-body problem.
+        """
+        self._check_name(name)
+        m = self._scalar(mass, "mass", name, "mass")
+        if not math.isfinite(m):
+            raise BodyError(f"mass must be finite, got {m}", body=name, field="mass")
+        if m < 0:
+            raise BodyError(f"mass must be >= 0, got {m} {self.units.mass}",
+                            body=name, field="mass")
+        elements = dict(a=a, e=e, inc=inc, Omega=Omega, omega=omega, f=f, M=M)
+        given = [k for k, val in elements.items() if val is not None]
+        if given or primary is not None:
+            if position is not None or velocity is not None:
+                raise BodyError("give either a Cartesian state (position, velocity) or "
+                                f"orbital elements, not both (got {', '.join(given)})",
+                                body=name, field="position")
+            x, v = self._state_from_elements(name, m, primary, **elements)
+            how = {"name": name, "from": "elements", "primary": primary,
+                   **{k: _describe(val) for k, val in elements.items() if val is not None}}
+        else:
+            x = (np.zeros(3) if position is None
+                 else self._vector(position, "length", name, "position"))
+            v = (np.zeros(3) if velocity is None
+                 else self._vector(velocity, "velocity", name, "velocity"))
+            how = {"name": name, "from": "state"}
+        self._append(name, m, x, v)
+        self.history.append(how)
+
+    @classmethod
+    def from_arrays(cls, masses, positions, velocities, names=None, units=None):
+        """Make a body set from arrays.
+
+        Parameters
+        ----------
+        masses : Quantity or array, shape (N,)
+        positions : Quantity or array, shape (N, 3)
+        velocities : Quantity or array, shape (N, 3)
+        names : sequence of str, optional
+            Default ``"0"``, ``"1"``, ...
+        units : UnitSystem, optional
+            If given, plain numbers are read in it; otherwise Quantities are needed.
+        """
+        bs = cls(units)
+        m = bs._array(masses, "mass", "masses", (None,))
+        n = m.shape[0]
+        x = bs._array(positions, "length", "positions", (n, 3))
+        v = bs._array(velocities, "velocity", "velocities", (n, 3))
+        if names is None:
+            names = [str(i) for i in range(n)]
+        names = list(names)
+        if len(names) != n:
+            raise BodyError(f"expected {n} names (one per mass), got {len(names)}",
+                            field="names")
+        for i, name in enumerate(names):
+            bs._check_name(name)
+            if not math.isfinite(m[i]) or m[i] < 0:
+                raise BodyError(f"mass must be finite and >= 0, got {m[i]}",
+                                body=name, field="mass")
+            for field, arr in (("position", x), ("velocity", v)):
+                if not np.all(np.isfinite(arr[i])):
+                    raise BodyError(f"{field} must be finite, got {arr[i]}",
+                                    body=name, field=field)
+            bs._append(name, float(m[i]), x[i], v[i])
+        bs.history.append({"from": "arrays", "n": n})
+        return bs
+
+    @classmethod
+    def from_rebound(cls, sim, units=None, names=None):
+        """Make a body set from a ``rebound.Simulation``.
+
+        REBOUND keeps plain numbers; they are read in ``units`` (default: a
+        dimensionless system with REBOUND's ``sim.G``).  Particle hashes are
+        not names, so names default to ``"0"``, ``"1"``, ...
+        """
+        n = sim.N
+        m = np.array([sim.particles[i].m for i in range(n)])
+        x = np.array([sim.particles[i].xyz for i in range(n)], dtype=float).reshape(n, 3)
+        v = np.array([sim.particles[i].vxyz for i in range(n)], dtype=float).reshape(n, 3)
+        if units is None:
+            units = UnitSystem.nbody(G=sim.G)
+        elif not math.isclose(units.G, sim.G, rel_tol=1e-15):
+            raise ValueError(f"units.G = {units.G!r} differs from the REBOUND "
+                             f"simulation's G = {sim.G!r}")
+        bs = cls.from_arrays(m, x, v, names=names, units=units)
+        bs.history[-1] = {"from": "rebound", "n": n}
+        return bs
+
+    def to_rebound(self):
+        """A ``rebound.Simulation`` with the same G, masses and states (plain floats).
+
+        Massive bodies must come before massless ones in REBOUND's active/test
+        particle split; the order of this set is kept as it is.
+        """
+        import rebound
+        sim = rebound.Simulation()
+        sim.G = self.units.G
+        for i in range(len(self)):
+            sim.add(m=float(self._m[i]), x=self._x[i, 0], y=self._x[i, 1], z=self._x[i, 2],
+                    vx=self._v[i, 0], vy=self._v[i, 1], vz=self._v[i, 2])
+        return sim
+
+    def copy(self):
+        """An independent copy."""
+        return _copy.deepcopy(self)
+
+    # -- access -----------------------------------------------------------------
+    def __len__(self):
+        return len(self._names)
+
+    def __contains__(self, name):
+        return name in self._names
+
+    def __repr__(self):
+        return f"<BodySet of {len(self)} bodies: {', '.join(self._names[:8])}" + \
+            (", ...>" if len(self) > 8 else ">")
+
+    @property
+    def names(self):
+        """Body names, in order (list of str)."""
+        return list(self._names)
+
+    @property
+    def masses(self):
+        """Quantity, shape (N,), mass."""
+        return self.units.quantity(self._m.copy(), "mass")
+
+    @property
+    def positions(self):
+        """Quantity, shape (N, 3), length."""
+        return self.units.quantity(self._x.copy(), "length")
+
+    @property
+    def velocities(self):
+        """Quantity, shape (N, 3), velocity."""
+        return self.units.quantity(self._v.copy(), "velocity")
+
+    def index(self, name):
+        """Position of ``name`` in the set."""
+        try:
+            return self._names.index(name)
+        except ValueError:
+            raise UnknownBodyError(f"no such body; known: {', '.join(self._names)}",
+                                   body=name) from None
+
+    @property
+    def total_mass(self):
+        """Quantity, scalar, mass."""
+        return self.units.quantity(self._m.sum(), "mass")
+
+    def center_of_mass(self):
+        """Position and velocity of the centre of mass: two Quantities, shape (3,)."""
+        x, v = self._com()
+        return self.units.quantity(x, "length"), self.units.quantity(v, "velocity")
+
+    def move_to_com(self):
+        """Shift positions and velocities so that the centre of mass is at rest at the origin."""
+        self._require_mass()
+        x, v = self._com()
+        self._x -= x
+        self._v -= v
+        self.history.append({"from": "move_to_com"})
+
+    def elements(self, name, primary=None):
+        """Osculating orbital elements of a body about a primary.
+
+        Parameters
+        ----------
+        name : str
+        primary : str, optional
+            Default: the centre of mass of the bodies before ``name`` in the set.
+
+        Returns
+        -------
+        dict
+            ``a`` (length), ``e``, ``inc``, ``Omega``, ``omega``, ``f``, ``M``
+            (angles in rad), as Quantities.
+        """
+        i = self.index(name)
+        mp, xp, vp = self._primary_state(name, primary, before=i)
+        mu = self.units.G * (mp + self._m[i])
+        out = np.empty(7)
+        status = _kepler.state_to_elements(mu, self._x[i] - xp, self._v[i] - vp, out)
+        if status != 0:
+            raise ElementsError(_kepler.describe_status(status), body=name, field="elements")
+        q = self.units.quantity
+        return {"a": q(out[0], "length"), "e": out[1] << u.dimensionless_unscaled,
+                **{k: out[j] << u.rad for j, k in enumerate(_ELEMENT_NAMES[2:], start=2)}}
+
+    def check(self):
+        """Check the set as a whole: at least one massive body, no two at one place.
+
+        Raises
+        ------
+        NoMassiveBodyError, CoincidentBodiesError
+        """
+        self._require_mass()
+        if len(self) > 1:
+            _, first, counts = np.unique(self._x, axis=0, return_index=True,
+                                         return_counts=True)
+            if np.any(counts > 1):
+                j = first[np.argmax(counts > 1)]
+                same = [self._names[k] for k in range(len(self))
+                        if np.array_equal(self._x[k], self._x[j])]
+                raise CoincidentBodiesError(
+                    f"is at the same position as {', '.join(map(repr, same[1:]))} "
+                    f"({self._x[j]} {self.units.length}); bodies must be at distinct "
+                    f"positions", body=same[0], field="position")
+
+    # -- internals ----------------------------------------------------------------
+    def _append(self, name, m, x, v):
+        self._names.append(name)
+        self._m = np.append(self._m, m)
+        self._x = np.vstack([self._x, np.asarray(x, dtype=float).reshape(1, 3)])
+        self._v = np.vstack([self._v, np.asarray(v, dtype=float).reshape(1, 3)])
+
+    def _check_name(self, name):
+        if not isinstance(name, str) or not name:
+            raise BodyError(f"name must be a non-empty string, got {name!r}",
+                            body=name, field="name")
+        if name in self._names:
+            raise DuplicateBodyError("a body of this name is already in the set",
+                                     body=name, field="name")
+
+    def _require_mass(self):
+        if len(self) == 0 or not np.any(self._m > 0):
+            raise NoMassiveBodyError(
+                f"the body set has no body with positive mass ({len(self)} bodies); "
+                "at least one is needed")
+
+    def _com(self):
+        mt = self._m.sum()
+        if mt <= 0:
+            return np.zeros(3), np.zeros(3)
+        return (self._m @ self._x) / mt, (self._m @ self._v) / mt
+
+    def _scalar(self, value, kind, body, field):
+        val = self.units.to_internal(value, kind, bare_ok=self._bare_ok, body=body,
+                                     field=field)
+        if val.shape != ():
+            raise BodyError(f"expected a scalar, got shape {val.shape}", body=body,
+                            field=field)
+        return float(val)
+
+    def _vector(self, value, kind, body, field):
+        val = self.units.to_internal(value, kind, bare_ok=self._bare_ok, body=body,
+                                     field=field)
+        if val.shape != (3,):
+            raise BodyError(f"expected 3 components (x, y, z), got shape {val.shape}",
+                            body=body, field=field)
+        if not np.all(np.isfinite(val)):
+            raise BodyError(f"must be finite, got {val}", body=body, field=field)
+        return val.copy()
+
+    def _array(self, value, kind, field, shape):
+        val = self.units.to_internal(value, kind, bare_ok=self._bare_ok, field=field)
+        ok = val.ndim == len(shape) and all(s is None or s == d
+                                            for s, d in zip(shape, val.shape))
+        if not ok:
+            want = "(" + ", ".join("N" if s is None else str(s) for s in shape) + ")"
+            raise BodyError(f"expected shape {want}, got {val.shape}", field=field)
+        return np.ascontiguousarray(val, dtype=np.float64)
+
+    def _primary_state(self, name, primary, before):
+        if primary is None:
+            if before == 0 or not np.any(self._m[:before] > 0):
+                raise BodyError("orbital elements need a primary: name one with "
+                                "primary=, or add a massive body first",
+                                body=name, field="primary")
+            m = self._m[:before]
+            mt = m.sum()
+            return mt, (m @ self._x[:before]) / mt, (m @ self._v[:before]) / mt
+        if not isinstance(primary, str):
+            raise BodyError(f"primary must be a body's name, got {primary!r}",
+                            body=name, field="primary")
+        if primary not in self._names:
+            raise UnknownBodyError(
+                f"unknown primary {primary!r}; known bodies: {', '.join(self._names)}",
+                body=name, field="primary")
+        j = self._names.index(primary)
+        return self._m[j], self._x[j], self._v[j]
+
+    def _state_from_elements(self, name, m, primary, a, e, inc, Omega, omega, f, M):
+        mp, xp, vp = self._primary_state(name, primary, before=len(self))
+        if a is None:
+            raise ElementsError("orbital elements need the semi-major axis a",
+                                body=name, field="a")
+        a_ = self._scalar(a, "length", name, "a")
+        e_ = 0.0 if e is None else self._scalar(e, "dimensionless", name, "e")
+        ang = {}
+        for key, val in (("inc", inc), ("Omega", Omega), ("omega", omega), ("f", f),
+                         ("M", M)):
+            ang[key] = None if val is None else self._scalar(val, "angle", name, key)
+        for key, val in (("a", a_), ("e", e_), *ang.items()):
+            if val is not None and not math.isfinite(val):
+                raise ElementsError(f"must be finite, got {val}", body=name, field=key)
+        if e_ < 0:
+            raise ElementsError(f"eccentricity must be >= 0, got {e_}", body=name, field="e")
+        if a_ == 0:
+            raise ElementsError("semi-major axis must be non-zero", body=name, field="a")
+        if a_ > 0 and e_ >= 1:
+            raise ElementsError(f"e = {e_} >= 1 needs a < 0 (a hyperbolic orbit); "
+                                f"got a = {a_} {self.units.length}. Parabolic orbits "
+                                f"(e = 1) must be given as a state", body=name, field="e")
+        if a_ < 0 and e_ <= 1:
+            raise ElementsError(f"a < 0 means a hyperbolic orbit and needs e > 1; "
+                                f"got e = {e_}", body=name, field="e")
+        if ang["f"] is not None and ang["M"] is not None:
+            raise ElementsError("give the true anomaly f or the mean anomaly M, not both",
+                                body=name, field="f")
+        anomaly = ang["f"] if ang["f"] is not None else (
+            _kepler.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
+        mu = self.units.G * (mp + m)
+        if mu <= 0:
+            raise ElementsError("the primary and the body are both massless; an orbit "
+                                "needs mass", body=name, field="primary")
+        pos, vel = np.empty(3), np.empty(3)
+        status = _kepler.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
+                                           ang["Omega"] or 0.0, ang["omega"] or 0.0,
+                                           anomaly, pos, vel)
+        if status != 0:
+            raise ElementsError(_kepler.describe_status(status), body=name,
+                                field="f" if ang["f"] is not None else "elements")
+        return xp + pos, vp + vel
+
+
+def _describe(value):
+    return str(value)

@@ -1,0 +1,85 @@
+"""Command line: ``orbits run | scenes | integrators``.
+
+``main(argv=None)`` only parses arguments and calls the library; the tests
+call it with a list.
+"""
+
+import argparse
+import re
+import sys
+
+import astropy.units as u
+
+__all__ = ["main", "parse_quantity"]
+
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z_]\w*(?:\s*\S*)?)?\s*$")
+
+
+def parse_quantity(text, physical_type="time"):
+    """Read ``"10d"``, ``"1000 yr"``, ``"2.5e3 day"``; a bare number stays a float."""
+    m = _QUANTITY.match(text)
+    if not m:
+        raise argparse.ArgumentTypeError(f"cannot read {text!r} as a number with a unit, "
+                                         f"e.g. 10d or 1000yr")
+    value, unit = float(m.group(1)), m.group(2)
+    if not unit:
+        return value
+    try:
+        q = value * u.Unit(unit.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"unknown unit {unit!r} in {text!r}") from None
+    if q.unit.physical_type != physical_type:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a {physical_type}")
+    return q
+
+
+def _parser():
+    p = argparse.ArgumentParser(prog="orbits", description="N-body orbital mechanics.")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    run = sub.add_parser("run", help="integrate a built-in scene and print a summary")
+    run.add_argument("scene", help="scene name (see 'orbits scenes')")
+    run.add_argument("--integrator", "-i", default="verlet",
+                     help="integrator name (see 'orbits integrators'); default verlet")
+    run.add_argument("--dt", type=parse_quantity, required=True,
+                     help="step, with a unit (10d, 1h) or a plain number in the scene's units")
+    run.add_argument("--until", type=parse_quantity, required=True,
+                     help="end time, e.g. 1000yr")
+    run.add_argument("--outputs", type=int, default=500, help="number of outputs (500)")
+    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+    sub.add_parser("scenes", help="list the built-in scenes")
+    sub.add_parser("integrators", help="list the integrators")
+    return p
+
+
+def main(argv=None):
+    """Entry point of the ``orbits`` command; returns the exit status."""
+    args = _parser().parse_args(argv)
+    import orbits
+    from orbits.errors import OrbitsError
+
+    try:
+        if args.command == "scenes":
+            for name, text in orbits.scenes.describe():
+                print(f"{name:22s} {text}")
+        elif args.command == "integrators":
+            print(f"{'name':18s} {'order':>5s}  {'symplectic':10s} {'adaptive':8s} summary")
+            for info in orbits.integrators.available():
+                print(f"{info.name:18s} {info.order:5d}  {str(info.symplectic):10s} "
+                      f"{str(info.adaptive):8s} {info.summary}")
+        elif args.command == "run":
+            bodies = orbits.scenes.get(args.scene)
+            sim = orbits.Simulation(bodies, integrator=args.integrator, dt=args.dt)
+            result = sim.run(until=args.until, outputs=args.outputs,
+                             progress=False if args.no_progress else None)
+            print(f"scene           {args.scene}")
+            print(result.summary())
+    except (OrbitsError, ValueError, u.UnitsError) as exc:
+        print(f"orbits: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

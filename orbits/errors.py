@@ -1,0 +1,133 @@
+"""The named exceptions of ``orbits``.
+
+Input errors say which body, which field, and what was expected.  Run-time
+failures say when and at which step they happened, and carry the result up to
+the last good state, so that nothing computed is lost.
+"""
+
+import astropy.units as u
+
+__all__ = [
+    "OrbitsError",
+    "BodyError",
+    "BodyUnitsError",
+    "ElementsError",
+    "UnknownBodyError",
+    "DuplicateBodyError",
+    "CoincidentBodiesError",
+    "NoMassiveBodyError",
+    "UnknownIntegratorError",
+    "IntegratorOptionError",
+    "RunError",
+    "SimulationStopped",
+    "NonFiniteState",
+    "StepSizeUnderflow",
+    "CloseEncounter",
+    "Escape",
+]
+
+
+class OrbitsError(Exception):
+    """Base class of every exception raised by ``orbits``."""
+
+
+def _where(body, field):
+    parts = []
+    if body is not None:
+        parts.append(f"body {body!r}")
+    if field is not None:
+        parts.append(f"field {field!r}")
+    return ", ".join(parts)
+
+
+class BodyError(OrbitsError, ValueError):
+    """A body's value is not acceptable.
+
+    Attributes
+    ----------
+    body : str or None
+        Name (or index) of the body concerned.
+    field : str or None
+        The field concerned: ``"mass"``, ``"position"``, ``"e"``, ...
+    """
+
+    def __init__(self, message, body=None, field=None):
+        self.body = body
+        self.field = field
+        where = _where(body, field)
+        super().__init__(f"{where}: {message}" if where else message)
+
+
+class BodyUnitsError(BodyError, u.UnitsError):
+    """A body's value has the wrong physical type, or no unit where one is needed."""
+
+
+class ElementsError(BodyError):
+    """Orbital elements that describe no orbit (e >= 1 with a > 0, e < 0, ...)."""
+
+
+class UnknownBodyError(BodyError, KeyError):
+    """A name that is not in the body set (an unknown ``primary=``, for example)."""
+
+    def __str__(self):  # KeyError would quote the message
+        return Exception.__str__(self)
+
+
+class DuplicateBodyError(BodyError):
+    """A body name that is already used."""
+
+
+class CoincidentBodiesError(BodyError):
+    """Two bodies at exactly the same position: their mutual force is infinite."""
+
+
+class NoMassiveBodyError(OrbitsError, ValueError):
+    """A simulation needs at least one body with positive mass."""
+
+
+class UnknownIntegratorError(OrbitsError, ValueError):
+    """An integrator name that is not in the registry."""
+
+
+class IntegratorOptionError(OrbitsError, ValueError):
+    """An integrator option that is unknown, or whose value is not acceptable."""
+
+
+class RunError(OrbitsError, RuntimeError):
+    """Base class of failures during a run.
+
+    Attributes
+    ----------
+    time : astropy.units.Quantity or float
+        Simulation time of the last good state.
+    step : int
+        Number of steps completed (since the simulation was made) at the last good state.
+    result : orbits.Result or None
+        Everything recorded up to the failure, ending with the last good state.
+    """
+
+    def __init__(self, message, time=None, step=None, result=None):
+        self.time = time
+        self.step = step
+        self.result = result
+        super().__init__(message)
+
+
+class SimulationStopped(RunError):
+    """A stopping condition ended the run."""
+
+
+class NonFiniteState(RunError):
+    """A position or velocity became NaN or infinite."""
+
+
+class StepSizeUnderflow(RunError):
+    """An adaptive integrator's step size collapsed below its minimum."""
+
+
+class CloseEncounter(SimulationStopped):
+    """Two bodies came closer than the encounter distance."""
+
+
+class Escape(SimulationStopped):
+    """A body left the system."""

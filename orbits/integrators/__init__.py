@@ -1,0 +1,76 @@
+"""The registry of integrators: name -> class.
+
+>>> import orbits
+>>> [i.name for i in orbits.integrators.available()][:3]
+['euler', 'symplectic-euler', 'verlet']
+>>> orbits.integrators.get("rk4")
+RK4()
+"""
+
+from typing import NamedTuple
+
+from ..errors import UnknownIntegratorError
+from .base import ExplicitRungeKutta, Integrator, SplittingMethod
+from .euler import Euler, SymplecticEuler
+from .leapfrog import Leapfrog, Verlet
+from .runge_kutta import RK2, RK4
+
+__all__ = ["get", "available", "register", "Integrator", "IntegratorInfo",
+           "SplittingMethod", "ExplicitRungeKutta"]
+
+_REGISTRY = {}
+
+
+class IntegratorInfo(NamedTuple):
+    """What :func:`available` lists about each integrator."""
+
+    name: str
+    order: int
+    symplectic: bool
+    adaptive: bool
+    summary: str
+
+
+def register(cls):
+    """Add an integrator class to the registry (usable as a decorator)."""
+    if not (isinstance(cls, type) and issubclass(cls, Integrator) and cls.name):
+        raise TypeError("only named Integrator subclasses can be registered")
+    _REGISTRY[cls.name] = cls
+    return cls
+
+
+for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4):
+    register(_cls)
+
+
+def get(name, **options):
+    """A configured integrator instance.
+
+    Parameters
+    ----------
+    name : str
+        Registry name; see :func:`available`.
+    **options
+        The integrator's options; unknown ones are an error.
+
+    Raises
+    ------
+    UnknownIntegratorError
+        The name is not registered; the message lists the valid ones.
+    """
+    if isinstance(name, Integrator):
+        if options:
+            return type(name)(**{**name.config, **options})
+        return name
+    try:
+        cls = _REGISTRY[name]
+    except (KeyError, TypeError):
+        raise UnknownIntegratorError(
+            f"unknown integrator {name!r}; valid names: {', '.join(_REGISTRY)}") from None
+    return cls(**options)
+
+
+def available():
+    """Registered integrators with their order and properties, in registry order."""
+    return [IntegratorInfo(c.name, c.order, c.symplectic, c.adaptive, c.summary)
+            for c in _REGISTRY.values()]

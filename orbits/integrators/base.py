@@ -1,0 +1,141 @@
+"""The contract every integrator meets.
+
+An integrator is a class with a registry name and a few facts about itself,
+plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
+
+1. sets ``name`` (the registry name, lowercase with hyphens), ``order`` (the
+   global order of accuracy, measured by the test suite), ``symplectic``,
+   ``time_symmetric``, ``adaptive`` and ``needs_central_body``;
+2. lists its options and their defaults in ``options``; unknown options and
+   bad values are rejected in ``__init__`` with
+   :class:`~orbits.errors.IntegratorOptionError`;
+3. implements ``workspace(n)``, returning the arrays a run keeps between
+   calls (force cache, stage buffers, internal state) as a dict;
+4. implements ``advance(ws, x, v, t, dt, nsteps, force, fargs, mon, step0,
+   mon_t, mon_out, velocity_dependent)``, which advances ``x`` and ``v`` (shape (N, 3), in place)
+   by ``nsteps`` steps of ``dt`` from time ``t`` with the compiled loop for
+   ``force`` and returns ``(status, steps_done, n_monitor_rows)`` as
+   described in :mod:`orbits._kernels.stepping`;
+5. implements ``synchronize(ws, x, v)`` (bring x and v to the same time
+   where the method keeps them apart; a no-op for methods that never do) and
+   ``invalidate(ws)`` (forget cached forces after the state was changed from
+   outside);
+6. is registered in :mod:`orbits.integrators` and documented with its update
+   equations, its reference and an example.
+
+Fixed-step methods are data over a shared loop: a splitting method is a table
+of drift and kick coefficients (:class:`SplittingMethod`), an explicit
+Runge-Kutta method a Butcher table (:class:`ExplicitRungeKutta`).
+"""
+
+import numpy as np
+
+from .._kernels import stepping
+from ..errors import IntegratorOptionError
+
+__all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta"]
+
+
+class Integrator:
+    """Base class; see the module docstring for the contract."""
+
+    name = None
+    order = None
+    symplectic = False
+    time_symmetric = False
+    adaptive = False
+    needs_central_body = False
+    #: option name -> default value
+    options = {}
+    #: one line for listings
+    summary = ""
+
+    def __init__(self, **options):
+        unknown = sorted(set(options) - set(self.options))
+        if unknown:
+            valid = ", ".join(sorted(self.options)) or "none"
+            raise IntegratorOptionError(
+                f"integrator {self.name!r} has no option {', '.join(map(repr, unknown))}; "
+                f"valid options: {valid}")
+        self.config = {**self.options, **options}
+        self._check_options()
+
+    def _check_options(self):
+        """Subclasses check their option values here."""
+
+    # contract, parts 3-5
+    def workspace(self, n):
+        raise NotImplementedError
+
+    def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
+                velocity_dependent=False):
+        raise NotImplementedError
+
+    def synchronize(self, ws, x, v):
+        """Fixed-step methods here always end a step with x and v at one time."""
+
+    def invalidate(self, ws):
+        """Forget anything computed from the old state."""
+
+    def info(self):
+        """The integrator and its options, for results and files."""
+        return {"name": self.name, "order": self.order, "symplectic": self.symplectic,
+                "adaptive": self.adaptive, **{f"option.{k}": v for k, v in self.config.items()}}
+
+    def __repr__(self):
+        opts = ", ".join(f"{k}={v!r}" for k, v in self.config.items())
+        return f"{type(self).__name__}({opts})"
+
+
+class SplittingMethod(Integrator):
+    """A symplectic splitting method given by its table of operators.
+
+    Subclasses set ``operators``: a sequence of ``("drift", c)`` and
+    ``("kick", c)``, applied left to right, where a drift advances positions by
+    ``c dt v`` and a kick velocities by ``c dt a(x)``.  Drift and kick
+    coefficients must each sum to one.
+    """
+
+    operators = ()
+    symplectic = True
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if cls.operators:
+            codes = {"drift": stepping.DRIFT, "kick": stepping.KICK}
+            cls._kinds = np.array([codes[k] for k, _ in cls.operators], dtype=np.int64)
+            cls._coefs = np.array([c for _, c in cls.operators], dtype=np.float64)
+
+    def workspace(self, n):
+        return {"acc": np.zeros((n, 3)), "cache": np.zeros(1, dtype=np.int64)}
+
+    def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
+                velocity_dependent=False):
+        loop = stepping.splitting_loop(force)
+        return loop(x, v, t, dt, nsteps, self._kinds, self._coefs, ws["acc"], ws["cache"],
+                    fargs, velocity_dependent, mon, step0, mon_t, mon_out)
+
+    def invalidate(self, ws):
+        ws["cache"][0] = 0
+
+
+class ExplicitRungeKutta(Integrator):
+    """An explicit Runge-Kutta method given by its Butcher table ``A``, ``B``, ``C``.
+
+    Applied to ``y = (x, v)`` with ``y' = (v, a(x, v, t))``.
+    """
+
+    A = None
+    B = None
+    C = None
+
+    def workspace(self, n):
+        s = len(self.B)
+        return {"kx": np.zeros((s, n, 3)), "kv": np.zeros((s, n, 3)),
+                "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3))}
+
+    def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
+                velocity_dependent=False):
+        loop = stepping.runge_kutta_loop(force)
+        return loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
+                    ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out)

@@ -1,0 +1,65 @@
+"""Explicit Euler and semi-implicit (symplectic) Euler."""
+
+from . import tableaux
+from .base import ExplicitRungeKutta, SplittingMethod
+
+__all__ = ["Euler", "SymplecticEuler"]
+
+
+class Euler(ExplicitRungeKutta):
+    """Explicit (forward) Euler, the first-order baseline.
+
+    Notes
+    -----
+    Both position and velocity are advanced from the old state::
+
+        x_{n+1} = x_n + h v_n
+        v_{n+1} = v_n + h a(x_n)
+
+    The energy of an orbit grows secularly (the map expands phase space);
+    use it to see why the other methods exist.
+
+    References
+    ----------
+    Hairer, Nørsett & Wanner (1993), *Solving ODEs I*, section I.7.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("euler").order
+    1
+    """
+
+    name = "euler"
+    order = 1
+    summary = "explicit Euler, x and v from the old state (baseline)"
+    A, B, C = tableaux.EULER
+
+
+class SymplecticEuler(SplittingMethod):
+    """Semi-implicit (symplectic) Euler: kick, then drift with the new velocity.
+
+    Notes
+    -----
+    ::
+
+        v_{n+1} = v_n + h a(x_n)
+        x_{n+1} = x_n + h v_{n+1}
+
+    First order, but symplectic: the energy error stays bounded.
+
+    References
+    ----------
+    Hairer, Lubich & Wanner (2006), *Geometric Numerical Integration*, section I.1.2.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("symplectic-euler").symplectic
+    True
+    """
+
+    name = "symplectic-euler"
+    order = 1
+    summary = "semi-implicit Euler: kick, then drift with the new velocity"
+    operators = tableaux.SYMPLECTIC_EULER

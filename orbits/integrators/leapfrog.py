@@ -1,0 +1,74 @@
+"""Second-order symmetric splittings: velocity Verlet and leapfrog."""
+
+from . import tableaux
+from .base import SplittingMethod
+
+__all__ = ["Verlet", "Leapfrog"]
+
+
+class Verlet(SplittingMethod):
+    """Velocity Verlet, kick-drift-kick (Verlet 1967; Swope et al. 1982).
+
+    Notes
+    -----
+    ::
+
+        v_{n+1/2} = v_n + (h/2) a(x_n)
+        x_{n+1}   = x_n + h v_{n+1/2}
+        v_{n+1}   = v_{n+1/2} + (h/2) a(x_{n+1})
+
+    Second order, symplectic and time-symmetric; one force evaluation a step
+    (the closing kick's acceleration is reused by the next step).
+
+    References
+    ----------
+    Hairer, Lubich & Wanner (2003), "Geometric numerical integration
+    illustrated by the Störmer-Verlet method", Acta Numerica 12, 399.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.1), integrator="verlet",
+    ...                         dt=1 * u.day)
+    >>> result = sim.run(until=1 * u.yr, outputs=10, progress=False)
+    >>> bool(result.energy_error.max() < 1e-4)
+    True
+    """
+
+    name = "verlet"
+    order = 2
+    time_symmetric = True
+    summary = "velocity Verlet, kick-drift-kick"
+    operators = tableaux.VELOCITY_VERLET
+
+
+class Leapfrog(SplittingMethod):
+    """Leapfrog in drift-kick-drift form, as REBOUND's ``leapfrog`` uses.
+
+    Notes
+    -----
+    ::
+
+        x_{n+1/2} = x_n + (h/2) v_n
+        v_{n+1}   = v_n + h a(x_{n+1/2})
+        x_{n+1}   = x_{n+1/2} + (h/2) v_{n+1}
+
+    Second order, symplectic and time-symmetric, one force evaluation a step.
+
+    References
+    ----------
+    Hairer, Lubich & Wanner (2006), *Geometric Numerical Integration*, section I.3.1.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("leapfrog").order
+    2
+    """
+
+    name = "leapfrog"
+    order = 2
+    time_symmetric = True
+    summary = "leapfrog, drift-kick-drift"
+    operators = tableaux.LEAPFROG_DKD

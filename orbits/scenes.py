@@ -1,0 +1,821 @@
+"""Ready-made body sets, each with the reference it comes from.
+
+Every scene is a function that returns a fresh :class:`~orbits.bodies.BodySet`
+and appends a record ``{"scene": name, ...parameters}`` to its ``history``,
+so that results say where their initial conditions came from.  Scenes are
+moved to the centre-of-mass frame unless their docstring says otherwise.
+
+:data:`SCENES` maps the command-line names (lowercase, with hyphens) to the
+functions; :func:`get` builds a scene by name and :func:`describe` lists them.
+
+Masses of solar-system bodies are given through their GM values, which are
+known far better than the masses themselves: a body's mass is stored as
+``GM / G`` in the set's unit system, so that ``G * m`` equals the published
+GM exactly.
+
+Examples
+--------
+>>> from orbits import scenes
+>>> bodies = scenes.get("outer-solar-system")
+>>> bodies.names
+['Sun', 'Jupiter', 'Saturn', 'Uranus', 'Neptune', 'Pluto']
+>>> [name for name, _ in scenes.describe()][:3]
+['earth-moon', 'sun-earth-moon', 'kepler']
+"""
+
+import math
+
+import astropy.units as u
+import numpy as np
+
+from .bodies import BodySet
+from .units import UnitSystem
+
+__all__ = [
+    "earth_moon",
+    "sun_earth_moon",
+    "kepler",
+    "outer_solar_system",
+    "solar_system",
+    "pythagorean",
+    "figure_eight",
+    "plummer",
+    "SCENES",
+    "get",
+    "describe",
+    "FIGURE_EIGHT_PERIOD",
+    "HLW_G",
+    "J2000_OBLIQUITY",
+    "MOON_SEMI_MAJOR_AXIS",
+    "MOON_ECCENTRICITY",
+]
+
+#: Period of the figure-eight choreography in N-body units (G = m = 1), from
+#: Simó's computation quoted by Chenciner & Montgomery (2000).
+FIGURE_EIGHT_PERIOD = 6.32591398
+
+#: The gravitational constant of the Hairer-Lubich-Wanner outer solar system,
+#: in au^3 / (Msun day^2) (Hairer, Lubich & Wanner 2006, sect. I.2.4).
+HLW_G = 2.95912208286e-4
+
+#: Mean obliquity of the ecliptic at J2000.0 (IAU 2006 precession, Capitaine
+#: et al. 2003, adopted by IAU 2006 Resolution B1).
+J2000_OBLIQUITY = 84381.406 * u.arcsec
+
+#: The Moon's mean distance and orbital eccentricity used by the Earth-Moon
+#: scenes (round textbook values; e.g. Murray & Dermott 1999, table A.4).
+MOON_SEMI_MAJOR_AXIS = 384_400 * u.km
+MOON_ECCENTRICITY = 0.0549
+
+#: Mean inclination of the Moon's orbit to the ecliptic (same source).
+_MOON_INCLINATION = 5.145 * u.deg
+
+# GM values in km^3 / s^2 from the JPL DE440 planetary ephemeris, as published
+# in NAIF's gm_de440.tpc (Park et al. 2021).  Planets other than the Earth are
+# planet-plus-satellites systems, which is what a point mass at a planet's
+# ephemeris position stands for.
+_GM_DE440 = {
+    "Sun": 1.3271244004127942e11,
+    "Mercury": 2.2031868551400003e04,
+    "Venus": 3.2485859200000000e05,
+    "Earth": 3.9860043550702266e05,
+    "Moon": 4.9028001184575496e03,
+    "Earth-Moon": 4.0350323562548019e05,
+    "Mars": 4.2828375815756102e04,
+    "Jupiter": 1.2671276409999998e08,
+    "Saturn": 3.7940584841799997e07,
+    "Uranus": 5.7945563999999985e06,
+    "Neptune": 6.8365271005803989e06,
+}
+_GM_UNIT = u.km ** 3 / u.s ** 2
+_DE440_REFERENCE = ("JPL DE440 GM values (NAIF gm_de440.tpc; Park et al. 2021, "
+                    "AJ 161, 105)")
+
+# Radii beyond this fraction of the Plummer mass are not sampled: the
+# untruncated model has no outer edge, and one star at r ~ 1000 would set the
+# size of every plot and the step of every integrator.
+PLUMMER_MASS_CUT = 0.999
+
+# Bound on g(q) = q^2 (1 - q^2)^(7/2) for the rejection sampling of speeds;
+# its maximum is 0.0922 at q^2 = 2/9 (Aarseth, Henon & Wielen 1974 use 0.1).
+_PLUMMER_G_BOUND = 0.1
+
+
+# -- helpers --------------------------------------------------------------------
+def _mass_from_gm(gm, units):
+    """The mass, in ``units``, whose ``G * m`` is ``gm`` (a Quantity)."""
+    gm_internal = gm.to_value(units.length ** 3 / units.time ** 2)
+    return (gm_internal / units.G) << units.mass
+
+
+def _record(bodies, scene, **params):
+    bodies.history.append({"scene": scene, **params})
+    return bodies
+
+
+def _earth_moon_units():
+    # Taking G from the Earth's GM makes the Earth's mass exactly 1 Mearth and
+    # the Moon's GM_moon / GM_earth = 0.0123000371.
+    G = (_GM_DE440["Earth"] * _GM_UNIT / (1 * u.Mearth))
+    return UnitSystem(length=u.km, mass=u.Mearth, time=u.day, G=G,
+                      name="km-Mearth-day (DE440 GM_earth)",
+                      G_source=f"GM of the Earth from {_DE440_REFERENCE}")
+
+
+def _body_set_from_arrays(masses, positions, velocities, units, names=None):
+    """A BodySet from float arrays already in ``units``, in time linear in N.
+
+    ``BodySet.from_arrays`` checks and appends one body at a time, which costs
+    O(N^2) and makes a 10^5-body cluster take minutes.  The values made here
+    are generated, finite and uniquely named, so they are checked once as
+    arrays and stored whole.
+    """
+    masses = np.ascontiguousarray(masses, dtype=np.float64)
+    positions = np.ascontiguousarray(positions, dtype=np.float64)
+    velocities = np.ascontiguousarray(velocities, dtype=np.float64)
+    n = masses.shape[0]
+    if positions.shape != (n, 3) or velocities.shape != (n, 3):
+        raise ValueError("positions and velocities must have shape (N, 3)")
+    if not (np.all(np.isfinite(masses)) and np.all(masses >= 0)
+            and np.all(np.isfinite(positions)) and np.all(np.isfinite(velocities))):
+        raise ValueError("masses, positions and velocities must be finite "
+                         "(and masses >= 0)")
+    names = [str(i) for i in range(n)] if names is None else list(names)
+    if len(names) != n or len(set(names)) != n:
+        raise ValueError("need one unique name per body")
+    bodies = BodySet(units)
+    bodies._names = names
+    bodies._m = masses
+    bodies._x = positions
+    bodies._v = velocities
+    bodies.history.append({"from": "arrays", "n": n})
+    return bodies
+
+
+def _as_tdb(epoch):
+    from astropy.time import Time
+
+    if isinstance(epoch, Time):
+        if epoch.scale == "tdb":
+            return epoch
+        if epoch.scale in ("utc", "ut1"):
+            # UTC needs the leap-second table and UT1 the IERS tables; never
+            # let the conversion go to the network for fresher ones.
+            from astropy.utils import iers
+            with iers.conf.set_temp("auto_download", False):
+                return epoch.tdb
+        return epoch.tdb
+    if isinstance(epoch, str):
+        return Time(epoch, scale="tdb")
+    raise TypeError(f"epoch must be a string or an astropy Time, got "
+                    f"{type(epoch).__name__}")
+
+
+def _rotate_to_ecliptic(vectors, obliquity):
+    """Rotate (N, 3) equatorial vectors about the x axis into the ecliptic."""
+    c, s = math.cos(obliquity), math.sin(obliquity)
+    out = np.empty_like(vectors)
+    out[:, 0] = vectors[:, 0]
+    out[:, 1] = c * vectors[:, 1] + s * vectors[:, 2]
+    out[:, 2] = -s * vectors[:, 1] + c * vectors[:, 2]
+    return out
+
+
+# -- scenes ---------------------------------------------------------------------
+def earth_moon():
+    """The Earth and the Moon on a Keplerian orbit of the Moon's mean size and shape.
+
+    The Earth is the central body and the Moon starts at perigee on the orbit
+    ``a = 384,400 km``, ``e = 0.0549`` about it, in the orbit's own plane
+    (``inc = 0``).  The pair is moved to the centre-of-mass frame.
+
+    Returns
+    -------
+    BodySet
+        Bodies ``"Earth"`` and ``"Moon"``, in km, Earth masses and days.  G is
+        taken from the Earth's DE440 GM, so the Earth's mass is exactly
+        1 Mearth and the Moon's is ``GM_moon / GM_earth = 0.0123000371``.
+
+    Notes
+    -----
+    The orbit is a two-body Keplerian ellipse with ``mu = G (m_E + m_M)``; the
+    real Moon's orbit is strongly perturbed by the Sun (see
+    :func:`sun_earth_moon` and :func:`solar_system`).
+
+    References
+    ----------
+    .. [1] Park, R. S., Folkner, W. M., Williams, J. G. & Boggs, D. H. 2021,
+       "The JPL Planetary and Lunar Ephemerides DE440 and DE441", AJ 161, 105;
+       GM values as distributed in NAIF's ``gm_de440.tpc``:
+       GM_earth = 398600.435507, GM_moon = 4902.800118 km^3/s^2.
+    .. [2] Murray, C. D. & Dermott, S. F. 1999, *Solar System Dynamics*,
+       Cambridge University Press, table A.4 (a = 384,400 km, e = 0.0549).
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> bodies = scenes.earth_moon()
+    >>> bodies.names
+    ['Earth', 'Moon']
+    >>> round(float(bodies.elements("Moon", primary="Earth")["a"].value))
+    384400
+    """
+    units = _earth_moon_units()
+    bodies = BodySet(units)
+    bodies.add("Earth", mass=_mass_from_gm(_GM_DE440["Earth"] * _GM_UNIT, units),
+               position=[0.0, 0.0, 0.0] * u.km)
+    bodies.add("Moon", mass=_mass_from_gm(_GM_DE440["Moon"] * _GM_UNIT, units),
+               primary="Earth", a=MOON_SEMI_MAJOR_AXIS, e=MOON_ECCENTRICITY)
+    bodies.move_to_com()
+    return _record(bodies, "earth-moon", a=str(MOON_SEMI_MAJOR_AXIS),
+                   e=MOON_ECCENTRICITY, gm=_DE440_REFERENCE)
+
+
+def sun_earth_moon():
+    """The Sun, the Earth and the Moon on idealised Keplerian orbits.
+
+    The Earth-Moon barycentre starts at perihelion of the heliocentric orbit
+    ``a = 1 au``, ``e = 0.0167`` in the xy plane (the ecliptic of this
+    model); the Moon starts at perigee of the geocentric orbit
+    ``a = 384,400 km``, ``e = 0.0549``, inclined 5.145 deg to the ecliptic.
+    The Earth and the Moon are placed about their barycentre by their mass
+    ratio, and the whole set is moved to the centre-of-mass frame.
+
+    Returns
+    -------
+    BodySet
+        Bodies ``"Sun"``, ``"Earth"``, ``"Moon"``, in au, solar masses and days
+        (the default :class:`~orbits.units.UnitSystem`, with astropy's
+        GM_sun).  The Sun's mass is 1 Msun; the Earth's and the Moon's come from
+        their DE440 GM values.
+
+    Notes
+    -----
+    A schematic configuration, not an ephemeris: the phases and orientations
+    are not those of any date.  Use :func:`solar_system` for the real sky.
+
+    References
+    ----------
+    .. [1] Park, R. S. et al. 2021, "The JPL Planetary and Lunar Ephemerides
+       DE440 and DE441", AJ 161, 105 (GM values from NAIF's ``gm_de440.tpc``).
+    .. [2] Murray, C. D. & Dermott, S. F. 1999, *Solar System Dynamics*,
+       Cambridge University Press, tables A.2 and A.4 (Earth: a = 1.000 au,
+       e = 0.0167; Moon: a = 384,400 km, e = 0.0549, inc = 5.145 deg).
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> bodies = scenes.sun_earth_moon()
+    >>> bodies.names
+    ['Sun', 'Earth', 'Moon']
+    """
+    units = UnitSystem.default()
+    m_sun = 1.0 * u.Msun
+    m_earth = _mass_from_gm(_GM_DE440["Earth"] * _GM_UNIT, units)
+    m_moon = _mass_from_gm(_GM_DE440["Moon"] * _GM_UNIT, units)
+    a_earth, e_earth = 1.0 * u.au, 0.0167
+
+    # The barycentre of the pair, not the Earth, follows the heliocentric ellipse.
+    helio = BodySet(units)
+    helio.add("Sun", mass=m_sun, position=[0.0, 0.0, 0.0] * u.au)
+    helio.add("Earth-Moon", mass=m_earth + m_moon, primary="Sun", a=a_earth, e=e_earth)
+    pair = BodySet(units)
+    pair.add("Earth", mass=m_earth, position=[0.0, 0.0, 0.0] * u.au)
+    pair.add("Moon", mass=m_moon, primary="Earth", a=MOON_SEMI_MAJOR_AXIS,
+             e=MOON_ECCENTRICITY, inc=_MOON_INCLINATION)
+    x_bary, v_bary = helio.positions[1], helio.velocities[1]
+    x_rel, v_rel = pair.positions[1], pair.velocities[1]
+    share_earth = float(m_moon / (m_earth + m_moon))
+    share_moon = float(m_earth / (m_earth + m_moon))
+
+    bodies = BodySet(units)
+    bodies.add("Sun", mass=m_sun, position=helio.positions[0],
+               velocity=helio.velocities[0])
+    bodies.add("Earth", mass=m_earth, position=x_bary - share_earth * x_rel,
+               velocity=v_bary - share_earth * v_rel)
+    bodies.add("Moon", mass=m_moon, position=x_bary + share_moon * x_rel,
+               velocity=v_bary + share_moon * v_rel)
+    bodies.move_to_com()
+    return _record(bodies, "sun-earth-moon", a_earth=str(a_earth), e_earth=e_earth,
+                   a_moon=str(MOON_SEMI_MAJOR_AXIS), e_moon=MOON_ECCENTRICITY,
+                   inc_moon=str(_MOON_INCLINATION), gm=_DE440_REFERENCE)
+
+
+def kepler(e=0.0, a=1.0 * u.au, f=1.0 * u.rad, m_central=1.0 * u.Msun,
+           m_orbiter=1e-3 * u.Msun, inc=0.0 * u.rad, units=None):
+    """A two-body Kepler problem: one orbiter about a central mass.
+
+    Parameters
+    ----------
+    e : float
+        Eccentricity, ``>= 0``.  ``e > 1`` (hyperbolic) needs ``a < 0``; the
+        parabola ``e = 1`` cannot be given by ``a`` and is refused.
+    a : Quantity, scalar, length
+        Semi-major axis of the relative orbit.  Default 1 au.
+    f : Quantity, scalar, angle
+        True anomaly at the start.  Default 1 rad (57.3 deg): away from both
+        apsides, so that an integrator's error shows in the radial and the
+        tangential direction at once, as convergence tests need; it is also
+        inside the asymptotes of every hyperbola (``|f| < pi/2 < arccos(-1/e)``).
+    m_central, m_orbiter : Quantity, scalar, mass
+        Default 1 Msun and 1e-3 Msun (about Jupiter's mass).  The orbiter has
+        mass by default so that the total energy and angular momentum are not
+        those of the central body alone: with a massless orbiter the energy of
+        the COM-frame pair is exactly zero and a relative energy error has no
+        meaning.  ``m_orbiter = 0`` is allowed.
+    inc : Quantity, scalar, angle
+        Inclination of the orbit to the xy plane.  Default 0.
+    units : UnitSystem, optional
+        Default au, solar masses and days.  When given, plain numbers are read
+        in it.
+
+    Returns
+    -------
+    BodySet
+        Bodies ``"Star"`` and ``"Planet"`` in the centre-of-mass frame.  The
+        relative orbit has ``mu = G (m_central + m_orbiter)`` and period
+        ``2 pi sqrt(a^3 / mu)``, and has its pericentre on the +x axis.
+
+    Raises
+    ------
+    orbits.errors.ElementsError
+        Elements that describe no orbit (``e < 0``, ``e >= 1`` with ``a > 0``, a
+        hyperbolic ``f`` beyond the asymptote...).
+
+    References
+    ----------
+    .. [1] Murray, C. D. & Dermott, S. F. 1999, *Solar System Dynamics*,
+       Cambridge University Press, ch. 2.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> from orbits import scenes
+    >>> bodies = scenes.kepler(e=0.5)
+    >>> float(bodies.elements("Planet", primary="Star")["e"])   # doctest: +FLOAT_CMP
+    0.5
+    >>> hyperbola = scenes.kepler(e=1.5, a=-1 * u.au)
+    """
+    bodies = BodySet(units)
+    bodies.add("Star", mass=m_central, position=np.zeros(3) << bodies.units.length)
+    bodies.add("Planet", mass=m_orbiter, primary="Star", a=a, e=e, f=f, inc=inc)
+    bodies.move_to_com()
+    return _record(bodies, "kepler", e=float(e), a=str(a), f=str(f), inc=str(inc),
+                   m_central=str(m_central), m_orbiter=str(m_orbiter))
+
+
+# Hairer, Lubich & Wanner (2006), Table I.2.1: masses relative to the Sun
+# (the Sun's including the inner planets), positions in au and velocities in
+# au/day, to the digits printed in the book.  The Sun is at rest at the origin.
+_HLW_NAMES = ("Sun", "Jupiter", "Saturn", "Uranus", "Neptune", "Pluto")
+_HLW_MASSES = (1.00000597682, 0.000954786104043, 0.000285583733151,
+               0.0000437273164546, 0.0000517759138449, 1 / 1.3e8)
+_HLW_POSITIONS = (
+    (0.0, 0.0, 0.0),
+    (-3.5023653, -3.8169847, -1.5507963),
+    (9.0755314, -3.0458353, -1.6483708),
+    (8.3101420, -16.2901086, -7.2521278),
+    (11.4707666, -25.7294829, -10.8169456),
+    (-15.5387357, -25.2225594, -3.1902382),
+)
+_HLW_VELOCITIES = (
+    (0.0, 0.0, 0.0),
+    (0.00565429, -0.00412490, -0.00190589),
+    (0.00168318, 0.00483525, 0.00192462),
+    (0.00354178, 0.00137102, 0.00055029),
+    (0.00288930, 0.00114527, 0.00039677),
+    (0.00276725, -0.00170702, -0.00136504),
+)
+
+
+def outer_solar_system(com=False):
+    """The Hairer–Lubich–Wanner outer solar system: Sun, four giant planets and Pluto.
+
+    The standard test problem of geometric numerical integration: the Sun
+    (its mass including the inner planets), Jupiter, Saturn, Uranus, Neptune
+    and Pluto, with the initial positions and velocities of 1994 September 5
+    printed in the book, and its own value of G.
+
+    Parameters
+    ----------
+    com : bool
+        Move to the centre-of-mass frame.  Default False: keep the published
+        frame, in which the Sun is at rest at the origin (heliocentric
+        positions and velocities) and the axes are equatorial (the planets'
+        orbits are inclined about 23 deg to the xy plane).  In that frame the
+        centre of mass drifts at about 6e-6 au/day; integrators do not mind,
+        but plots over long times do.
+
+    Returns
+    -------
+    BodySet
+        Bodies ``"Sun"``, ``"Jupiter"``, ``"Saturn"``, ``"Uranus"``,
+        ``"Neptune"``, ``"Pluto"``, in au, solar masses and days with
+        ``G = 2.95912208286e-4`` au^3/(Msun day^2) (:data:`HLW_G`; the book's
+        value, within 1e-11 of Gauss's constant squared).  Masses:
+        ``m0 = 1.00000597682`` (Sun plus inner planets),
+        ``m1 = 0.000954786104043``, ``m2 = 0.000285583733151``,
+        ``m3 = 0.0000437273164546``, ``m4 = 0.0000517759138449``,
+        ``m5 = 1 / 1.3e8``.
+
+    References
+    ----------
+    .. [1] Hairer, E., Lubich, C. & Wanner, G. 2006, *Geometric Numerical
+       Integration: Structure-Preserving Algorithms for Ordinary Differential
+       Equations*, 2nd ed., Springer Series in Computational Mathematics 31,
+       section I.2.4 and table 2.1.
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> bodies = scenes.outer_solar_system()
+    >>> bodies.units.G
+    0.000295912208286
+    >>> bodies.positions[1]                      # doctest: +FLOAT_CMP
+    <Quantity [-3.5023653, -3.8169847, -1.5507963] AU>
+    """
+    units = UnitSystem(length=u.au, mass=u.Msun, time=u.day, G=HLW_G, name="hlw",
+                       G_source="Hairer, Lubich & Wanner 2006, sect. I.2.4")
+    bodies = BodySet.from_arrays(np.array(_HLW_MASSES), np.array(_HLW_POSITIONS),
+                                 np.array(_HLW_VELOCITIES), names=_HLW_NAMES,
+                                 units=units)
+    if com:
+        bodies.move_to_com()
+    return _record(bodies, "outer-solar-system", com=bool(com),
+                   epoch="1994-09-05",
+                   source="Hairer, Lubich & Wanner 2006, table I.2.1")
+
+
+_PLANETS = ("Mercury", "Venus", "Earth", "Mars", "Jupiter", "Saturn", "Uranus",
+            "Neptune")
+_FRAMES = ("ecliptic", "icrs")
+
+
+def solar_system(epoch="2000-01-01 12:00:00", moon=True, frame="ecliptic"):
+    """The Sun, the eight planets and the Moon at an epoch, from astropy's built-in ephemeris.
+
+    Positions and velocities come from
+    ``astropy.coordinates.get_body_barycentric_posvel(..., ephemeris="builtin")``,
+    which needs no download: ERFA's ``epv00`` (the Earth and the Sun, from
+    VSOP2000), ``plan94`` (the other planets, Simon et al. 1994) and
+    ``moon98`` (the Moon, Meeus 1998, with analytic velocities).  Nothing
+    here touches the network.
+
+    Parameters
+    ----------
+    epoch : str or astropy.time.Time
+        A string is read in the TDB time scale (so that no UTC leap-second or
+        IERS table is consulted); default J2000.0, ``"2000-01-01 12:00:00"``
+        TDB.  A ``Time`` in another scale is converted to TDB with IERS
+        downloads switched off for the conversion.
+    moon : bool
+        Include the Moon as its own body (the Earth is then the geocentre).
+        With ``moon=False`` the body named ``"Earth"`` is the Earth-Moon
+        barycentre with the pair's mass.
+    frame : {"ecliptic", "icrs"}
+        Orientation of the axes.  ``"icrs"``: the barycentric ICRS axes of the
+        ephemeris (equatorial).  ``"ecliptic"`` (default, as planetary orbits
+        are nearly flat in it): those axes rotated about x by the J2000 mean
+        obliquity 84381.406 arcsec (IAU 2006), i.e. the mean ecliptic and
+        equinox of J2000; the 23 mas frame bias between ICRS and the J2000
+        mean equator is below the ephemeris's accuracy and is neglected.
+
+    Returns
+    -------
+    BodySet
+        ``"Sun"``, ``"Mercury"``, ``"Venus"``, ``"Earth"``, (``"Moon"``),
+        ``"Mars"``, ``"Jupiter"``, ``"Saturn"``, ``"Uranus"``, ``"Neptune"``, in
+        au, solar masses and days (the default unit system, with astropy's
+        GM_sun), moved to the centre-of-mass frame (a shift of order 1e-7 au:
+        the ephemeris is barycentric for the full solar system, which has more
+        bodies than these).  The Sun's mass is 1 Msun; the others are their
+        DE440 GM values divided by G: systems (planet and satellites) for Mars
+        to Neptune, the Earth and the Moon separately.
+
+    Notes
+    -----
+    Accuracy is that of the analytic theories, as quoted in ERFA's
+    documentation: for the Earth about 5 km (epv00, 1900-2100); for the
+    planets up to 300 km (Mercury) to 700,000 km (Uranus) over 1800-2050,
+    degrading outside 1000-3000 AD (plan94); for the Moon 6 km RMS and
+    36 mm/s RMS in velocity over 1950-2100 (moon98).  Good for realistic
+    starting conditions, not for comparison with a numerical ephemeris.
+
+    References
+    ----------
+    .. [1] Park, R. S., Folkner, W. M., Williams, J. G. & Boggs, D. H. 2021,
+       "The JPL Planetary and Lunar Ephemerides DE440 and DE441", AJ 161, 105
+       (GM values from NAIF's ``gm_de440.tpc``).
+    .. [2] Simon, J. L. et al. 1994, "Numerical expressions for precession
+       formulae and mean elements for the Moon and the planets", A&A 282, 663
+       (ERFA ``plan94``).
+    .. [3] Moisson, X. & Bretagnon, P. 2001, "Analytical planetary solution
+       VSOP2000", Celest. Mech. Dyn. Astron. 80, 205 (ERFA ``epv00``).
+    .. [4] Meeus, J. 1998, *Astronomical Algorithms*, 2nd ed., Willmann-Bell
+       (ERFA ``moon98``).
+    .. [5] Capitaine, N., Wallace, P. T. & Chapront, J. 2003, "Expressions for
+       IAU 2000 precession quantities", A&A 412, 567 (obliquity 84381.406").
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> bodies = scenes.solar_system()
+    >>> len(bodies)
+    10
+    >>> r = bodies.positions[3] - bodies.positions[0]     # Earth - Sun
+    >>> round(float((r ** 2).sum() ** 0.5 / u.au), 3)     # doctest: +SKIP
+    0.983
+    """
+    from astropy.coordinates import get_body_barycentric_posvel
+
+    if frame not in _FRAMES:
+        raise ValueError(f"unknown frame {frame!r}; expected one of {_FRAMES}")
+    time = _as_tdb(epoch)
+    units = UnitSystem.default()
+
+    names, gms, ephemeris_names = ["Sun"], [None], ["sun"]
+    for planet in _PLANETS:
+        if planet == "Earth" and not moon:
+            names.append("Earth")
+            gms.append(_GM_DE440["Earth-Moon"])
+            ephemeris_names.append("earth-moon-barycenter")
+            continue
+        names.append(planet)
+        gms.append(_GM_DE440[planet])
+        ephemeris_names.append(planet.lower())
+        if planet == "Earth":
+            names.append("Moon")
+            gms.append(_GM_DE440["Moon"])
+            ephemeris_names.append("moon")
+
+    n = len(names)
+    x = np.empty((n, 3))
+    v = np.empty((n, 3))
+    for i, body in enumerate(ephemeris_names):
+        pos, vel = get_body_barycentric_posvel(body, time, ephemeris="builtin")
+        x[i] = pos.xyz.to_value(units.length)
+        v[i] = vel.xyz.to_value(units.unit("velocity"))
+    if frame == "ecliptic":
+        eps = J2000_OBLIQUITY.to_value(u.rad)
+        x, v = _rotate_to_ecliptic(x, eps), _rotate_to_ecliptic(v, eps)
+    m = np.array([1.0] + [_mass_from_gm(gm * _GM_UNIT, units).value for gm in gms[1:]])
+
+    bodies = BodySet.from_arrays(m, x, v, names=names, units=units)
+    bodies.move_to_com()
+    return _record(bodies, "solar-system", epoch=f"{time.isot} TDB", moon=bool(moon),
+                   frame=frame, ephemeris="astropy builtin (ERFA epv00, plan94, moon98)",
+                   gm=_DE440_REFERENCE)
+
+
+def pythagorean():
+    """Burrau's Pythagorean three-body problem.
+
+    Masses 3, 4 and 5 start at rest at the corners of a 3-4-5 right triangle,
+    each opposite the side of its own length: at (1, 3), (-2, -1) and (1, -1),
+    with ``G = 1``.  The motion is chaotic, with close encounters, and ends
+    (near t = 60) with the lightest two bodies leaving as a binary and the
+    heaviest escaping the other way, as Szebehely & Peters found; a hard test
+    of adaptive step control.
+
+    Returns
+    -------
+    BodySet
+        Bodies ``"1"`` (m = 3), ``"2"`` (m = 4) and ``"3"`` (m = 5) in the
+        plane z = 0, in N-body units (:meth:`UnitSystem.nbody`, G = 1).  The
+        centre of mass is at rest at the origin as given; the total energy is
+        ``-769/60``.
+
+    References
+    ----------
+    .. [1] Burrau, C. 1913, "Numerische Berechnung eines Spezialfalles des
+       Dreikörperproblems", Astron. Nachr. 195, 113.
+    .. [2] Szebehely, V. & Peters, C. F. 1967, "Complete solution of a general
+       problem of three bodies", AJ 72, 876.
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> bodies = scenes.pythagorean()
+    >>> bodies.masses
+    <Quantity [3., 4., 5.]>
+    """
+    bodies = BodySet.from_arrays(
+        np.array([3.0, 4.0, 5.0]),
+        np.array([[1.0, 3.0, 0.0], [-2.0, -1.0, 0.0], [1.0, -1.0, 0.0]]),
+        np.zeros((3, 3)), names=["1", "2", "3"], units=UnitSystem.nbody())
+    bodies.move_to_com()
+    return _record(bodies, "pythagorean", source="Burrau 1913; Szebehely & Peters 1967")
+
+
+def figure_eight():
+    """The figure-eight choreography of three equal masses.
+
+    Three bodies of mass 1 chase one another around one figure-eight curve,
+    with ``G = 1`` and period :data:`FIGURE_EIGHT_PERIOD` (6.32591398).  The
+    initial conditions are Simó's, as given by Chenciner & Montgomery:
+    ``x1 = -x2 = (0.97000436, -0.24308753, 0)``, ``x3 = 0``,
+    ``v3 = (-0.93240737, -0.86473146, 0)``, ``v1 = v2 = -v3 / 2``.
+    The total momentum and angular momentum are zero.
+
+    Returns
+    -------
+    BodySet
+        Bodies ``"1"``, ``"2"``, ``"3"`` in the plane z = 0, in N-body units
+        (:meth:`UnitSystem.nbody`, G = 1), already in the centre-of-mass frame.
+
+    References
+    ----------
+    .. [1] Chenciner, A. & Montgomery, R. 2000, "A remarkable periodic solution
+       of the three-body problem in the case of equal masses", Annals of
+       Mathematics 152, 881.
+    .. [2] Moore, C. 1993, "Braids in classical dynamics", Phys. Rev. Lett. 70,
+       3675 (first found numerically).
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> bodies = scenes.figure_eight()
+    >>> bodies.velocities[0]                      # doctest: +FLOAT_CMP
+    <Quantity [ 0.466203685,  0.43236573 ,  0.        ]>
+    """
+    x1 = np.array([0.97000436, -0.24308753, 0.0])
+    v3 = np.array([-0.93240737, -0.86473146, 0.0])
+    bodies = BodySet.from_arrays(
+        np.ones(3), np.array([x1, -x1, np.zeros(3)]),
+        np.array([-v3 / 2, -v3 / 2, v3]), names=["1", "2", "3"],
+        units=UnitSystem.nbody())
+    return _record(bodies, "figure-eight", period=FIGURE_EIGHT_PERIOD,
+                   source="Chenciner & Montgomery 2000 (Simo's initial conditions)")
+
+
+def plummer(n=1000, seed=None, mass_cut=PLUMMER_MASS_CUT):
+    """A Plummer-sphere star cluster of ``n`` equal masses, in Hénon units.
+
+    Sampled by the method of Aarseth, Hénon & Wielen (1974): the radius by
+    inverting the cumulative mass ``M(r) = r^3 / (r^2 + b^2)^(3/2)``, isotropic
+    directions for position and velocity, and the speed, as a fraction ``q``
+    of the local escape speed, by von Neumann rejection on
+    ``g(q) = q^2 (1 - q^2)^(7/2)``.
+
+    Parameters
+    ----------
+    n : int
+        Number of stars, ``>= 2``.  Default 1000.  Building takes linear time
+        (10^5 stars in well under a second).
+    seed : int, numpy.random.Generator or None
+        Passed to :func:`numpy.random.default_rng`; equal seeds give equal sets.
+    mass_cut : float
+        Radii are drawn from the inner ``mass_cut`` of the mass, ``0 < mass_cut
+        <= 1``.  Default 0.999 (radii below ``38.7 b`` = 22.8 Hénon length
+        units); the missing 0.1% changes the energy by about 1e-3 relative.
+
+    Returns
+    -------
+    BodySet
+        Bodies ``"0"`` ... ``"n-1"`` of mass ``1/n`` in N-body units
+        (:meth:`UnitSystem.nbody`, G = 1), moved to the centre-of-mass frame.
+        Hénon units (G = M = 1, E = -1/4) make the Plummer scale radius
+        ``b = 3 pi / 16``; the sample's energy and virial ratio ``2T/|W|``
+        scatter about -1/4 and 1 by a few times ``1/sqrt(n)``.
+
+    Raises
+    ------
+    ValueError
+        ``n`` is not an integer >= 2, or ``mass_cut`` is outside (0, 1].
+
+    Notes
+    -----
+    With the radius ``r`` in units of ``b`` from ``X`` uniform in
+    ``(0, mass_cut)``: ``r = (X^(-2/3) - 1)^(-1/2)``.  The escape speed at
+    radius ``r`` (Hénon units) is ``sqrt(2) (r^2 + b^2)^(-1/4)``.
+
+    References
+    ----------
+    .. [1] Aarseth, S. J., Hénon, M. & Wielen, R. 1974, "A comparison of
+       numerical methods for the study of star cluster dynamics", A&A 37, 183.
+    .. [2] Plummer, H. C. 1911, "On the problem of distribution in globular
+       star clusters", MNRAS 71, 460.
+    .. [3] Hénon, M. 1971, "The Monte Carlo method", Ap&SS 14, 151 (the units).
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> cluster = scenes.plummer(1000, seed=42)
+    >>> len(cluster)
+    1000
+    >>> float(cluster.total_mass)                        # doctest: +FLOAT_CMP
+    1.0
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+        raise ValueError(f"n must be an integer >= 2, got {n!r}")
+    n = int(n)
+    if n < 2:
+        raise ValueError(f"n must be an integer >= 2, got {n}")
+    mass_cut = float(mass_cut)
+    if not 0.0 < mass_cut <= 1.0:
+        raise ValueError(f"mass_cut must be in (0, 1], got {mass_cut}")
+    rng = np.random.default_rng(seed)
+    b = 3.0 * math.pi / 16.0
+
+    # 1 - uniform lies in (0, 1], so X > 0 and the radius is finite.
+    X = mass_cut * (1.0 - rng.random(n))
+    with np.errstate(divide="ignore"):
+        r = b / np.sqrt(X ** (-2.0 / 3.0) - 1.0)
+    r[~np.isfinite(r)] = np.finfo(float).max ** 0.25  # only if mass_cut == 1 and X == 1
+    positions = r[:, None] * _isotropic(rng, n)
+
+    q = _plummer_speed_fractions(rng, n)
+    speed = q * math.sqrt(2.0) * (r ** 2 + b ** 2) ** -0.25
+    velocities = speed[:, None] * _isotropic(rng, n)
+
+    bodies = _body_set_from_arrays(np.full(n, 1.0 / n), positions, velocities,
+                                   UnitSystem.nbody())
+    bodies.move_to_com()
+    return _record(bodies, "plummer", n=n, seed=None if seed is None else repr(seed),
+                   mass_cut=mass_cut, units="Henon (G = M = 1, E = -1/4)",
+                   source="Aarseth, Henon & Wielen 1974")
+
+
+def _isotropic(rng, n):
+    """``n`` unit vectors uniformly distributed on the sphere."""
+    z = 2.0 * rng.random(n) - 1.0
+    phi = 2.0 * math.pi * rng.random(n)
+    s = np.sqrt(1.0 - z ** 2)
+    return np.column_stack([s * np.cos(phi), s * np.sin(phi), z])
+
+
+def _plummer_speed_fractions(rng, n):
+    """``n`` draws of q in [0, 1) with density proportional to q^2 (1 - q^2)^(7/2)."""
+    out = np.empty(n)
+    filled = 0
+    while filled < n:
+        # About 43% of the candidates are accepted; ask for enough at once.
+        want = n - filled
+        m = int(want / 0.4) + 16
+        q = rng.random(m)
+        y = _PLUMMER_G_BOUND * rng.random(m)
+        keep = q[y < q ** 2 * (1.0 - q ** 2) ** 3.5][:want]
+        out[filled:filled + keep.size] = keep
+        filled += keep.size
+    return out
+
+
+# -- registry -------------------------------------------------------------------
+#: Scene names, as the command line spells them, and the functions that build them.
+SCENES = {
+    "earth-moon": earth_moon,
+    "sun-earth-moon": sun_earth_moon,
+    "kepler": kepler,
+    "outer-solar-system": outer_solar_system,
+    "solar-system": solar_system,
+    "pythagorean": pythagorean,
+    "figure-eight": figure_eight,
+    "plummer": plummer,
+}
+
+
+def get(name, **kwargs):
+    """Build the scene called ``name`` (underscores are read as hyphens).
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`SCENES`, such as ``"outer-solar-system"``.
+    **kwargs
+        Passed to the scene's function.
+
+    Returns
+    -------
+    BodySet
+
+    Raises
+    ------
+    ValueError
+        Unknown name; the message lists the valid ones.
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> len(scenes.get("plummer", n=100, seed=1))
+    100
+    """
+    key = name.strip().lower().replace("_", "-") if isinstance(name, str) else name
+    try:
+        function = SCENES[key]
+    except (KeyError, TypeError):
+        raise ValueError(f"unknown scene {name!r}; valid scenes: "
+                         f"{', '.join(SCENES)}") from None
+    return function(**kwargs)
+
+
+def describe():
+    """The scenes' names with one-line descriptions: a list of (name, line) pairs.
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> dict(scenes.describe())["kepler"]
+    'A two-body Kepler problem: one orbiter about a central mass.'
+    """
+    return [(name, function.__doc__.strip().splitlines()[0].strip())
+            for name, function in SCENES.items()]

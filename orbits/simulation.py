@@ -1,0 +1,395 @@
+"""Simulation: bodies + gravity + integrator + monitors, and ``run``.
+
+Units are converted once, when the simulation is made; the run works on
+float64 arrays in the body set's unit system and attaches units again only
+to what it returns.
+"""
+
+import math
+import time as _time
+
+import numpy as np
+
+from . import integrators as _integrators
+from ._kernels import invariants as _inv
+from ._kernels import stepping as _stepping
+from ._driver import advance_checked
+from ._kernels.status import Status
+from .bodies import BodySet
+from .errors import BodyUnitsError, IntegratorOptionError, NonFiniteState
+from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
+                       vector_relative_error)
+from .result import Result
+
+__all__ = ["Simulation", "PARALLEL_THRESHOLD"]
+
+#: Bodies from which the threaded gravity kernel is used.  Measured with
+#: benchmarks/bench_gravity.py on the 2-core reference machine: below this the
+#: serial j<i loop (half the arithmetic, no thread start-up) is faster.
+PARALLEL_THRESHOLD = 96
+
+#: A run's compiled loop returns to Python about this often, so that progress
+#: bars move; the chunk length in steps adapts to keep to it.
+CHUNK_SECONDS = 0.25
+
+#: tqdm waits this long before showing a bar, so short runs stay quiet.
+PROGRESS_DELAY = 3.0
+
+
+class Simulation:
+    """A body set evolving under Newtonian gravity with a chosen integrator.
+
+    Parameters
+    ----------
+    bodies : BodySet
+        Copied; later changes to it do not affect the simulation.
+    integrator : str or Integrator
+        Registry name (see :func:`orbits.integrators.available`) or a configured
+        instance from :func:`orbits.integrators.get`.
+    dt : Quantity (time) or float
+        Step size.  A plain number is read in the body set's unit of time, and is
+        accepted only when the body set was given its unit system explicitly.
+    monitors : sequence of str
+        Any of ``"energy"``, ``"angular_momentum"``, ``"momentum"``,
+        ``"center_of_mass"``.  Default: energy and angular momentum.  An empty
+        sequence switches them off and costs nothing.
+    monitor_every : int, optional
+        Also record the monitors inside the compiled loop every this many
+        steps (in ``result.monitor``).  Default: only at outputs.
+    softening : Quantity (length) or float, optional
+        Plummer softening length.
+    parallel : bool, optional
+        Force the threaded (True) or serial (False) gravity kernel.  Default:
+        threaded from :data:`PARALLEL_THRESHOLD` bodies on.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.earth_moon(), integrator="leapfrog",
+    ...                         dt=1 * u.hour)
+    >>> result = sim.run(until=30 * u.day, outputs=31, progress=False)
+    >>> result.positions.shape
+    (31, 2, 3)
+    """
+
+    def __init__(self, bodies, integrator="verlet", dt=None, *, monitors=DEFAULT_MONITORS,
+                 monitor_every=None, softening=None, parallel=None):
+        if not isinstance(bodies, BodySet):
+            raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
+        bodies.check()
+        self.units = bodies.units
+        self._bare_ok = bodies._bare_ok
+        self._names = bodies.names
+        self._history = list(bodies.history)
+        self.integrator = _integrators.get(integrator)
+        self._dt = self._time_value(dt, "dt")
+        if not (self._dt > 0 and math.isfinite(self._dt)):
+            raise IntegratorOptionError(f"dt must be a positive finite time, got {dt}")
+
+        # massive bodies first (stable), as the gravity kernels expect
+        m = bodies._m
+        self._order = np.concatenate([np.flatnonzero(m > 0), np.flatnonzero(m == 0)])
+        self._m = np.ascontiguousarray(m[self._order])
+        self._x = np.ascontiguousarray(bodies._x[self._order])
+        self._v = np.ascontiguousarray(bodies._v[self._order])
+        self._n_active = int(np.count_nonzero(self._m > 0))
+        self._gm = self.units.G * self._m
+        eps = 0.0 if softening is None else float(
+            self.units.to_internal(softening, "length", bare_ok=self._bare_ok,
+                                   field="softening"))
+        if not (eps >= 0 and math.isfinite(eps)):
+            raise IntegratorOptionError(f"softening must be a finite length >= 0, got {softening}")
+        self._eps2 = eps * eps
+        n = len(self._m)
+        self.parallel = (n >= PARALLEL_THRESHOLD) if parallel is None else bool(parallel)
+        self._force = _stepping.gravity_force(self.parallel)
+        self._fargs = (self._gm, self._n_active, self._eps2)
+
+        self.monitors = tuple(monitors)
+        self._mask = monitor_mask(self.monitors)
+        if monitor_every is not None and (int(monitor_every) != monitor_every
+                                          or monitor_every < 1):
+            raise ValueError(f"monitor_every must be a whole number of steps >= 1, "
+                             f"got {monitor_every}")
+        self.monitor_every = None if monitor_every is None else int(monitor_every)
+
+        self._ws = self.integrator.workspace(n)
+        self._t_base = 0.0          # time = t_base + steps_since_base * dt
+        self._steps_since_base = 0
+        self.steps = 0              # steps since the simulation was made
+        self.force_evaluations = 0
+        self._reference = self._monitor_row(np.zeros(10), all_bits=True)
+        self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
+        self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
+                                     * np.linalg.norm(self._v, axis=1))) or 1.0
+
+    # -- state ------------------------------------------------------------------------
+    @property
+    def time(self):
+        """Current simulation time (Quantity)."""
+        return self.units.quantity(self._now(), "time")
+
+    @property
+    def dt(self):
+        """Step size (Quantity)."""
+        return self.units.quantity(self._dt, "time")
+
+    @property
+    def bodies(self):
+        """The current state as a new :class:`BodySet`."""
+        self.integrator.synchronize(self._ws, self._x, self._v)
+        inv = np.argsort(self._order)
+        bs = BodySet(self.units)
+        bs._bare_ok = self._bare_ok
+        bs._names = list(self._names)
+        bs._m = self._m[inv].copy()
+        bs._x = self._x[inv].copy()
+        bs._v = self._v[inv].copy()
+        bs.history = list(self._history)
+        return bs
+
+    def _now(self):
+        return self._t_base + self._steps_since_base * self._dt
+
+    def _time_value(self, value, field):
+        if value is None:
+            raise IntegratorOptionError(f"{field} is required for integrator "
+                                        f"{self.integrator.name!r}")
+        try:
+            val = self.units.to_internal(value, "time", bare_ok=self._bare_ok, field=field)
+        except BodyUnitsError as exc:
+            raise BodyUnitsError(str(exc).replace("field ", "argument ", 1)) from None
+        if val.shape != ():
+            raise IntegratorOptionError(f"{field} must be a scalar time, got shape {val.shape}")
+        return float(val)
+
+    def _monitor_row(self, row, all_bits=False):
+        _inv.monitor_row(self._x, self._v, self._m, self.units.G, self._n_active, self._eps2,
+                         15 if all_bits else self._mask, row)
+        return row
+
+    # -- running ------------------------------------------------------------------------
+    def run(self, until, outputs=500, progress=None):
+        """Advance to ``until``, recording ``outputs`` evenly spread states.
+
+        Parameters
+        ----------
+        until : Quantity (time) or float
+            End time; must be later than :attr:`time`.
+        outputs : int
+            Number of outputs, the current state first and the state at
+            ``until`` last (1: only the state at ``until``).  Fixed-step methods never change their step inside
+            a run: each output is taken at the step boundary nearest its even
+            spacing (``result.times`` are the exact times), and only the very
+            last step is shortened, if needed, to end exactly at ``until``.
+        progress : bool, optional
+            Show a progress bar.  Default: shown only if the run goes on for
+            more than a few seconds.
+
+        Returns
+        -------
+        Result
+
+        Raises
+        ------
+        NonFiniteState
+            A position or velocity became NaN or infinite.  The exception
+            carries ``time``, ``step`` and ``result``, which ends with the last
+            good state; the simulation is left at that state.
+        """
+        until_v = self._time_value(until, "until")
+        now = self._now()
+        if not until_v > now:
+            raise ValueError(f"until = {until} is not after the current time "
+                             f"{self.time:.10g}")
+        outputs = int(outputs)
+        if outputs < 1:
+            raise ValueError(f"outputs must be >= 1, got {outputs}")
+        span = until_v - now
+        ratio = span / self._dt
+        n_full = int(round(ratio))
+        if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
+            n_full = int(math.floor(ratio))
+        partial = span - n_full * self._dt
+        if partial <= 1e-12 * max(span, self._dt):
+            partial = 0.0
+        total = n_full + (partial > 0)
+        marks = [min(int(round(k * ratio / (outputs - 1))), n_full)
+                 for k in range(1, outputs - 1)]
+        if outputs > total + 1 or any(b <= a for a, b in zip([0] + marks, marks + [total])):
+            raise ValueError(f"outputs = {outputs} needs more steps than the run has "
+                             f"({total}); ask for at most {total + 1} outputs or use a "
+                             f"smaller dt")
+
+        rec = _Recorder(self, initial=outputs > 1)
+        bar = _progress_bar(total, progress)
+        wall0 = _time.perf_counter()
+        done = 0
+        try:
+            for mark in marks:
+                done = self._advance_to(done, mark, rec, bar, wall0)
+                rec.output(self)
+            done = self._advance_to(done, n_full, rec, bar, wall0)
+            if partial > 0.0:
+                self._step_partial(partial, rec)
+                if bar is not None:
+                    bar.update(1)
+            rec.output(self)
+        finally:
+            if bar is not None:
+                bar.close()
+        return rec.result(self, _time.perf_counter() - wall0)
+
+    def _advance_to(self, done, target, rec, bar, wall0):
+        chunk = 1024
+        while done < target:
+            n = min(chunk, target - done)
+            t0 = _time.perf_counter()
+            self._advance(n, rec, wall0)
+            elapsed = _time.perf_counter() - t0
+            done += n
+            if bar is not None:
+                bar.update(n)
+            if elapsed < CHUNK_SECONDS / 4:
+                chunk *= 4
+            elif elapsed > CHUNK_SECONDS:
+                chunk = max(1, chunk // 2)
+        return done
+
+    def _advance(self, n, rec, wall0, dt=None):
+        dt = self._dt if dt is None else dt
+        every = self.monitor_every or 0
+        if every:
+            first = (self.steps // every + 1) * every  # next step index that records
+            size = max(0, (self.steps + n - first) // every + 1)
+        else:
+            size = 0
+        mon_t = np.empty(size)
+        mon_out = np.zeros((size, 10))
+        mon = (every, self._mask, self._m, self.units.G, self._n_active, self._eps2)
+        status, steps, n_mon, self._ws = advance_checked(
+            self.integrator, self._ws, self._x, self._v, self._now(), dt, n, self._force,
+            self._fargs, mon, self.steps, mon_t, mon_out)
+        if n_mon:
+            rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
+        if status != Status.OK:
+            self._count(steps, dt)
+            self._fail(status, rec, wall0)
+        self._count(n, dt)
+
+    def _count(self, n, dt):
+        if n == 0:
+            return
+        if dt == self._dt:
+            self._steps_since_base += n
+        else:
+            self._t_base = self._now() + dt
+            self._steps_since_base = 0
+        self.steps += n
+        self.force_evaluations += n * self._forces_per_step()
+
+    def _forces_per_step(self):
+        integ = self.integrator
+        if hasattr(integ, "B"):
+            return len(integ.B)
+        return sum(1 for kind, _ in integ.operators if kind == "kick") - (
+            1 if integ.operators[0][0] == "kick" and integ.operators[-1][0] == "kick" else 0)
+
+    def _step_partial(self, h, rec):
+        self._advance(1, rec, None, dt=h)
+
+    def _fail(self, status, rec, wall0):
+        rec.output(self)
+        result = rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
+                            status="non-finite state")
+        t = self.time
+        if status == Status.NON_FINITE:
+            raise NonFiniteState(
+                f"the state became non-finite in step {self.steps + 1} (from t = {t:.10g}); "
+                f"the result up to the last good state, at step {self.steps}, is kept on "
+                f"this exception (.result) and the simulation was left there",
+                time=t, step=self.steps, result=result)
+        raise RuntimeError(f"unexpected status {status!r}")  # pragma: no cover
+
+    def __repr__(self):
+        return (f"<Simulation of {len(self._m)} bodies, {self.integrator.name}, "
+                f"dt={self.dt:.6g}, t={self.time:.6g}>")
+
+
+class _Recorder:
+    """Collects outputs and monitor rows during one run."""
+
+    def __init__(self, sim, initial=True):
+        n = len(sim._m)
+        self.inv = np.argsort(sim._order)
+        self.t = []
+        self.x = []
+        self.v = []
+        self.rows = []
+        self.mon_t = []
+        self.mon_rows = []
+        self.steps0 = sim.steps
+        self.forces0 = sim.force_evaluations
+        self.n = n
+        if initial:
+            self.output(sim)
+
+    def output(self, sim):
+        sim.integrator.synchronize(sim._ws, sim._x, sim._v)
+        self.t.append(sim._now())
+        self.x.append(sim._x[self.inv].copy())
+        self.v.append(sim._v[self.inv].copy())
+        if sim._mask:
+            self.rows.append(sim._monitor_row(np.zeros(10)))
+
+    def monitor_rows(self, t, rows):
+        self.mon_t.append(t.copy())
+        self.mon_rows.append(rows.copy())
+
+    def result(self, sim, wall, status="completed"):
+        U = sim.units
+        q = U.quantity
+        fields = dict(
+            times=q(np.array(self.t), "time"), positions=q(np.array(self.x), "length"),
+            velocities=q(np.array(self.v), "velocity"), names=list(sim._names),
+            masses=q(sim._m[self.inv].copy(), "mass"), steps=sim.steps - self.steps0,
+            force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
+            integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
+            monitors=sim.monitors)
+        ref = sim._reference
+        if self.rows:
+            fields.update(_monitor_fields(np.array(self.rows), sim, ref))
+        if self.mon_t:
+            mon = _monitor_fields(np.concatenate(self.mon_rows), sim, ref)
+            mon["times"] = q(np.concatenate(self.mon_t), "time")
+            fields["monitor"] = mon
+        return Result(**fields)
+
+
+def _monitor_fields(rows, sim, ref):
+    q = sim.units.quantity
+    out = {}
+    if "energy" in sim.monitors:
+        out["energy"] = q(rows[:, 0], "energy")
+        out["energy_error"] = relative_error(rows[:, 0], ref[0], scale=sim._E_scale)
+    if "angular_momentum" in sim.monitors:
+        out["angular_momentum"] = q(rows[:, 1:4], "angular_momentum")
+        out["angular_momentum_error"] = vector_relative_error(rows[:, 1:4], ref[1:4],
+                                                              sim._L_scale)
+    if "momentum" in sim.monitors:
+        out["momentum"] = q(rows[:, 4:7], "momentum")
+    if "center_of_mass" in sim.monitors:
+        out["center_of_mass"] = q(rows[:, 7:10], "length")
+    return out
+
+
+def _progress_bar(total, progress):
+    if progress is False:
+        return None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:  # pragma: no cover - tqdm is a dependency
+        return None
+    return tqdm(total=total, unit="step", unit_scale=True, leave=False,
+                delay=0.0 if progress else PROGRESS_DELAY, desc="orbits")

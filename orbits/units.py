@@ -1,0 +1,236 @@
+"""The one place where astropy units meet plain floats.
+
+A :class:`UnitSystem` fixes the units of length, mass and time in which a
+body set's numbers are stored and integrated, and the value of the
+gravitational constant ``G`` in those units, together with where that value
+came from.  Everything inside the integrators is a float in this system;
+quantities are converted once on the way in and once on the way out.
+"""
+
+import math
+
+import astropy.constants as const
+import astropy.units as u
+import numpy as np
+
+from .errors import BodyUnitsError
+
+__all__ = ["UnitSystem", "GAUSSIAN_GRAVITATIONAL_CONSTANT"]
+
+#: Gauss's constant k in au^(3/2) / (day Msun^(1/2)) (IAU 1976).  k**2 is the
+#: G that REBOUND's unit table and the Hairer-Lubich-Wanner data set use for
+#: au, day and solar masses.
+GAUSSIAN_GRAVITATIONAL_CONSTANT = 0.01720209895
+
+# For a mass unit that is a body's mass, G * (1 mass unit) is that body's GM,
+# which is known far better than G itself (1e-10 against 2e-5 relative).
+_GM_FOR_MASS_UNIT = (
+    (u.Msun, const.GM_sun, "astropy.constants.GM_sun"),
+    (u.Mjup, const.GM_jup, "astropy.constants.GM_jup"),
+    (u.Mearth, const.GM_earth, "astropy.constants.GM_earth"),
+)
+
+# REBOUND's own unit names for the units it knows.
+_REBOUND_NAMES = {
+    "length": {u.au: "AU", u.m: "m", u.km: "km", u.cm: "cm", u.pc: "pc"},
+    "mass": {u.Msun: "Msun", u.kg: "kg", u.g: "g", u.Mearth: "Mearth", u.Mjup: "Mjupiter"},
+    "time": {u.day: "day", u.s: "s", u.yr: "yr", u.hour: "hr"},
+}
+
+_KINDS = ("length", "mass", "time", "velocity", "acceleration", "energy",
+          "angular_momentum", "momentum", "dimensionless", "angle")
+
+
+class UnitSystem:
+    """Units of length, mass and time, and the gravitational constant in them.
+
+    Parameters
+    ----------
+    length, mass, time : astropy.units.Unit
+        The units in which states are stored and integrated.
+        Default: au, solar masses and days.
+    G : float, astropy.units.Quantity or None
+        The gravitational constant.  A float is taken to be in
+        ``length**3 / (mass * time**2)``; a Quantity is converted to that; None
+        takes it from astropy's constants (from the body's GM where the mass
+        unit is the Sun, Jupiter or the Earth, else CODATA G).
+    name : str, optional
+        A short label recorded with results.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> from orbits import UnitSystem
+    >>> UnitSystem().G                          # doctest: +FLOAT_CMP
+    0.00029591220819207774
+    >>> hlw = UnitSystem(length=u.au, mass=u.Msun, time=u.day, G=2.95912208286e-4)
+    >>> UnitSystem.nbody().G
+    1.0
+    """
+
+    def __init__(self, length=u.au, mass=u.Msun, time=u.day, G=None, name=None,
+                 G_source=None):
+        self.length = u.Unit(length)
+        self.mass = u.Unit(mass)
+        self.time = u.Unit(time)
+        dims = self._dimensionless = all(
+            x == u.dimensionless_unscaled for x in (self.length, self.mass, self.time))
+        for kind, unit, expected in (("length", self.length, "length"),
+                                     ("mass", self.mass, "mass"),
+                                     ("time", self.time, "time")):
+            if not dims and unit.physical_type != expected:
+                raise u.UnitsError(f"UnitSystem {kind} unit {unit} is not a {expected}")
+        g_unit = self.length ** 3 / (self.mass * self.time ** 2)
+        if G is None:
+            if dims:
+                raise ValueError("a dimensionless unit system needs an explicit G "
+                                 "(UnitSystem.nbody() gives G = 1)")
+            G, G_source = self._astropy_G(g_unit)
+        elif isinstance(G, u.Quantity):
+            G = G.to_value(g_unit)
+            G_source = G_source or "given as a Quantity"
+        else:
+            G_source = G_source or "given"
+        G = float(G)
+        if not math.isfinite(G) or G <= 0:
+            raise ValueError(f"G must be a positive finite number, got {G}")
+        self.G = G
+        self.G_source = G_source
+        self.name = name or self._default_name()
+
+    # -- constructors -----------------------------------------------------------
+    @classmethod
+    def default(cls):
+        """au, solar masses and days, with G * Msun = astropy's GM_sun."""
+        return cls(name="au-Msun-day")
+
+    @classmethod
+    def nbody(cls, G=1.0):
+        """Dimensionless N-body units with ``G = 1`` (Hénon units for a cluster)."""
+        d = u.dimensionless_unscaled
+        return cls(length=d, mass=d, time=d, G=G, name="nbody",
+                   G_source="N-body units" if G == 1.0 else None)
+
+    @classmethod
+    def rebound(cls, length=u.au, mass=u.Msun, time=u.day):
+        """The units with REBOUND's value of G, so that a comparison matches it exactly.
+
+        REBOUND derives G from its own table of unit values; for au, solar
+        masses and days that is the square of Gauss's constant.  Other units
+        are looked up in REBOUND itself, which must then be installed.
+        """
+        length, mass, time = u.Unit(length), u.Unit(mass), u.Unit(time)
+        try:
+            import rebound
+        except ImportError:  # pragma: no cover - rebound is a test dependency
+            rebound = None
+        if rebound is None:
+            if (length, mass, time) == (u.au, u.Msun, u.day):
+                # REBOUND's own table gives this to within one unit in the last place.
+                return cls(length, mass, time, G=GAUSSIAN_GRAVITATIONAL_CONSTANT ** 2,
+                           name="au-Msun-day (REBOUND G)",
+                           G_source="Gauss's constant squared (rebound not installed)")
+            raise ImportError("UnitSystem.rebound for these units needs the rebound "
+                              "package (pip install rebound)")
+        try:
+            names = tuple(_REBOUND_NAMES[k][unit] for k, unit in
+                          (("time", time), ("length", length), ("mass", mass)))
+        except KeyError as exc:
+            raise u.UnitsError(f"REBOUND has no unit for {exc.args[0]}") from None
+        sim = rebound.Simulation()
+        sim.units = names
+        return cls(length, mass, time, G=sim.G, name=f"{'-'.join(names)} (REBOUND G)",
+                   G_source=f"REBOUND {rebound.__version__} unit table")
+
+    # -- conversion -------------------------------------------------------------
+    def unit(self, kind):
+        """The unit of a physical kind: ``"length"``, ``"velocity"``, ``"energy"``..."""
+        L, M, T = self.length, self.mass, self.time
+        units = {
+            "length": L, "mass": M, "time": T, "velocity": L / T,
+            "acceleration": L / T ** 2, "energy": M * L ** 2 / T ** 2,
+            "angular_momentum": M * L ** 2 / T, "momentum": M * L / T,
+            "dimensionless": u.dimensionless_unscaled, "angle": u.rad,
+        }
+        try:
+            return units[kind]
+        except KeyError:
+            raise ValueError(f"unknown kind {kind!r}; expected one of {_KINDS}") from None
+
+    def to_internal(self, value, kind, *, bare_ok=False, body=None, field=None):
+        """Convert ``value`` to a float64 array in this system.
+
+        A Quantity is converted to the unit of ``kind``.  A bare number is
+        accepted only where ``bare_ok`` (the caller was given this unit system
+        explicitly) and is then taken to be in this system already; angles
+        given as bare numbers are radians.
+
+        Raises
+        ------
+        BodyUnitsError
+            The value has the wrong physical type, or is a bare number where a
+            Quantity is needed.
+        """
+        target = self.unit(kind)
+        if isinstance(value, u.Quantity):
+            try:
+                return np.asarray(value.to_value(target), dtype=np.float64)
+            except u.UnitConversionError:
+                expected = ("a dimensionless number" if target == u.dimensionless_unscaled
+                            else f"a {target.physical_type} (e.g. in {target})")
+                raise BodyUnitsError(
+                    f"expected {expected}, got {value.unit.physical_type} "
+                    f"({value.unit})", body=body, field=field) from None
+        if kind == "dimensionless" or bare_ok or (self._dimensionless and kind != "angle"):
+            try:
+                return np.asarray(value, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise BodyUnitsError(f"expected a number, got {value!r}",
+                                     body=body, field=field) from None
+        raise BodyUnitsError(
+            f"expected a Quantity with a unit of {target.physical_type} (e.g. "
+            f"{target}), got the bare number {value!r}; pass a unit, or give the "
+            f"unit system explicitly to use plain numbers", body=body, field=field)
+
+    def quantity(self, value, kind):
+        """Attach the unit of ``kind`` to a float array, without copying."""
+        return np.asarray(value) << self.unit(kind)
+
+    # -- bookkeeping ------------------------------------------------------------
+    def to_dict(self):
+        """Plain description, for results and files."""
+        return {"name": self.name, "length": self.length.to_string(),
+                "mass": self.mass.to_string(), "time": self.time.to_string(),
+                "G": self.G, "G_source": self.G_source}
+
+    @classmethod
+    def from_dict(cls, d):
+        """Inverse of :meth:`to_dict`."""
+        return cls(u.Unit(d["length"]), u.Unit(d["mass"]), u.Unit(d["time"]),
+                   G=d["G"], name=d["name"], G_source=d["G_source"])
+
+    def __eq__(self, other):
+        if not isinstance(other, UnitSystem):
+            return NotImplemented
+        return ((self.length, self.mass, self.time, self.G)
+                == (other.length, other.mass, other.time, other.G))
+
+    def __hash__(self):
+        return hash((self.length.to_string(), self.mass.to_string(),
+                     self.time.to_string(), self.G))
+
+    def __repr__(self):
+        return (f"UnitSystem(length={self.length}, mass={self.mass}, time={self.time}, "
+                f"G={self.G!r}  # {self.G_source})")
+
+    # -- helpers ----------------------------------------------------------------
+    def _astropy_G(self, g_unit):
+        for unit, gm, source in _GM_FOR_MASS_UNIT:
+            if self.mass == unit:
+                return (gm / (1 * unit)).to_value(g_unit), f"{source} ({gm.reference})"
+        return const.G.to_value(g_unit), f"astropy.constants.G ({const.G.reference})"
+
+    def _default_name(self):
+        if self._dimensionless:
+            return "nbody"
+        return f"{self.length}-{self.mass}-{self.time}"

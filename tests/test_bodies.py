@@ -1,0 +1,175 @@
+"""BodySet: construction, elements, frames, REBOUND round trip, and every bad input."""
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+import orbits
+from orbits.errors import (BodyError, BodyUnitsError, CoincidentBodiesError,
+                           DuplicateBodyError, ElementsError, NoMassiveBodyError,
+                           UnknownBodyError)
+
+
+def sun_jupiter():
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    b.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.048, inc=1.3 * u.deg)
+    return b
+
+
+def test_issue_example_builds():
+    b = sun_jupiter()
+    b.add("probe", mass=0 * u.kg, position=[1, 0, 0] * u.au, velocity=[0, 30, 0] * u.km / u.s)
+    b.move_to_com()
+    assert b.names == ["Sun", "Jupiter", "probe"]
+    assert b.positions.unit == u.au and b.velocities.unit == u.au / u.day
+    # probe's velocity converted once: 30 km/s in au/day
+    np.testing.assert_allclose(b.velocities[2, 1] - b.velocities[0, 1] * 0,
+                               b.velocities[2, 1])
+    x, v = b.center_of_mass()
+    # after move_to_com the centre of mass is at the origin to rounding (|x| ~ 5 au)
+    assert np.all(np.abs(x.to_value(u.au)) < 1e-15 * 10)
+    assert np.all(np.abs(v.to_value(u.au / u.day)) < 1e-18)
+    assert b.total_mass.to_value(u.Msun) == pytest.approx(1 + (1 * u.Mjup).to_value(u.Msun),
+                                                         rel=1e-15)
+
+
+def test_elements_round_trip_through_bodyset():
+    b = sun_jupiter()
+    el = b.elements("Jupiter", primary="Sun")
+    # elements -> state -> elements: ~50 flops each way, so 1e-12 is generous
+    assert el["a"].to_value(u.au) == pytest.approx(5.2, rel=1e-12)
+    assert el["e"].value == pytest.approx(0.048, abs=1e-12)
+    assert el["inc"].to_value(u.deg) == pytest.approx(1.3, rel=1e-12)
+
+
+def test_hyperbolic_orbit_by_elements():
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    b.add("comet", mass=0 * u.kg, primary="Sun", a=-2 * u.au, e=1.5, f=30 * u.deg)
+    el = b.elements("comet", primary="Sun")
+    assert el["a"].to_value(u.au) == pytest.approx(-2, rel=1e-12)
+    assert el["e"].value == pytest.approx(1.5, rel=1e-12)
+    assert el["f"].to_value(u.deg) == pytest.approx(30, rel=1e-12)
+
+
+def test_mean_anomaly_and_default_primary():
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    b.add("p", mass=1e-3 * u.Msun, a=1 * u.au, e=0.3, M=2 * u.rad)   # primary: the Sun
+    el = b.elements("p", primary="Sun")
+    assert el["M"].to_value(u.rad) == pytest.approx(2.0, rel=1e-12)
+
+
+def test_from_arrays_with_explicit_units():
+    hlw = orbits.UnitSystem(length=u.au, mass=u.Msun, time=u.day, G=2.95912208286e-4)
+    b = orbits.BodySet.from_arrays([1.0, 1e-3], [[0, 0, 0], [5, 0, 0]],
+                                   [[0, 0, 0], [0, 0.0075, 0]], names=["a", "b"], units=hlw)
+    assert b.units.G == 2.95912208286e-4
+    assert b.positions[1, 0] == 5 * u.au
+
+
+def test_rebound_round_trip():
+    rebound = pytest.importorskip("rebound")
+    b = sun_jupiter()
+    sim = b.to_rebound()
+    assert sim.G == b.units.G
+    back = orbits.BodySet.from_rebound(sim, units=b.units, names=b.names)
+    # plain float copies: exact
+    assert np.array_equal(back.positions.value, b.positions.value)
+    assert np.array_equal(back.velocities.value, b.velocities.value)
+    assert isinstance(sim, rebound.Simulation)
+
+
+# -- bad input: each names the body and the field -------------------------------------
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(mass=np.nan * u.Msun), "mass"),
+    (dict(mass=np.inf * u.Msun), "mass"),
+    (dict(mass=-1 * u.Msun), "mass"),
+    (dict(mass=1 * u.Msun, position=[np.nan, 0, 0] * u.au), "position"),
+    (dict(mass=1 * u.Msun, position=[1, 0, 0] * u.au, velocity=[np.inf, 0, 0] * u.km / u.s),
+     "velocity"),
+    (dict(mass=1 * u.Msun, position=[1, 0] * u.au), "position"),
+])
+def test_bad_values(kwargs, field):
+    b = orbits.BodySet()
+    with pytest.raises(BodyError) as exc:
+        b.add("X", **kwargs)
+    assert exc.value.body == "X" and exc.value.field == field
+    assert "'X'" in str(exc.value) and field in str(exc.value)
+    assert len(b) == 0  # nothing half-added
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(mass=1 * u.m), "mass"),
+    (dict(mass=1.0), "mass"),                                          # bare number
+    (dict(mass=1 * u.Msun, position=[1, 0, 0] * u.s), "position"),
+    (dict(mass=1 * u.Msun, position=[1, 0, 0] * u.au, velocity=[1, 0, 0] * u.au), "velocity"),
+])
+def test_wrong_physical_type_or_bare_number(kwargs, field):
+    b = orbits.BodySet()
+    with pytest.raises(BodyUnitsError) as exc:
+        b.add("X", **kwargs)
+    assert exc.value.field == field
+    assert isinstance(exc.value, u.UnitsError)
+
+
+def test_bare_numbers_allowed_with_explicit_units():
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("a", mass=1.0, position=[0, 0, 0], velocity=[0, 0, 0])
+    assert b.masses[0].value == 1.0
+
+
+@pytest.mark.parametrize("a, e, field", [
+    (1.0, 1.0, "e"), (1.0, 1.5, "e"), (-1.0, 0.5, "e"), (1.0, -0.1, "e"),
+    (0.0, 0.1, "a"), (np.nan, 0.1, "a"),
+])
+def test_bad_elements(a, e, field):
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    with pytest.raises(ElementsError) as exc:
+        b.add("p", mass=0 * u.kg, primary="Sun", a=a * u.au, e=e)
+    assert exc.value.body == "p" and exc.value.field == field
+
+
+def test_hyperbola_beyond_asymptote():
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    with pytest.raises(ElementsError, match="'p'"):
+        b.add("p", mass=0 * u.kg, primary="Sun", a=-1 * u.au, e=1.5, f=170 * u.deg)
+
+
+def test_unknown_primary_and_duplicate_name():
+    b = sun_jupiter()
+    with pytest.raises(UnknownBodyError, match="Saturn.*known bodies: Sun, Jupiter"):
+        b.add("Io", mass=0 * u.kg, primary="Saturn", a=0.003 * u.au)
+    with pytest.raises(DuplicateBodyError, match="'Jupiter'"):
+        b.add("Jupiter", mass=1 * u.Mjup, position=[1, 2, 3] * u.au)
+
+
+def test_wrong_array_shapes():
+    U = orbits.UnitSystem.nbody()
+    with pytest.raises(BodyError, match="positions.*shape \\(2, 3\\)"):
+        orbits.BodySet.from_arrays([1, 1], [[0, 0, 0]], [[0, 0, 0], [0, 0, 0]], units=U)
+    with pytest.raises(BodyError, match="velocities"):
+        orbits.BodySet.from_arrays([1, 1], np.zeros((2, 3)), np.zeros((2, 2)), units=U)
+    with pytest.raises(BodyError, match="names"):
+        orbits.BodySet.from_arrays([1, 1], np.zeros((2, 3)), np.zeros((2, 3)),
+                                   names=["a"], units=U)
+    with pytest.raises(BodyError, match="body '1'.*mass"):
+        orbits.BodySet.from_arrays([1, -1], [[0, 0, 0], [1, 0, 0]], np.zeros((2, 3)), units=U)
+
+
+def test_no_massive_body_and_coincident_bodies():
+    U = orbits.UnitSystem.nbody()
+    b = orbits.BodySet(units=U)
+    b.add("a", mass=0.0, position=[1, 0, 0])
+    with pytest.raises(NoMassiveBodyError):
+        b.check()
+    with pytest.raises(NoMassiveBodyError):
+        orbits.Simulation(b, dt=0.1)
+    b.add("b", mass=1.0, position=[0, 0, 0])
+    b.add("c", mass=1.0, position=[1, 0, 0])
+    with pytest.raises(CoincidentBodiesError, match="'a'.*'c'"):
+        orbits.Simulation(b, dt=0.1)

@@ -1,0 +1,15 @@
+"""The import-linter contract in pyproject.toml: orbits._kernels never imports astropy."""
+
+import pathlib
+import shutil
+import subprocess
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def test_import_linter_contract():
+    exe = shutil.which("lint-imports")
+    assert exe is not None, "import-linter is missing: pip install -e '.[test]'"
+    proc = subprocess.run([exe], cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "Kernels are free of astropy KEPT" in proc.stdout
