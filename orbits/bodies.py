@@ -145,16 +145,30 @@ class BodySet:
         if len(names) != n:
             raise BodyError(f"expected {n} names (one per mass), got {len(names)}",
                             field="names")
-        for i, name in enumerate(names):
-            bs._check_name(name)
-            if not math.isfinite(m[i]) or m[i] < 0:
-                raise BodyError(f"mass must be finite and >= 0, got {m[i]}",
-                                body=name, field="mass")
-            for field, arr in (("position", x), ("velocity", v)):
-                if not np.all(np.isfinite(arr[i])):
-                    raise BodyError(f"{field} must be finite, got {arr[i]}",
-                                    body=name, field=field)
-            bs._append(name, float(m[i]), x[i], v[i])
+        for name in names:
+            if not isinstance(name, str) or not name:
+                raise BodyError(f"name must be a non-empty string, got {name!r}",
+                                body=name, field="name")
+        if len(set(names)) != n:
+            seen = set()
+            dup = next(nm for nm in names if nm in seen or seen.add(nm))
+            raise DuplicateBodyError("a body of this name is already in the set",
+                                     body=dup, field="name")
+        bad = ~np.isfinite(m) | (m < 0)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise BodyError(f"mass must be finite and >= 0, got {m[i]}", body=names[i],
+                            field="mass")
+        for field, arr in (("position", x), ("velocity", v)):
+            bad = ~np.all(np.isfinite(arr), axis=1)
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise BodyError(f"{field} must be finite, got {arr[i]}", body=names[i],
+                                field=field)
+        bs._names = names
+        bs._m = m.copy()
+        bs._x = x.copy()
+        bs._v = v.copy()
         bs.history.append({"from": "arrays", "n": n})
         return bs
 

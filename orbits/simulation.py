@@ -14,6 +14,7 @@ from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
 from ._driver import advance_checked
+from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import BodyUnitsError, IntegratorOptionError, NonFiniteState
@@ -104,7 +105,8 @@ class Simulation:
         n = len(self._m)
         self.parallel = (n >= PARALLEL_THRESHOLD) if parallel is None else bool(parallel)
         self._force = _stepping.gravity_force(self.parallel)
-        self._fargs = (self._gm, self._n_active, self._eps2)
+        self._fargs = (self._gm, self._n_active, self._eps2,
+                       _gravity.pair_workspace(n, self._n_active))
 
         self.monitors = tuple(monitors)
         self._mask = monitor_mask(self.monitors)

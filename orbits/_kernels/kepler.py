@@ -126,6 +126,10 @@ RADIAL_TOL = 8.0 * 2.220446049250313e-16
 # 5 Newton steps on either side of 0.5.
 _CUBIC_STARTER_E = 0.5
 
+# Up to this eccentricity 1 + e cos f is evaluated in half angles (see
+# _one_plus_e_cos); it is the root of (e^2 - 1) / e = 1.
+_HALF_ANGLE_MAX_E = 0.5 * (1.0 + math.sqrt(5.0))
+
 _EPS = 2.220446049250313e-16
 _PI = math.pi
 _TWO_PI = 2.0 * math.pi
@@ -205,14 +209,17 @@ def _cubic_root(p, q):
 
 @njit
 def _one_plus_e_cos(e, f):
-    """``1 + e cos f`` as ``(1 + e) cos^2(f/2) + (1 - e) sin^2(f/2)``.
+    """``1 + e cos f``, with the smaller rounding error of two forms.
 
-    The direct form loses eps / (1 + e cos f) relative near apocentre when
-    e -> 1 and near the asymptotes of a hyperbola, because cos f ~ -1 is only
-    known to eps absolute there; in the half-angle form the terms are both
-    positive for an ellipse, and for a hyperbola they are small and accurate
-    where they cancel.
+    Where ``1 + e cos f`` is small, ``e cos f`` is near -1 and the direct form
+    carries an absolute error ~eps.  The half-angle form
+    ``(1 + e) cos^2(f/2) + (1 - e) sin^2(f/2)`` has positive terms for an
+    ellipse (relative error ~eps, also at apocentre as e -> 1), and for a
+    hyperbola its terms are ~(e^2 - 1) / (2 e) where they cancel, so it is
+    the better form while (e^2 - 1) / e < 1.
     """
+    if e > _HALF_ANGLE_MAX_E:
+        return 1.0 + e * math.cos(f)
     c = math.cos(0.5 * f)
     s = math.sin(0.5 * f)
     return (1.0 + e) * (c * c) + (1.0 - e) * (s * s)

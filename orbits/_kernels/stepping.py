@@ -59,8 +59,8 @@ def _record(x, v, t, mon, n_mon, mon_t, mon_out):
 # -- forces ------------------------------------------------------------------------
 
 def _gravity_force(x, v, t, fargs, acc):
-    gm, n_active, eps2 = fargs
-    pair_kernel(x, gm, n_active, eps2, acc)  # noqa: F821 - bound by specialize
+    gm, n_active, eps2, work = fargs
+    pair_kernel(x, gm, n_active, eps2, acc, work)  # noqa: F821 - bound by specialize
 
 
 def _user_force(x, v, t, fargs, acc):

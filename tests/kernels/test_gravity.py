@@ -3,8 +3,18 @@
 import numpy as np
 import pytest
 
-from orbits._kernels.gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
-                                     accelerate_reference)
+from orbits._kernels import gravity
+from orbits._kernels.gravity import accelerate_reference, pair_workspace
+
+
+def accelerate_pairwise(x, gm, n_active, eps2, acc):
+    return gravity.accelerate_pairwise(x, gm, n_active, eps2, acc,
+                                       pair_workspace(len(x), n_active))
+
+
+def accelerate_pairwise_parallel(x, gm, n_active, eps2, acc):
+    return gravity.accelerate_pairwise_parallel(x, gm, n_active, eps2, acc,
+                                                pair_workspace(len(x), n_active))
 
 
 def random_system(rng, n, n_massless=0):
@@ -63,3 +73,16 @@ def test_two_body_value():
     accelerate_pairwise(x, gm, 2, 0.0, acc)
     # |a_0| = G m_1 / r^2 = 1/4 towards body 1, |a_1| = 4/4 towards body 0: exact in binary
     np.testing.assert_array_equal(acc, [[0.25, 0, 0], [-1.0, 0, 0]])
+
+
+@pytest.mark.parametrize("batch", [7, 50, 10_000])
+def test_batching_does_not_change_the_result(rng, batch):
+    # the serial kernel gathers pairs in batches; any batch size (at least one
+    # row of n_active pairs) must give bit-identical accelerations
+    x, gm, n_active = random_system(rng, 40, 10)
+    ref = np.empty_like(x)
+    accelerate_pairwise(x, gm, n_active, 0.0, ref)
+    acc = np.empty_like(x)
+    work = np.zeros((4, max(batch, n_active)))
+    gravity.accelerate_pairwise(x, gm, n_active, 0.0, acc, work)
+    np.testing.assert_array_equal(acc, ref)
