@@ -33,9 +33,12 @@ import statistics
 import sys
 import time
 
+import inspect
+
 import numba
 import numpy as np
 
+from orbits._kernels import gravity
 from orbits._kernels.gravity import accelerate_pairwise, accelerate_pairwise_parallel
 
 SIZES = (16, 32, 48, 64, 96, 128, 192, 256, 512, 1000, 2000, 4000)
@@ -43,15 +46,24 @@ QUICK_SIZES = (16, 64, 128, 512, 1000)
 
 
 @numba.njit
-def _repeat_serial(x, gm, n_active, eps2, acc, k):
+def _repeat_serial(args, k):
     for _ in range(k):
-        accelerate_pairwise(x, gm, n_active, eps2, acc)
+        accelerate_pairwise(*args)
 
 
 @numba.njit
-def _repeat_parallel(x, gm, n_active, eps2, acc, k):
+def _repeat_parallel(args, k):
     for _ in range(k):
-        accelerate_pairwise_parallel(x, gm, n_active, eps2, acc)
+        accelerate_pairwise_parallel(*args)
+
+
+def _kernel_args(x, gm, acc):
+    """The kernels' arguments, with the scratch array where they take one."""
+    n = x.shape[0]
+    args = (x, gm, n, 0.0, acc)
+    if "work" in inspect.signature(accelerate_pairwise.py_func).parameters:
+        args += (gravity.pair_workspace(n, n),)
+    return args
 
 
 def _positions(n, seed=1):
@@ -63,7 +75,7 @@ def _positions(n, seed=1):
 
 def _time_calls(repeat, args, k):
     t0 = time.perf_counter()
-    repeat(*args, k)
+    repeat(args, k)
     return (time.perf_counter() - t0) / k
 
 
@@ -74,11 +86,11 @@ def measure_kernels(sizes, repeats, target):
         x, gm = _positions(n)
         acc_s = np.zeros((n, 3))
         acc_p = np.zeros((n, 3))
-        args_s = (x, gm, n, 0.0, acc_s)
-        args_p = (x, gm, n, 0.0, acc_p)
+        args_s = _kernel_args(x, gm, acc_s)
+        args_p = _kernel_args(x, gm, acc_p)
         # warm-up (compiles on first use) and calibration
-        _repeat_serial(*args_s, 1)
-        _repeat_parallel(*args_p, 1)
+        _repeat_serial(args_s, 1)
+        _repeat_parallel(args_p, 1)
         probe = max(1, int(2e5 / (n * n)))
         t_probe = min(_time_calls(_repeat_serial, args_s, probe),
                       _time_calls(_repeat_parallel, args_p, probe))

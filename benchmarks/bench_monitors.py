@@ -2,13 +2,14 @@
 
 What is measured
 ----------------
-The outer solar system (Sun and the four giant planets) with ``leapfrog``
+The outer solar system (``orbits.scenes.outer_solar_system()``) with ``leapfrog``
 and a 10-day step, advanced ``--steps`` steps (default 10^6) in one
 ``Simulation.run`` call, in these configurations:
 
 * ``bare loop``: the integrator's compiled loop called directly through the
   integrator contract (``Integrator.advance``) with monitors off, once for
-  all steps; no ``Simulation`` at all.  The floor.
+  all steps, on the arrays a ``Simulation`` prepared; nothing of ``run``.
+  The floor.
 * ``off, outputs=2`` and ``off, outputs=500``: ``monitors=()``.
 * ``default``: energy and angular momentum at each of the 500 outputs (the
   defaults of ``Simulation`` and ``run``).
@@ -38,38 +39,35 @@ import astropy.units as u
 import numpy as np
 
 import orbits
-from orbits._kernels import stepping
 
 DEFAULT_GOAL = 0.05   # default monitors against off, same outputs
 OFF_TOLERANCE = 0.02  # "costs nothing": within the noise of a run of this length
 
 
 class BareLoop:
-    """The compiled leapfrog loop through the integrator contract, monitors off."""
+    """The compiled leapfrog loop on its own, monitors off.
+
+    It takes the arrays, force and force arguments that a ``Simulation``
+    prepares (private attributes, read here so that the floor is exactly the
+    loop that ``run`` calls) and advances them through the integrator contract
+    (``Integrator.advance``), with none of ``run``'s bookkeeping.
+    """
 
     def __init__(self, bodies, dt):
-        U = bodies.units
-        self.x = np.ascontiguousarray(bodies.positions.to_value(U.unit("length")))
-        self.v = np.ascontiguousarray(bodies.velocities.to_value(U.unit("velocity")))
-        m = np.ascontiguousarray(bodies.masses.to_value(U.unit("mass")))
-        if not np.all(m > 0):
-            raise ValueError("the bare loop expects massive bodies only")
-        self.dt = dt.to_value(U.unit("time"))
-        self.integ = orbits.integrators.get("leapfrog")
-        self.ws = self.integ.workspace(len(m))
-        self.force = stepping.gravity_force(False)
-        self.fargs = (U.G * m, len(m), 0.0)
-        self.mon = (0, 0, m, U.G, len(m), 0.0)
+        sim = orbits.Simulation(bodies, integrator="leapfrog", dt=dt, monitors=())
+        self.sim = sim
+        self.mon = (0, 0, sim._m, sim.units.G, sim._n_active, sim._eps2)
         self.t = 0.0
         self.step0 = 0
 
     def run(self, n):
-        status, done, _ = self.integ.advance(self.ws, self.x, self.v, self.t, self.dt, n,
-                                             self.force, self.fargs, self.mon, self.step0,
-                                             np.empty(0), np.zeros((0, 10)))
+        s = self.sim
+        status, done, _ = s.integrator.advance(s._ws, s._x, s._v, self.t, s._dt, n, s._force,
+                                               s._fargs, self.mon, self.step0, np.empty(0),
+                                               np.zeros((0, 10)))
         if status != 0 or done != n:
             raise RuntimeError(f"bare loop stopped with status {status} after {done} steps")
-        self.t += n * self.dt
+        self.t += n * s._dt
         self.step0 += n
 
 

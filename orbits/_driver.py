@@ -6,9 +6,12 @@ import numpy as np
 
 from ._kernels.status import Status
 
-__all__ = ["advance_checked", "MONITOR_OFF"]
+__all__ = ["advance_checked", "CHECK_EVERY"]
 
-MONITOR_OFF_ROWS = (np.empty(0), np.zeros((0, 10)))
+#: The compiled loops test the state for NaN and inf every this many steps
+#: (a test is a dependent chain of 6N additions, as dear as the force for a few
+#: bodies); a failure is then located exactly by re-running from a copy.
+CHECK_EVERY = 16
 
 
 def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, mon_out,
@@ -16,20 +19,26 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     """Advance ``n`` steps; on failure, leave ``x``, ``v`` at the last good state.
 
     Returns ``(status, good_steps, n_monitor_rows, ws)``; ``ws`` is the
-    workspace to keep (a restored copy after a failure).  The compiled loops
-    are deterministic, so the last good state is recomputed from a copy taken
-    here rather than saved by the loop every step.
+    workspace to keep (a restored copy after a failure).  After a failure the
+    monitor rows are those of the good steps only.  The compiled loops are
+    deterministic, so the failing step and the last good state are recomputed
+    from a copy taken here rather than saved by the loop every step.
     """
     saved = (x.copy(), v.copy(), copy.deepcopy(ws))
     status, steps, n_mon = integ.advance(ws, x, v, t, dt, n, force, fargs, mon, step0,
-                                         mon_t, mon_out, velocity_dependent)
+                                         mon_t, mon_out, velocity_dependent, CHECK_EVERY)
     if status == Status.OK:
         return Status.OK, n, n_mon, ws
-    x[...] = saved[0]
-    v[...] = saved[1]
-    ws = saved[2]
-    if steps:
-        off = (0,) + tuple(mon[1:])
-        integ.advance(ws, x, v, t, dt, steps, force, fargs, off, step0, *MONITOR_OFF_ROWS,
-                      velocity_dependent)
-    return Status(status), steps, n_mon, ws
+
+    def rerun(nsteps, monitors):
+        x[...] = saved[0]
+        v[...] = saved[1]
+        work = copy.deepcopy(saved[2])
+        m = mon if monitors else (0,) + tuple(mon[1:])
+        result = integ.advance(work, x, v, t, dt, nsteps, force, fargs, m, step0, mon_t,
+                               mon_out, velocity_dependent, 1)
+        return result, work
+
+    (status, good, n_mon), _ = rerun(n, monitors=True)    # finds the failing step
+    (_, _, _), ws = rerun(good, monitors=False)             # back to the last good state
+    return Status(status), good, n_mon, ws

@@ -9,12 +9,16 @@ only the loop and force it uses.
 Forces have the signature ``force(x, v, t, fargs, acc)`` and write the
 accelerations into ``acc``; ``fargs`` is a tuple of whatever the force needs.
 
-Every loop returns ``(status, steps_done, n_monitor_rows)``.  After each
-step it checks that the state is finite; on failure it returns at once with
-``Status.NON_FINITE`` and ``steps_done`` the number of good steps before the
-bad one.  The caller keeps a copy of the state it passed in, so it can
-recompute the last good state exactly (the loops are deterministic) without
-the loop paying for a copy every step.
+Every loop returns ``(status, steps_done, n_monitor_rows)``.  Every
+``check_every`` steps, and after the last, it checks that the state is
+finite; NaN and inf never turn finite again under these updates, so a failure
+is never missed, only seen up to ``check_every - 1`` steps late.  On failure
+the loop returns at once with ``Status.NON_FINITE``; with ``check_every = 1``
+``steps_done`` is then exactly the number of good steps.  The caller keeps a
+copy of the state it passed in and, the loops being deterministic, finds the
+exact failing step and recomputes the last good state from it
+(:func:`orbits._driver.advance_checked`), so the loop pays for neither a
+copy nor a check every step.
 
 Monitors (energy, angular momentum, ...) are recorded every ``every`` steps,
 counted from the start of the simulation (``step0``), into ``mon_t`` and
@@ -103,7 +107,7 @@ def user_force(accel, jit):
 # -- splitting methods --------------------------------------------------------------
 
 def _splitting_loop(x, v, t, dt, nsteps, kinds, coefs, acc, cache, fargs,
-                    velocity_dependent, mon, step0, mon_t, mon_out):
+                    velocity_dependent, mon, step0, mon_t, mon_out, check_every):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
     # (v += c dt a(x)).  The acceleration depends only on positions (unless
     # velocity_dependent), so it is recomputed only after a drift: velocity
@@ -134,8 +138,9 @@ def _splitting_loop(x, v, t, dt, nsteps, kinds, coefs, acc, cache, fargs,
                     v[i, 2] += h * acc[i, 2]
                 if velocity_dependent:
                     cache[0] = 0
-        if not state_is_finite(x, v):
-            return Status.NON_FINITE, k, n_mon
+        if (k + 1) % check_every == 0 or k + 1 == nsteps:
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
         if every > 0 and (step0 + k + 1) % every == 0:
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1
@@ -151,7 +156,7 @@ def splitting_loop(force):
 # -- explicit Runge-Kutta ---------------------------------------------------------------
 
 def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, step0,
-                      mon_t, mon_out):
+                      mon_t, mon_out, check_every):
     # y = (x, v), y' = (v, a(x, v, t)); stage s has state
     # y + dt sum_j A[s, j] k_j and derivative k_s.  kx[s] = stage velocity,
     # kv[s] = stage acceleration.
@@ -184,8 +189,9 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
                     dv += b[s] * kv[s, i, d]
                 x[i, d] += dt * dx
                 v[i, d] += dt * dv
-        if not state_is_finite(x, v):
-            return Status.NON_FINITE, k, n_mon
+        if (k + 1) % check_every == 0 or k + 1 == nsteps:
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
         if every > 0 and (step0 + k + 1) % every == 0:
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1

@@ -12,7 +12,7 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
 3. implements ``workspace(n)``, returning the arrays a run keeps between
    calls (force cache, stage buffers, internal state) as a dict;
 4. implements ``advance(ws, x, v, t, dt, nsteps, force, fargs, mon, step0,
-   mon_t, mon_out, velocity_dependent)``, which advances ``x`` and ``v`` (shape (N, 3), in place)
+   mon_t, mon_out, velocity_dependent, check_every)``, which advances ``x`` and ``v`` (shape (N, 3), in place)
    by ``nsteps`` steps of ``dt`` from time ``t`` with the compiled loop for
    ``force`` and returns ``(status, steps_done, n_monitor_rows)`` as
    described in :mod:`orbits._kernels.stepping`;
@@ -68,7 +68,7 @@ class Integrator:
         raise NotImplementedError
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
-                velocity_dependent=False):
+                velocity_dependent=False, check_every=1):
         raise NotImplementedError
 
     def synchronize(self, ws, x, v):
@@ -110,10 +110,10 @@ class SplittingMethod(Integrator):
         return {"acc": np.zeros((n, 3)), "cache": np.zeros(1, dtype=np.int64)}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
-                velocity_dependent=False):
+                velocity_dependent=False, check_every=1):
         loop = stepping.splitting_loop(force)
         return loop(x, v, t, dt, nsteps, self._kinds, self._coefs, ws["acc"], ws["cache"],
-                    fargs, velocity_dependent, mon, step0, mon_t, mon_out)
+                    fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every)
 
     def invalidate(self, ws):
         ws["cache"][0] = 0
@@ -135,7 +135,7 @@ class ExplicitRungeKutta(Integrator):
                 "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3))}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
-                velocity_dependent=False):
+                velocity_dependent=False, check_every=1):
         loop = stepping.runge_kutta_loop(force)
         return loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
-                    ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out)
+                    ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every)
