@@ -22,7 +22,7 @@ wins at every larger N; it is the value for ``PARALLEL_THRESHOLD`` in
 the same choice through ``Simulation(parallel=False/True)`` with a whole
 leapfrog step, where the O(N) drifts and kicks are part of the cost.
 
-Run ``python benchmarks/bench_gravity.py`` (about a minute and a half) or
+Run ``python benchmarks/bench_gravity.py`` (about two minutes) or
 with ``--quick`` for a smoke test.
 """
 
@@ -184,12 +184,12 @@ def main(argv=None):
     parser.add_argument("--repeats", type=int, default=None,
                         help="alternating repetitions per size (default 7, quick 3)")
     parser.add_argument("--target", type=float, default=None,
-                        help="seconds per measurement (default 0.4, quick 0.05)")
+                        help="seconds per measurement (default 0.25, quick 0.05)")
     parser.add_argument("--no-sim", action="store_true",
                         help="skip the whole-step check through Simulation")
     args = parser.parse_args(argv)
     repeats = args.repeats or (3 if args.quick else 7)
-    target = args.target or (0.05 if args.quick else 0.4)
+    target = args.target or (0.05 if args.quick else 0.25)
     sizes = QUICK_SIZES if args.quick else SIZES
 
     t0 = time.perf_counter()

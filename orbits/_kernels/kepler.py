@@ -22,8 +22,9 @@ Mean anomaly
   ``D = tan(f / 2)``, so that ``M = sqrt(mu / (2 q^3)) (t - tau)`` for
   pericentre distance ``q`` and time of pericentre passage ``tau``.
 
-In all three cases ``M`` grows as ``sqrt(mu / |a|^3) (t - tau)`` away from the
-parabola, so a caller advances an orbit by adding ``n dt`` to ``M``.
+For ellipses and hyperbolae ``M = n (t - tau)`` with mean motion
+``n = sqrt(mu / |a|^3)``, so a caller advances an orbit by adding ``n dt`` to
+``M``.
 
 Status codes
 ------------
@@ -102,7 +103,7 @@ _MESSAGES = {
 }
 
 # Bounded iteration count for the Kepler solvers.  The starters below need at
-# most 5 Newton steps over e in [0, 1 - 1e-6] and e in (1, 1e8]; the rest is
+# most 6 iterations over e in [0, 1 - 1e-6] and e in (1, 1e8]; the rest is
 # headroom for the bisection safeguard, which halves the bracket each time.
 KEPLER_MAX_ITER = 100
 
