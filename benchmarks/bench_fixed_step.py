@@ -258,7 +258,7 @@ def main(argv=None):
           f"REBOUND runs on one thread)")
     print()
 
-    calls = 2000 if args.quick else 20000
+    calls = 200 if args.quick else 1000
     overhead = measure_call_overhead(repeats, calls)
     print("Fixed cost of one call (two bodies, one step)")
     for name, t in overhead.items():

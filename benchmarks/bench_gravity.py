@@ -17,10 +17,11 @@ although the threaded one does twice the arithmetic), and the speed-up
 serial / threaded as the median of the paired ratios.
 
 The crossover is the smallest N of the list from which the threaded kernel
-wins at every larger N; it is the value for ``PARALLEL_THRESHOLD`` in
-``orbits/simulation.py``.  A second table (skip it with ``--no-sim``) checks
-the same choice through ``Simulation(parallel=False/True)`` with a whole
-leapfrog step, where the O(N) drifts and kicks are part of the cost.
+wins at every larger N.  A second table (skip it with ``--no-sim``) makes the
+same comparison through ``Simulation(parallel=False/True)`` with a whole
+leapfrog step, where the O(N) drifts and kicks are part of the cost; its
+crossover is the suggested ``PARALLEL_THRESHOLD`` of ``orbits/simulation.py``,
+since that constant chooses the kernel for whole steps.
 
 Run ``python benchmarks/bench_gravity.py`` (about two minutes) or
 with ``--quick`` for a smoke test.
@@ -199,13 +200,18 @@ def main(argv=None):
           f"median of {repeats} alternating repetitions of ~{target:g} s")
     print()
     print_table("Gravity kernel, one call inside a compiled loop", "us/call", rows, 1e6)
-    if not args.no_sim:
+    n_kernel = crossover(rows)
+    if args.no_sim:
+        print(f"suggested PARALLEL_THRESHOLD = {n_kernel}  (orbits/simulation.py; "
+              f"from the kernels alone)")
+    else:
         sim_sizes = [n for n in sizes if n <= (512 if args.quick else 1000)]
         sim_rows = measure_simulation(sim_sizes, repeats, target)
         print_table("Whole leapfrog step through Simulation(parallel=False/True)",
                     "us/step", sim_rows, 1e6)
-    n0 = crossover(rows)
-    print(f"suggested PARALLEL_THRESHOLD = {n0}  (orbits/simulation.py)")
+        # the threshold chooses the kernel for whole steps, so that table decides
+        print(f"suggested PARALLEL_THRESHOLD = {crossover(sim_rows)}  (orbits/simulation.py; "
+              f"from whole steps, the kernels alone give {n_kernel})")
     print(f"[bench_gravity took {time.perf_counter() - t0:.1f} s]")
     return 0
 

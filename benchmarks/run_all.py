@@ -92,6 +92,7 @@ def header(quick):
         f"numba {version('numba')}, numpy {version('numpy')}, rebound {version('rebound')}, "
         f"astropy {version('astropy')}",
         f"- source: git {git_revision()}",
+        f"- numba cache: {os.environ.get('NUMBA_CACHE_DIR') or 'next to the modules (default)'}",
         f"- load average (1, 5, 15 min) at start: {load_average()}",
     ]
     return lines

@@ -1,7 +1,5 @@
 """Advancing an integrator with the guarantee that a failure loses nothing."""
 
-import copy
-
 import numpy as np
 
 from ._kernels.status import Status
@@ -24,7 +22,7 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     deterministic, so the failing step and the last good state are recomputed
     from a copy taken here rather than saved by the loop every step.
     """
-    saved = (x.copy(), v.copy(), copy.deepcopy(ws))
+    saved = (x.copy(), v.copy(), _copy_workspace(ws))
     status, steps, n_mon = integ.advance(ws, x, v, t, dt, n, force, fargs, mon, step0,
                                          mon_t, mon_out, velocity_dependent, CHECK_EVERY)
     if status == Status.OK:
@@ -33,7 +31,7 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     def rerun(nsteps, monitors):
         x[...] = saved[0]
         v[...] = saved[1]
-        work = copy.deepcopy(saved[2])
+        work = _copy_workspace(saved[2])
         m = mon if monitors else (0,) + tuple(mon[1:])
         result = integ.advance(work, x, v, t, dt, nsteps, force, fargs, m, step0, mon_t,
                                mon_out, velocity_dependent, 1)
@@ -42,3 +40,7 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     (status, good, n_mon), _ = rerun(n, monitors=True)    # finds the failing step
     (_, _, _), ws = rerun(good, monitors=False)             # back to the last good state
     return Status(status), good, n_mon, ws
+
+
+def _copy_workspace(ws):
+    return {k: (a.copy() if isinstance(a, np.ndarray) else a) for k, a in ws.items()}

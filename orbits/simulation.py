@@ -33,7 +33,7 @@ PARALLEL_THRESHOLD = 96
 #: bars move; the chunk length in steps adapts to keep to it.
 CHUNK_SECONDS = 0.25
 
-#: tqdm waits this long before showing a bar, so short runs stay quiet.
+#: A progress bar appears once a run has gone on this long, so short runs stay quiet.
 PROGRESS_DELAY = 3.0
 
 
@@ -121,7 +121,9 @@ class Simulation:
         self._steps_since_base = 0
         self.steps = 0              # steps since the simulation was made
         self.force_evaluations = 0
-        self._reference = self._monitor_row(np.zeros(10), all_bits=True)
+        self._chunk = 1024          # steps per compiled call; adapts in run()
+        # only the monitors asked for: the energy of a large N costs O(N^2)
+        self._reference = self._monitor_row(np.zeros(10))
         self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
@@ -166,9 +168,9 @@ class Simulation:
             raise IntegratorOptionError(f"{field} must be a scalar time, got shape {val.shape}")
         return float(val)
 
-    def _monitor_row(self, row, all_bits=False):
+    def _monitor_row(self, row):
         _inv.monitor_row(self._x, self._v, self._m, self.units.G, self._n_active, self._eps2,
-                         15 if all_bits else self._mask, row)
+                         self._mask, row)
         return row
 
     # -- running ------------------------------------------------------------------------
@@ -225,7 +227,7 @@ class Simulation:
                              f"smaller dt")
 
         rec = _Recorder(self, initial=outputs > 1)
-        bar = _progress_bar(total, progress)
+        bar = _ProgressBar(total, progress)
         wall0 = _time.perf_counter()
         done = 0
         try:
@@ -234,29 +236,28 @@ class Simulation:
                 rec.output(self)
             done = self._advance_to(done, n_full, rec, bar, wall0)
             if partial > 0.0:
-                self._step_partial(partial, rec)
-                if bar is not None:
-                    bar.update(1)
+                self._advance(1, rec, wall0, dt=partial)
+                bar.update(1)
             rec.output(self)
         finally:
-            if bar is not None:
-                bar.close()
+            bar.close()
         return rec.result(self, _time.perf_counter() - wall0)
 
     def _advance_to(self, done, target, rec, bar, wall0):
-        chunk = 1024
+        # the loop returns to Python about every CHUNK_SECONDS (progress bar);
+        # the chunk length adapts and is kept from one call to the next
         while done < target:
-            n = min(chunk, target - done)
+            n = min(self._chunk, target - done)
             t0 = _time.perf_counter()
             self._advance(n, rec, wall0)
             elapsed = _time.perf_counter() - t0
             done += n
-            if bar is not None:
-                bar.update(n)
-            if elapsed < CHUNK_SECONDS / 4:
-                chunk *= 4
-            elif elapsed > CHUNK_SECONDS:
-                chunk = max(1, chunk // 2)
+            bar.update(n)
+            if n == self._chunk:
+                if elapsed < CHUNK_SECONDS / 4:
+                    self._chunk *= 4
+                elif elapsed > CHUNK_SECONDS:
+                    self._chunk = max(1, self._chunk // 2)
         return done
 
     def _advance(self, n, rec, wall0, dt=None):
@@ -297,9 +298,6 @@ class Simulation:
             return len(integ.B)
         return sum(1 for kind, _ in integ.operators if kind == "kick") - (
             1 if integ.operators[0][0] == "kick" and integ.operators[-1][0] == "kick" else 0)
-
-    def _step_partial(self, h, rec):
-        self._advance(1, rec, None, dt=h)
 
     def _fail(self, status, rec, wall0):
         rec.output(self)
@@ -386,12 +384,31 @@ def _monitor_fields(rows, sim, ref):
     return out
 
 
-def _progress_bar(total, progress):
-    if progress is False:
-        return None
-    try:
+class _ProgressBar:
+    """A tqdm bar that appears only for long runs (or always, or never)."""
+
+    def __init__(self, total, progress):
+        self.total = total
+        self.progress = progress
+        self.done = 0
+        self.start = _time.perf_counter()
+        self.bar = None
+        if progress:
+            self._open()
+
+    def _open(self):
         from tqdm.auto import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a dependency
-        return None
-    return tqdm(total=total, unit="step", unit_scale=True, leave=False,
-                delay=0.0 if progress else PROGRESS_DELAY, desc="orbits")
+        self.bar = tqdm(total=self.total, initial=self.done, unit="step", unit_scale=True,
+                        leave=False, desc="orbits")
+
+    def update(self, n):
+        self.done += n
+        if self.bar is not None:
+            self.bar.update(n)
+        elif (self.progress is None
+              and _time.perf_counter() - self.start > PROGRESS_DELAY):
+            self._open()
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()

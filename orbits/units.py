@@ -145,17 +145,24 @@ class UnitSystem:
     # -- conversion -------------------------------------------------------------
     def unit(self, kind):
         """The unit of a physical kind: ``"length"``, ``"velocity"``, ``"energy"``..."""
-        L, M, T = self.length, self.mass, self.time
-        units = {
-            "length": L, "mass": M, "time": T, "velocity": L / T,
-            "acceleration": L / T ** 2, "energy": M * L ** 2 / T ** 2,
-            "angular_momentum": M * L ** 2 / T, "momentum": M * L / T,
-            "dimensionless": u.dimensionless_unscaled, "angle": u.rad,
-        }
         try:
-            return units[kind]
+            return self._units[kind]
         except KeyError:
             raise ValueError(f"unknown kind {kind!r}; expected one of {_KINDS}") from None
+
+    @property
+    def _units(self):
+        # composing astropy units costs ~10 us each: build the table once
+        table = self.__dict__.get("_unit_table")
+        if table is None:
+            L, M, T = self.length, self.mass, self.time
+            table = self.__dict__["_unit_table"] = {
+                "length": L, "mass": M, "time": T, "velocity": L / T,
+                "acceleration": L / T ** 2, "energy": M * L ** 2 / T ** 2,
+                "angular_momentum": M * L ** 2 / T, "momentum": M * L / T,
+                "dimensionless": u.dimensionless_unscaled, "angle": u.rad,
+            }
+        return table
 
     def to_internal(self, value, kind, *, bare_ok=False, body=None, field=None):
         """Convert ``value`` to a float64 array in this system.
@@ -199,9 +206,13 @@ class UnitSystem:
     # -- bookkeeping ------------------------------------------------------------
     def to_dict(self):
         """Plain description, for results and files."""
-        return {"name": self.name, "length": self.length.to_string(),
+        d = self.__dict__.get("_description")
+        if d is None:
+            d = self.__dict__["_description"] = {
+                "name": self.name, "length": self.length.to_string(),
                 "mass": self.mass.to_string(), "time": self.time.to_string(),
                 "G": self.G, "G_source": self.G_source}
+        return dict(d)
 
     @classmethod
     def from_dict(cls, d):

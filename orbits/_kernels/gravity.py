@@ -154,7 +154,10 @@ def _row_sum(xi, yi, zi, xs, ys, zs, gms, lo, hi, eps2):
     return ax, ay, az
 
 
-@njit_parallel
+# Not cached on disk: a cached serial loop that calls a cached parallel
+# function can crash when loaded (numba issue #8578).  The loops that call this
+# kernel are cached themselves and carry its compiled code, so nothing is lost.
+@njit_parallel(cache=False)
 def accelerate_pairwise_parallel(x, gm, n_active, eps2, acc, work):
     """Accelerations with threads over rows; same arguments as :func:`accelerate_pairwise`.
 
