@@ -104,7 +104,9 @@ class Simulation:
         self._eps2 = eps * eps
         n = len(self._m)
         self.parallel = (n >= PARALLEL_THRESHOLD) if parallel is None else bool(parallel)
-        self._force = _stepping.gravity_force(self.parallel)
+        kind = ("parallel" if self.parallel else
+                "small" if self._n_active <= _gravity.SMALL_N else "serial")
+        self._force = _stepping.gravity_force(kind)
         self._fargs = (self._gm, self._n_active, self._eps2,
                        _gravity.pair_workspace(n, self._n_active))
 

@@ -53,7 +53,7 @@ KERNEL_STAMP = _stamp()
 _SPECIALISED = {}
 
 
-def specialize(template, suffix, jit=True, cache=True, **bindings):
+def specialize(template, suffix, jit=True, cache=True, inline=False, **bindings):
     """Compile a copy of ``template`` whose global names are bound to ``bindings``.
 
     A stepping loop is written once, with the force (or another kernel) as a
@@ -72,20 +72,27 @@ def specialize(template, suffix, jit=True, cache=True, **bindings):
         False returns the plain Python copy (for a user's Python force).
     cache : bool
         False when a binding cannot be cached on disk (a user's function).
+    inline : bool
+        Inline the copy into its callers at numba's IR level (for small wrappers
+        called once a step, whose call overhead would otherwise show).
     **bindings
         Global names to replace, typically jitted kernels.
     """
-    key = (template, suffix, jit, cache)
+    key = (template, suffix, jit, cache, inline)
     if key in _SPECIALISED:
         return _SPECIALISED[key]
     glob = dict(template.__globals__)
     glob.update(bindings)
-    name = f"{template.__name__}__{suffix}__{KERNEL_STAMP}"
+    safe = "".join(ch if ch.isalnum() else "_" for ch in suffix)
+    name = f"{template.__name__}__{safe}__{KERNEL_STAMP}"
     func = types.FunctionType(template.__code__, glob, name,
                               template.__defaults__, template.__closure__)
     func.__qualname__ = name
     func.__module__ = template.__module__
     func.__doc__ = template.__doc__
-    result = numba.njit(**dict(NUMBA_OPTIONS, cache=cache))(func) if jit else func
+    options = dict(NUMBA_OPTIONS, cache=cache)
+    if inline:
+        options["inline"] = "always"
+    result = numba.njit(**options)(func) if jit else func
     _SPECIALISED[key] = result
     return result

@@ -31,7 +31,8 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from ._jit import njit, specialize
-from .gravity import accelerate_pairwise, accelerate_pairwise_parallel
+from .gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
+                      accelerate_pairwise_small)
 from .invariants import monitor_row
 from .status import Status
 
@@ -88,13 +89,19 @@ class ForceKernel(NamedTuple):
     cache: bool    # False where the force cannot be cached on disk (a user's function)
 
 
-def gravity_force(parallel):
-    """The pairwise-gravity force, serial or threaded."""
-    if parallel:
-        key, pair = "gravity_parallel", accelerate_pairwise_parallel
-    else:
-        key, pair = "gravity_serial", accelerate_pairwise
-    return ForceKernel(specialize(_gravity_force, key, pair_kernel=pair), key, True, True)
+_PAIR_KERNELS = {
+    "small": accelerate_pairwise_small,
+    "serial": accelerate_pairwise,
+    "parallel": accelerate_pairwise_parallel,
+}
+
+
+def gravity_force(kind):
+    """The pairwise-gravity force: ``kind`` is ``"small"``, ``"serial"`` or ``"parallel"``
+    (see :mod:`orbits._kernels.gravity`)."""
+    key = f"gravity_{kind}"
+    kernel = specialize(_gravity_force, key, inline=True, pair_kernel=_PAIR_KERNELS[kind])
+    return ForceKernel(kernel, key, True, True)
 
 
 def user_force(accel, jit):
@@ -106,51 +113,66 @@ def user_force(accel, jit):
 
 # -- splitting methods --------------------------------------------------------------
 
-def _splitting_loop(x, v, t, dt, nsteps, kinds, coefs, acc, cache, fargs,
-                    velocity_dependent, mon, step0, mon_t, mon_out, check_every):
+def _splitting_loop(x, v, t, dt, nsteps, acc, cache, fargs, velocity_dependent, mon, step0,
+                    mon_t, mon_out, check_every):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
-    # (v += c dt a(x)).  The acceleration depends only on positions (unless
-    # velocity_dependent), so it is recomputed only after a drift: velocity
-    # Verlet's closing kick and the next step's opening kick share one force
-    # evaluation.  cache[0] is 1 while acc belongs to the current positions.
+    # (v += c dt a(x)), the table KINDS/COEFS bound by specialize as constant
+    # tuples, so that the compiler unrolls it.  The acceleration depends only
+    # on positions (unless velocity_dependent), so it is recomputed only after
+    # a drift: velocity Verlet's closing kick and the next step's opening kick
+    # share one force evaluation.  `fresh` (kept in cache[0] between calls)
+    # says whether acc belongs to the current positions.
     n = x.shape[0]
-    n_ops = kinds.shape[0]
     every = mon[0]
     n_mon = 0
+    fresh = cache[0] != 0
+    until_check = check_every
+    until_record = every - step0 % every if every > 0 else -1
     for k in range(nsteps):
         tx = t + k * dt
-        for op in range(n_ops):
-            h = coefs[op] * dt
-            if kinds[op] == DRIFT:
+        for op in range(len(KINDS)):  # noqa: F821 - bound by specialize
+            h = COEFS[op] * dt  # noqa: F821
+            if KINDS[op] == DRIFT:  # noqa: F821
                 for i in range(n):
                     x[i, 0] += h * v[i, 0]
                     x[i, 1] += h * v[i, 1]
                     x[i, 2] += h * v[i, 2]
                 tx += h
-                cache[0] = 0
+                fresh = False
             else:
-                if cache[0] == 0:
+                if not fresh:
                     force(x, v, tx, fargs, acc)  # noqa: F821 - bound by specialize
-                    cache[0] = 1
+                    fresh = not velocity_dependent
                 for i in range(n):
                     v[i, 0] += h * acc[i, 0]
                     v[i, 1] += h * acc[i, 1]
                     v[i, 2] += h * acc[i, 2]
                 if velocity_dependent:
-                    cache[0] = 0
-        if (k + 1) % check_every == 0 or k + 1 == nsteps:
+                    fresh = False
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
             if not state_is_finite(x, v):
+                cache[0] = 0
                 return Status.NON_FINITE, k, n_mon
-        if every > 0 and (step0 + k + 1) % every == 0:
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1
+    cache[0] = 1 if fresh else 0
     return Status.OK, nsteps, n_mon
 
 
-def splitting_loop(force):
-    """The splitting loop compiled for a :class:`ForceKernel`."""
-    return specialize(_splitting_loop, force.key, jit=force.jit, cache=force.cache,
-                      force=force.kernel)
+def splitting_loop(force, name, kinds, coefs):
+    """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
+
+    ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method.
+    """
+    return specialize(_splitting_loop, f"{name}_{force.key}", jit=force.jit,
+                      cache=force.cache, force=force.kernel,
+                      KINDS=tuple(int(k) for k in kinds),
+                      COEFS=tuple(float(c) for c in coefs))
 
 
 # -- explicit Runge-Kutta ---------------------------------------------------------------
@@ -164,6 +186,8 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
     n_stages = b.shape[0]
     every = mon[0]
     n_mon = 0
+    until_check = check_every
+    until_record = every - step0 % every if every > 0 else -1
     for k in range(nsteps):
         tk = t + k * dt
         for s in range(n_stages):
@@ -189,10 +213,14 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
                     dv += b[s] * kv[s, i, d]
                 x[i, d] += dt * dx
                 v[i, d] += dt * dv
-        if (k + 1) % check_every == 0 or k + 1 == nsteps:
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
             if not state_is_finite(x, v):
                 return Status.NON_FINITE, k, n_mon
-        if every > 0 and (step0 + k + 1) % every == 0:
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1
     return Status.OK, nsteps, n_mon

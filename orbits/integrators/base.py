@@ -103,17 +103,17 @@ class SplittingMethod(Integrator):
         super().__init_subclass__(**kwargs)
         if cls.operators:
             codes = {"drift": stepping.DRIFT, "kick": stepping.KICK}
-            cls._kinds = np.array([codes[k] for k, _ in cls.operators], dtype=np.int64)
-            cls._coefs = np.array([c for _, c in cls.operators], dtype=np.float64)
+            cls._kinds = tuple(codes[k] for k, _ in cls.operators)
+            cls._coefs = tuple(float(c) for _, c in cls.operators)
 
     def workspace(self, n):
         return {"acc": np.zeros((n, 3)), "cache": np.zeros(1, dtype=np.int64)}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1):
-        loop = stepping.splitting_loop(force)
-        return loop(x, v, t, dt, nsteps, self._kinds, self._coefs, ws["acc"], ws["cache"],
-                    fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every)
+        loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs)
+        return loop(x, v, t, dt, nsteps, ws["acc"], ws["cache"], fargs, velocity_dependent,
+                    mon, step0, mon_t, mon_out, check_every)
 
     def invalidate(self, ws):
         ws["cache"][0] = 0

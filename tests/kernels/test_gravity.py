@@ -12,6 +12,11 @@ def accelerate_pairwise(x, gm, n_active, eps2, acc):
                                        pair_workspace(len(x), n_active))
 
 
+def accelerate_pairwise_small(x, gm, n_active, eps2, acc):
+    return gravity.accelerate_pairwise_small(x, gm, n_active, eps2, acc,
+                                             pair_workspace(len(x), n_active))
+
+
 def accelerate_pairwise_parallel(x, gm, n_active, eps2, acc):
     return gravity.accelerate_pairwise_parallel(x, gm, n_active, eps2, acc,
                                                 pair_workspace(len(x), n_active))
@@ -25,7 +30,8 @@ def random_system(rng, n, n_massless=0):
 
 
 @pytest.mark.parametrize("n, n_massless", [(2, 0), (5, 0), (9, 3), (200, 50)])
-@pytest.mark.parametrize("kernel", [accelerate_pairwise, accelerate_pairwise_parallel])
+@pytest.mark.parametrize("kernel", [accelerate_pairwise_small, accelerate_pairwise,
+                                    accelerate_pairwise_parallel])
 @pytest.mark.parametrize("eps2", [0.0, 0.01])
 def test_against_numpy_reference(rng, n, n_massless, kernel, eps2):
     x, gm, n_active = random_system(rng, n, n_massless)
@@ -34,6 +40,17 @@ def test_against_numpy_reference(rng, n, n_massless, kernel, eps2):
     ref = accelerate_reference(x, gm, eps2)
     # sums of n terms of size ~|a|: relative rounding ~ n eps; 1e-13 holds to n ~ 500
     np.testing.assert_allclose(acc, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+
+
+def test_small_and_batched_serial_kernels_agree_bit_for_bit(rng):
+    # the same j < i pair terms in the same order: identical results
+    for n, massless in ((2, 0), (8, 2), (30, 5)):
+        x, gm, n_active = random_system(rng, n, massless)
+        a1 = np.empty_like(x)
+        a2 = np.empty_like(x)
+        accelerate_pairwise_small(x, gm, n_active, 0.0, a1)
+        accelerate_pairwise(x, gm, n_active, 0.0, a2)
+        np.testing.assert_array_equal(a1, a2)
 
 
 def test_serial_and_parallel_agree_for_large_n(rng):
