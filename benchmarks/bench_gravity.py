@@ -34,7 +34,6 @@ import statistics
 import sys
 import time
 
-import inspect
 
 import numba
 import numpy as np
@@ -47,24 +46,29 @@ QUICK_SIZES = (16, 64, 128, 512, 1000)
 
 
 @numba.njit
-def _repeat_serial(args, k):
+def _repeat_serial_loop(x, gm, n_active, eps2, acc, work, k):
     for _ in range(k):
-        accelerate_pairwise(*args)
+        accelerate_pairwise(x, gm, n_active, eps2, acc, work)
 
 
 @numba.njit
-def _repeat_parallel(args, k):
+def _repeat_parallel_loop(x, gm, n_active, eps2, acc, work, k):
     for _ in range(k):
-        accelerate_pairwise_parallel(*args)
+        accelerate_pairwise_parallel(x, gm, n_active, eps2, acc, work)
 
 
-def _kernel_args(x, gm, acc):
-    """The kernels' arguments, with the scratch array where they take one."""
+def _repeat_serial(args, k):
+    _repeat_serial_loop(*args, k)
+
+
+def _repeat_parallel(args, k):
+    _repeat_parallel_loop(*args, k)
+
+
+def _kernel_args(x, gm, acc, parallel):
+    """The kernels' arguments, with the scratch array each one takes."""
     n = x.shape[0]
-    args = (x, gm, n, 0.0, acc)
-    if "work" in inspect.signature(accelerate_pairwise.py_func).parameters:
-        args += (gravity.pair_workspace(n, n),)
-    return args
+    return (x, gm, n, 0.0, acc, gravity.pair_workspace(n, n, parallel))
 
 
 def _positions(n, seed=1):
@@ -87,8 +91,8 @@ def measure_kernels(sizes, repeats, target):
         x, gm = _positions(n)
         acc_s = np.zeros((n, 3))
         acc_p = np.zeros((n, 3))
-        args_s = _kernel_args(x, gm, acc_s)
-        args_p = _kernel_args(x, gm, acc_p)
+        args_s = _kernel_args(x, gm, acc_s, False)
+        args_p = _kernel_args(x, gm, acc_p, True)
         # warm-up (compiles on first use) and calibration
         _repeat_serial(args_s, 1)
         _repeat_parallel(args_p, 1)

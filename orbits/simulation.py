@@ -25,9 +25,11 @@ from .result import Result
 __all__ = ["Simulation", "PARALLEL_THRESHOLD"]
 
 #: Bodies from which the threaded gravity kernel is used.  Measured with
-#: benchmarks/bench_gravity.py on the 2-core reference machine: below this the
-#: serial j<i loop (half the arithmetic, no thread start-up) is faster.
-PARALLEL_THRESHOLD = 96
+#: benchmarks/bench_gravity.py on the 2-core reference machine (whole leapfrog
+#: steps): serial 6.8 us against threaded 8.0 us at N = 64, threaded 1.9 times
+#: faster at N = 128, break-even near N = 73.  Below it thread start-up
+#: (~4 us a step) outweighs the split work.
+PARALLEL_THRESHOLD = 80
 
 #: A run's compiled loop returns to Python about this often, so that progress
 #: bars move; the chunk length in steps adapts to keep to it.
@@ -108,7 +110,7 @@ class Simulation:
                 "small" if self._n_active <= _gravity.SMALL_N else "serial")
         self._force = _stepping.gravity_force(kind)
         self._fargs = (self._gm, self._n_active, self._eps2,
-                       _gravity.pair_workspace(n, self._n_active))
+                       _gravity.pair_workspace(n, self._n_active, self.parallel))
 
         self.monitors = tuple(monitors)
         self._mask = monitor_mask(self.monitors)

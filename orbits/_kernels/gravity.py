@@ -9,10 +9,9 @@ Two kernels compute the same accelerations:
 
 * :func:`accelerate_pairwise` visits each pair once (j < i) and uses Newton's
   third law; it is the fastest for small N and is deterministic.
-* :func:`accelerate_pairwise_parallel` gives each thread whole rows i and
-  sums over all j, writing only ``acc[i]``, so threads never write the same
-  element.  It costs twice the arithmetic but spreads over cores, and works on
-  separate x, y, z arrays whose inner loops vectorise.
+* :func:`accelerate_pairwise_parallel` also visits each pair once, in blocks
+  of rows spread over threads, each block adding into its own accumulator so
+  that threads never write the same element; its inner loops vectorise.
 """
 
 import math
@@ -23,7 +22,7 @@ import numba
 from ._jit import njit, njit_parallel
 
 __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_reference",
-           "pair_workspace", "PAIR_BATCH", "SMALL_N",
+           "pair_workspace", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
            "accelerate_pairwise_small"]
 
 
@@ -39,8 +38,11 @@ SMALL_N = 8
 PAIR_BATCH = 1024
 
 
-def pair_workspace(n, n_active):
-    """Scratch array for :func:`accelerate_pairwise`, shape (4, batch)."""
+def pair_workspace(n, n_active, parallel=False):
+    """Scratch array for :func:`accelerate_pairwise`, shape (4, batch), or for
+    :func:`accelerate_pairwise_parallel` (``parallel=True``), shape (3 * N_BLOCKS, n)."""
+    if parallel:
+        return np.zeros((3 * N_BLOCKS, n))
     pairs = n_active * (n_active - 1) // 2 + (n - n_active) * n_active
     return np.zeros((4, max(n_active, min(pairs, PAIR_BATCH), 1)))
 
@@ -181,60 +183,116 @@ def _apply_batch(gm, n_active, eps2, acc, work, first, stop, npairs):
         acc[i, 2] += azi
 
 
-@njit(fastmath={"reassoc", "contract"})
-def _row_sum(xi, yi, zi, xs, ys, zs, gms, lo, hi, eps2):
-    # Re-association lets LLVM vectorise these sums; the result differs from
-    # the serial kernel only by round-off (tested to 1e-13 relative).
-    ax = 0.0
-    ay = 0.0
-    az = 0.0
-    for j in range(lo, hi):
-        dx = xs[j] - xi
-        dy = ys[j] - yi
-        dz = zs[j] - zi
-        r2 = dx * dx + dy * dy + dz * dz + eps2
-        s = gms[j] / (r2 * math.sqrt(r2))
-        ax += s * dx
-        ay += s * dy
-        az += s * dz
-    return ax, ay, az
+#: Blocks of rows the threaded kernel splits the pairs into.  Each block owns a
+#: private accumulator, so a fixed number (not the number of threads) keeps
+#: the result the same whatever the thread count; 16 balances two to sixteen
+#: threads.
+N_BLOCKS = 16
 
 
 # Not cached on disk: a cached serial loop that calls a cached parallel
 # function can crash when loaded (numba issue #8578).  The loops that call this
 # kernel are cached themselves and carry its compiled code, so nothing is lost.
-@njit_parallel(cache=False)
+# Re-association lets LLVM vectorise the row sums; the result differs from the
+# serial kernel only by rounding (tested to 1e-13 relative).
+@njit_parallel(cache=False, fastmath={"reassoc", "contract"})
 def accelerate_pairwise_parallel(x, gm, n_active, eps2, acc, work):
-    """Accelerations with threads over rows; same arguments as :func:`accelerate_pairwise`.
+    """Accelerations with threads; same arguments as :func:`accelerate_pairwise`.
 
-    ``work`` is not used (the rows need no shared scratch); it is there so
-    that both kernels take the same arguments.
+    ``work`` has shape (3 * N_BLOCKS, N) (:func:`pair_workspace` with
+    ``parallel=True``).
+
+    Notes
+    -----
+    Each pair is computed once, as in the serial kernel (Newton's third law):
+    the rows i are cut into :data:`N_BLOCKS` blocks of equal pair counts, and
+    the threads take whole blocks.  A block adds its terms, for row i and for
+    the reaction on every j < i, into its own slice of ``work``, so no two
+    threads ever write the same element; the slices are then summed in block
+    order, so the result does not depend on how blocks were given to threads.
+    The inner loops run over separate x, y, z arrays and vectorise.  Filling
+    only row i per thread (no reaction terms) would also be race-free but does
+    every pair twice; measured here it was 3.5 times slower at N = 4000.
     """
     n = x.shape[0]
-    xs = np.empty(n_active)
-    ys = np.empty(n_active)
-    zs = np.empty(n_active)
-    gms = np.empty(n_active)
-    for j in range(n_active):
+    xs = np.empty(n)
+    ys = np.empty(n)
+    zs = np.empty(n)
+    for j in range(n):
         xs[j] = x[j, 0]
         ys[j] = x[j, 1]
         zs[j] = x[j, 2]
-        gms[j] = gm[j]
+    # block boundaries with equal numbers of pairs: row i has min(i, n_active)
+    bounds = np.empty(N_BLOCKS + 1, dtype=np.int64)
+    total = 0.0
+    for i in range(n):
+        total += min(i, n_active)
+    bounds[0] = 0
+    b = 1
+    acc_pairs = 0.0
+    for i in range(n):
+        while b < N_BLOCKS and acc_pairs >= total * b / N_BLOCKS:
+            bounds[b] = i
+            b += 1
+        acc_pairs += min(i, n_active)
+    while b <= N_BLOCKS:
+        bounds[b] = n
+        b += 1
+    for blk in numba.prange(N_BLOCKS):
+        bx = work[3 * blk]
+        by = work[3 * blk + 1]
+        bz = work[3 * blk + 2]
+        for j in range(n):
+            bx[j] = 0.0
+            by[j] = 0.0
+            bz[j] = 0.0
+        for i in range(bounds[blk], bounds[blk + 1]):
+            xi = xs[i]
+            yi = ys[i]
+            zi = zs[i]
+            gmi = gm[i]
+            ax = 0.0
+            ay = 0.0
+            az = 0.0
+            if i < n_active:
+                for j in range(i):
+                    dx = xs[j] - xi
+                    dy = ys[j] - yi
+                    dz = zs[j] - zi
+                    r2 = dx * dx + dy * dy + dz * dz + eps2
+                    inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+                    sj = gm[j] * inv_r3
+                    ax += sj * dx
+                    ay += sj * dy
+                    az += sj * dz
+                    si = gmi * inv_r3
+                    bx[j] -= si * dx
+                    by[j] -= si * dy
+                    bz[j] -= si * dz
+            else:
+                for j in range(n_active):
+                    dx = xs[j] - xi
+                    dy = ys[j] - yi
+                    dz = zs[j] - zi
+                    r2 = dx * dx + dy * dy + dz * dz + eps2
+                    sj = gm[j] / (r2 * math.sqrt(r2))
+                    ax += sj * dx
+                    ay += sj * dy
+                    az += sj * dz
+            bx[i] += ax
+            by[i] += ay
+            bz[i] += az
     for i in numba.prange(n):
-        xi = x[i, 0]
-        yi = x[i, 1]
-        zi = x[i, 2]
-        # the self term is skipped by splitting the row at i, not by a branch
-        hi = i if i < n_active else n_active
-        ax, ay, az = _row_sum(xi, yi, zi, xs, ys, zs, gms, 0, hi, eps2)
-        if i + 1 < n_active:
-            bx, by, bz = _row_sum(xi, yi, zi, xs, ys, zs, gms, i + 1, n_active, eps2)
-            ax += bx
-            ay += by
-            az += bz
-        acc[i, 0] = ax
-        acc[i, 1] = ay
-        acc[i, 2] = az
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
+        for blk in range(N_BLOCKS):
+            sx += work[3 * blk, i]
+            sy += work[3 * blk + 1, i]
+            sz += work[3 * blk + 2, i]
+        acc[i, 0] = sx
+        acc[i, 1] = sy
+        acc[i, 2] = sz
     return 0
 
 

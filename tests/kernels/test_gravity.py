@@ -19,7 +19,7 @@ def accelerate_pairwise_small(x, gm, n_active, eps2, acc):
 
 def accelerate_pairwise_parallel(x, gm, n_active, eps2, acc):
     return gravity.accelerate_pairwise_parallel(x, gm, n_active, eps2, acc,
-                                                pair_workspace(len(x), n_active))
+                                                pair_workspace(len(x), n_active, True))
 
 
 def random_system(rng, n, n_massless=0):
@@ -103,3 +103,20 @@ def test_batching_does_not_change_the_result(rng, batch):
     work = np.zeros((4, max(batch, n_active)))
     gravity.accelerate_pairwise(x, gm, n_active, 0.0, acc, work)
     np.testing.assert_array_equal(acc, ref)
+
+
+def test_parallel_result_does_not_depend_on_thread_count(rng):
+    # blocks, not threads, own the accumulators: bit-identical for 1 and 2 threads
+    import numba
+    x, gm, n_active = random_system(rng, 300, 40)
+    out = []
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            acc = np.empty_like(x)
+            accelerate_pairwise_parallel(x, gm, n_active, 0.0, acc)
+            out.append(acc)
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(out[0], out[1])
