@@ -26,10 +26,9 @@ __all__ = ["Simulation", "PARALLEL_THRESHOLD"]
 
 #: Bodies from which the threaded gravity kernel is used.  Measured with
 #: benchmarks/bench_gravity.py on the 2-core reference machine (whole leapfrog
-#: steps): serial 6.8 us against threaded 8.0 us at N = 64, threaded 1.9 times
-#: faster at N = 128, break-even near N = 73.  Below it thread start-up
-#: (~4 us a step) outweighs the split work.
-PARALLEL_THRESHOLD = 80
+#: steps): break-even at N = 64 and 73 in two runs, threaded 1.25 times faster
+#: at N = 96.  Below it thread start-up (~4 us a step) outweighs the split work.
+PARALLEL_THRESHOLD = 72
 
 #: A run's compiled loop returns to Python about this often, so that progress
 #: bars move; the chunk length in steps adapts to keep to it.
