@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 from ..errors import UnknownIntegratorError
 from .base import ExplicitRungeKutta, Integrator, SplittingMethod
+from .composition import Yoshida4, Yoshida6, Yoshida8
 from .euler import Euler, SymplecticEuler
 from .leapfrog import Leapfrog, Verlet
 from .runge_kutta import RK2, RK4
@@ -39,7 +40,8 @@ def register(cls):
     return cls
 
 
-for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4):
+for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
+             Yoshida8):
     register(_cls)
 
 
