@@ -10,7 +10,7 @@
 
 from importlib.metadata import PackageNotFoundError, version as _version
 
-from . import errors, integrators, monitors, scenes
+from . import errors, integrators, io, monitors, scenes
 from .bodies import BodySet
 from .custom import Trajectory, integrate
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, ElementsError, Escape,
@@ -19,6 +19,7 @@ from .errors import (BodyError, BodyUnitsError, CloseEncounter, ElementsError, E
 from .result import Result
 from .simulation import Simulation
 from .units import UnitSystem
+from .io.hdf5 import load
 
 try:
     __version__ = _version("orbits")
@@ -29,4 +30,4 @@ __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajec
            "scenes", "integrators", "monitors", "errors", "OrbitsError", "BodyError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow",
-           "CloseEncounter", "Escape", "__version__"]
+           "CloseEncounter", "Escape", "load", "io", "__version__"]

@@ -1,4 +1,4 @@
-"""Command line: ``orbits run | scenes | integrators``.
+"""Command line: ``orbits run | resume | info | plot | scenes | integrators``.
 
 ``main(argv=None)`` only parses arguments and calls the library; the tests
 call it with a list.
@@ -47,6 +47,27 @@ def _parser():
                      help="end time, e.g. 1000yr")
     run.add_argument("--outputs", type=int, default=500, help="number of outputs (500)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run.add_argument("--out", help="stream outputs and checkpoints to this HDF5 file")
+    run.add_argument("--force", action="store_true", help="overwrite an existing --out file")
+    run.add_argument("--checkpoint-interval", type=float, default=None,
+                     help="seconds between checkpoints in --out (default 60; 0: every output)")
+
+    res = sub.add_parser("resume", help="finish an interrupted run, or continue a finished "
+                                        "one, from its HDF5 file")
+    res.add_argument("file")
+    res.add_argument("--until", type=parse_quantity,
+                     help="continue to this time after the interrupted run is finished")
+    res.add_argument("--outputs", type=int, default=500, help="outputs of the --until run")
+    res.add_argument("--no-progress", action="store_true")
+    res.add_argument("--checkpoint-interval", type=float, default=None)
+
+    info = sub.add_parser("info", help="say what an output file holds")
+    info.add_argument("file")
+
+    plot = sub.add_parser("plot", help="orbits in the x-y plane and the invariants' errors, "
+                                       "as a PNG")
+    plot.add_argument("file")
+    plot.add_argument("-o", "--output", help="PNG path (default: next to the file)")
 
     sub.add_parser("scenes", help="list the built-in scenes")
     sub.add_parser("integrators", help="list the integrators")
@@ -72,9 +93,35 @@ def main(argv=None):
             bodies = orbits.scenes.get(args.scene)
             sim = orbits.Simulation(bodies, integrator=args.integrator, dt=args.dt)
             result = sim.run(until=args.until, outputs=args.outputs,
-                             progress=False if args.no_progress else None)
+                             progress=False if args.no_progress else None,
+                             output=args.out, overwrite=args.force,
+                             checkpoint_interval=args.checkpoint_interval)
             print(f"scene           {args.scene}")
             print(result.summary())
+            if args.out:
+                print(f"written         {args.out}")
+        elif args.command == "resume":
+            sim = orbits.Simulation.from_file(args.file)
+            progress = False if args.no_progress else None
+            result = None
+            if not sim._resume.finished:
+                result = sim.resume(progress=progress,
+                                    checkpoint_interval=args.checkpoint_interval)
+                print(f"finished the interrupted run in {args.file}")
+            if args.until is not None:
+                result = sim.run(until=args.until, outputs=args.outputs, progress=progress,
+                                 output=args.file,
+                                 checkpoint_interval=args.checkpoint_interval)
+            if result is None:
+                print(f"{args.file}: its run is complete; give --until to continue it")
+                return 0
+            print(result.summary())
+        elif args.command == "info":
+            print(orbits.io.describe(args.file))
+        elif args.command == "plot":
+            from orbits.plotting import plot_file
+            path = plot_file(args.file, args.output)
+            print(f"wrote {path}")
     except (OrbitsError, ValueError, u.UnitsError) as exc:
         print(f"orbits: error: {exc}", file=sys.stderr)
         return 2

@@ -7,6 +7,7 @@ to what it returns.
 
 import math
 import time as _time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -22,7 +23,7 @@ from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
                        vector_relative_error)
 from .result import Result
 
-__all__ = ["Simulation", "PARALLEL_THRESHOLD"]
+__all__ = ["Simulation", "RunPlan", "PARALLEL_THRESHOLD"]
 
 #: Bodies from which the threaded gravity kernel is used.  Measured with
 #: benchmarks/bench_gravity.py on the 2-core reference machine (whole leapfrog
@@ -36,6 +37,27 @@ CHUNK_SECONDS = 0.25
 
 #: A progress bar appears once a run has gone on this long, so short runs stay quiet.
 PROGRESS_DELAY = 3.0
+
+
+class RunPlan(NamedTuple):
+    """Where one ``run`` takes its steps and outputs; stored in output files so
+    that an interrupted run resumes with exactly the same steps."""
+
+    until: float            # end time (internal units)
+    outputs: int
+    ratio: float            # (until - start) / dt
+    n_full: int             # whole steps of dt
+    has_partial: bool       # one shortened last step to land on until
+    start_step: int         # Simulation.steps when the run began
+
+    @property
+    def total_steps(self):
+        return self.n_full + int(self.has_partial)
+
+    def marks(self):
+        """Step counts (from the run's start) of the outputs between the first and last."""
+        return [min(int(round(k * self.ratio / (self.outputs - 1))), self.n_full)
+                for k in range(1, self.outputs - 1)]
 
 
 class Simulation:
@@ -131,6 +153,41 @@ class Simulation:
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
 
+    # -- files ------------------------------------------------------------------------
+    @classmethod
+    def from_file(cls, path):
+        """The simulation at the last checkpoint of an output file.
+
+        Everything is restored, the integrator's internal state included, so
+        that continuing gives bit for bit what an uninterrupted run gives.  If
+        the run that wrote the file was interrupted, :meth:`resume` finishes
+        it; :meth:`run` with ``output=path`` appends a new run to the file.
+        """
+        from .io import hdf5
+        return hdf5.restore(path)
+
+    def resume(self, progress=None, checkpoint_interval=None):
+        """Finish the run that was interrupted, writing on into its file.
+
+        Output rows written after the last checkpoint are dropped and computed
+        again, so the file ends as if the run had never stopped.
+        """
+        from .io import hdf5
+        point = getattr(self, "_resume", None)
+        if point is None:
+            raise ValueError("this simulation was not restored from a file "
+                             "(use Simulation.from_file)")
+        if point.finished:
+            raise ValueError(f"the run in {self._output_path} finished; continue with "
+                             f"run(until=..., output={self._output_path!r})")
+        hdf5.truncate(self._output_path, point)
+        rec = hdf5.FileRecorder(self._output_path, self, point.plan,
+                                checkpoint_interval=checkpoint_interval,
+                                resume_rows=point.outputs_written)
+        self._resume = None
+        first_mark = max(0, point.outputs_written - 1)
+        return self._execute(point.plan, rec, progress, first_mark=first_mark)
+
     # -- state ------------------------------------------------------------------------
     @property
     def time(self):
@@ -177,7 +234,8 @@ class Simulation:
         return row
 
     # -- running ------------------------------------------------------------------------
-    def run(self, until, outputs=500, progress=None):
+    def run(self, until, outputs=500, progress=None, output=None, overwrite=False,
+            checkpoint_interval=None):
         """Advance to ``until``, recording ``outputs`` evenly spread states.
 
         Parameters
@@ -186,13 +244,27 @@ class Simulation:
             End time; must be later than :attr:`time`.
         outputs : int
             Number of outputs, the current state first and the state at
-            ``until`` last (1: only the state at ``until``).  Fixed-step methods never change their step inside
-            a run: each output is taken at the step boundary nearest its even
-            spacing (``result.times`` are the exact times), and only the very
-            last step is shortened, if needed, to end exactly at ``until``.
+            ``until`` last (1: only the state at ``until``).  Fixed-step
+            methods never change their step inside a run: each output is taken
+            at the step boundary nearest its even spacing (``result.times``
+            are the exact times), and only the very last step is shortened, if
+            needed, to end exactly at ``until``.
         progress : bool, optional
             Show a progress bar.  Default: shown only if the run goes on for
             more than a few seconds.
+        output : str or path, optional
+            Stream the outputs and monitors to this HDF5 file instead of
+            keeping them in memory, with restart checkpoints (see
+            :mod:`orbits.io.hdf5`).  The returned result then holds only the
+            last output; :func:`orbits.load` reads the whole file.  A file that
+            this simulation wrote (or was restored from) is appended to; any
+            other existing file is an error unless ``overwrite=True``.
+        overwrite : bool
+            Replace an existing file at ``output``.
+        checkpoint_interval : float, optional
+            Seconds of wall time between restart checkpoints in the file
+            (default :data:`orbits.io.hdf5.CHECKPOINT_SECONDS`); 0 writes one
+            at every output.  One is always written at the end.
 
         Returns
         -------
@@ -205,45 +277,62 @@ class Simulation:
             carries ``time``, ``step`` and ``result``, which ends with the last
             good state; the simulation is left at that state.
         """
-        until_v = self._time_value(until, "until")
+        plan = self._plan(self._time_value(until, "until"), outputs, until)
+        if output is None:
+            rec = _Recorder(self, initial=plan.outputs > 1)
+        else:
+            from .io import hdf5
+            rec = hdf5.FileRecorder(output, self, plan, overwrite=overwrite,
+                                    checkpoint_interval=checkpoint_interval)
+        return self._execute(plan, rec, progress)
+
+    def _plan(self, until_v, outputs, until=None):
+        """Where a run to ``until_v`` takes its outputs: a :class:`RunPlan`."""
         now = self._now()
         if not until_v > now:
-            raise ValueError(f"until = {until} is not after the current time "
-                             f"{self.time:.10g}")
+            raise ValueError(f"until = {until if until is not None else until_v} is not "
+                             f"after the current time {self.time:.10g}")
         outputs = int(outputs)
         if outputs < 1:
             raise ValueError(f"outputs must be >= 1, got {outputs}")
-        span = until_v - now
-        ratio = span / self._dt
+        ratio = (until_v - now) / self._dt
         n_full = int(round(ratio))
         if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
             n_full = int(math.floor(ratio))
-        partial = span - n_full * self._dt
-        if partial <= 1e-12 * max(span, self._dt):
-            partial = 0.0
-        total = n_full + (partial > 0)
-        marks = [min(int(round(k * ratio / (outputs - 1))), n_full)
-                 for k in range(1, outputs - 1)]
+        partial = until_v - self._time_after(n_full)
+        has_partial = partial > 1e-12 * max(until_v - now, self._dt)
+        plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps)
+        total = plan.total_steps
+        marks = plan.marks()
         if outputs > total + 1 or any(b <= a for a, b in zip([0] + marks, marks + [total])):
             raise ValueError(f"outputs = {outputs} needs more steps than the run has "
                              f"({total}); ask for at most {total + 1} outputs or use a "
                              f"smaller dt")
+        return plan
 
-        rec = _Recorder(self, initial=outputs > 1)
-        bar = _ProgressBar(total, progress)
+    def _time_after(self, n):
+        # the time after n more steps of dt, computed as every step count is
+        return self._t_base + (self._steps_since_base + n) * self._dt
+
+    def _execute(self, plan, rec, progress, first_mark=0):
+        """Carry out ``plan`` from its output ``first_mark`` on (resuming)."""
+        marks = plan.marks()
+        done = self.steps - plan.start_step
+        bar = _ProgressBar(plan.total_steps, progress)
+        bar.update(done)
         wall0 = _time.perf_counter()
-        done = 0
         try:
-            for mark in marks:
+            for mark in marks[first_mark:]:
                 done = self._advance_to(done, mark, rec, bar, wall0)
                 rec.output(self)
-            done = self._advance_to(done, n_full, rec, bar, wall0)
-            if partial > 0.0:
-                self._advance(1, rec, wall0, dt=partial)
+            done = self._advance_to(done, plan.n_full, rec, bar, wall0)
+            if plan.has_partial and done == plan.n_full:
+                self._advance(1, rec, wall0, dt=plan.until - self._now())
                 bar.update(1)
-            rec.output(self)
+            rec.output(self, final=True)
         finally:
             bar.close()
+            rec.close()
         return rec.result(self, _time.perf_counter() - wall0)
 
     def _advance_to(self, done, target, rec, bar, wall0):
@@ -293,17 +382,11 @@ class Simulation:
             self._t_base = self._now() + dt
             self._steps_since_base = 0
         self.steps += n
-        self.force_evaluations += n * self._forces_per_step()
-
-    def _forces_per_step(self):
-        integ = self.integrator
-        if hasattr(integ, "B"):
-            return len(integ.B)
-        return sum(1 for kind, _ in integ.operators if kind == "kick") - (
-            1 if integ.operators[0][0] == "kick" and integ.operators[-1][0] == "kick" else 0)
+        self.force_evaluations += n * self.integrator.forces_per_step
 
     def _fail(self, status, rec, wall0):
-        rec.output(self)
+        rec.output(self, final=True)
+        rec.close()
         result = rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
                             status="non-finite state")
         t = self.time
@@ -338,7 +421,10 @@ class _Recorder:
         if initial:
             self.output(sim)
 
-    def output(self, sim):
+    def close(self):
+        """Nothing to release for a run kept in memory."""
+
+    def output(self, sim, final=False):
         sim.integrator.synchronize(sim._ws, sim._x, sim._v)
         self.t.append(sim._now())
         self.x.append(sim._x[self.inv].copy())

@@ -49,6 +49,8 @@ class Integrator:
     options = {}
     #: one line for listings
     summary = ""
+    #: force evaluations per step (for the counts in results)
+    forces_per_step = 1
 
     def __init__(self, **options):
         unknown = sorted(set(options) - set(self.options))
@@ -105,6 +107,9 @@ class SplittingMethod(Integrator):
             codes = {"drift": stepping.DRIFT, "kick": stepping.KICK}
             cls._kinds = tuple(codes[k] for k, _ in cls.operators)
             cls._coefs = tuple(float(c) for _, c in cls.operators)
+            kinds = [k for k, _ in cls.operators]
+            # a closing kick shares its force with the next step's opening kick
+            cls.forces_per_step = kinds.count("kick") - (kinds[0] == kinds[-1] == "kick")
 
     def workspace(self, n):
         return {"acc": np.zeros((n, 3)), "cache": np.zeros(1, dtype=np.int64)}
@@ -128,6 +133,11 @@ class ExplicitRungeKutta(Integrator):
     A = None
     B = None
     C = None
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if cls.B is not None:
+            cls.forces_per_step = len(cls.B)
 
     def workspace(self, n):
         s = len(self.B)

@@ -1,0 +1,5 @@
+"""Reading and writing runs: :mod:`orbits.io.hdf5`."""
+
+from .hdf5 import OrbitsFileError, describe, load
+
+__all__ = ["load", "describe", "OrbitsFileError"]

@@ -1,0 +1,247 @@
+"""HDF5 output: layout, reading back, bit-exact restart, crash safety, bad files."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import astropy.units as u
+import h5py
+import numpy as np
+import pytest
+
+import orbits
+from orbits.io.hdf5 import FileRecorder, OrbitsFileError
+
+FIXED = [i.name for i in orbits.integrators.available() if not i.adaptive]
+
+
+def outer(integrator="leapfrog", **kw):
+    return orbits.Simulation(orbits.scenes.outer_solar_system(), integrator=integrator,
+                             dt=10 * u.day, **kw)
+
+
+def test_layout_units_and_metadata(tmp_path):
+    path = tmp_path / "run.h5"
+    outer(monitors=("energy", "angular_momentum", "momentum", "center_of_mass"),
+          monitor_every=100).run(until=10_000 * u.day, outputs=11, output=path,
+                                 progress=False)
+    with h5py.File(path, "r") as f:
+        assert f.attrs["orbits_format"] == "orbits-h5md"
+        assert list(f["h5md"].attrs["version"]) == [1, 1]
+        assert f["particles/bodies/position/value"].shape == (11, 6, 3)
+        assert f["particles/bodies/position/step"][-1] == 1000
+        missing = []
+
+        def check(name, obj):
+            if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
+                if "unit" not in obj.attrs:
+                    missing.append(name)
+        f.visititems(check)
+        assert missing == []
+        par = f["parameters"].attrs
+        for key in ("orbits_version", "integrator", "integrator_options", "dt", "G",
+                    "G_source", "units", "written", "bodies_history", "h5py_version"):
+            assert key in par, key
+        assert par["G"] == 2.95912208286e-4
+        assert f["observables/in_loop/energy/time"].shape == (10,)
+        assert f["particles/bodies/names"].asstr()[0] == "Sun"
+
+
+def test_load_gives_the_same_numbers_as_memory(tmp_path):
+    path = tmp_path / "run.h5"
+    mem = outer().run(until=10_000 * u.day, outputs=21, progress=False)
+    res = outer().run(until=10_000 * u.day, outputs=21, output=path, progress=False)
+    assert res.positions.shape == (1, 6, 3) and res.path == str(path)
+    back = orbits.load(path)
+    assert back.positions.unit == u.au and back.times.unit == u.day
+    np.testing.assert_array_equal(back.positions.value, mem.positions.value)
+    np.testing.assert_array_equal(back.velocities.value, mem.velocities.value)
+    np.testing.assert_array_equal(back.times.value, mem.times.value)
+    np.testing.assert_array_equal(back.energy_error, mem.energy_error)
+    assert back.names == mem.names
+
+
+@pytest.mark.parametrize("name", FIXED)
+def test_stop_at_an_output_and_continue_is_bit_identical(tmp_path, name):
+    # a run stopped at an output (182,600 d is a whole number of steps) and
+    # continued from the file equals one that never stopped, bit for bit
+    path = tmp_path / "run.h5"
+    ref = outer(name)
+    ref.run(until=1000 * u.yr, outputs=2, progress=False)
+    first = outer(name)
+    first.run(until=182_600 * u.day, outputs=11, output=path, progress=False)
+    again = orbits.Simulation.from_file(path)
+    assert again.time == 182_600 * u.day and again.steps == 18_260
+    again.run(until=1000 * u.yr, outputs=11, output=path, progress=False)
+    assert np.array_equal(again._x, ref._x) and np.array_equal(again._v, ref._v)
+    assert again.steps == ref.steps
+    assert orbits.load(path).positions.shape == (22, 6, 3)
+
+
+class Crash(Exception):
+    pass
+
+
+@pytest.mark.parametrize("name", FIXED)
+def test_interrupted_run_resumes_to_the_same_file(tmp_path, name, monkeypatch):
+    whole = tmp_path / "whole.h5"
+    cut = tmp_path / "cut.h5"
+    outer(name).run(until=50_000 * u.day, outputs=41, output=whole, progress=False,
+                    checkpoint_interval=0)
+    # crash after the 17th output, before anything else is written
+    real = FileRecorder.output
+    seen = []
+
+    def crashing(self, sim, final=False):
+        real(self, sim, final)
+        seen.append(1)
+        if len(seen) == 17:
+            raise Crash()
+    monkeypatch.setattr(FileRecorder, "output", crashing)
+    with pytest.raises(Crash):
+        outer(name).run(until=50_000 * u.day, outputs=41, output=cut, progress=False,
+                        checkpoint_interval=0)
+    monkeypatch.setattr(FileRecorder, "output", real)
+    assert "interrupted" in orbits.io.describe(cut)
+    sim = orbits.Simulation.from_file(cut)
+    sim.resume(progress=False)
+    a, b = orbits.load(whole), orbits.load(cut)
+    np.testing.assert_array_equal(a.positions.value, b.positions.value)
+    np.testing.assert_array_equal(a.times.value, b.times.value)
+    np.testing.assert_array_equal(a.energy_error, b.energy_error)
+    assert b.status == "completed"
+
+
+CHILD = textwrap.dedent("""
+    import sys, astropy.units as u, orbits
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator="verlet",
+                            dt=1 * u.day)
+    sim.run(until=4e6 * u.day, outputs=4001, output=sys.argv[1], progress=False,
+            checkpoint_interval=0)
+""")
+
+
+def test_sigkill_leaves_a_resumable_file(tmp_path):
+    path = tmp_path / "killed.h5"
+    proc = subprocess.Popen([sys.executable, "-c", CHILD, str(path)])
+    try:
+        deadline = time.time() + 60
+        count = 0
+        while time.time() < deadline and count < 20:
+            time.sleep(0.05)
+            if path.exists():
+                try:
+                    with h5py.File(path, "r", swmr=True) as f:
+                        count = int(f["restart/count"][()])
+                except (OSError, KeyError):
+                    pass
+        assert count >= 20, "the child wrote no checkpoints"
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(10)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == -signal.SIGKILL, "the run finished before it was killed"
+    text = orbits.io.describe(path)          # opens and says what it holds
+    assert "interrupted" in text or "no checkpoint" not in text
+    partial = orbits.load(path)
+    assert 0 < len(partial.times) < 4001
+    sim = orbits.Simulation.from_file(path)
+    sim.resume(progress=False)
+    ref = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator="verlet",
+                            dt=1 * u.day)
+    ref.run(until=4e6 * u.day, outputs=2, progress=False)
+    assert np.array_equal(sim._x, ref._x) and np.array_equal(sim._v, ref._v)
+    done = orbits.load(path)
+    assert len(done.times) == 4001 and done.status == "completed"
+    np.testing.assert_array_equal(done.times.value, np.linspace(0, 4e6, 4001))
+
+
+def test_no_overwrite_without_permission(tmp_path):
+    path = tmp_path / "run.h5"
+    outer().run(until=100 * u.day, outputs=2, output=path, progress=False)
+    with pytest.raises(OrbitsFileError, match="exists; pass overwrite=True"):
+        outer().run(until=100 * u.day, outputs=2, output=path, progress=False)
+    outer().run(until=200 * u.day, outputs=2, output=path, progress=False, overwrite=True)
+    assert orbits.load(path).times[-1] == 200 * u.day
+
+
+def test_bad_files(tmp_path):
+    text = tmp_path / "notes.h5"
+    text.write_text("not hdf5")
+    with pytest.raises(OrbitsFileError, match="notes.h5.*not a readable HDF5"):
+        orbits.load(text)
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f["x"] = 1.0
+    with pytest.raises(OrbitsFileError, match="other.h5.*not an orbits output"):
+        orbits.load(other)
+    good = tmp_path / "good.h5"
+    outer().run(until=1000 * u.day, outputs=5, output=good, progress=False)
+    data = good.read_bytes()
+    short = tmp_path / "short.h5"
+    short.write_bytes(data[: len(data) // 3])
+    with pytest.raises(OrbitsFileError, match="short.h5"):
+        orbits.load(short)
+    with h5py.File(good, "a") as f:
+        f.attrs["orbits_format_version"] = 99
+    with pytest.raises(OrbitsFileError, match="good.h5.*layout version 99"):
+        orbits.load(good)
+    with pytest.raises(OrbitsFileError, match="no such file"):
+        orbits.load(tmp_path / "missing.h5")
+
+
+def test_cli_run_info_resume_plot(tmp_path, capsys):
+    from orbits.cli import main
+    path = tmp_path / "cli.h5"
+    assert main(["run", "outer-solar-system", "--dt", "10d", "--until", "100yr",
+                 "--out", str(path), "--no-progress"]) == 0
+    assert main(["run", "outer-solar-system", "--dt", "10d", "--until", "100yr",
+                 "--out", str(path), "--no-progress"]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "6: Sun, Jupiter" in out and "outputs         500" in out and "completed" in out
+    assert main(["resume", str(path), "--until", "200yr", "--outputs", "11",
+                 "--no-progress"]) == 0
+    assert orbits.load(path).times[-1].to_value(u.yr) == pytest.approx(200, rel=1e-12)
+    png = tmp_path / "cli.png"
+    assert main(["plot", str(path), "-o", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    assert main(["info", str(tmp_path / "nope.h5")]) == 2
+
+
+MEMORY_CHILD = textwrap.dedent("""
+    import resource, sys, astropy.units as u, orbits
+    n = int(sys.argv[2])
+    sim = orbits.Simulation(orbits.scenes.kepler(e=0.1), integrator="leapfrog",
+                            dt=1 * u.day)
+    sim.run(until=(n - 1) * u.day, outputs=n, output=sys.argv[1], progress=False)
+    print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+""")
+
+
+def peak_rss_kb(path, n):
+    out = subprocess.run([sys.executable, "-c", MEMORY_CHILD, str(path), str(n)],
+                         capture_output=True, text=True, check=True)
+    return int(out.stdout.split()[-1])
+
+
+def memory_growth_kb(tmp_path, n):
+    small = peak_rss_kb(tmp_path / "small.h5", 1000)
+    large = peak_rss_kb(tmp_path / "large.h5", n)
+    return large - small
+
+
+def test_memory_stays_flat_1e5_outputs(tmp_path):
+    # 1e5 outputs kept in memory would take 1e5 * (2 * 2 * 3 + 2) * 8 B = 11 MB
+    # plus Python objects (~30 MB); streamed, the growth is HDF5's chunk cache
+    assert memory_growth_kb(tmp_path, 100_000) < 5_000
+
+
+@pytest.mark.slow
+def test_memory_stays_flat_1e6_outputs(tmp_path):
+    assert memory_growth_kb(tmp_path, 1_000_000) < 5_000
