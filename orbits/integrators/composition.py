@@ -42,7 +42,7 @@ class Yoshida4(SplittingMethod):
     >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.1), integrator="yoshida4",
     ...                         dt=5 * u.day)
     >>> result = sim.run(until=1 * u.yr, outputs=5, progress=False)
-    >>> bool(result.energy_error.max() < 1e-7)
+    >>> bool(result.energy_error.max() < 1e-5)
     True
     """
 
