@@ -54,10 +54,12 @@ class RunPlan(NamedTuple):
     def total_steps(self):
         return self.n_full + int(self.has_partial)
 
-    def marks(self):
-        """Step counts (from the run's start) of the outputs between the first and last."""
-        return [min(int(round(k * self.ratio / (self.outputs - 1))), self.n_full)
-                for k in range(1, self.outputs - 1)]
+    def marks(self, first=0):
+        """Step counts (from the run's start) of the outputs between the first and
+        last, from the ``first``-th on; a generator, so a run of a million outputs
+        holds none of them in memory."""
+        for k in range(first + 1, self.outputs - 1):
+            yield min(int(round(k * self.ratio / (self.outputs - 1))), self.n_full)
 
 
 class Simulation:
@@ -303,8 +305,7 @@ class Simulation:
         has_partial = partial > 1e-12 * max(until_v - now, self._dt)
         plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps)
         total = plan.total_steps
-        marks = plan.marks()
-        if outputs > total + 1 or any(b <= a for a, b in zip([0] + marks, marks + [total])):
+        if outputs > total + 1 or not _increasing(plan.marks(), total):
             raise ValueError(f"outputs = {outputs} needs more steps than the run has "
                              f"({total}); ask for at most {total + 1} outputs or use a "
                              f"smaller dt")
@@ -316,13 +317,12 @@ class Simulation:
 
     def _execute(self, plan, rec, progress, first_mark=0):
         """Carry out ``plan`` from its output ``first_mark`` on (resuming)."""
-        marks = plan.marks()
         done = self.steps - plan.start_step
         bar = _ProgressBar(plan.total_steps, progress)
         bar.update(done)
         wall0 = _time.perf_counter()
         try:
-            for mark in marks[first_mark:]:
+            for mark in plan.marks(first_mark):
                 done = self._advance_to(done, mark, rec, bar, wall0)
                 rec.output(self)
             done = self._advance_to(done, plan.n_full, rec, bar, wall0)
@@ -401,6 +401,15 @@ class Simulation:
     def __repr__(self):
         return (f"<Simulation of {len(self._m)} bodies, {self.integrator.name}, "
                 f"dt={self.dt:.6g}, t={self.time:.6g}>")
+
+
+def _increasing(marks, total):
+    last = 0
+    for mark in marks:
+        if mark <= last:
+            return False
+        last = mark
+    return last < total or (last == 0 and total > 0)
 
 
 class _Recorder:
