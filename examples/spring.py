@@ -39,6 +39,9 @@ def main():
                   f"{drift.max():12.3e}")
         except orbits.NonFiniteState as exc:
             print(f"{info.name:18s} {info.order:5d} failed: {exc}")
+        except orbits.IntegratorOptionError as exc:
+            # methods built for gravity alone (Wisdom-Holman) take no user force
+            print(f"{info.name:18s} {info.order:5d} not applicable: {exc}")
 
 
 if __name__ == "__main__":

@@ -13,7 +13,7 @@ CHECK_EVERY = 16
 
 
 def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, mon_out,
-                    velocity_dependent=False):
+                    velocity_dependent=False, stop=None):
     """Advance ``n`` steps; on failure, leave ``x``, ``v`` at the last good state.
 
     Returns ``(status, good_steps, n_monitor_rows, ws)``; ``ws`` is the
@@ -23,10 +23,14 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     from a copy taken here rather than saved by the loop every step.
     """
     saved = (x.copy(), v.copy(), _copy_workspace(ws))
+    kw = {} if stop is None else {"stop": stop}
     status, steps, n_mon = integ.advance(ws, x, v, t, dt, n, force, fargs, mon, step0,
-                                         mon_t, mon_out, velocity_dependent, CHECK_EVERY)
+                                         mon_t, mon_out, velocity_dependent, CHECK_EVERY, **kw)
     if status == Status.OK:
         return Status.OK, n, n_mon, ws
+    if status != Status.NON_FINITE:
+        # a stopping condition: the state is good, and it is where the run ends
+        return Status(status), steps, n_mon, ws
 
     def rerun(nsteps, monitors):
         x[...] = saved[0]
@@ -34,7 +38,7 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
         work = _copy_workspace(saved[2])
         m = mon if monitors else (0,) + tuple(mon[1:])
         result = integ.advance(work, x, v, t, dt, nsteps, force, fargs, m, step0, mon_t,
-                               mon_out, velocity_dependent, 1)
+                               mon_out, velocity_dependent, 1, **kw)
         return result, work
 
     (status, good, n_mon), _ = rerun(n, monitors=True)    # finds the failing step

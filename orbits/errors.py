@@ -114,7 +114,17 @@ class RunError(OrbitsError, RuntimeError):
 
 
 class SimulationStopped(RunError):
-    """A stopping condition ended the run."""
+    """A stopping condition ended the run.
+
+    Attributes
+    ----------
+    bodies : tuple of str
+        The bodies concerned (the pair for an encounter, the one for an escape).
+    """
+
+    def __init__(self, message, time=None, step=None, result=None, bodies=()):
+        self.bodies = tuple(bodies)
+        super().__init__(message, time=time, step=step, result=result)
 
 
 class NonFiniteState(RunError):

@@ -18,7 +18,8 @@ from ._driver import advance_checked
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
-from .errors import BodyUnitsError, IntegratorOptionError, NonFiniteState
+from .errors import (BodyUnitsError, CloseEncounter, Escape, IntegratorOptionError,
+                     NonFiniteState)
 from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
                        vector_relative_error)
 from .result import Result
@@ -87,6 +88,22 @@ class Simulation:
     parallel : bool, optional
         Force the threaded (True) or serial (False) gravity kernel.  Default:
         threaded from :data:`PARALLEL_THRESHOLD` bodies on.
+    encounter_distance : Quantity (length), optional
+        Stop with :class:`~orbits.errors.CloseEncounter` when two bodies come
+        closer than this.
+    encounter_hill : float, optional
+        Stop with :class:`~orbits.errors.CloseEncounter` when two bodies other
+        than the central (most massive) one come within this many mutual Hill
+        radii, ``((m_i + m_j) / (3 m_c))^(1/3) (r_i + r_j) / 2``.
+    escape_distance : Quantity (length), optional
+        Stop with :class:`~orbits.errors.Escape` when a body is farther than
+        this from the centre of mass.
+    escape_unbound : bool
+        With ``escape_distance``: count a body beyond it only if it is also
+        unbound (positive energy about the centre of mass).
+
+    The stopping conditions are checked inside the compiled loop after every
+    step; a simulation without them compiles a loop without the check.
 
     Examples
     --------
@@ -100,7 +117,8 @@ class Simulation:
     """
 
     def __init__(self, bodies, integrator="verlet", dt=None, *, monitors=DEFAULT_MONITORS,
-                 monitor_every=None, softening=None, parallel=None):
+                 monitor_every=None, softening=None, parallel=None, encounter_distance=None,
+                 encounter_hill=None, escape_distance=None, escape_unbound=False):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
@@ -143,6 +161,8 @@ class Simulation:
                              f"got {monitor_every}")
         self.monitor_every = None if monitor_every is None else int(monitor_every)
 
+        self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
+                                     escape_unbound)
         self._ws = self.integrator.workspace(n)
         self._t_base = 0.0          # time = t_base + steps_since_base * dt
         self._steps_since_base = 0
@@ -154,6 +174,49 @@ class Simulation:
         self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
+
+    def _stop_args(self, distance, hill, escape, unbound):
+        from ._kernels import stopping as _s
+        mask = 0
+        d2 = esc2 = 0.0
+        k = 0.0
+        if distance is not None:
+            d = float(self.units.to_internal(distance, "length", bare_ok=self._bare_ok,
+                                             field="encounter_distance"))
+            if not (d > 0 and math.isfinite(d)):
+                raise ValueError(f"encounter_distance must be a positive length, got {distance}")
+            mask |= _s.ENCOUNTER_DISTANCE
+            d2 = d * d
+        if hill is not None:
+            k = float(hill)
+            if not (k > 0 and math.isfinite(k)):
+                raise ValueError(f"encounter_hill must be a positive number of Hill radii, "
+                                 f"got {hill}")
+            mask |= _s.ENCOUNTER_HILL
+        if escape is not None:
+            e = float(self.units.to_internal(escape, "length", bare_ok=self._bare_ok,
+                                             field="escape_distance"))
+            if not (e > 0 and math.isfinite(e)):
+                raise ValueError(f"escape_distance must be a positive length, got {escape}")
+            mask |= _s.ESCAPE
+            esc2 = e * e
+        if unbound:
+            if escape is None:
+                raise ValueError("escape_unbound needs escape_distance (the radius beyond "
+                                 "which an unbound body counts as escaped)")
+            mask |= _s.UNBOUND
+        self._stop_config = {"encounter_distance": math.sqrt(d2) if d2 else None,
+                             "encounter_hill": k or None,
+                             "escape_distance": math.sqrt(esc2) if esc2 else None,
+                             "escape_unbound": bool(unbound)}
+        if not mask:
+            return None
+        if not self.integrator.stop_conditions:
+            raise IntegratorOptionError(f"integrator {self.integrator.name!r} does not check "
+                                        f"stopping conditions")
+        central = int(np.argmax(self._m))
+        self._stop_info = np.zeros(2, dtype=np.int64)
+        return (mask, d2, k, esc2, self._gm, central, self._stop_info)
 
     # -- files ------------------------------------------------------------------------
     @classmethod
@@ -365,7 +428,7 @@ class Simulation:
         mon = (every, self._mask, self._m, self.units.G, self._n_active, self._eps2)
         status, steps, n_mon, self._ws = advance_checked(
             self.integrator, self._ws, self._x, self._v, self._now(), dt, n, self._force,
-            self._fargs, mon, self.steps, mon_t, mon_out)
+            self._fargs, mon, self.steps, mon_t, mon_out, stop=self._stop)
         if n_mon:
             rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
         if status != Status.OK:
@@ -385,10 +448,14 @@ class Simulation:
         self.force_evaluations += n * self.integrator.forces_per_step
 
     def _fail(self, status, rec, wall0):
+        reason = {Status.NON_FINITE: "non-finite state",
+                  Status.CLOSE_ENCOUNTER: "close encounter",
+                  Status.ESCAPE: "escape"}.get(status, f"status {status!r}")
+        rec.end_status = int(status)
         rec.output(self, final=True)
         rec.close()
         result = rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
-                            status="non-finite state")
+                            status=reason)
         t = self.time
         if status == Status.NON_FINITE:
             raise NonFiniteState(
@@ -396,6 +463,19 @@ class Simulation:
                 f"the result up to the last good state, at step {self.steps}, is kept on "
                 f"this exception (.result) and the simulation was left there",
                 time=t, step=self.steps, result=result)
+        i, j = (int(k) for k in self._stop_info)
+        name = lambda k: self._names[self._order[k]]  # noqa: E731
+        if status == Status.CLOSE_ENCOUNTER:
+            bodies = (name(i), name(j))
+            raise CloseEncounter(f"close encounter of {bodies[0]!r} and {bodies[1]!r} at "
+                                 f"t = {t:.10g} (step {self.steps}); the result up to here "
+                                 f"is kept on .result", time=t, step=self.steps,
+                                 result=result, bodies=bodies)
+        if status == Status.ESCAPE:
+            bodies = (name(i),)
+            raise Escape(f"{bodies[0]!r} escaped at t = {t:.10g} (step {self.steps}); the "
+                         f"result up to here is kept on .result", time=t, step=self.steps,
+                         result=result, bodies=bodies)
         raise RuntimeError(f"unexpected status {status!r}")  # pragma: no cover
 
     def __repr__(self):
@@ -429,6 +509,8 @@ class _Recorder:
         self.n = n
         if initial:
             self.output(sim)
+
+    end_status = 0
 
     def close(self):
         """Nothing to release for a run kept in memory."""

@@ -20,6 +20,11 @@ exact failing step and recomputes the last good state from it
 (:func:`orbits._driver.advance_checked`), so the loop pays for neither a
 copy nor a check every step.
 
+After every step a loop calls its stopping check (:mod:`.stopping`); a
+check that fires ends the loop with its status and ``steps_done`` counting
+the step that triggered it.  Loops compiled without conditions call
+:func:`~.stopping.no_stop`, which compiles to nothing.
+
 Monitors (energy, angular momentum, ...) are recorded every ``every`` steps,
 counted from the start of the simulation (``step0``), into ``mon_t`` and
 ``mon_out``; ``every = 0`` switches them off and costs one branch a step.
@@ -35,9 +40,13 @@ from .gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
                       accelerate_pairwise_small)
 from .invariants import monitor_row
 from .status import Status
+from .stopping import check_stop, no_stop
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
-           "user_force", "state_is_finite", "ForceKernel"]
+           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS"]
+
+#: the stopping arguments of a loop compiled without conditions
+NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
 
 #: operator codes of a splitting table
 DRIFT = 0
@@ -114,7 +123,7 @@ def user_force(accel, jit):
 # -- splitting methods --------------------------------------------------------------
 
 def _splitting_loop(x, v, t, dt, nsteps, acc, cache, fargs, velocity_dependent, mon, step0,
-                    mon_t, mon_out, check_every):
+                    mon_t, mon_out, check_every, sargs):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
     # (v += c dt a(x)), the table KINDS/COEFS bound by specialize as constant
     # tuples, so that the compiler unrolls it.  The acceleration depends only
@@ -160,17 +169,25 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, cache, fargs, velocity_dependent, 
             until_record = every
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+        if stop != 0:
+            cache[0] = 1 if fresh else 0
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
+            return stop, k + 1, n_mon
     cache[0] = 1 if fresh else 0
     return Status.OK, nsteps, n_mon
 
 
-def splitting_loop(force, name, kinds, coefs):
+def splitting_loop(force, name, kinds, coefs, stop=False):
     """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
 
-    ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method.
+    ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method;
+    ``stop`` compiles in the stopping conditions of :mod:`.stopping`.
     """
-    return specialize(_splitting_loop, f"{name}_{force.key}", jit=force.jit,
-                      cache=force.cache, force=force.kernel,
+    return specialize(_splitting_loop, f"{name}_{force.key}{'_stop' if stop else ''}",
+                      jit=force.jit, cache=force.cache, force=force.kernel,
+                      stop_check=check_stop if stop else no_stop,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs))
 
@@ -178,7 +195,7 @@ def splitting_loop(force, name, kinds, coefs):
 # -- explicit Runge-Kutta ---------------------------------------------------------------
 
 def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, step0,
-                      mon_t, mon_out, check_every):
+                      mon_t, mon_out, check_every, sargs):
     # y = (x, v), y' = (v, a(x, v, t)); stage s has state
     # y + dt sum_j A[s, j] k_j and derivative k_s.  kx[s] = stage velocity,
     # kv[s] = stage acceleration.
@@ -223,10 +240,17 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
             until_record = every
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+        if stop != 0:
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
+            return stop, k + 1, n_mon
     return Status.OK, nsteps, n_mon
 
 
-def runge_kutta_loop(force):
-    """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`."""
-    return specialize(_runge_kutta_loop, force.key, jit=force.jit, cache=force.cache,
-                      force=force.kernel)
+def runge_kutta_loop(force, stop=False):
+    """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`
+    (``stop``: with the stopping conditions of :mod:`.stopping`)."""
+    return specialize(_runge_kutta_loop, f"{force.key}{'_stop' if stop else ''}",
+                      jit=force.jit, cache=force.cache, force=force.kernel,
+                      stop_check=check_stop if stop else no_stop)

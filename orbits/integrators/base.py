@@ -16,7 +16,7 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
    arrays (:mod:`orbits.io.hdf5`), and a test parametrized over the registry
    checks that a resumed run is bit-identical;
 4. implements ``advance(ws, x, v, t, dt, nsteps, force, fargs, mon, step0,
-   mon_t, mon_out, velocity_dependent, check_every)``, which advances ``x`` and ``v`` (shape (N, 3), in place)
+   mon_t, mon_out, velocity_dependent, check_every, stop)``, which advances ``x`` and ``v`` (shape (N, 3), in place)
    by ``nsteps`` steps of ``dt`` from time ``t`` with the compiled loop for
    ``force`` and returns ``(status, steps_done, n_monitor_rows)`` as
    described in :mod:`orbits._kernels.stepping`;
@@ -55,6 +55,8 @@ class Integrator:
     summary = ""
     #: force evaluations per step (for the counts in results)
     forces_per_step = 1
+    #: whether ``advance`` checks the stopping conditions (``stop=``) inside its loop
+    stop_conditions = False
 
     def __init__(self, **options):
         unknown = sorted(set(options) - set(self.options))
@@ -74,7 +76,7 @@ class Integrator:
         raise NotImplementedError
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
-                velocity_dependent=False, check_every=1):
+                velocity_dependent=False, check_every=1, stop=None):
         raise NotImplementedError
 
     def synchronize(self, ws, x, v):
@@ -104,6 +106,7 @@ class SplittingMethod(Integrator):
 
     operators = ()
     symplectic = True
+    stop_conditions = True
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -119,10 +122,12 @@ class SplittingMethod(Integrator):
         return {"acc": np.zeros((n, 3)), "cache": np.zeros(1, dtype=np.int64)}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
-                velocity_dependent=False, check_every=1):
-        loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs)
+                velocity_dependent=False, check_every=1, stop=None):
+        loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs,
+                                       stop=stop is not None)
         return loop(x, v, t, dt, nsteps, ws["acc"], ws["cache"], fargs, velocity_dependent,
-                    mon, step0, mon_t, mon_out, check_every)
+                    mon, step0, mon_t, mon_out, check_every,
+                    stepping.NO_STOP_ARGS if stop is None else stop)
 
     def invalidate(self, ws):
         ws["cache"][0] = 0
@@ -137,6 +142,7 @@ class ExplicitRungeKutta(Integrator):
     A = None
     B = None
     C = None
+    stop_conditions = True
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -149,7 +155,8 @@ class ExplicitRungeKutta(Integrator):
                 "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3))}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
-                velocity_dependent=False, check_every=1):
-        loop = stepping.runge_kutta_loop(force)
+                velocity_dependent=False, check_every=1, stop=None):
+        loop = stepping.runge_kutta_loop(force, stop=stop is not None)
         return loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
-                    ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every)
+                    ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every,
+                    stepping.NO_STOP_ARGS if stop is None else stop)

@@ -24,8 +24,9 @@ adds two groups of its own::
                              monitor_every steps, when that was asked for
     /parameters              attrs: the run's metadata (orbits and library versions,
                              integrator and its options, dt, unit system, G and its
-                             source, softening, monitors, when written, how the body
-                             set was made, as JSON where structured)
+                             source, softening, monitors, stopping conditions, when
+                             written, how the body set was made, as JSON where
+                             structured)
         reference            (10,) the monitors' values when the simulation was made
         scales               (2,) energy and angular-momentum scales for relative errors
     /restart                 the last two checkpoints, in alternating slots
@@ -38,7 +39,9 @@ adds two groups of its own::
         t_base               (2,) float
         plan                 (2, 6) float: the run in progress (until, outputs, ratio,
                              n_full, has_partial, start_step) and
-        progress             (2, 2) int64: (outputs of that run written, run finished)
+        progress             (2, 3) int64: (outputs of that run written, run finished,
+                             status code when it ended early: 1 non-finite state,
+                             2 step-size underflow, 3 close encounter, 4 escape)
         ws/<name>            (2, ...) the integrator's workspace arrays
 
 Every float dataset has a ``unit`` attribute (H5MD's convention); ``orbits.load``
@@ -149,6 +152,7 @@ class FileRecorder:
         self.steps0 = sim.steps
         self.forces0 = sim.force_evaluations
         self.closed = False
+        self.end_status = 0          # a Status code when a run ends early
         mine = getattr(sim, "_output_path", None)
         if self.path.exists() and not overwrite and (mine is None or
                                                       os.path.abspath(mine) != os.path.abspath(self.path)):
@@ -259,7 +263,7 @@ class FileRecorder:
         p = self.plan
         r["plan"][slot] = (p.until, p.outputs, p.ratio, p.n_full, float(p.has_partial),
                            p.start_step)
-        r["progress"][slot] = (self.outputs_written, int(finished))
+        r["progress"][slot] = (self.outputs_written, int(finished), self.end_status)
         for name, arr in sim._ws.items():
             if isinstance(arr, np.ndarray):
                 r["ws"][name][slot] = arr
@@ -337,6 +341,7 @@ def _create(path, sim):
         "monitors": json.dumps(list(sim.monitors)),
         "monitor_every": sim.monitor_every or 0,
         "parallel": bool(sim.parallel),
+        "stop_conditions": json.dumps(sim._stop_config),
         "bodies_history": json.dumps(sim._history, default=str),
     }
     for k, v in meta.items():
@@ -356,7 +361,7 @@ def _create(path, sim):
     r.create_dataset("t_base", shape=(_SLOTS,), dtype=np.float64).attrs["unit"] = unit("time")
     r.create_dataset("plan", shape=(_SLOTS, 6), dtype=np.float64).attrs["unit"] = \
         f"{unit('time')}, 1, 1, 1, 1, 1"
-    r.create_dataset("progress", shape=(_SLOTS, 2), dtype=np.int64)
+    r.create_dataset("progress", shape=(_SLOTS, 3), dtype=np.int64)
     ws = r.create_group("ws")
     for name, arr in sim._ws.items():
         if isinstance(arr, np.ndarray):
@@ -443,10 +448,15 @@ def load(path):
 
 
 def _status(f):
+    from .._kernels.status import Status
     count = int(f["restart/count"][()])
     if count == 0:
         return "no checkpoint yet (the writer stopped early)"
-    finished = int(f["restart/progress"][(count - 1) % _SLOTS][1])
+    _, finished, code = (int(a) for a in f["restart/progress"][(count - 1) % _SLOTS])
+    if code:
+        return {Status.NON_FINITE: "non-finite state", Status.CLOSE_ENCOUNTER:
+                "close encounter", Status.ESCAPE: "escape",
+                Status.STEP_UNDERFLOW: "step-size underflow"}.get(code, f"stopped ({code})")
     return "completed" if finished else "interrupted (resumable from the last checkpoint)"
 
 
@@ -515,11 +525,17 @@ def restore(path):
         integ = integrators.get(par.attrs["integrator"],
                                 **json.loads(par.attrs["integrator_options"]))
         soft = float(par.attrs["softening"])
+        stop = json.loads(par.attrs["stop_conditions"])
+        length = lambda val: None if val is None else val << units.length  # noqa: E731
         sim = Simulation(bodies, integrator=integ, dt=float(par.attrs["dt"]) << units.time,
                          monitors=tuple(json.loads(par.attrs["monitors"])),
                          monitor_every=int(par.attrs["monitor_every"]) or None,
                          softening=(soft << units.length) if soft > 0 else None,
-                         parallel=bool(par.attrs["parallel"]))
+                         parallel=bool(par.attrs["parallel"]),
+                         encounter_distance=length(stop["encounter_distance"]),
+                         encounter_hill=stop["encounter_hill"],
+                         escape_distance=length(stop["escape_distance"]),
+                         escape_unbound=stop["escape_unbound"])
         if not np.array_equal(sim._order, order):
             raise OrbitsFileError(f"{path}: the stored body order does not match the masses")
         clock = r["clock"][slot]
@@ -536,7 +552,7 @@ def restore(path):
         sim._E_scale, sim._L_scale = (float(s) for s in par["scales"][()])
         p = r["plan"][slot]
         plan = RunPlan(float(p[0]), int(p[1]), float(p[2]), int(p[3]), bool(p[4]), int(p[5]))
-        written, finished = (int(a) for a in r["progress"][slot])
+        written, finished, _ = (int(a) for a in r["progress"][slot])
         rows = int(clock[3])
     sim._output_path = str(path)
     sim._resume = ResumePoint(plan, written, bool(finished), rows,

@@ -1,0 +1,122 @@
+"""Stopping conditions: close encounters and escapes, inside the compiled loop."""
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+import orbits
+from orbits.errors import CloseEncounter, Escape
+
+
+def head_on(**kw):
+    # two light bodies flying at each other at 1 length/time each, G = 1
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("a", mass=1e-9, position=[5, 0, 0], velocity=[-1, 0, 0])
+    b.add("b", mass=1e-9, position=[-5, 0.1, 0], velocity=[1, 0, 0])
+    return orbits.Simulation(b, integrator="leapfrog", dt=0.01, **kw)
+
+
+def separation(sim, i=0, j=1):
+    x = sim.bodies.positions.value
+    return np.linalg.norm(x[i] - x[j])
+
+
+def test_encounter_distance_stops_at_the_first_step_inside():
+    sim = head_on(encounter_distance=1.0)
+    with pytest.raises(CloseEncounter) as exc:
+        sim.run(until=10.0, outputs=11, progress=False)
+    err = exc.value
+    assert set(err.bodies) == {"a", "b"} and "'a'" in str(err) and "'b'" in str(err)
+    # they close at 2 per unit time from 10 apart: inside 1 after t = 4.5
+    assert 4.49 < err.time.value < 4.52 and separation(sim) < 1.0
+    assert err.result.status == "close encounter"
+    assert err.result.times[-1] == err.time
+    # one step fewer is still outside: the check runs every step
+    again = head_on()
+    again.run(until=(err.step - 1) * 0.01, outputs=2, progress=False)
+    assert separation(again) >= 1.0
+
+
+def test_hill_criterion():
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    b.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au)
+    b.add("Saturnino", mass=1e-4 * u.Msun, primary="Sun", a=5.9 * u.au, f=0.4 * u.rad)
+    sim = orbits.Simulation(b, integrator="verlet", dt=10 * u.day, encounter_hill=3.0)
+    with pytest.raises(CloseEncounter) as exc:
+        sim.run(until=2000 * u.yr, outputs=2, progress=False)
+    assert set(exc.value.bodies) == {"Jupiter", "Saturnino"}
+
+    def hill_ratio(s):
+        x = s.bodies.positions.to_value(u.au)
+        m = s.bodies.masses.to_value(u.Msun)
+        r1, r2 = np.linalg.norm(x[1] - x[0]), np.linalg.norm(x[2] - x[0])
+        rh = ((m[1] + m[2]) / (3 * m[0])) ** (1 / 3) * (r1 + r2) / 2
+        return np.linalg.norm(x[1] - x[2]) / rh
+    assert hill_ratio(sim) < 3.0
+    before = orbits.Simulation(b, integrator="verlet", dt=10 * u.day)
+    before.run(until=(exc.value.step - 1) * 10 * u.day, outputs=2, progress=False)
+    assert hill_ratio(before) >= 3.0
+
+
+def comet(e):
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    a = (-3 if e > 1 else 30) * u.au
+    b.add("comet", mass=0 * u.kg, primary="Sun", a=a, e=e, f=0 * u.rad)
+    return b
+
+
+def test_escape_distance_and_unbound():
+    sim = orbits.Simulation(comet(1.5), integrator="leapfrog", dt=1 * u.day,
+                            escape_distance=50 * u.au, escape_unbound=True)
+    with pytest.raises(Escape) as exc:
+        sim.run(until=100 * u.yr, outputs=2, progress=False)
+    assert exc.value.bodies == ("comet",)
+    assert np.linalg.norm(sim.bodies.positions[1].to_value(u.au)) > 50
+    # a bound comet with apocentre 30 (1 + 0.9) = 57 au passes 50 au: an escape
+    # by distance alone, but not when the body must also be unbound
+    bound = comet(0.9)
+    with pytest.raises(Escape):
+        orbits.Simulation(bound, integrator="leapfrog", dt=5 * u.day,
+                          escape_distance=50 * u.au).run(until=200 * u.yr, outputs=2,
+                                                         progress=False)
+    r = orbits.Simulation(bound, integrator="leapfrog", dt=5 * u.day, escape_distance=50 * u.au,
+                          escape_unbound=True).run(until=200 * u.yr, outputs=2,
+                                                   progress=False)
+    assert r.status == "completed"
+
+
+def test_rk_methods_check_too():
+    with pytest.raises(CloseEncounter):
+        head_on(encounter_distance=1.0).run(until=10.0, progress=False, outputs=2)
+    sim = orbits.Simulation(head_on().bodies, integrator="rk4", dt=0.01,
+                            encounter_distance=1.0)
+    with pytest.raises(CloseEncounter):
+        sim.run(until=10.0, outputs=2, progress=False)
+
+
+def test_conditions_survive_a_restart(tmp_path):
+    path = tmp_path / "stop.h5"
+    head_on(encounter_distance=1.0).run(until=2.0, outputs=3, output=path, progress=False)
+    sim = orbits.Simulation.from_file(path)
+    with pytest.raises(CloseEncounter):
+        sim.run(until=10.0, outputs=2, output=path, progress=False)
+    assert orbits.load(path).status == "close encounter"
+    assert "close encounter" in orbits.io.describe(path)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(encounter_distance=-1.0), "encounter_distance"),
+    (dict(encounter_hill=0), "encounter_hill"),
+    (dict(escape_distance=0.0), "escape_distance"),
+    (dict(escape_unbound=True), "escape_unbound needs escape_distance"),
+])
+def test_bad_conditions(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        head_on(**kwargs)
+
+
+def test_wrong_unit_for_a_distance():
+    with pytest.raises(orbits.BodyUnitsError, match="escape_distance"):
+        orbits.Simulation(comet(1.5), dt=1 * u.day, escape_distance=3 * u.day)
