@@ -27,6 +27,10 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
 6. is registered in :mod:`orbits.integrators` and documented with its update
    equations, its reference and an example.
 
+Adaptive methods (:class:`AdaptiveIntegrator`, ``adaptive = True``) meet
+the same contract with ``advance_to`` in place of ``advance``: they integrate
+to an exact time with their own step control (see there).
+
 Fixed-step methods are data over a shared loop: a splitting method is a table
 of drift and kick coefficients (:class:`SplittingMethod`), an explicit
 Runge-Kutta method a Butcher table (:class:`ExplicitRungeKutta`).
@@ -37,7 +41,7 @@ import numpy as np
 from .._kernels import stepping
 from ..errors import IntegratorOptionError
 
-__all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta"]
+__all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator"]
 
 
 class Integrator:
@@ -160,3 +164,51 @@ class ExplicitRungeKutta(Integrator):
         return loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
                     ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every,
                     stepping.NO_STOP_ARGS if stop is None else stop)
+
+
+class AdaptiveIntegrator(Integrator):
+    """Base of the adaptive integrators: they choose their own steps.
+
+    Contract (in addition to points 1-3, 5 and 6 of the module docstring):
+
+    * ``advance_to(ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out,
+      stop, max_steps)`` integrates ``x``, ``v`` (in place) from ``t`` to
+      exactly ``t_end``, or returns early after ``max_steps`` accepted steps
+      (so that Python can show progress), and returns ``(status, t_reached,
+      steps_accepted, steps_rejected, force_evaluations, n_monitor_rows)``.
+      ``t_end`` is hit by shortening the last step; the step size the method
+      proposed is kept in ``ws`` and used again afterwards, so outputs do not
+      disturb the step sequence.
+    * On a non-OK status (``Status.NON_FINITE``, ``Status.STEP_UNDERFLOW``, or a
+      stopping condition) ``x`` and ``v`` hold the last good state and
+      ``t_reached`` its time; ``ws["info"]`` (int64, shape (2,)) names the
+      bodies concerned (internal indices, -1 for none).
+    * ``ws["dt"]`` (shape (1,)) holds the next step size; ``initial_step`` is
+      the ``dt`` the user gave (or 0 to let the method choose).
+    * Everything a bit-exact restart needs lives in ``ws`` as arrays, as for
+      every integrator.
+    * Options are checked in ``_check_options``: tolerances must be positive,
+      and unknown options are rejected by :class:`Integrator`.
+    """
+
+    adaptive = True
+    stop_conditions = True
+
+    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out,
+                   stop, max_steps):
+        raise NotImplementedError
+
+    def workspace(self, n, initial_step=0.0):
+        raise NotImplementedError
+
+    def _positive(self, *names):
+        for name in names:
+            value = self.config[name]
+            try:
+                ok = float(value) > 0 and float(value) < float("inf")
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise IntegratorOptionError(
+                    f"integrator {self.name!r}: option {name!r} must be a positive finite "
+                    f"number, got {value!r}")
