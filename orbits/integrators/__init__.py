@@ -15,6 +15,7 @@ from .composition import Yoshida4, Yoshida6, Yoshida8
 from .euler import Euler, SymplecticEuler
 from .leapfrog import Leapfrog, Verlet
 from .runge_kutta import RK2, RK4
+from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
 __all__ = ["get", "available", "register", "Integrator", "IntegratorInfo",
            "SplittingMethod", "ExplicitRungeKutta"]
@@ -41,7 +42,7 @@ def register(cls):
 
 
 for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
-             Yoshida8):
+             Yoshida8, WisdomHolman, SABA2, SABA3, SABA4):
     register(_cls)
 
 

@@ -21,7 +21,8 @@ import numpy as np
 
 __all__ = ["EULER", "MIDPOINT", "RK4", "SYMPLECTIC_EULER", "VELOCITY_VERLET",
            "LEAPFROG_DKD", "compose_leapfrog", "YOSHIDA4", "YOSHIDA6", "YOSHIDA8",
-           "YOSHIDA4_WEIGHTS", "YOSHIDA6_WEIGHTS", "YOSHIDA8_WEIGHTS"]
+           "YOSHIDA4_WEIGHTS", "YOSHIDA6_WEIGHTS", "YOSHIDA8_WEIGHTS", "WH_DKD", "SABA2",
+           "SABA3", "SABA4"]
 
 
 def _butcher(A, B, C):
@@ -125,3 +126,34 @@ YOSHIDA6 = compose_leapfrog(YOSHIDA6_WEIGHTS)
 
 #: eighth order, fifteen leapfrogs (Yoshida 1990, solution D)
 YOSHIDA8 = compose_leapfrog(YOSHIDA8_WEIGHTS)
+
+
+# -- Kepler + perturbation splittings (Wisdom & Holman 1991; Laskar & Robutel 2001) --------
+#
+# Here "drift" is an exact Kepler drift and "kick" the interaction kick of
+# orbits._kernels.wisdom_holman.
+
+#: the Wisdom-Holman map, drift-kick-drift (SABA_1 of Laskar & Robutel)
+WH_DKD = (("drift", 0.5), ("kick", 1.0), ("drift", 0.5))
+
+_S3 = math.sqrt(3.0)
+_S15 = math.sqrt(15.0)
+_S30 = math.sqrt(30.0)
+_A = math.sqrt(525.0 + 70.0 * _S30)
+_B = math.sqrt(525.0 - 70.0 * _S30)
+
+#: Laskar & Robutel (2001), table 1: SABA_2 (drift nodes from Gauss-Legendre quadrature)
+SABA2 = (("drift", 0.5 - _S3 / 6.0), ("kick", 0.5), ("drift", _S3 / 3.0), ("kick", 0.5),
+         ("drift", 0.5 - _S3 / 6.0))
+
+#: Laskar & Robutel (2001), table 1: SABA_3
+SABA3 = (("drift", 0.5 - _S15 / 10.0), ("kick", 5.0 / 18.0), ("drift", _S15 / 10.0),
+         ("kick", 4.0 / 9.0), ("drift", _S15 / 10.0), ("kick", 5.0 / 18.0),
+         ("drift", 0.5 - _S15 / 10.0))
+
+#: Laskar & Robutel (2001), table 1: SABA_4
+SABA4 = (("drift", 0.5 - _A / 70.0), ("kick", 0.25 - _S30 / 72.0),
+         ("drift", (_A - _B) / 70.0), ("kick", 0.25 + _S30 / 72.0),
+         ("drift", _B / 35.0), ("kick", 0.25 + _S30 / 72.0),
+         ("drift", (_A - _B) / 70.0), ("kick", 0.25 - _S30 / 72.0),
+         ("drift", 0.5 - _A / 70.0))

@@ -1,0 +1,189 @@
+"""The compiled loop of the Wisdom-Holman map and its relatives (SABA).
+
+The Hamiltonian of N bodies in Jacobi coordinates is split as
+``H = H_Kepler + H_interaction`` (Wisdom & Holman 1991)::
+
+    H_Kepler      = sum_{i>=1} [ m'_i |v'_i|^2 / 2 - G m'_i eta_i / r'_i ]
+    H_interaction = sum_{i>=2} G m'_i eta_i / r'_i - sum_{j<i} G m_i m_j / r_ij
+
+with reduced masses ``m'_i = m_i eta_{i-1} / eta_i`` and interior masses
+``eta_i = m_0 + ... + m_i``.  ``H_Kepler`` moves every Jacobi coordinate on
+its own two-body orbit about ``G eta_i`` (:func:`kepler_drift`); the centre of
+mass drifts in a straight line.  ``H_interaction`` depends on positions only
+and changes the Jacobi velocities by (:func:`interaction_kick`)::
+
+    dv'_i/dt = (J a)_i + G eta_i x'_i / r'_i^3     (i >= 2)
+    dv'_1/dt = (J a)_1
+
+where ``a`` are the inertial accelerations of all pairs except (0, 1) and
+``J`` the Jacobi transformation (:mod:`orbits._kernels.coordinates`).  The pair
+(0, 1) and the Kepler term of body 1 cancel exactly and are left out, so a
+two-body problem is integrated exactly up to the Kepler solver.
+
+A step is a table of Kepler drifts and interaction kicks, bound as constant
+tuples (``KINDS``, ``COEFS``) by :func:`orbits._kernels._jit.specialize`.  A
+table that ends with a drift defers it: the next step's first drift absorbs
+it (the leapfrog's two half drifts become one), and :func:`synchronize` applies
+it to a copy when the inertial state is wanted.  The Jacobi state and the
+deferred drift live in the workspace between calls.
+
+References
+----------
+.. [1] Wisdom, J. & Holman, M. 1991, "Symplectic maps for the N-body
+   problem", AJ 102, 1528.
+.. [2] Rein, H. & Tamayo, D. 2015, "WHFAST: a fast and unbiased implementation
+   of a symplectic Wisdom-Holman integrator for long-term gravitational
+   simulations", MNRAS 452, 376 (lazy synchronisation).
+.. [3] Laskar, J. & Robutel, P. 2001, Celest. Mech. Dyn. Astron. 80, 39.
+"""
+
+import math
+
+from ._jit import njit, specialize
+from .coordinates import from_jacobi, from_jacobi_one, to_jacobi
+from .kepler import kepler_drift
+from .status import Status
+from .stepping import DRIFT, _record, state_is_finite
+
+__all__ = ["wh_loop", "interaction_kick", "kepler_drift_all", "synchronize"]
+
+
+@njit(inline="always")
+def kepler_drift_all(xj, vj, mu, h):
+    """Drift every Jacobi coordinate by ``h``: body i on its orbit about ``mu[i]``,
+    the centre of mass (row 0) in a straight line."""
+    xj[0, 0] += h * vj[0, 0]
+    xj[0, 1] += h * vj[0, 1]
+    xj[0, 2] += h * vj[0, 2]
+    for i in range(1, xj.shape[0]):
+        kepler_drift(mu[i], xj, vj, i, h)
+
+
+@njit(inline="always")
+def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
+    """Kick the Jacobi velocities by ``h`` times the interaction accelerations.
+
+    ``x`` and ``acc`` (shape (N, 3)) are scratch: the inertial positions and
+    accelerations.  See the module notes for the formula.
+    """
+    n = xj.shape[0]
+    from_jacobi_one(xj, gm, eta, x)
+    for i in range(n):
+        acc[i, 0] = 0.0
+        acc[i, 1] = 0.0
+        acc[i, 2] = 0.0
+    for i in range(1, n):
+        xi = x[i, 0]
+        yi = x[i, 1]
+        zi = x[i, 2]
+        gmi = gm[i]
+        axi = 0.0
+        ayi = 0.0
+        azi = 0.0
+        for j in range(1 if i == 1 else 0, min(i, n_active)):
+            dx = xi - x[j, 0]
+            dy = yi - x[j, 1]
+            dz = zi - x[j, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+            sj = gm[j] * inv_r3
+            axi -= sj * dx
+            ayi -= sj * dy
+            azi -= sj * dz
+            if i < n_active:
+                si = gmi * inv_r3
+                acc[j, 0] += si * dx
+                acc[j, 1] += si * dy
+                acc[j, 2] += si * dz
+        acc[i, 0] += axi
+        acc[i, 1] += ayi
+        acc[i, 2] += azi
+    # to Jacobi components, with the Kepler terms i >= 2; row 0 (the centre
+    # of mass) feels no internal force
+    sx = acc[0, 0]
+    sy = acc[0, 1]
+    sz = acc[0, 2]
+    for i in range(1, n):
+        ax = acc[i, 0] - sx
+        ay = acc[i, 1] - sy
+        az = acc[i, 2] - sz
+        w = gm[i] / eta[i]
+        sx += w * ax
+        sy += w * ay
+        sz += w * az
+        if i >= 2:
+            rx = xj[i, 0]
+            ry = xj[i, 1]
+            rz = xj[i, 2]
+            r2 = rx * rx + ry * ry + rz * rz
+            s = eta[i] / (r2 * math.sqrt(r2))
+            ax += s * rx
+            ay += s * ry
+            az += s * rz
+        vj[i, 0] += h * ax
+        vj[i, 1] += h * ay
+        vj[i, 2] += h * az
+
+
+@njit
+def synchronize(xj, vj, gm, eta, owed, xs, vs, x, v):
+    """Inertial ``x``, ``v`` at the current time: the Jacobi state with the
+    deferred drift ``owed`` applied to a copy (``xs``, ``vs``)."""
+    xs[...] = xj
+    vs[...] = vj
+    if owed != 0.0:
+        kepler_drift_all(xs, vs, eta, owed)
+    from_jacobi(xs, vs, gm, eta, x, v)
+
+
+def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
+             mon, step0, mon_t, mon_out, check_every):
+    # state[0]: xj, vj hold the current state (else start from x, v);
+    # owed_box[0]: the drift the Jacobi state still owes, deferred from the
+    # last step's closing drift.
+    n = x.shape[0]
+    every = mon[0]
+    n_mon = 0
+    if state[0] == 0:
+        to_jacobi(x, v, gm, eta, xj, vj)
+        state[0] = 1
+        owed_box[0] = 0.0
+    owed = owed_box[0]
+    n_ops = len(KINDS)  # noqa: F821 - bound by specialize
+    defer = KINDS[n_ops - 1] == DRIFT  # noqa: F821
+    until_check = check_every
+    until_record = every - step0 % every if every > 0 else -1
+    for k in range(nsteps):
+        for op in range(n_ops):
+            h = COEFS[op] * dt  # noqa: F821
+            if KINDS[op] == DRIFT:  # noqa: F821
+                if op == 0:
+                    h += owed
+                    owed = 0.0
+                if op == n_ops - 1 and defer:
+                    owed = h
+                else:
+                    kepler_drift_all(xj, vj, eta, h)
+            else:
+                interaction_kick(xj, vj, xs, acc, gm, eta, n_active, h)
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
+            if not state_is_finite(xj, vj):
+                owed_box[0] = owed
+                return Status.NON_FINITE, k, n_mon
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
+            synchronize(xj, vj, gm, eta, owed, xs, vs, x, v)
+            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
+            n_mon += 1
+    owed_box[0] = owed
+    return Status.OK, nsteps, n_mon
+
+
+def wh_loop(name, kinds, coefs):
+    """The Wisdom-Holman loop compiled for one table of Kepler drifts (DRIFT) and
+    interaction kicks (KICK); ``name`` names the table."""
+    return specialize(_wh_loop, f"wh_{name}", KINDS=tuple(int(k) for k in kinds),
+                      COEFS=tuple(float(c) for c in coefs))

@@ -1,0 +1,281 @@
+"""The Wisdom-Holman map in Jacobi coordinates, and the SABA methods.
+
+Planetary systems are nearly Keplerian: each planet moves on an ellipse about
+the star, perturbed by the others.  The Wisdom-Holman map splits the motion
+into exact Kepler drifts and kicks from the planets' mutual pull (see
+:mod:`orbits._kernels.wisdom_holman` for the split and its formulas), so its
+error is of order ``epsilon h^2`` with ``epsilon`` the planet-to-star mass
+ratio instead of ``h^2``.  The SABA methods of Laskar & Robutel use the same
+two operators with more stages, bringing the error to
+``O(epsilon h^(2n) + epsilon^2 h^2)``.
+"""
+
+import warnings
+
+import numpy as np
+
+from .._kernels import coordinates as _coordinates
+from .._kernels import wisdom_holman as _wh
+from .._kernels.stepping import DRIFT, KICK
+from ..errors import IntegratorOptionError
+from . import tableaux
+from .base import Integrator
+
+__all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
+           "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS"]
+
+#: Above this ratio of the largest other mass to the central one the split's
+#: premise fails: the kicks are no longer small against the Kepler drifts and
+#: the error, ``O(epsilon h^2)``, is no better than a leapfrog's.  (The giant
+#: planets have 1e-3; a binary companion or a cluster member has ~1.)
+MASS_RATIO_LIMIT = 0.01
+
+#: coordinate systems: name -> implemented
+COORDINATES = {"jacobi": True, "democratic-heliocentric": False}
+
+#: symplectic corrector orders (Wisdom, Holman & Touma 1996; Wisdom 2006):
+#: order -> implemented
+CORRECTORS = {0: True, 3: False, 5: False, 7: False, 11: False, 17: False}
+
+
+class NoDominantBodyWarning(UserWarning):
+    """The Wisdom-Holman split is used on a system without one dominant mass."""
+
+
+class WisdomHolman(Integrator):
+    """Wisdom-Holman map in Jacobi coordinates, with lazy synchronisation.
+
+    Options
+    -------
+    coordinates : {"jacobi", "democratic-heliocentric"}
+        The split.  Only ``"jacobi"`` is implemented so far; the other is
+        refused with an error that says so.
+    corrector : {0, 3, 5, 7, 11, 17}
+        Order of the symplectic corrector.  Only 0 (none) is implemented so
+        far; the others are refused with an error that says so.
+
+    Notes
+    -----
+    With the Kepler drift ``K(h)`` (every Jacobi coordinate on its two-body
+    orbit about ``G eta_i``, the centre of mass in a straight line) and the
+    interaction kick ``I(h)``, one step is::
+
+        Phi(h) = K(h/2) I(h) K(h/2)
+
+    Symplectic, time-symmetric, second order in ``h`` with an error
+    proportional to the mass ratio ``epsilon`` of the perturbers to the
+    central body.  One force evaluation and N - 1 Kepler drifts a step.
+
+    The bodies are taken in the simulation's order (massive first) and the
+    first one is the central body; ``needs_central_body`` is True, and a
+    system whose largest other mass exceeds :data:`MASS_RATIO_LIMIT` times the
+    first runs with a :class:`NoDominantBodyWarning`.  Only Newtonian gravity
+    without softening can be split this way.
+
+    State kept between calls (lazy synchronisation, Rein & Tamayo 2015): the
+    Jacobi positions and velocities and the closing half drift still owed.
+    Consecutive steps merge their half drifts into one, and the inertial
+    state in ``x``, ``v`` is brought up to date only by :meth:`synchronize`
+    (which outputs and monitors call), on a copy, so that the merged drifts
+    go on.  :meth:`invalidate` makes the next step start again from ``x``, ``v``.
+
+    References
+    ----------
+    Wisdom, J. & Holman, M. 1991, "Symplectic maps for the N-body problem",
+    AJ 102, 1528.  Rein, H. & Tamayo, D. 2015, "WHFAST: a fast and unbiased
+    implementation of a symplectic Wisdom-Holman integrator", MNRAS 452, 376.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator="wh",
+    ...                         dt=200 * u.day)
+    >>> result = sim.run(until=10_000 * u.yr, outputs=11, progress=False)
+    >>> bool(result.energy_error.max() < 1e-5)
+    True
+    """
+
+    name = "wh"
+    order = 2
+    symplectic = True
+    time_symmetric = True
+    needs_central_body = True
+    options = {"coordinates": "jacobi", "corrector": 0}
+    summary = "Wisdom-Holman map, Kepler drifts and interaction kicks in Jacobi coordinates"
+    #: the step as a table of Kepler drifts ("drift") and interaction kicks ("kick")
+    operators = tableaux.WH_DKD
+    forces_per_step = 1
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        cls._prepare_table()
+
+    @classmethod
+    def _prepare_table(cls):
+        ops = tuple(cls.operators)
+        if ops != ops[::-1] or ops[0][0] != "drift":
+            raise TypeError(f"{cls.__name__}: a Kepler-split table must be a palindrome "
+                            "that starts and ends with a drift")
+        codes = {"drift": DRIFT, "kick": KICK}
+        cls._kinds = tuple(codes[k] for k, _ in ops)
+        cls._coefs = tuple(float(c) for _, c in ops)
+        cls.forces_per_step = sum(1 for k, _ in ops if k == "kick")
+
+    def _check_options(self):
+        coords = self.config["coordinates"]
+        if coords not in COORDINATES:
+            raise IntegratorOptionError(
+                f"{self.name}: unknown coordinates {coords!r}; valid: "
+                f"{', '.join(map(repr, COORDINATES))}")
+        if not COORDINATES[coords]:
+            raise IntegratorOptionError(
+                f"{self.name}: coordinates={coords!r} is not implemented yet; "
+                f"implemented: {', '.join(repr(c) for c, ok in COORDINATES.items() if ok)}")
+        corr = self.config["corrector"]
+        if isinstance(corr, bool) or corr not in CORRECTORS:
+            raise IntegratorOptionError(
+                f"{self.name}: unknown corrector order {corr!r}; valid: "
+                f"{', '.join(map(str, CORRECTORS))}")
+        if not CORRECTORS[corr]:
+            raise IntegratorOptionError(
+                f"{self.name}: the symplectic corrector of order {corr} is not implemented "
+                f"yet; implemented: "
+                f"{', '.join(str(c) for c, ok in CORRECTORS.items() if ok)}")
+
+    def workspace(self, n):
+        return {"xj": np.zeros((n, 3)), "vj": np.zeros((n, 3)),
+                "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3)), "acc": np.zeros((n, 3)),
+                "gm": np.zeros(n), "eta": np.zeros(n),
+                # [Jacobi state current, system checked]
+                "state": np.zeros(2, dtype=np.int64),
+                "owed": np.zeros(1)}
+
+    def _check_system(self, ws, force, fargs):
+        if not force.key.startswith("gravity"):
+            raise IntegratorOptionError(
+                f"{self.name} splits Newtonian gravity into Kepler drifts and kicks and "
+                "cannot integrate another force; use a general method such as 'leapfrog' "
+                "or 'yoshida4'")
+        gm, n_active, eps2, _ = fargs
+        if eps2 != 0.0:
+            raise IntegratorOptionError(
+                f"{self.name} needs unsoftened gravity (its Kepler drifts are exact "
+                "two-body orbits); use 'leapfrog' or 'verlet' with softening")
+        if n_active < 1 or not gm[0] > 0.0:
+            raise IntegratorOptionError(
+                f"{self.name} needs a massive central body first; the first body has no mass")
+        if n_active > 2:
+            ratio = float(np.max(gm[1:n_active]) / gm[0])
+            if ratio > MASS_RATIO_LIMIT:
+                warnings.warn(
+                    f"{self.name}: no dominant central body (the largest other mass is "
+                    f"{ratio:.3g} times the first body's, above {MASS_RATIO_LIMIT}): the "
+                    "Wisdom-Holman split treats the pull between the other bodies as a "
+                    "small perturbation of Kepler orbits about the first, which it is "
+                    "not here, so the error will be large. Use an integrator that "
+                    "does not split the motion, such as 'ias15' (adaptive, for close "
+                    "encounters) or 'verlet'/'leapfrog' with a small step.",
+                    NoDominantBodyWarning, stacklevel=4)
+        ws["gm"][:] = gm
+        _coordinates.interior_gm(gm, ws["eta"])
+        ws["state"][1] = 1
+
+    def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
+                velocity_dependent=False, check_every=1):
+        if ws["state"][1] == 0:
+            self._check_system(ws, force, fargs)
+        gm, n_active = fargs[0], fargs[1]
+        loop = _wh.wh_loop(self.name, self._kinds, self._coefs)
+        return loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
+                    ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], mon, step0,
+                    mon_t, mon_out, check_every)
+
+    def synchronize(self, ws, x, v):
+        """Write the current inertial state into ``x``, ``v``; the Jacobi state and
+        its owed drift are kept, so that the following steps go on unchanged."""
+        if ws["state"][0]:
+            _wh.synchronize(ws["xj"], ws["vj"], ws["gm"], ws["eta"],
+                            ws["owed"][0], ws["xs"], ws["vs"], x, v)
+
+    def invalidate(self, ws):
+        """The state was changed from outside: start again from ``x``, ``v``."""
+        ws["state"][0] = 0
+        ws["owed"][0] = 0.0
+
+
+WisdomHolman._prepare_table()
+
+
+class SABA2(WisdomHolman):
+    """SABA_2 of Laskar & Robutel (2001): two interaction kicks a step.
+
+    Notes
+    -----
+    ``K(c_1 h) I(h/2) K(c_2 h) I(h/2) K(c_1 h)`` with
+    ``c_1 = 1/2 - sqrt(3)/6``, ``c_2 = sqrt(3)/3`` (the drifts end at the
+    Gauss-Legendre nodes).  Error ``O(epsilon h^4 + epsilon^2 h^2)``: fourth
+    order while ``epsilon h^2`` dominates, second order in general.  Options,
+    state and requirements as :class:`WisdomHolman` (correctors: only 0).
+
+    References
+    ----------
+    Laskar, J. & Robutel, P. 2001, "High order symplectic integrators for
+    perturbed Hamiltonian systems", Celest. Mech. Dyn. Astron. 80, 39, table 1.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("saba2").forces_per_step
+    2
+    """
+
+    name = "saba2"
+    summary = "SABA_2 (Laskar & Robutel 2001): Kepler drifts, two kicks a step"
+    operators = tableaux.SABA2
+
+
+class SABA3(WisdomHolman):
+    """SABA_3 of Laskar & Robutel (2001): three interaction kicks a step.
+
+    Notes
+    -----
+    Error ``O(epsilon h^6 + epsilon^2 h^2)``; see :class:`SABA2`.
+
+    References
+    ----------
+    Laskar & Robutel (2001), table 1.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("saba3").forces_per_step
+    3
+    """
+
+    name = "saba3"
+    summary = "SABA_3 (Laskar & Robutel 2001): Kepler drifts, three kicks a step"
+    operators = tableaux.SABA3
+
+
+class SABA4(WisdomHolman):
+    """SABA_4 of Laskar & Robutel (2001): four interaction kicks a step.
+
+    Notes
+    -----
+    Error ``O(epsilon h^8 + epsilon^2 h^2)``; see :class:`SABA2`.
+
+    References
+    ----------
+    Laskar & Robutel (2001), table 1.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("saba4").forces_per_step
+    4
+    """
+
+    name = "saba4"
+    summary = "SABA_4 (Laskar & Robutel 2001): Kepler drifts, four kicks a step"
+    operators = tableaux.SABA4

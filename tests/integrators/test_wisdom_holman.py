@@ -1,0 +1,216 @@
+"""The Wisdom-Holman map and SABA: against REBOUND's WHFast, exactness on two
+bodies, reversibility, lazy synchronisation, orders, and what it refuses."""
+
+import math
+import warnings
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+import orbits
+from orbits.errors import IntegratorOptionError
+from orbits.integrators.wisdom_holman import NoDominantBodyWarning
+from orbits._kernels import stepping
+
+from helpers import kepler_bodies
+
+KEPLER_SPLIT = ["wh", "saba2", "saba3", "saba4"]
+
+
+def run(bodies, name, dt, until, outputs=2, **kw):
+    sim = orbits.Simulation(bodies, integrator=name, dt=dt, **kw)
+    return sim.run(until=until, outputs=outputs, progress=False)
+
+
+def test_matches_rebound_whfast_on_the_outer_solar_system():
+    rebound = pytest.importorskip("rebound")
+    bodies = orbits.scenes.outer_solar_system()
+    n, dt = 10_000, 10.0
+    r = run(bodies, "wh", dt * u.day, n * dt * u.day, monitors=())
+    reb = bodies.to_rebound()
+    reb.integrator = "whfast"
+    reb.integrator.safe_mode = 0
+    reb.integrator.corrector = 0
+    reb.dt = dt
+    reb.steps(n)
+    reb.synchronize()
+    xr = np.array([p.xyz for p in reb.particles])
+    x = r.positions.to_value(u.au)[-1]
+    # the same map in the same floating point up to the order of operations:
+    # measured 3e-12 for the Sun (whose position is small) and 6e-13 for the
+    # planets; the issue's bound is 1e-10
+    rel = np.linalg.norm(x - xr, axis=1) / np.linalg.norm(xr, axis=1)
+    assert rel.max() < 1e-10, rel
+
+
+def test_two_body_orbit_is_exact_up_to_the_kepler_solver():
+    # e = 0.999, 100 steps an orbit, 10 orbits: the interaction of the pair
+    # is the Kepler drift's, so only the solver's rounding is left: measured
+    # 5e-14 at apocentre, once an orbit.  (Near pericentre, r = 1e-3 a, the
+    # f and g functions cancel to 1 part in ~600 and the energy of the
+    # rounded state is off by ~2e-10 there, without accumulating; REBOUND's
+    # WHFast shows 4e-10 on the same problem.)
+    b = kepler_bodies(e=0.999, m_orbiter=1e-3, f=math.pi)
+    period = 2 * math.pi / math.sqrt(1.001)
+    r = run(b, "wh", period / 100, 10 * period, outputs=11, monitors=("energy",))
+    assert r.energy_error.max() < 1e-12
+
+
+@pytest.mark.parametrize("name", KEPLER_SPLIT)
+def test_time_reversible(name):
+    # n steps with h, n with -h, return to the start up to rounding: 1e-13
+    # relative (the issue's bound).  Rounding errors in the semi-major axes
+    # shift the phases, so the return error grows like n^1.5: measured 4e-15
+    # (x) and 1.5e-14 (v) at n = 300, as the leapfrog's, but 2e-12 at n = 2000.
+    b = orbits.scenes.outer_solar_system()
+    sim = orbits.Simulation(b, integrator=name, dt=50 * u.day, monitors=())
+    integ, ws = sim.integrator, sim._ws
+    x, v = sim._x, sim._v
+    x0, v0 = x.copy(), v.copy()
+    mon = (0, 0, sim._m, 1.0, sim._n_active, 0.0)
+    args = (sim._force, sim._fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+    for h in (50.0, -50.0):
+        status, _, _ = integ.advance(ws, x, v, 0.0, h, 300, *args)
+        assert status == 0
+    integ.synchronize(ws, x, v)
+    assert np.abs(x - x0).max() < 1e-13 * np.abs(x0).max()
+    assert np.abs(v - v0).max() < 1e-13 * np.abs(v0).max()
+
+
+@pytest.mark.parametrize("name", KEPLER_SPLIT)
+def test_outputs_do_not_disturb_the_run(name):
+    # lazy synchronisation: outputs (and in-loop monitors) work on a copy, so
+    # the trajectory is the same bit for bit however often it is looked at
+    b = orbits.scenes.outer_solar_system()
+    few = run(b, name, 20 * u.day, 20_000 * u.day, outputs=2, monitors=())
+    many = run(b, name, 20 * u.day, 20_000 * u.day, outputs=101, monitor_every=7)
+    assert np.array_equal(few.positions[-1], many.positions[-1])
+    assert np.array_equal(few.velocities[-1], many.velocities[-1])
+
+
+def test_invalidate_restarts_from_the_inertial_state():
+    b = orbits.scenes.outer_solar_system()
+    sim = orbits.Simulation(b, integrator="wh", dt=30 * u.day, monitors=())
+    integ = sim.integrator
+    mon = (0, 0, sim._m, 1.0, sim._n_active, 0.0)
+    args = (sim._force, sim._fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+    x, v = sim._x.copy(), sim._v.copy()
+    ws = integ.workspace(len(x))
+    integ.advance(ws, x, v, 0.0, 30.0, 100, *args)
+    # change the state from outside: back to the start
+    x[...] = sim._x
+    v[...] = sim._v
+    integ.invalidate(ws)
+    integ.advance(ws, x, v, 0.0, 30.0, 50, *args)
+    integ.synchronize(ws, x, v)
+    x2, v2 = sim._x.copy(), sim._v.copy()
+    ws2 = integ.workspace(len(x2))
+    integ.advance(ws2, x2, v2, 0.0, 30.0, 50, *args)
+    integ.synchronize(ws2, x2, v2)
+    assert np.array_equal(x, x2) and np.array_equal(v, v2)
+
+
+# dt = 1/20 of Jupiter's period (216.6 days).  The map's energy error is
+# epsilon h^2 in size: measured 2.4e-6 over 1e4 years, and REBOUND's WHFast
+# without corrector gives 1.9e-6 at this step (4e-9 with its order-17
+# corrector).  The issue's 1e-7 needs the corrector; without it the bound
+# here is the method's own, and the test is that it does not grow.
+ENERGY_BOUND_NO_CORRECTOR = 5e-6
+
+
+def test_energy_bounded_on_the_outer_solar_system():
+    b = orbits.scenes.outer_solar_system()
+    r = run(b, "wh", 4332.59 / 20 * u.day, 1e5 * u.yr, outputs=1001, monitors=("energy",))
+    err = r.energy_error
+    assert err.max() < ENERGY_BOUND_NO_CORRECTOR
+    tenth = len(err) // 10
+    assert err[-tenth:].max() < 1.5 * err[1:tenth].max()
+
+
+@pytest.mark.slow
+def test_energy_bounded_for_a_million_years():
+    b = orbits.scenes.outer_solar_system()
+    r = run(b, "wh", 4332.59 / 20 * u.day, 1e6 * u.yr, outputs=2001, monitors=("energy",))
+    err = r.energy_error
+    assert err.max() < ENERGY_BOUND_NO_CORRECTOR
+    tenth = len(err) // 10
+    assert err[-tenth:].max() < 1.5 * err[1:tenth].max()
+
+
+def final_positions(name, dt, until=20_000.0):
+    b = orbits.scenes.outer_solar_system()
+    return run(b, name, dt * u.day, until * u.day, monitors=()).positions.to_value(u.au)[-1]
+
+
+def test_measured_orders_on_the_outer_solar_system():
+    # the Kepler problem is exact for these methods (test_convergence skips
+    # them), so orders are measured on the planets: WH is second order; SABA_n
+    # are too in general (error epsilon h^2n + epsilon^2 h^2), with the
+    # epsilon^2 term dominating here: measured 2.00, 1.97, 2.00, 2.00 for
+    # steps 100 -> 50 days, and SABA's errors 150-500 times below WH's.
+    ref = final_positions("yoshida8", 5.0)
+    errs = {}
+    for name in KEPLER_SPLIT:
+        e1, e2 = (np.abs(final_positions(name, dt) - ref).max() for dt in (100.0, 50.0))
+        errs[name] = e2
+        assert abs(math.log2(e1 / e2) - 2) < 0.2, (name, e1, e2)
+    for name in KEPLER_SPLIT[1:]:
+        assert errs[name] < errs["wh"] / 100
+
+
+@pytest.mark.parametrize("scene", ["pythagorean", "plummer"])
+def test_warns_without_a_dominant_body(scene):
+    bodies = orbits.scenes.pythagorean() if scene == "pythagorean" else \
+        orbits.scenes.plummer(16, seed=3)
+    dt = 1e-3 * bodies.units.unit("time")
+    with pytest.warns(NoDominantBodyWarning, match="ias15.*verlet"):
+        run(bodies, "wh", dt, 10 * dt)
+
+
+def test_no_warning_with_a_dominant_body():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run(orbits.scenes.outer_solar_system(), "wh", 10 * u.day, 100 * u.day)
+        run(orbits.scenes.earth_moon(), "wh", 1 * u.hour, 10 * u.hour)
+
+
+def test_unknown_and_unimplemented_options_are_errors():
+    with pytest.raises(IntegratorOptionError, match="'jacobi', 'democratic-heliocentric'"):
+        orbits.integrators.get("wh", coordinates="heliocentric")
+    with pytest.raises(IntegratorOptionError, match="0, 3, 5, 7, 11, 17"):
+        orbits.integrators.get("wh", corrector=4)
+    # valid but not implemented: said so, never silently ignored
+    for corr in (3, 5, 7, 11, 17):
+        with pytest.raises(IntegratorOptionError, match="not implemented"):
+            orbits.integrators.get("wh", corrector=corr)
+    with pytest.raises(IntegratorOptionError, match="not implemented"):
+        orbits.integrators.get("wh", coordinates="democratic-heliocentric")
+
+
+def test_refuses_softening_and_other_forces():
+    b = orbits.scenes.outer_solar_system()
+    with pytest.raises(IntegratorOptionError, match="softening"):
+        run(b, "wh", 10 * u.day, 100 * u.day, softening=1e-3 * u.au)
+    with pytest.raises(IntegratorOptionError, match="gravity"):
+        orbits.integrate(lambda x, v, t: -x, np.ones(3), np.zeros(3), dt=0.1, steps=3,
+                         method="wh")
+
+
+def test_massless_bodies():
+    # a massless body (after the massive ones, as Simulation orders them)
+    # moves as a body of negligible mass would: Pluto's orbit turned by 180
+    # degrees about z, massless and with 1e-25 solar masses, agree to
+    # rounding (the 1e-25 mass changes the interior masses by 1e-25 relative)
+    b = orbits.scenes.outer_solar_system()
+    x = b.positions.to_value(u.au)
+    v = b.velocities.to_value(u.au / u.day)
+    m = b.masses.to_value(u.Msun)
+    turn = np.array([-1.0, -1.0, 1.0])
+    final = []
+    for mass in (0.0, 1e-25):
+        tp = orbits.BodySet.from_arrays(np.r_[m, mass], np.r_[x, x[5:6] * turn],
+                                        np.r_[v, v[5:6] * turn], units=b.units)
+        r = run(tp, "wh", 50 * u.day, 50_000 * u.day, monitors=())
+        final.append(r.positions.to_value(u.au)[-1])
+    assert np.abs(final[0] - final[1]).max() < 1e-12 * np.abs(final[0]).max()
