@@ -1,0 +1,136 @@
+"""Wisdom-Holman speed against REBOUND's WHFast and WHFast512, per step.
+
+For each scene our ``wh`` (Jacobi, no corrector) and REBOUND's ``whfast``
+(``safe_mode = 0``, corrector 0, Jacobi) and, where this REBOUND has it,
+``whfast512`` take the same bodies, G and step; they are timed in turn in one
+process, ``--repeats`` times, ``n`` steps each (``n`` chosen so that one
+REBOUND run lasts about ``--target`` seconds).  Ours is timed around the
+public ``Simulation.run`` with ``monitors=()`` and two outputs.  The table
+gives median microseconds per step and the median of the paired ratios.
+
+After ``whfast512`` has run, REBOUND's other integrators run about twice as
+slow until an AVX ``vzeroupper`` executes (the 512-bit registers are left
+dirty); any numba call executes one, so a one-step run of ours is made before
+each timed REBOUND run to put every measurement on the same footing.
+
+Goals (issue 4), printed with PASS/MISS: at most 0.6 of ``whfast``'s time per
+step; within 1.5 times ``whfast512``'s.
+
+Run ``python benchmarks/bench_wh.py`` (about a minute) or ``--quick``.
+"""
+
+import argparse
+import statistics
+import time
+
+import astropy.units as u
+
+import orbits
+
+WHFAST_RATIO_GOAL = 0.6
+WHFAST512_RATIO_GOAL = 1.5
+
+
+def scenes():
+    s = orbits.scenes
+    return [("Kepler e=0.1", s.kepler(e=0.1), 1 * u.day),
+            ("Earth-Moon", s.earth_moon(), 1 * u.hour),
+            ("outer solar system", s.outer_solar_system(), 10 * u.day),
+            ("Sun + 8 planets", s.solar_system(moon=False), 0.5 * u.day)]
+
+
+def rebound_sim(bodies, dt, name):
+    sim = bodies.to_rebound()
+    sim.integrator = name
+    if name == "whfast":
+        sim.integrator.safe_mode = 0
+        sim.integrator.corrector = 0
+    sim.dt = dt
+    return sim
+
+
+def has_whfast512():
+    import rebound
+    try:
+        sim = rebound.Simulation()
+        sim.add(m=1.0)
+        sim.add(m=1e-3, a=1.0)
+        sim.integrator = "whfast512"
+        sim.dt = 0.01
+        sim.steps(2)
+        return True
+    except Exception:
+        return False
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--target", type=float, default=0.2)
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.repeats, args.target = 2, 0.02
+    rebound_names = ["whfast"] + (["whfast512"] if has_whfast512() else [])
+    rows = []
+    for label, bodies, dt in scenes():
+        ours = orbits.Simulation(bodies, integrator="wh", dt=dt, monitors=())
+        clear = orbits.Simulation(bodies, integrator="wh", dt=dt, monitors=())
+        dt_v = ours.dt.to_value(bodies.units.unit("time"))
+        rebs = {}
+        for name in rebound_names:
+            try:
+                rebs[name] = rebound_sim(bodies, dt_v, name)
+            except Exception:
+                pass
+
+        def vzeroupper():
+            clear.run(until=clear.time + clear.dt, outputs=1, progress=False)
+
+        def time_ours(n):
+            until = ours.time + n * ours.dt
+            t0 = time.perf_counter()
+            ours.run(until=until, outputs=2, progress=False)
+            return (time.perf_counter() - t0) / n
+
+        def time_reb(sim, n):
+            vzeroupper()
+            t0 = time.perf_counter()
+            sim.steps(n)
+            return (time.perf_counter() - t0) / n
+
+        time_ours(10)
+        vzeroupper()
+        probe = time_reb(rebs["whfast"], 10000)
+        n = max(1000, int(args.target / probe))
+        times = {k: [] for k in ["wh", *rebs]}
+        for _ in range(args.repeats):
+            times["wh"].append(time_ours(n))
+            for name, sim in rebs.items():
+                times[name].append(time_reb(sim, n))
+        row = {"scene": label, "N": len(bodies),
+               **{k: 1e6 * statistics.median(v) for k, v in times.items()}}
+        for name in rebs:
+            row[f"ratio_{name}"] = statistics.median(
+                a / b for a, b in zip(times["wh"], times[name]))
+        rows.append(row)
+    print(f"{'scene':22s} {'N':>3s} {'wh us':>8s} " + " ".join(
+        f"{k + ' us':>13s} {'ratio':>6s}" for k in rebound_names))
+    for r in rows:
+        print(f"{r['scene']:22s} {r['N']:3d} {r['wh']:8.3f} " + " ".join(
+            f"{r.get(k, float('nan')):13.3f} {r.get('ratio_' + k, float('nan')):6.2f}"
+            for k in rebound_names))
+    worst = max(r["ratio_whfast"] for r in rows)
+    print(f"goal wh <= {WHFAST_RATIO_GOAL} x whfast: worst {worst:.2f} "
+          f"{'PASS' if worst <= WHFAST_RATIO_GOAL else 'MISS'}")
+    if "whfast512" in rebound_names:
+        worst = max(r.get("ratio_whfast512", 0.0) for r in rows)
+        print(f"goal wh <= {WHFAST512_RATIO_GOAL} x whfast512: worst {worst:.2f} "
+              f"{'PASS' if worst <= WHFAST512_RATIO_GOAL else 'MISS'}")
+    else:
+        print("whfast512: not available in this REBOUND build")
+    return rows
+
+
+if __name__ == "__main__":
+    main()
