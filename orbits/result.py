@@ -29,7 +29,8 @@ class Result:
         Series recorded inside the compiled loop every ``monitor_every``
         steps: ``times`` and the same error arrays as above.
     steps : int
-        Steps taken in this run.  ``force_evaluations`` likewise.
+        Steps taken (accepted) in this run.  ``force_evaluations`` and
+        ``steps_rejected`` (adaptive integrators) likewise.
     wall_time : float
         Seconds of wall-clock time the run took.
     integrator : dict
@@ -46,6 +47,7 @@ class Result:
         self.angular_momentum = self.angular_momentum_error = None
         self.momentum = self.center_of_mass = None
         self.status = "completed"
+        self.steps_rejected = 0
         for k, v in fields.items():
             setattr(self, k, v)
 
@@ -76,8 +78,11 @@ class Result:
             + (f" [{opts}]" if opts else ""),
             f"bodies          {len(self.names)}: {', '.join(self.names[:6])}"
             + (", ..." if len(self.names) > 6 else ""),
-            f"time            {self.times[0]:.6g} -> {self.times[-1]:.6g}, dt = {self.dt:.6g}",
-            f"steps           {self.steps} ({self.force_evaluations} force evaluations), "
+            f"time            {self.times[0]:.6g} -> {self.times[-1]:.6g}, "
+            + ("adaptive steps" if self.integrator.get("adaptive") else f"dt = {self.dt:.6g}"),
+            f"steps           {self.steps} "
+            + (f"(+{self.steps_rejected} rejected) " if self.integrator.get("adaptive") else "")
+            + f"({self.force_evaluations} force evaluations), "
             f"wall time {self.wall_time:.3g} s ({rate:.3g} steps/s)",
             f"units           {self.units['name']}, G = {self.units['G']!r} "
             f"({self.units['G_source']})",

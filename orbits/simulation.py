@@ -19,7 +19,7 @@ from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import (BodyUnitsError, CloseEncounter, Escape, IntegratorOptionError,
-                     NonFiniteState)
+                     NonFiniteState, StepSizeUnderflow)
 from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
                        vector_relative_error)
 from .result import Result
@@ -50,10 +50,17 @@ class RunPlan(NamedTuple):
     n_full: int             # whole steps of dt
     has_partial: bool       # one shortened last step to land on until
     start_step: int         # Simulation.steps when the run began
+    start_time: float = 0.0  # time when the run began (adaptive runs' output times)
 
     @property
     def total_steps(self):
         return self.n_full + int(self.has_partial)
+
+    def output_time(self, k):
+        """Time of output ``k`` of an adaptive run (exactly ``until`` for the last)."""
+        if k >= self.outputs - 1:
+            return self.until
+        return self.start_time + k * (self.until - self.start_time) / (self.outputs - 1)
 
     def marks(self, first=0):
         """Step counts (from the run's start) of the outputs between the first and
@@ -74,8 +81,10 @@ class Simulation:
         Registry name (see :func:`orbits.integrators.available`) or a configured
         instance from :func:`orbits.integrators.get`.
     dt : Quantity (time) or float
-        Step size.  A plain number is read in the body set's unit of time, and is
-        accepted only when the body set was given its unit system explicitly.
+        Step size; for adaptive integrators the first step to try (optional:
+        by default they choose it).  A plain number is read in the body set's
+        unit of time, and is accepted only when the body set was given its
+        unit system explicitly.
     monitors : sequence of str
         Any of ``"energy"``, ``"angular_momentum"``, ``"momentum"``,
         ``"center_of_mass"``.  Default: energy and angular momentum.  An empty
@@ -127,8 +136,9 @@ class Simulation:
         self._names = bodies.names
         self._history = list(bodies.history)
         self.integrator = _integrators.get(integrator)
-        self._dt = self._time_value(dt, "dt")
-        if not (self._dt > 0 and math.isfinite(self._dt)):
+        adaptive = self.integrator.adaptive
+        self._dt = 0.0 if (adaptive and dt is None) else self._time_value(dt, "dt")
+        if not ((self._dt > 0 or (adaptive and dt is None)) and math.isfinite(self._dt)):
             raise IntegratorOptionError(f"dt must be a positive finite time, got {dt}")
 
         # massive bodies first (stable), as the gravity kernels expect
@@ -161,9 +171,12 @@ class Simulation:
                              f"got {monitor_every}")
         self.monitor_every = None if monitor_every is None else int(monitor_every)
 
+        self._stop_info = np.zeros(2, dtype=np.int64)
         self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
                                      escape_unbound)
-        self._ws = self.integrator.workspace(n)
+        self._ws = (self.integrator.workspace(n, self._dt) if adaptive
+                    else self.integrator.workspace(n))
+        self.steps_rejected = 0
         self._t_base = 0.0          # time = t_base + steps_since_base * dt
         self._steps_since_base = 0
         self.steps = 0              # steps since the simulation was made
@@ -215,7 +228,6 @@ class Simulation:
             raise IntegratorOptionError(f"integrator {self.integrator.name!r} does not check "
                                         f"stopping conditions")
         central = int(np.argmax(self._m))
-        self._stop_info = np.zeros(2, dtype=np.int64)
         return (mask, d2, k, esc2, self._gm, central, self._stop_info)
 
     # -- files ------------------------------------------------------------------------
@@ -360,13 +372,16 @@ class Simulation:
         outputs = int(outputs)
         if outputs < 1:
             raise ValueError(f"outputs must be >= 1, got {outputs}")
+        if self.integrator.adaptive:
+            # outputs at exactly evenly spaced times, hit by shortening a step
+            return RunPlan(until_v, outputs, 0.0, 0, False, self.steps, now)
         ratio = (until_v - now) / self._dt
         n_full = int(round(ratio))
         if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
             n_full = int(math.floor(ratio))
         partial = until_v - self._time_after(n_full)
         has_partial = partial > 1e-12 * max(until_v - now, self._dt)
-        plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps)
+        plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps, now)
         total = plan.total_steps
         if outputs > total + 1 or not _increasing(plan.marks(), total):
             raise ValueError(f"outputs = {outputs} needs more steps than the run has "
@@ -380,6 +395,8 @@ class Simulation:
 
     def _execute(self, plan, rec, progress, first_mark=0):
         """Carry out ``plan`` from its output ``first_mark`` on (resuming)."""
+        if self.integrator.adaptive:
+            return self._execute_adaptive(plan, rec, progress, first_mark)
         done = self.steps - plan.start_step
         bar = _ProgressBar(plan.total_steps, progress)
         bar.update(done)
@@ -397,6 +414,52 @@ class Simulation:
             bar.close()
             rec.close()
         return rec.result(self, _time.perf_counter() - wall0)
+
+    def _execute_adaptive(self, plan, rec, progress, first_mark):
+        bar = _ProgressBar(plan.outputs - 1, progress)
+        bar.update(first_mark)
+        wall0 = _time.perf_counter()
+        try:
+            for k in range(first_mark + 1, plan.outputs):
+                self._advance_adaptive(plan.output_time(k), rec, wall0)
+                bar.update(1)
+                rec.output(self, final=k == plan.outputs - 1)
+            if plan.outputs == 1:
+                self._advance_adaptive(plan.until, rec, wall0)
+                rec.output(self, final=True)
+        finally:
+            bar.close()
+            rec.close()
+        return rec.result(self, _time.perf_counter() - wall0)
+
+    def _advance_adaptive(self, t_end, rec, wall0):
+        integ = self.integrator
+        every = self.monitor_every or 0
+        while self._t_base < t_end:
+            n = self._chunk
+            size = n // every + 1 if every else 0
+            mon_t = np.empty(size)
+            mon_out = np.zeros((size, 10))
+            mon = (every, self._mask, self._m, self.units.G, self._n_active, self._eps2)
+            t0 = _time.perf_counter()
+            status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
+                self._ws, self._x, self._v, self._t_base, t_end, self._force, self._fargs,
+                mon, self.steps, mon_t, mon_out, self._stop, n)
+            elapsed = _time.perf_counter() - t0
+            if n_mon:
+                rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
+            self._t_base = float(t_reached)
+            self.steps += int(acc)
+            self.steps_rejected += int(rej)
+            self.force_evaluations += int(fev)
+            if status != Status.OK:
+                if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
+                    self._stop_info[:] = self._ws["info"]
+                self._fail(status, rec, wall0)
+            if acc == n and elapsed < CHUNK_SECONDS / 4:
+                self._chunk *= 4
+            elif elapsed > CHUNK_SECONDS:
+                self._chunk = max(16, self._chunk // 2)
 
     def _advance_to(self, done, target, rec, bar, wall0):
         # the loop returns to Python about every CHUNK_SECONDS (progress bar);
@@ -449,6 +512,7 @@ class Simulation:
 
     def _fail(self, status, rec, wall0):
         reason = {Status.NON_FINITE: "non-finite state",
+                  Status.STEP_UNDERFLOW: "step-size underflow",
                   Status.CLOSE_ENCOUNTER: "close encounter",
                   Status.ESCAPE: "escape"}.get(status, f"status {status!r}")
         rec.end_status = int(status)
@@ -463,8 +527,16 @@ class Simulation:
                 f"the result up to the last good state, at step {self.steps}, is kept on "
                 f"this exception (.result) and the simulation was left there",
                 time=t, step=self.steps, result=result)
-        i, j = (int(k) for k in self._stop_info)
         name = lambda k: self._names[self._order[k]]  # noqa: E731
+        if status == Status.STEP_UNDERFLOW:
+            who = [name(int(k)) for k in self._ws["info"] if k >= 0]
+            raise StepSizeUnderflow(
+                f"the step size of {self.integrator.name!r} collapsed at t = {t:.10g} "
+                f"(step {self.steps})" + (f", driven by {', '.join(map(repr, who))}"
+                                           if who else "")
+                + "; the result up to the last good state is kept on .result",
+                time=t, step=self.steps, result=result)
+        i, j = (int(k) for k in self._stop_info)
         if status == Status.CLOSE_ENCOUNTER:
             bodies = (name(i), name(j))
             raise CloseEncounter(f"close encounter of {bodies[0]!r} and {bodies[1]!r} at "
@@ -506,6 +578,7 @@ class _Recorder:
         self.mon_rows = []
         self.steps0 = sim.steps
         self.forces0 = sim.force_evaluations
+        self.rejected0 = sim.steps_rejected
         self.n = n
         if initial:
             self.output(sim)
@@ -536,7 +609,7 @@ class _Recorder:
             masses=q(sim._m[self.inv].copy(), "mass"), steps=sim.steps - self.steps0,
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
             integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
-            monitors=sim.monitors)
+            monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0)
         ref = sim._reference
         if self.rows:
             fields.update(_monitor_fields(np.array(self.rows), sim, ref))

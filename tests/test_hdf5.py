@@ -16,11 +16,13 @@ import orbits
 from orbits.io.hdf5 import FileRecorder, OrbitsFileError
 
 FIXED = [i.name for i in orbits.integrators.available() if not i.adaptive]
+ALL = [i.name for i in orbits.integrators.available()]
 
 
 def outer(integrator="leapfrog", **kw):
+    adaptive = orbits.integrators.get(integrator).adaptive
     return orbits.Simulation(orbits.scenes.outer_solar_system(), integrator=integrator,
-                             dt=10 * u.day, **kw)
+                             dt=None if adaptive else 10 * u.day, **kw)
 
 
 def test_layout_units_and_metadata(tmp_path):
@@ -85,8 +87,10 @@ class Crash(Exception):
     pass
 
 
-@pytest.mark.parametrize("name", FIXED)
+@pytest.mark.parametrize("name", ALL)
 def test_interrupted_run_resumes_to_the_same_file(tmp_path, name, monkeypatch):
+    # every integrator in the registry: a run killed after an output and
+    # resumed from the file's checkpoint writes the same file, bit for bit
     whole = tmp_path / "whole.h5"
     cut = tmp_path / "cut.h5"
     outer(name).run(until=50_000 * u.day, outputs=41, output=whole, progress=False,
@@ -119,7 +123,7 @@ CHILD = textwrap.dedent("""
     import sys, astropy.units as u, orbits
     sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator="verlet",
                             dt=1 * u.day)
-    sim.run(until=4e6 * u.day, outputs=4001, output=sys.argv[1], progress=False,
+    sim.run(until=1e7 * u.day, outputs=4001, output=sys.argv[1], progress=False,
             checkpoint_interval=0)
 """)
 
@@ -130,7 +134,7 @@ def test_sigkill_leaves_a_resumable_file(tmp_path):
     try:
         deadline = time.time() + 60
         count = 0
-        while time.time() < deadline and count < 20:
+        while time.time() < deadline and count < 5:
             time.sleep(0.05)
             if path.exists():
                 try:
@@ -138,7 +142,7 @@ def test_sigkill_leaves_a_resumable_file(tmp_path):
                         count = int(f["restart/count"][()])
                 except (OSError, KeyError):
                     pass
-        assert count >= 20, "the child wrote no checkpoints"
+        assert count >= 5, "the child wrote no checkpoints"
         proc.send_signal(signal.SIGKILL)
         proc.wait(10)
     finally:
@@ -153,11 +157,11 @@ def test_sigkill_leaves_a_resumable_file(tmp_path):
     sim.resume(progress=False)
     ref = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator="verlet",
                             dt=1 * u.day)
-    ref.run(until=4e6 * u.day, outputs=2, progress=False)
+    ref.run(until=1e7 * u.day, outputs=2, progress=False)
     assert np.array_equal(sim._x, ref._x) and np.array_equal(sim._v, ref._v)
     done = orbits.load(path)
     assert len(done.times) == 4001 and done.status == "completed"
-    np.testing.assert_array_equal(done.times.value, np.linspace(0, 4e6, 4001))
+    np.testing.assert_array_equal(done.times.value, np.linspace(0, 1e7, 4001))
 
 
 def test_no_overwrite_without_permission(tmp_path):

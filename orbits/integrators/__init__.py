@@ -12,6 +12,7 @@ from typing import NamedTuple
 from ..errors import UnknownIntegratorError
 from .base import ExplicitRungeKutta, Integrator, SplittingMethod
 from .composition import Yoshida4, Yoshida6, Yoshida8
+from .embedded import DOP853, Dopri5
 from .euler import Euler, SymplecticEuler
 from .leapfrog import Leapfrog, Verlet
 from .runge_kutta import RK2, RK4
@@ -42,7 +43,7 @@ def register(cls):
 
 
 for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
-             Yoshida8, WisdomHolman, SABA2, SABA3, SABA4):
+             Yoshida8, WisdomHolman, SABA2, SABA3, SABA4, Dopri5, DOP853):
     register(_cls)
 
 

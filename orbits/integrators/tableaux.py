@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-__all__ = ["EULER", "MIDPOINT", "RK4", "SYMPLECTIC_EULER", "VELOCITY_VERLET",
+__all__ = ["EULER", "MIDPOINT", "RK4", "DOPRI5", "SYMPLECTIC_EULER", "VELOCITY_VERLET",
            "LEAPFROG_DKD", "compose_leapfrog", "YOSHIDA4", "YOSHIDA6", "YOSHIDA8",
            "YOSHIDA4_WEIGHTS", "YOSHIDA6_WEIGHTS", "YOSHIDA8_WEIGHTS", "WH_DKD", "SABA2",
            "SABA3", "SABA4"]
@@ -157,3 +157,17 @@ SABA4 = (("drift", 0.5 - _A / 70.0), ("kick", 0.25 - _S30 / 72.0),
          ("drift", _B / 35.0), ("kick", 0.25 + _S30 / 72.0),
          ("drift", (_A - _B) / 70.0), ("kick", 0.25 - _S30 / 72.0),
          ("drift", 0.5 - _A / 70.0))
+
+
+#: Dormand & Prince (1980) 5(4) pair; E = b - b_hat over the 6 stages and the
+#: first stage of the next step (HNW 1993, Table II.5.2)
+_DP_A = [[0, 0, 0, 0, 0, 0],
+         [1 / 5, 0, 0, 0, 0, 0],
+         [3 / 40, 9 / 40, 0, 0, 0, 0],
+         [44 / 45, -56 / 15, 32 / 9, 0, 0, 0],
+         [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0],
+         [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0]]
+_DP_B = [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84]
+_DP_BHAT = [5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 187 / 2100, 1 / 40]
+DOPRI5 = (*_butcher(_DP_A, _DP_B, [0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1]),
+          np.array(_DP_B + [0.0]) - np.array(_DP_BHAT))

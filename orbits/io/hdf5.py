@@ -34,11 +34,11 @@ adds two groups of its own::
                              is (count - 1) % 2
         x, v                 (2, N, 3) internal order (massive bodies first)
         order                (N,) int64: internal index -> body-set index
-        clock                (2, 4) int64: steps, steps_since_base, force_evaluations,
-                             output rows written
+        clock                (2, 5) int64: steps, steps_since_base, force_evaluations,
+                             output rows written, steps rejected
         t_base               (2,) float
-        plan                 (2, 6) float: the run in progress (until, outputs, ratio,
-                             n_full, has_partial, start_step) and
+        plan                 (2, 7) float: the run in progress (until, outputs, ratio,
+                             n_full, has_partial, start_step, start_time) and
         progress             (2, 3) int64: (outputs of that run written, run finished,
                              status code when it ended early: 1 non-finite state,
                              2 step-size underflow, 3 close encounter, 4 escape)
@@ -258,11 +258,12 @@ class FileRecorder:
         slot = count % _SLOTS
         r["x"][slot] = sim._x
         r["v"][slot] = sim._v
-        r["clock"][slot] = (sim.steps, sim._steps_since_base, sim.force_evaluations, self.rows)
+        r["clock"][slot] = (sim.steps, sim._steps_since_base, sim.force_evaluations, self.rows,
+                            sim.steps_rejected)
         r["t_base"][slot] = sim._t_base
         p = self.plan
         r["plan"][slot] = (p.until, p.outputs, p.ratio, p.n_full, float(p.has_partial),
-                           p.start_step)
+                           p.start_step, p.start_time)
         r["progress"][slot] = (self.outputs_written, int(finished), self.end_status)
         for name, arr in sim._ws.items():
             if isinstance(arr, np.ndarray):
@@ -357,10 +358,10 @@ def _create(path, sim):
     for name in ("x", "v"):
         r.create_dataset(name, shape=(_SLOTS, n, 3), dtype=np.float64).attrs["unit"] = \
             unit("length" if name == "x" else "velocity")
-    r.create_dataset("clock", shape=(_SLOTS, 4), dtype=np.int64)
+    r.create_dataset("clock", shape=(_SLOTS, 5), dtype=np.int64)
     r.create_dataset("t_base", shape=(_SLOTS,), dtype=np.float64).attrs["unit"] = unit("time")
-    r.create_dataset("plan", shape=(_SLOTS, 6), dtype=np.float64).attrs["unit"] = \
-        f"{unit('time')}, 1, 1, 1, 1, 1"
+    r.create_dataset("plan", shape=(_SLOTS, 7), dtype=np.float64).attrs["unit"] = \
+        f"{unit('time')}, 1, 1, 1, 1, 1, {unit('time')}"
     r.create_dataset("progress", shape=(_SLOTS, 3), dtype=np.int64)
     ws = r.create_group("ws")
     for name, arr in sim._ws.items():
@@ -527,7 +528,9 @@ def restore(path):
         soft = float(par.attrs["softening"])
         stop = json.loads(par.attrs["stop_conditions"])
         length = lambda val: None if val is None else val << units.length  # noqa: E731
-        sim = Simulation(bodies, integrator=integ, dt=float(par.attrs["dt"]) << units.time,
+        dt = float(par.attrs["dt"])
+        sim = Simulation(bodies, integrator=integ,
+                         dt=(dt << units.time) if dt > 0 or not integ.adaptive else None,
                          monitors=tuple(json.loads(par.attrs["monitors"])),
                          monitor_every=int(par.attrs["monitor_every"]) or None,
                          softening=(soft << units.length) if soft > 0 else None,
@@ -542,6 +545,7 @@ def restore(path):
         sim.steps = int(clock[0])
         sim._steps_since_base = int(clock[1])
         sim.force_evaluations = int(clock[2])
+        sim.steps_rejected = int(clock[4])
         sim._t_base = float(r["t_base"][slot])
         sim._x[...] = x
         sim._v[...] = v
@@ -551,7 +555,8 @@ def restore(path):
         sim._reference = par["reference"][()].copy()
         sim._E_scale, sim._L_scale = (float(s) for s in par["scales"][()])
         p = r["plan"][slot]
-        plan = RunPlan(float(p[0]), int(p[1]), float(p[2]), int(p[3]), bool(p[4]), int(p[5]))
+        plan = RunPlan(float(p[0]), int(p[1]), float(p[2]), int(p[3]), bool(p[4]), int(p[5]),
+                       float(p[6]))
         written, finished, _ = (int(a) for a in r["progress"][slot])
         rows = int(clock[3])
     sim._output_path = str(path)

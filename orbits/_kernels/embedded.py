@@ -1,0 +1,167 @@
+"""The compiled adaptive loop of the embedded Runge-Kutta pairs (dopri5, dop853).
+
+One loop serves every pair: the method is its Butcher table ``A``, ``b``,
+``c`` and error weights ``e`` (and, for DOP853, ``e3``), all over the last
+stage being the first stage of the next step ("first same as last"), so a step
+costs ``s`` force evaluations.  The state is ``y = (x, v)`` with
+``y' = (v, a(x, v, t))``.
+
+Step control (Hairer, Nørsett & Wanner 1993, section II.4): the error of a
+step is measured against ``atol + rtol * max(|y0|, |y1|)`` component by
+component in the root-mean-square norm (DOP853 combines its 5th- and
+3rd-order estimates as in section II.10); a step with error <= 1 is accepted,
+and the next step is ``h * min(FAC_MAX, max(FAC_MIN, SAFETY * err^(-1/(q+1))))``
+with ``q`` the order of the error estimator.  A step shortened to land on an
+output time does not change the proposed step size, so outputs do not disturb
+the step sequence.
+"""
+
+import math
+
+from ._jit import specialize
+from .status import Status
+from .stepping import _record
+from .stopping import check_stop, no_stop
+
+__all__ = ["embedded_loop", "SAFETY", "FAC_MIN", "FAC_MAX"]
+
+SAFETY = 0.9   # step-size safety factor (HNW II.4)
+FAC_MIN = 0.2  # a rejected step shrinks by at most 5
+FAC_MAX = 10.0  # an accepted step grows by at most 10
+_EPS = 2.220446049250313e-16
+
+
+def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
+                   info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps, rtol, atol):
+    n = x.shape[0]
+    s = b.shape[0]
+    every = mon[0]
+    n_mon = 0
+    until_record = every - step0 % every if every > 0 else -1
+    steps = 0
+    rejected = 0
+    fev = 0
+    info[0] = -1
+    info[1] = -1
+    ncomp = 6 * n
+    if fsal[0] == 0:
+        force(x, v, t, fargs, kv[0])  # noqa: F821 - bound by specialize
+        fev += 1
+        for i in range(n):
+            for d in range(3):
+                kx[0, i, d] = v[i, d]
+        fsal[0] = 1
+    h_prop = dtbox[0]
+    if h_prop <= 0.0:
+        # starting step (HNW II.4): from the sizes of y and y' in the error norm
+        d0 = 0.0
+        d1 = 0.0
+        for i in range(n):
+            for d in range(3):
+                sx = atol + rtol * abs(x[i, d])
+                sv = atol + rtol * abs(v[i, d])
+                d0 += (x[i, d] / sx) ** 2 + (v[i, d] / sv) ** 2
+                d1 += (kx[0, i, d] / sx) ** 2 + (kv[0, i, d] / sv) ** 2
+        d0 = math.sqrt(d0 / ncomp)
+        d1 = math.sqrt(d1 / ncomp)
+        h_prop = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+        h_prop = min(h_prop, t_end - t)
+    status = Status.OK
+    while steps < max_steps and t < t_end:
+        h = h_prop
+        shortened = False
+        if t + 1.01 * h >= t_end:
+            # land on t_end, also when only a sliver would be left (HNW's DOPRI5)
+            h = t_end - t
+            shortened = True
+        for st in range(1, s):
+            for i in range(n):
+                for d in range(3):
+                    xi = x[i, d]
+                    vi = v[i, d]
+                    for j in range(st):
+                        a = A[st, j]
+                        if a != 0.0:
+                            xi += h * a * kx[j, i, d]
+                            vi += h * a * kv[j, i, d]
+                    xs[i, d] = xi
+                    vs[i, d] = vi
+                    kx[st, i, d] = vi
+            force(xs, vs, t + c[st] * h, fargs, kv[st])  # noqa: F821
+        fev += s - 1
+        for i in range(n):
+            for d in range(3):
+                dx = 0.0
+                dv = 0.0
+                for j in range(s):
+                    dx += b[j] * kx[j, i, d]
+                    dv += b[j] * kv[j, i, d]
+                x1[i, d] = x[i, d] + h * dx
+                v1[i, d] = v[i, d] + h * dv
+                kx[s, i, d] = v1[i, d]
+        force(x1, v1, t + h, fargs, kv[s])  # noqa: F821
+        fev += 1
+        err5 = 0.0
+        err3 = 0.0
+        for i in range(n):
+            for d in range(3):
+                ex = 0.0
+                ev = 0.0
+                fx = 0.0
+                fv = 0.0
+                for j in range(s + 1):
+                    ex += e[j] * kx[j, i, d]
+                    ev += e[j] * kv[j, i, d]
+                    fx += e3[j] * kx[j, i, d]
+                    fv += e3[j] * kv[j, i, d]
+                sx = atol + rtol * max(abs(x[i, d]), abs(x1[i, d]))
+                sv = atol + rtol * max(abs(v[i, d]), abs(v1[i, d]))
+                err5 += (ex / sx) ** 2 + (ev / sv) ** 2
+                err3 += (fx / sx) ** 2 + (fv / sv) ** 2
+        if has_e3:  # noqa: F821 - bound by specialize
+            denom = err5 + 0.01 * err3
+            err = 0.0 if denom == 0.0 else abs(h) * err5 / math.sqrt(denom * ncomp)
+        else:
+            err = abs(h) * math.sqrt(err5 / ncomp)
+        if not math.isfinite(err):
+            err = math.inf  # a step that overflowed is rejected and shrunk
+        if err <= 1.0:
+            for i in range(n):
+                for d in range(3):
+                    x[i, d] = x1[i, d]
+                    v[i, d] = v1[i, d]
+                    kx[0, i, d] = kx[s, i, d]
+                    kv[0, i, d] = kv[s, i, d]
+            t = t_end if shortened else t + h
+            steps += 1
+            if not shortened:
+                fac = FAC_MAX if err == 0.0 else SAFETY * err ** (-1.0 / (q + 1))
+                h_prop = h * min(FAC_MAX, max(FAC_MIN, fac))
+            until_record -= 1
+            if until_record == 0:
+                until_record = every
+                _record(x, v, t, mon, n_mon, mon_t, mon_out)
+                n_mon += 1
+            stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+            if stop != 0:
+                info[0] = sargs[-1][0]
+                info[1] = sargs[-1][1]
+                status = stop
+                break
+        else:
+            rejected += 1
+            fac = 0.0 if err == math.inf else SAFETY * err ** (-1.0 / (q + 1))
+            h_prop = h * max(FAC_MIN, fac)
+            if h_prop <= 4.0 * _EPS * max(abs(t), abs(t_end)):
+                status = Status.STEP_UNDERFLOW
+                break
+    dtbox[0] = h_prop
+    return status, t, steps, rejected, fev, n_mon
+
+
+def embedded_loop(force, has_e3, stop=False):
+    """The adaptive embedded Runge-Kutta loop compiled for a force and an estimator."""
+    key = f"{force.key}{'_e3' if has_e3 else ''}{'_stop' if stop else ''}"
+    return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
+                      force=force.kernel, has_e3=bool(has_e3),
+                      stop_check=check_stop if stop else no_stop)
