@@ -30,4 +30,12 @@ __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajec
            "scenes", "integrators", "monitors", "errors", "OrbitsError", "BodyError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow",
-           "CloseEncounter", "Escape", "load", "io", "__version__"]
+           "CloseEncounter", "Escape", "load", "io", "Ensemble", "__version__"]
+
+
+def __getattr__(name):
+    # Ensemble needs dask and pandas: imported on first use, not with orbits
+    if name == "Ensemble":
+        from .ensemble import Ensemble
+        return Ensemble
+    raise AttributeError(f"module 'orbits' has no attribute {name!r}")

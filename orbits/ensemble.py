@@ -1,0 +1,655 @@
+"""Ensembles and parameter sweeps: many simulations, run on Dask.
+
+An :class:`Ensemble` is a list of runs, each described by a dictionary of
+parameters, and one function that turns a dictionary into a
+:class:`~orbits.Simulation`.  What travels to the workers is that function
+and the dictionaries, never a simulation (its compiled kernels do not
+pickle); each worker builds its own simulations and keeps the kernels it
+compiled, or loaded from numba's on-disk cache, for every later task.
+
+:meth:`Ensemble.run` returns a :class:`pandas.DataFrame`, one row per run.
+Its columns:
+
+``run``
+    The run's number (the frame's index), its place in the parameter list.
+parameters
+    One column per parameter; a Quantity ``x`` becomes ``x_<unit>``.
+``outcome``
+    ``"completed"``, ``"close-encounter"``, ``"escape"``,
+    ``"non-finite-state"``, ``"step-size-underflow"``, ``"stopped"`` (another
+    stopping condition), ``"run-error"`` (another failure during the run) or
+    ``"invalid"`` (``build`` or the simulation rejected the parameters with an
+    :class:`~orbits.errors.OrbitsError`).
+``message``, ``stop_bodies``
+    The exception's text and the bodies it names (comma-separated); empty for
+    a completed run.
+``t_stop_<time unit>``
+    Time at which the run ended: ``until``, or the time of the stop.
+``steps``
+    Steps taken.
+``energy_error_max``, ``angular_momentum_error_max``
+    Largest relative errors at the outputs (and in the in-loop monitor series,
+    if the simulation records one); NaN when the monitor is off.
+``<body>_a_<length unit>``, ``<body>_e``, ``<body>_inc_rad``
+    Osculating elements at the end, of every body but the most massive one,
+    about the most massive one; NaN where no orbit is defined.
+``wall_time_s``
+    Seconds the run itself took (building and elements excluded).
+``worker``, ``kernels_compiled``, ``kernels_loaded``
+    Where the run ran (``host:pid``), and how many compiled loops this task
+    compiled, and loaded from the on-disk cache, before it could start: only a
+    worker's first task of a kind loads any; none compiles once the cache is
+    warm.
+``file``
+    The run's HDF5 file, relative to ``out_dir`` (empty without one).
+
+``df.attrs`` holds ``until``, the units of the columns, and the element
+columns' primary.
+
+Runs are deterministic: a run gives the same numbers, bit for bit, on any
+worker as in a serial loop (``client="serial"``).
+"""
+
+import hashlib
+import json
+import math
+import os
+import pathlib
+import socket
+import time as _time
+
+import astropy.units as u
+import numpy as np
+
+from . import integrators as _integrators
+from .errors import (CloseEncounter, Escape, NonFiniteState, OrbitsError, RunError,
+                     SimulationStopped, StepSizeUnderflow)
+
+__all__ = ["Ensemble", "local_cluster", "INDEX_FILE", "SWEEP_FILE", "ELEMENTS_MAX_BODIES",
+           "PROGRESS_DELAY", "WORKER_ENVIRONMENT"]
+
+#: The index of finished runs in ``out_dir``: one CSV row per run, appended as
+#: each finishes, so that an interrupted sweep knows what it has done.
+INDEX_FILE = "index.csv"
+
+#: What the sweep in ``out_dir`` is (runs, ``until``, outputs, a hash of the
+#: parameters), so that a different sweep is not resumed into it by mistake.
+SWEEP_FILE = "sweep.json"
+
+#: Final elements are reported for every non-central body up to this many
+#: bodies; above it only for the bodies named in ``elements=``.
+ELEMENTS_MAX_BODIES = 16
+
+#: The sweep's progress bar appears after this many seconds, so short sweeps stay quiet.
+PROGRESS_DELAY = 3.0
+
+#: Set in every worker of :func:`local_cluster`.  One numba thread per worker
+#: process: the workers already use every core, and threads on top of them
+#: would only compete (the threaded gravity kernel starts at 72 bodies).
+WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
+                      "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+
+_OUTCOMES = ((CloseEncounter, "close-encounter"), (Escape, "escape"),
+             (NonFiniteState, "non-finite-state"), (StepSizeUnderflow, "step-size-underflow"),
+             (SimulationStopped, "stopped"), (RunError, "run-error"))
+
+
+class Ensemble:
+    """Many simulations, built from parameters by one function.
+
+    Parameters
+    ----------
+    build : callable
+        ``build(**p)`` returns a :class:`~orbits.Simulation` for one parameter
+        dictionary ``p``.  It is sent to the workers, so it must pickle: a
+        function defined at module level (or in the script being run) always
+        does; Dask's cloudpickle also sends most closures and lambdas.
+    parameters : iterable of dict, or pandas.DataFrame
+        One dictionary (or row) per run.  Values may be numbers, strings or
+        scalar Quantities.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> def build(e):
+    ...     return orbits.Simulation(orbits.scenes.kepler(e=e), integrator="leapfrog",
+    ...                              dt=1 * u.day)
+    >>> ens = orbits.Ensemble(build, [{"e": 0.1}, {"e": 0.5}])
+    >>> df = ens.run(until=1 * u.yr, client="serial", progress=False)
+    >>> list(df.outcome)
+    ['completed', 'completed']
+    """
+
+    def __init__(self, build, parameters):
+        if not callable(build):
+            raise TypeError(f"build must be callable, got {type(build).__name__}")
+        if hasattr(parameters, "to_dict") and hasattr(parameters, "columns"):
+            parameters = parameters.to_dict(orient="records")
+        params = [dict(p) for p in parameters]
+        for i, p in enumerate(params):
+            bad = [k for k in p if not isinstance(k, str) or not k.isidentifier()]
+            if bad:
+                raise ValueError(f"parameter set {i}: names must be identifiers "
+                                 f"(they are passed as keywords), got {bad}")
+        self.build = build
+        self.parameters = params
+
+    # -- construction ---------------------------------------------------------------
+    @classmethod
+    def grid(cls, build, **axes):
+        """Every combination of the values along each axis (the first varies slowest).
+
+        >>> import numpy as np
+        >>> ens = Ensemble.grid(lambda a, e: None, a=[1.0, 2.0], e=np.linspace(0, 0.2, 3))
+        >>> len(ens), ens.parameters[1]
+        (6, {'a': 1.0, 'e': 0.1})
+        """
+        if not axes:
+            raise ValueError("grid needs at least one axis, e.g. a=[...]")
+        names = list(axes)
+        values = [list(axes[k]) for k in names]
+        shape = [len(v) for v in values]
+        params = []
+        for flat in range(int(np.prod(shape))):
+            idx = np.unravel_index(flat, shape)
+            params.append({k: _plain(values[j][idx[j]]) for j, k in enumerate(names)})
+        return cls(build, params)
+
+    @classmethod
+    def perturbed(cls, sim, n=100, scale=1e-10, seed=1):
+        """``n`` copies of a simulation with slightly shifted positions.
+
+        Each body's position moves by ``scale`` times its distance from the
+        centre of mass, in a random direction; velocities are kept.  Run ``k``
+        draws its directions from ``numpy.random.SeedSequence(seed,
+        spawn_key=(k,))``, so a run's perturbation depends only on ``seed`` and
+        ``k`` (not on ``n``) and is the same on any machine.
+
+        Parameters
+        ----------
+        sim : Simulation
+            Its current state (time reset to zero), integrator and options,
+            step, monitors, softening and stopping conditions are copied.
+        n : int
+            Number of runs; the parameter of run ``k`` is ``member = k``.
+        scale : float
+            Relative size of the shifts (dimensionless).
+        seed : int
+        """
+        if int(n) != n or n < 1:
+            raise ValueError(f"n must be a whole number >= 1, got {n}")
+        if not (scale >= 0 and math.isfinite(scale)):
+            raise ValueError(f"scale must be a finite number >= 0, got {scale}")
+        recipe = _Perturbation(sim, float(scale), int(seed))
+        return cls(recipe, [{"member": k} for k in range(int(n))])
+
+    # -- access ---------------------------------------------------------------------
+    def __len__(self):
+        return len(self.parameters)
+
+    def __repr__(self):
+        return f"<Ensemble of {len(self)} runs of {_describe(self.build)}>"
+
+    def simulation(self, run):
+        """The simulation of run number ``run``, built here (to look at or run alone)."""
+        return self.build(**self.parameters[run])
+
+    # -- running --------------------------------------------------------------------
+    def run(self, until, client=None, *, outputs=100, out_dir=None, n_workers=None,
+            elements=None, progress=None):
+        """Run every simulation to ``until`` and tabulate how each went.
+
+        Parameters
+        ----------
+        until : Quantity (time) or float
+            End time of every run (a float is read in each body set's time unit).
+        client : None, "serial", str or distributed.Client
+            ``None``: a local cluster of ``n_workers`` processes with one thread
+            each (:func:`local_cluster`), closed at the end.  ``"serial"``: one
+            after the other in this process.  A scheduler address such as
+            ``"tcp://10.0.0.5:8786"``: that cluster.  A ``Client``: its cluster.
+        outputs : int
+            Outputs per run (see :meth:`orbits.Simulation.run`); the largest
+            energy and angular-momentum errors are taken over them.
+        out_dir : str or path, optional
+            Write each run's outputs to ``out_dir/run-00042.h5`` and its row to
+            ``out_dir/index.csv`` as it finishes.  Called again with the same
+            ``out_dir`` the sweep skips the runs the index lists, and starts the
+            others afresh (a run cut off in the middle is run again from its
+            start).  The directory must be reachable by the workers under the
+            same path.
+        n_workers : int, optional
+            Workers of the local cluster (default: ``os.cpu_count()``).
+        elements : sequence of str, optional
+            Bodies whose final elements to report.  Default: every body but the
+            most massive, when there are at most :data:`ELEMENTS_MAX_BODIES`.
+        progress : bool, optional
+            A bar counting finished runs.  Default: shown once the sweep has
+            gone on for :data:`PROGRESS_DELAY` seconds.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per run, indexed by run number; the columns are listed in
+            the module docstring.  A failed run is a row with its outcome; an
+            exception from ``build`` other than an
+            :class:`~orbits.errors.OrbitsError` stops the sweep (the rows
+            finished before are kept in ``out_dir``).
+        """
+        import pandas as pd
+
+        spec = _Spec(until, int(outputs), None if elements is None else tuple(elements))
+        n = len(self.parameters)
+        done = {}
+        if out_dir is not None:
+            out_dir = pathlib.Path(out_dir)
+            done = _open_out_dir(out_dir, self._fingerprint(spec))
+        todo = [i for i in range(n) if i not in done]
+        rows = dict(done)
+        if todo:
+            if isinstance(client, str) and client == "serial":
+                self._run_serial(todo, spec, out_dir, rows, progress)
+            else:
+                self._run_dask(todo, spec, out_dir, rows, progress, client, n_workers)
+        frame = pd.DataFrame([rows[i] for i in range(n)])
+        frame = frame[_column_order(frame.columns, self.parameters)].set_index("run")
+        frame.attrs.update(_frame_attrs(spec, frame))
+        return frame
+
+    def _run_serial(self, todo, spec, out_dir, rows, progress):
+        bar = _bar(len(todo), progress)
+        try:
+            for i in todo:
+                row = run_one(self.build, self.parameters[i], i, spec, _path(out_dir, i))
+                _finish(row, rows, out_dir)
+                bar.update(1)
+        finally:
+            bar.close()
+
+    def _run_dask(self, todo, spec, out_dir, rows, progress, client, n_workers):
+        from distributed import Client, as_completed
+
+        own = None
+        if client is None:
+            client = own = local_cluster(n_workers)
+        elif isinstance(client, str):
+            client = own = Client(client)
+        token = self._fingerprint(spec)[:12]
+        bar = _bar(len(todo), progress)
+        futures = []
+        try:
+            [build] = client.scatter([self.build], broadcast=True, hash=False)
+            futures = [client.submit(run_one, build, self.parameters[i], i, spec,
+                                     _path(out_dir, i), key=f"orbits-run-{token}-{i}",
+                                     pure=False)
+                       for i in todo]
+            for fut in as_completed(futures):
+                _finish(fut.result(), rows, out_dir)
+                bar.update(1)
+                fut.release()
+        finally:
+            bar.close()
+            unfinished = [f for f in futures if not f.done()]
+            if unfinished:
+                client.cancel(unfinished)
+            if own is not None:
+                cluster = own.cluster
+                own.close()
+                if cluster is not None:
+                    cluster.close()
+
+    def _fingerprint(self, spec):
+        h = hashlib.sha1()
+        h.update(json.dumps([_describe(self.build), len(self), str(spec.until), spec.outputs,
+                             spec.elements, self.parameters],
+                            sort_keys=True, default=str).encode())
+        if isinstance(self.build, _Perturbation):
+            h.update(self.build.fingerprint())
+        return h.hexdigest()
+
+
+def local_cluster(n_workers=None):
+    """A Dask client of a new cluster on this machine: ``n_workers`` processes
+    (default ``os.cpu_count()``) of one thread each, on the loopback interface,
+    without dashboard, each with :data:`WORKER_ENVIRONMENT`.  Close it with
+    ``client.close(); client.cluster.close()`` (or use it in a ``with``)."""
+    from distributed import Client, LocalCluster
+
+    n = os.cpu_count() if n_workers is None else int(n_workers)
+    if n < 1:
+        raise ValueError(f"n_workers must be >= 1, got {n_workers}")
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           host="127.0.0.1", dashboard_address=None,
+                           env=dict(WORKER_ENVIRONMENT))
+    return Client(cluster)
+
+
+# -- one run (on a worker) -------------------------------------------------------------
+
+class _Spec:
+    """What every run of a sweep shares; small, so that it travels with each task."""
+
+    def __init__(self, until, outputs, elements):
+        self.until = until
+        self.outputs = outputs
+        self.elements = elements
+
+
+def run_one(build, params, index, spec, path=None):
+    """Build and run one simulation; return its row (a dict).  Runs on a worker.
+
+    Failures of the run become its outcome; an :class:`~orbits.errors.OrbitsError`
+    from ``build`` is the outcome ``"invalid"``.
+    """
+    _limit_numba_threads()
+    row = {"run": index}
+    for k, val in params.items():
+        if isinstance(val, u.Quantity):
+            row[_column(k, val.unit)] = float(val.value)
+        else:
+            row[k] = _plain(val)
+    loaded0 = _cache_loads()
+    with _CompileRecorder() as log:
+        try:
+            sim = build(**params)
+            outcome, exc, wall, result = _advance(sim, spec, path)
+        except OrbitsError as err:     # parameters that make no simulation
+            row.update(outcome="invalid", message=str(err), stop_bodies="", steps=0,
+                       energy_error_max=math.nan, angular_momentum_error_max=math.nan,
+                       wall_time_s=0.0, **_worker_fields(loaded0, log), file="")
+            return row
+    row["outcome"] = outcome
+    row["message"] = "" if exc is None else str(exc)
+    row["stop_bodies"] = ",".join(getattr(exc, "bodies", ()) or ())
+    units = sim.units
+    t_end = sim._now() if exc is None or exc.time is None else exc.time
+    row[_column("t_stop", units.time)] = _value(t_end, units.time)
+    row["steps"] = sim.steps
+    if path is not None:   # the result of a run to a file holds only its last output
+        from .io.hdf5 import load
+        result = load(path)
+    e = result.max_energy_error() if result is not None else None
+    lerr = result.max_angular_momentum_error() if result is not None else None
+    row["energy_error_max"] = math.nan if e is None else e
+    row["angular_momentum_error_max"] = math.nan if lerr is None else lerr
+    row.update(_final_elements(sim, spec.elements))
+    row["wall_time_s"] = wall
+    row.update(_worker_fields(loaded0, log))
+    row["file"] = "" if path is None else path.name
+    return row
+
+
+def _limit_numba_threads():
+    # A worker whose script imported numba before the nanny set the worker's
+    # environment has numba's default pool size; keep to what the environment says.
+    want = os.environ.get("NUMBA_NUM_THREADS")
+    if want and want.isdigit() and int(want) >= 1:
+        import numba
+        if numba.get_num_threads() > int(want):
+            numba.set_num_threads(int(want))
+
+
+def _advance(sim, spec, path):
+    wall0 = _time.perf_counter()
+    try:
+        result = sim.run(spec.until, outputs=spec.outputs, progress=False, output=path,
+                         overwrite=True)
+    except RunError as exc:
+        outcome = next(name for cls, name in _OUTCOMES if isinstance(exc, cls))
+        return outcome, exc, _time.perf_counter() - wall0, exc.result
+    return "completed", None, _time.perf_counter() - wall0, result
+
+
+def _final_elements(sim, names):
+    bodies = sim.bodies
+    m = bodies._m
+    central = bodies.names[int(np.argmax(m))]
+    if names is None:
+        names = ([b for b in bodies.names if b != central]
+                 if len(bodies) <= ELEMENTS_MAX_BODIES else [])
+    out = {}
+    for b in names:
+        try:
+            el = bodies.elements(b, primary=central)
+            vals = (el["a"].to_value(bodies.units.length), float(el["e"]),
+                    el["inc"].to_value(u.rad))
+        except OrbitsError:
+            vals = (math.nan,) * 3
+        out[_column(f"{b}_a", bodies.units.length)] = vals[0]
+        out[f"{b}_e"] = vals[1]
+        out[f"{b}_inc_rad"] = vals[2]
+    return out
+
+
+# kernel bookkeeping: what this task had to compile or load before it could run
+
+def _dispatchers():
+    import sys
+
+    from numba.core.dispatcher import Dispatcher
+
+    from ._kernels import _jit
+    found = [d for d in list(_jit._SPECIALISED.values()) if isinstance(d, Dispatcher)]
+    for name, mod in list(sys.modules.items()):
+        if name.startswith("orbits._kernels") and mod is not None:
+            found.extend(d for d in vars(mod).values() if isinstance(d, Dispatcher))
+    return list({id(d): d for d in found}.values())
+
+
+def _cache_loads():
+    """Compiled functions of the package loaded from numba's disk cache so far."""
+    return sum(sum(d.stats.cache_hits.values()) for d in _dispatchers())
+
+
+class _CompileRecorder:
+    """Counts numba compilations (not cache loads) inside a ``with``."""
+
+    def __enter__(self):
+        from numba.core import event
+        self._ctx = event.install_recorder("numba:compile")
+        self.recorder = self._ctx.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        return self._ctx.__exit__(*exc)
+
+    @property
+    def compiled(self):
+        return sum(1 for _, ev in self.recorder.buffer if ev.is_start)
+
+
+def _worker_fields(loaded0, log):
+    compiled = log.compiled
+    return {"worker": f"{socket.gethostname()}:{os.getpid()}",
+            "kernels_compiled": compiled,
+            "kernels_loaded": _cache_loads() - loaded0}
+
+
+# -- perturbed copies of one simulation --------------------------------------------------
+
+class _Perturbation:
+    """Rebuilds a simulation with shifted positions on a worker: holds a body set
+    and the simulation's options, which pickle, rather than the simulation."""
+
+    def __init__(self, sim, scale, seed):
+        self.bodies = sim.bodies
+        self.integrator = (sim.integrator.name, dict(sim.integrator.config))
+        self.options = _simulation_options(sim)
+        self.scale = scale
+        self.seed = seed
+
+    def __call__(self, member):
+        from .simulation import Simulation
+        bodies = self.bodies.copy()
+        x = bodies._x
+        r = np.linalg.norm(x - bodies._com()[0], axis=1)
+        rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(member,)))
+        direction = rng.standard_normal((len(bodies), 3))
+        direction /= np.linalg.norm(direction, axis=1)[:, None]
+        bodies._x = x + (self.scale * r)[:, None] * direction
+        bodies.history.append({"from": "perturbed", "scale": self.scale, "seed": self.seed,
+                               "member": int(member)})
+        name, config = self.integrator
+        return Simulation(bodies, integrator=_integrators.get(name, **config), **self.options)
+
+    def fingerprint(self):
+        b = self.bodies
+        h = hashlib.sha1()
+        for a in (b._m, b._x, b._v):
+            h.update(np.ascontiguousarray(a).tobytes())
+        h.update(repr((b.names, self.integrator, sorted(self.options.items(), key=str),
+                       self.scale, self.seed)).encode())
+        return h.digest()
+
+
+def _simulation_options(sim):
+    """The keyword arguments that make a simulation like ``sim`` from its bodies."""
+    units = sim.units
+    options = dict(dt=sim.dt, monitors=tuple(sim.monitors), monitor_every=sim.monitor_every,
+                   parallel=sim.parallel)
+    if sim._eps2 > 0:   # sqrt(eps*eps) == eps exactly, so the copy has the same eps2
+        options["softening"] = units.quantity(math.sqrt(sim._eps2), "length")
+    stop = getattr(sim, "_stop", None)
+    if stop is not None:
+        from ._kernels import stopping as _s
+        mask, d2, hill_k, esc2 = stop[:4]
+        if mask & _s.ENCOUNTER_DISTANCE:
+            options["encounter_distance"] = units.quantity(math.sqrt(d2), "length")
+        if mask & _s.ENCOUNTER_HILL:
+            options["encounter_hill"] = float(hill_k)
+        if mask & _s.ESCAPE:
+            options["escape_distance"] = units.quantity(math.sqrt(esc2), "length")
+        if mask & _s.UNBOUND:
+            options["escape_unbound"] = True
+    return options
+
+
+# -- output directory ---------------------------------------------------------------------
+
+def _open_out_dir(out_dir, fingerprint):
+    """Create ``out_dir`` or check it holds this sweep; the rows already finished."""
+    import pandas as pd
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    sweep = out_dir / SWEEP_FILE
+    if sweep.exists():
+        stored = json.loads(sweep.read_text()).get("fingerprint")
+        if stored != fingerprint:
+            raise ValueError(f"{out_dir} holds another sweep (different build, parameters, "
+                             f"until, outputs or elements); use a new out_dir")
+    else:
+        sweep.write_text(json.dumps({"fingerprint": fingerprint}) + "\n")
+    index = out_dir / INDEX_FILE
+    if not index.exists():
+        return {}
+    frame = _read_index(index)
+    rows = {}
+    for rec in frame.to_dict(orient="records"):
+        rec = {k: _from_csv(k, val) for k, val in rec.items()}
+        rows[int(rec["run"])] = rec
+    return rows
+
+
+def _read_index(index):
+    import pandas as pd
+    # floats come back bit for bit: pandas 3 parses them exactly by default,
+    # pandas 2 only when asked for "round_trip"
+    exact = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
+    return pd.read_csv(index, keep_default_na=False, na_values=[""], **exact)
+
+
+_TEXT_COLUMNS = ("outcome", "message", "stop_bodies", "worker", "file")
+
+
+def _from_csv(key, val):
+    if key in _TEXT_COLUMNS:
+        return "" if isinstance(val, float) and math.isnan(val) else str(val)
+    return val.item() if isinstance(val, np.generic) else val
+
+
+def _finish(row, rows, out_dir):
+    rows[row["run"]] = row
+    if out_dir is None:
+        return
+    import pandas as pd
+
+    index = out_dir / INDEX_FILE
+    frame = pd.DataFrame([row])
+    if index.exists():
+        # keep one header: a row with columns the file lacks rewrites the file
+        header = pd.read_csv(index, nrows=0).columns.tolist()
+        if set(frame.columns) <= set(header):
+            frame.reindex(columns=header).to_csv(index, mode="a", header=False, index=False)
+            return
+        old = _read_index(index)
+        frame = pd.concat([old, frame], ignore_index=True)
+        tmp = index.with_suffix(".tmp")
+        frame.to_csv(tmp, index=False)
+        os.replace(tmp, index)
+        return
+    frame.to_csv(index, index=False)
+
+
+_FIRST = ("outcome", "message", "stop_bodies")
+_MIDDLE = ("steps", "energy_error_max", "angular_momentum_error_max")
+_LAST = ("wall_time_s", "worker", "kernels_compiled", "kernels_loaded", "file")
+
+
+def _column_order(columns, parameters):
+    """run, parameters, outcome, stop time, errors, elements (sorted), where it ran:
+    the same order whether the rows were computed now or read from the index."""
+    columns = list(columns)
+    params = []
+    for p in parameters:
+        for k, val in p.items():
+            name = _column(k, val.unit) if isinstance(val, u.Quantity) else k
+            if name not in params:
+                params.append(name)
+    t_stop = sorted(c for c in columns if c.startswith("t_stop"))
+    fixed = ["run", *params, *_FIRST, *t_stop, *_MIDDLE]
+    elements = sorted(c for c in columns if c not in fixed and c not in _LAST)
+    return [c for c in (*fixed, *elements, *_LAST) if c in columns]
+
+
+def _path(out_dir, i):
+    return None if out_dir is None else out_dir / f"run-{i:05d}.h5"
+
+
+# -- small helpers ----------------------------------------------------------------------
+
+def _bar(total, progress):
+    from tqdm.auto import tqdm
+    return tqdm(total=total, unit="run", desc="orbits ensemble", disable=progress is False,
+                delay=0 if progress else PROGRESS_DELAY, leave=progress is True)
+
+
+def _frame_attrs(spec, frame):
+    return {"until": str(spec.until), "outputs": spec.outputs,
+            "elements_primary": "the most massive body"}
+
+
+def _plain(val):
+    if isinstance(val, np.generic):
+        return val.item()
+    return val
+
+
+def _column(name, unit):
+    """``name_<unit>``, e.g. ``t_stop_day``, ``a_au``; just ``name`` without a unit."""
+    s = u.Unit(unit).to_string()
+    s = {"d": "day"}.get(s, s.lower())
+    s = "".join(ch if ch.isalnum() else "_" for ch in s)
+    return f"{name}_{s}" if s else name
+
+
+def _value(t, unit):
+    if isinstance(t, u.Quantity):
+        return float(t.to_value(unit))
+    return float(t)
+
+
+def _describe(build):
+    if isinstance(build, _Perturbation):
+        return "perturbed copies of a simulation"
+    return getattr(build, "__qualname__", type(build).__name__)
