@@ -1,0 +1,155 @@
+"""The compiled adaptive loop of RK4 with step doubling.
+
+Each step is taken twice: once with step ``h`` and once as two steps of
+``h/2``.  Their difference divided by ``2^4 - 1 = 15`` estimates the error of
+the two half steps (Richardson); the step is accepted when that error, in
+the root-mean-square norm against ``atol + rtol * |y|``, is at most one, and
+the result of the two half steps is kept (no local extrapolation, so the
+method stays fourth order).  Step sizes follow the same controller as the
+embedded pairs (:mod:`.embedded`), with the error exponent 1/5.  Eleven force
+evaluations a step (the first stage is shared).
+"""
+
+import math
+
+from ._jit import specialize
+from .embedded import FAC_MAX, FAC_MIN, SAFETY
+from .status import Status
+from .stepping import _record
+from .stopping import check_stop, no_stop
+
+__all__ = ["doubling_loop"]
+
+_EPS = 2.220446049250313e-16
+
+
+def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs):
+    # classic RK4 from (x, v) with its first stage (k0x, k0v) given; result in
+    # (xo, vo).  kx, kv hold stages 1..3.
+    n = x.shape[0]
+    for st in range(3):
+        a = 0.5 * h if st < 2 else h
+        for i in range(n):
+            for d in range(3):
+                if st == 0:
+                    gx = k0x[i, d]
+                    gv = k0v[i, d]
+                else:
+                    gx = kx[st - 1, i, d]
+                    gv = kv[st - 1, i, d]
+                xs[i, d] = x[i, d] + a * gx
+                vs[i, d] = v[i, d] + a * gv
+                kx[st, i, d] = vs[i, d]
+        force(xs, vs, t + (0.5 * h if st < 2 else h), fargs, kv[st])  # noqa: F821
+    for i in range(n):
+        for d in range(3):
+            xo[i, d] = x[i, d] + h / 6.0 * (k0x[i, d] + 2.0 * kx[0, i, d]
+                                            + 2.0 * kx[1, i, d] + kx[2, i, d])
+            vo[i, d] = v[i, d] + h / 6.0 * (k0v[i, d] + 2.0 * kv[0, i, d]
+                                            + 2.0 * kv[1, i, d] + kv[2, i, d])
+
+
+def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
+                   dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
+                   rtol, atol):
+    n = x.shape[0]
+    every = mon[0]
+    n_mon = 0
+    until_record = every - step0 % every if every > 0 else -1
+    steps = 0
+    rejected = 0
+    fev = 0
+    info[0] = -1
+    info[1] = -1
+    ncomp = 6 * n
+    if fsal[0] == 0:
+        force(x, v, t, fargs, k0v)  # noqa: F821
+        fev += 1
+        for i in range(n):
+            for d in range(3):
+                k0x[i, d] = v[i, d]
+        fsal[0] = 1
+    h_prop = dtbox[0]
+    if h_prop <= 0.0:
+        d0 = 0.0
+        d1 = 0.0
+        for i in range(n):
+            for d in range(3):
+                sx = atol + rtol * abs(x[i, d])
+                sv = atol + rtol * abs(v[i, d])
+                d0 += (x[i, d] / sx) ** 2 + (v[i, d] / sv) ** 2
+                d1 += (k0x[i, d] / sx) ** 2 + (k0v[i, d] / sv) ** 2
+        d0 = math.sqrt(d0 / ncomp)
+        d1 = math.sqrt(d1 / ncomp)
+        h_prop = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+        h_prop = min(h_prop, t_end - t)
+    status = Status.OK
+    while steps < max_steps and t < t_end:
+        h = h_prop
+        shortened = False
+        if t + 1.01 * h >= t_end:
+            h = t_end - t
+            shortened = True
+        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs)  # noqa: F821
+        rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh, fargs)  # noqa: F821
+        for i in range(n):
+            for d in range(3):
+                kmx[i, d] = vh[i, d]
+        force(xh, vh, t + 0.5 * h, fargs, kmv)  # noqa: F821
+        rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs, x2, v2,  # noqa: F821
+                 fargs)
+        fev += 10
+        err = 0.0
+        for i in range(n):
+            for d in range(3):
+                sx = atol + rtol * max(abs(x[i, d]), abs(x2[i, d]))
+                sv = atol + rtol * max(abs(v[i, d]), abs(v2[i, d]))
+                err += ((x2[i, d] - xf[i, d]) / (15.0 * sx)) ** 2 \
+                    + ((v2[i, d] - vf[i, d]) / (15.0 * sv)) ** 2
+        err = math.sqrt(err / ncomp)
+        if not math.isfinite(err):
+            err = math.inf
+        if err <= 1.0:
+            for i in range(n):
+                for d in range(3):
+                    x[i, d] = x2[i, d]
+                    v[i, d] = v2[i, d]
+            t = t_end if shortened else t + h
+            force(x, v, t, fargs, k0v)  # noqa: F821
+            fev += 1
+            for i in range(n):
+                for d in range(3):
+                    k0x[i, d] = v[i, d]
+            steps += 1
+            if not shortened:
+                fac = FAC_MAX if err == 0.0 else SAFETY * err ** (-0.2)
+                h_prop = h * min(FAC_MAX, max(FAC_MIN, fac))
+            until_record -= 1
+            if until_record == 0:
+                until_record = every
+                _record(x, v, t, mon, n_mon, mon_t, mon_out)
+                n_mon += 1
+            stop = stop_check(x, v, sargs)  # noqa: F821
+            if stop != 0:
+                info[0] = sargs[-1][0]
+                info[1] = sargs[-1][1]
+                status = stop
+                break
+        else:
+            rejected += 1
+            fac = 0.0 if err == math.inf else SAFETY * err ** (-0.2)
+            h_prop = h * max(FAC_MIN, fac)
+            if h_prop <= 4.0 * _EPS * max(abs(t), abs(t_end)):
+                status = Status.STEP_UNDERFLOW
+                break
+    dtbox[0] = h_prop
+    return status, t, steps, rejected, fev, n_mon
+
+
+def doubling_loop(force, stop=False):
+    """The RK4 step-doubling loop compiled for a force."""
+    key = f"{force.key}{'_stop' if stop else ''}"
+    step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel)
+    return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
+                      force=force.kernel, rk4_step=step,
+                      stop_check=check_stop if stop else no_stop)

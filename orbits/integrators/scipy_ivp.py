@@ -1,0 +1,112 @@
+"""Reference solvers from scipy: ``radau`` and ``lsoda`` through ``solve_ivp``.
+
+These are scipy's implementations (Radau IIA of order 5, Hairer & Wanner
+1996; LSODA, Petzold 1983), wrapped in the integrator contract so that a stiff
+user problem or a check of our own methods can use them through the same API.
+They run in Python and are slow; they are references, not workhorses.
+
+Each ``advance_to`` call starts ``solve_ivp`` afresh from the current state
+(with the last step size as its first step), so a run resumed from a file
+continues exactly as an uninterrupted one.  ``scipy`` must be installed.
+"""
+
+import numpy as np
+
+from .._kernels.status import Status
+from ..errors import IntegratorOptionError
+from .base import AdaptiveIntegrator
+
+__all__ = ["ScipyIntegrator", "Radau", "LSODA"]
+
+
+class ScipyIntegrator(AdaptiveIntegrator):
+    """A ``scipy.integrate.solve_ivp`` method behind the integrator contract.
+
+    In-loop monitors (``monitor_every``) and stopping conditions are not
+    available with these; outputs and their monitors are.  ``steps`` counts
+    scipy's accepted steps; it does not report rejected ones.
+    """
+
+    method = None
+    options = {"rtol": 1e-9, "atol": 1e-12}
+    stop_conditions = False
+
+    def _check_options(self):
+        self._positive("rtol", "atol")
+
+    def workspace(self, n, initial_step=0.0):
+        return {"dt": np.array([float(initial_step)]), "info": np.full(2, -1, dtype=np.int64)}
+
+    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
+                   max_steps):
+        try:
+            from scipy.integrate import solve_ivp
+        except ImportError:  # pragma: no cover - scipy is a test dependency
+            raise IntegratorOptionError(f"integrator {self.name!r} needs scipy "
+                                        "(pip install scipy)") from None
+        if mon[0]:
+            raise IntegratorOptionError(f"integrator {self.name!r} records no in-loop "
+                                        "monitors; drop monitor_every")
+        n = x.shape[0]
+        acc = np.empty((n, 3))
+
+        def rhs(time, y):
+            xs = np.ascontiguousarray(y[:3 * n].reshape(n, 3))
+            vs = np.ascontiguousarray(y[3 * n:].reshape(n, 3))
+            force.kernel(xs, vs, time, fargs, acc)
+            return np.concatenate([y[3 * n:], acc.ravel()])
+
+        y0 = np.concatenate([x.ravel(), v.ravel()])
+        first = float(ws["dt"][0])
+        kw = {"first_step": min(first, t_end - t)} if first > 0 else {}
+        sol = solve_ivp(rhs, (t, t_end), y0, method=self.method, rtol=self.config["rtol"],
+                        atol=self.config["atol"], **kw)
+        if sol.status != 0 or not np.all(np.isfinite(sol.y[:, -1])):
+            return Status.STEP_UNDERFLOW, t, 0, 0, int(sol.nfev), 0
+        x[...] = sol.y[:3 * n, -1].reshape(n, 3)
+        v[...] = sol.y[3 * n:, -1].reshape(n, 3)
+        if len(sol.t) > 1:
+            ws["dt"][0] = sol.t[-1] - sol.t[-2]
+        return Status.OK, t_end, len(sol.t) - 1, 0, int(sol.nfev), 0
+
+
+class Radau(ScipyIntegrator):
+    """Radau IIA (order 5), implicit, for stiff problems, from scipy.
+
+    References
+    ----------
+    Hairer & Wanner (1996), *Solving ODEs II*, section IV.8; scipy's
+    ``solve_ivp(method="Radau")``.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("radau", rtol=1e-10).order
+    5
+    """
+
+    name = "radau"
+    order = 5
+    method = "Radau"
+    summary = "Radau IIA via scipy.solve_ivp (reference, stiff)"
+
+
+class LSODA(ScipyIntegrator):
+    """LSODA (Adams/BDF with automatic stiffness switching), from scipy.
+
+    References
+    ----------
+    Petzold (1983), SIAM J. Sci. Stat. Comput. 4, 136; scipy's
+    ``solve_ivp(method="LSODA")``.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("lsoda").adaptive
+    True
+    """
+
+    name = "lsoda"
+    order = 12
+    method = "LSODA"
+    summary = "LSODA via scipy.solve_ivp (reference, switches to BDF when stiff)"

@@ -1,0 +1,46 @@
+"""radau and lsoda: scipy's solvers behind the integrator contract."""
+
+import math
+
+import numpy as np
+import pytest
+
+import orbits
+
+from helpers import kepler_bodies
+
+
+@pytest.mark.parametrize("name", ["radau", "lsoda"])
+def test_agree_with_the_exact_orbit(name):
+    # after exactly one period the orbit is back at its start; at rtol 1e-10
+    # the global error over one orbit is ~1e-8 (measured 1e-9 .. 1e-8)
+    b = kepler_bodies(e=0.3)
+    integ = orbits.integrators.get(name, rtol=1e-10, atol=1e-12)
+    r = orbits.Simulation(b, integrator=integ).run(until=2 * math.pi, outputs=5,
+                                                   progress=False)
+    err = np.abs(r.positions.value[-1, 1] - b.positions.value[1]).max()
+    assert err < 1e-7
+    assert r.steps > 10 and r.force_evaluations > r.steps
+    np.testing.assert_array_equal(r.times.value, [k * 2 * math.pi / 4 for k in range(4)]
+                                  + [2 * math.pi])
+
+
+def test_tighter_tolerance_is_more_accurate():
+    b = kepler_bodies(e=0.3)
+    errs = []
+    for rtol in (1e-6, 1e-10):
+        integ = orbits.integrators.get("radau", rtol=rtol, atol=rtol * 1e-2)
+        r = orbits.Simulation(b, integrator=integ).run(until=2 * math.pi, outputs=2,
+                                                       progress=False)
+        errs.append(np.abs(r.positions.value[-1, 1] - b.positions.value[1]).max())
+    assert errs[0] > 100 * errs[1]
+
+
+def test_options_and_unsupported_features():
+    with pytest.raises(orbits.IntegratorOptionError, match="rtol"):
+        orbits.integrators.get("lsoda", rtol=0)
+    with pytest.raises(orbits.IntegratorOptionError, match="stopping conditions"):
+        orbits.Simulation(kepler_bodies(), integrator="radau", escape_distance=10.0)
+    sim = orbits.Simulation(kepler_bodies(), integrator="radau", monitor_every=5)
+    with pytest.raises(orbits.IntegratorOptionError, match="monitor_every"):
+        sim.run(until=1.0, outputs=2, progress=False)
