@@ -12,10 +12,12 @@ from typing import NamedTuple
 from ..errors import UnknownIntegratorError
 from .base import ExplicitRungeKutta, Integrator, SplittingMethod
 from .composition import Yoshida4, Yoshida6, Yoshida8
+from .doubling import RK4Doubling
 from .embedded import DOP853, Dopri5
 from .euler import Euler, SymplecticEuler
 from .leapfrog import Leapfrog, Verlet
 from .runge_kutta import RK2, RK4
+from .scipy_ivp import LSODA, Radau
 from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
 __all__ = ["get", "available", "register", "Integrator", "IntegratorInfo",
@@ -43,7 +45,8 @@ def register(cls):
 
 
 for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
-             Yoshida8, WisdomHolman, SABA2, SABA3, SABA4, Dopri5, DOP853):
+             Yoshida8, WisdomHolman, SABA2, SABA3, SABA4, Dopri5, DOP853,
+             RK4Doubling, Radau, LSODA):
     register(_cls)
 
 
