@@ -15,6 +15,7 @@ from .composition import Yoshida4, Yoshida6, Yoshida8
 from .doubling import RK4Doubling
 from .embedded import DOP853, Dopri5
 from .euler import Euler, SymplecticEuler
+from .ias15 import IAS15
 from .leapfrog import Leapfrog, Verlet
 from .runge_kutta import RK2, RK4
 from .scipy_ivp import LSODA, Radau
@@ -46,7 +47,7 @@ def register(cls):
 
 for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
              Yoshida8, WisdomHolman, SABA2, SABA3, SABA4, Dopri5, DOP853,
-             RK4Doubling, Radau, LSODA):
+             RK4Doubling, Radau, LSODA, IAS15):
     register(_cls)
 
 

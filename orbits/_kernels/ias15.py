@@ -1,0 +1,470 @@
+"""The compiled IAS15 loop: Gauss-Radau predictor-corrector with adaptive steps.
+
+Over a step of length ``dt`` from ``t0`` the acceleration is written as a
+polynomial in the fraction ``h = (t - t0) / dt`` of the step (Everhart 1985)::
+
+    a(h) = a0 + b0 h + b1 h^2 + ... + b6 h^7
+         = a0 + g0 h + g1 h (h - h1) + ... + g6 h (h - h1) ... (h - h6),
+
+with ``h1 .. h7`` the Gauss-Radau spacings.  The ``g`` are divided
+differences of the accelerations at the spacings, so each force evaluation at
+``h_n`` fixes ``g_{n-1}`` once the others are known; ``b = C g`` and
+``g = D b`` convert between the two forms.  Integrating the polynomial twice
+gives the predictor::
+
+    x(h) = x0 + h dt v0 + (h dt)^2 (a0/2 + b0 h/6 + b1 h^2/12 + ... + b6 h^7/72)
+    v(h) = v0 + h dt (a0 + b0 h/2 + b1 h^2/3 + ... + b6 h^7/8).
+
+A step predicts the state at ``h1 .. h7``, evaluates the force there,
+updates ``g`` and ``b``, and repeats until the last coefficient stops
+changing (the corrector, an implicit Runge-Kutta iteration of order 15).
+
+Step control follows Rein & Spiegel (2015): the step just taken is accepted
+unless the step it implies is smaller by more than the factor :data:`SAFETY`,
+and the next one is ``dt (epsilon / b6~)^(1/7)`` with
+``b6~ = max|b6| / max|a|`` over all components ("global").  Option
+``prs24`` uses instead the timescale of Pham, Rein & Spiegel (2024), per
+body, from the acceleration, jerk and snap at the end of the step::
+
+    tau_i^2 = 2 |a_i|^2 / (|j_i|^2 + |a_i| |s_i|),  dt_next = (7! epsilon)^(1/7) min_i tau_i.
+
+The first guess of the next step's ``b`` extrapolates the polynomial of an
+earlier step (Everhart's ``e``), corrected by how wrong that step's own guess
+was (``b - e`` of that step, kept as ``br - er``).  Positions and velocities
+are accumulated with compensated summation so that rounding does not grow
+with the number of steps.
+
+References
+----------
+.. [1] Everhart, E. 1985, "An efficient integrator that uses Gauss-Radau
+   spacings", in Dynamics of Comets: Their Origin and Evolution, IAU Coll. 83,
+   ed. A. Carusi & G. B. Valsecchi, Reidel, p. 185.
+.. [2] Rein, H. & Spiegel, D. S. 2015, "IAS15: a fast, adaptive, high-order
+   integrator for gravitational dynamics, accurate to machine precision over
+   a billion orbits", MNRAS 446, 1424.
+.. [3] Pham, D., Rein, H. & Spiegel, D. S. 2024, "A new timestep criterion
+   for N-body simulations", Open Journal of Astrophysics 7, 1.
+"""
+
+import math
+from fractions import Fraction
+
+import numpy as np
+
+from ._jit import njit, specialize
+from .invariants import monitor_row
+from .status import Status
+from .stopping import check_stop, no_stop
+
+__all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
+           "PC_MAX_ITERATIONS", "MODE_GLOBAL", "MODE_PRS24", "ias15_loop",
+           "radau_spacings"]
+
+#: Gauss-Radau spacings h_1 .. h_7 on [0, 1] (h_0 = 0 is the start of the
+#: step): the roots of the degree-7 Radau polynomial, as printed by Everhart
+#: (1985) and Rein & Spiegel (2015, eq. 8); tests/integrators/test_ias15.py
+#: checks them against the roots computed from Legendre polynomials.
+SPACINGS = np.array([
+    0.0562625605369221464656521910318,
+    0.180240691736892364987579942780,
+    0.352624717113169637373907769648,
+    0.547153626330555383001448554766,
+    0.734210177215410531523210605558,
+    0.885320946839095768090359771030,
+    0.977520613561287501891174488626,
+])
+
+#: A step is redone when the step it implies is below SAFETY times itself, and
+#: the next step grows at most by 1 / SAFETY (Rein & Spiegel 2015, sect. 3.4).
+SAFETY = 0.25
+#: The corrector has converged when the last change of b6 relative to the
+#: largest acceleration is below this (Rein & Spiegel 2015, sect. 3.2) ...
+PC_TOLERANCE = 1e-16
+#: ... or when that change stopped decreasing (it reached rounding) after at
+#: least two iterations; a step is never iterated more often than this.
+PC_MAX_ITERATIONS = 12
+
+MODE_GLOBAL = 0
+MODE_PRS24 = 1
+
+
+def radau_spacings():
+    """The spacings computed afresh: roots of ``(P_7(s) + P_8(s)) / (1 + s)`` with
+    ``s = 2h - 1`` (Gauss-Radau nodes with the fixed node at ``h = 0``)."""
+    from numpy.polynomial import legendre as L
+    p = L.Legendre.basis(7) + L.Legendre.basis(8)
+    roots = np.sort(p.roots().real)
+    roots = roots[roots > -1 + 1e-8]            # drop the fixed node s = -1
+    # polish by Newton's method on the full polynomial
+    for _ in range(3):
+        roots = roots - p(roots) / p.deriv()(roots)
+    return (roots + 1.0) / 2.0
+
+
+def _tables(h):
+    """C (b = C g), D = C^-1 (g = D b) and R (R[n, j] = 1 / (h_n - h_j), h_0 = 0),
+    computed in exact rational arithmetic from the float spacings ``h``."""
+    hs = [Fraction(0)] + [Fraction(float(x)) for x in h]
+    # N_k(h) = h (h - h_1) ... (h - h_k) = sum_m C[m, k] h^(m+1)
+    C = [[Fraction(0)] * 7 for _ in range(7)]
+    poly = [Fraction(1)]                         # coefficients of h^1, h^2, ... of N_k
+    for k in range(7):
+        if k > 0:
+            hk = hs[k]
+            new = [Fraction(0)] * (len(poly) + 1)
+            for m, c in enumerate(poly):
+                new[m + 1] += c
+                new[m] -= hk * c
+            poly = new
+        for m, c in enumerate(poly):
+            C[m][k] = c
+    # D = C^-1, upper triangular with unit diagonal
+    D = [[Fraction(0)] * 7 for _ in range(7)]
+    for k in range(7):
+        D[k][k] = Fraction(1)
+        for m in range(k - 1, -1, -1):
+            D[m][k] = -sum(C[m][j] * D[j][k] for j in range(m + 1, k + 1))
+    R = np.zeros((8, 8))
+    for n in range(1, 8):
+        for j in range(n):
+            R[n, j] = float(1 / (hs[n] - hs[j]))
+    return (np.array([[float(c) for c in row] for row in C]),
+            np.array([[float(c) for c in row] for row in D]), R)
+
+
+C_TABLE, D_TABLE, R_TABLE = _tables(SPACINGS)
+
+# constants read by the compiled loop (numba freezes global arrays)
+_H = SPACINGS
+_C = C_TABLE
+_D = D_TABLE
+_R = R_TABLE
+# binomial(k + 1, m + 1) for the extrapolation of b to the next step
+_BINOM = np.array([[float(math.comb(k + 1, m + 1)) for k in range(7)] for m in range(7)])
+# 7! = 5040: the Taylor coefficient of the seventh derivative (Pham et al. 2024)
+_FACT7 = 5040.0
+
+
+def _predict(b, e, br, er, u, q, P):
+    # The reference step's polynomial a(h), h in units of its length, re-expanded
+    # about h = u with the new step's scale q:
+    # e_m = q^(m+1) sum_{k >= m} binom(k+1, m+1) u^(k-m) br_k;  b = e + (br - er).
+    for m in range(7):
+        qm = q ** (m + 1)
+        for k in range(7):
+            P[m, k] = qm * _BINOM[m, k] * u ** (k - m) if k >= m else 0.0
+    n = b.shape[1]
+    for i in range(n):
+        for d in range(3):
+            for m in range(7):
+                s = 0.0
+                for k in range(m, 7):
+                    s += P[m, k] * br[k, i, d]
+                e[m, i, d] = s
+                b[m, i, d] = s + (br[m, i, d] - er[m, i, d])
+
+
+def _g_from_b(b, g):
+    n = b.shape[1]
+    for i in range(n):
+        for d in range(3):
+            for k in range(7):
+                s = 0.0
+                for m in range(k, 7):
+                    s += _D[k, m] * b[m, i, d]
+                g[k, i, d] = s
+
+
+def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, dtp, ref,
+                flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
+                epsilon, min_dt, mode):
+    # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
+    # ref = (length of the reference step, time from its start to now).
+    # counts: (accepted, rejected, force evaluations) of this call.
+    n = x.shape[0]
+    every = mon[0]
+    cap = mon_t.shape[0]
+    n_mon = 0
+    until_record = every - step0 % every if every > 0 else -1
+    counts[0] = 0
+    counts[1] = 0
+    counts[2] = 0
+    info[0] = -1
+    info[1] = -1
+    if t == t_end:
+        return Status.OK, t, n_mon
+    direction = 1.0 if t_end > t else -1.0
+    eps7 = epsilon ** (1.0 / 7.0)
+    prs7 = (_FACT7 * epsilon) ** (1.0 / 7.0)
+    while True:
+        if counts[0] >= max_steps:
+            return Status.OK, t, n_mon
+        if until_record == 1 and n_mon >= cap:
+            return Status.OK, t, n_mon               # caller collects the rows first
+        if flags[0] == 0:
+            force(x, v, t, fargs, a0)  # noqa: F821 - bound by specialize
+            counts[2] += 1
+            flags[0] = 1
+            s = 0.0
+            for i in range(n):
+                s += a0[i, 0] + a0[i, 1] + a0[i, 2]
+            if not math.isfinite(s):
+                flags[0] = 0
+                return Status.NON_FINITE, t, n_mon
+        proposed = dtp[0]
+        if proposed == 0.0 or not math.isfinite(proposed):
+            proposed = _first_step(x, a0, t_end - t)
+        proposed = abs(proposed) * direction
+        remaining = t_end - t
+        trimmed = abs(proposed) >= abs(remaining)
+        dt = remaining if trimmed else proposed
+        if not trimmed and (abs(dt) < min_dt or t + dt == t):
+            dtp[0] = proposed
+            return Status.STEP_UNDERFLOW, t, n_mon
+
+        # first guess of b
+        predicted = flags[1] != 0
+        if predicted:
+            _predict(b, e, br, er, ref[1] / ref[0], dt / ref[0], P)
+        else:
+            b[...] = 0.0
+            e[...] = 0.0
+        _g_from_b(b, g)
+
+        # predictor-corrector
+        err_last = 2.0
+        for it in range(PC_MAX_ITERATIONS):
+            maxdb6 = 0.0
+            maxa = 0.0
+            for sub in range(1, 8):
+                h = _H[sub - 1]
+                hdt = h * dt
+                for i in range(n):
+                    for d in range(3):
+                        xs[i, d] = x[i, d] + (csx[i, d] + hdt * (v[i, d] + hdt * (
+                            a0[i, d] / 2.0 + h * (b[0, i, d] / 6.0 + h * (
+                                b[1, i, d] / 12.0 + h * (b[2, i, d] / 20.0 + h * (
+                                    b[3, i, d] / 30.0 + h * (b[4, i, d] / 42.0 + h * (
+                                        b[5, i, d] / 56.0 + h * b[6, i, d] / 72.0)))))))))
+                        if PREDICT_V:  # noqa: F821 - bound by specialize
+                            vs[i, d] = v[i, d] + (csv[i, d] + hdt * (a0[i, d] + h * (
+                                b[0, i, d] / 2.0 + h * (b[1, i, d] / 3.0 + h * (
+                                    b[2, i, d] / 4.0 + h * (b[3, i, d] / 5.0 + h * (
+                                        b[4, i, d] / 6.0 + h * (b[5, i, d] / 7.0 + h * (
+                                            b[6, i, d] / 8.0)))))))))
+                force(xs, vs, t + hdt, fargs, acc)  # noqa: F821
+                for i in range(n):
+                    for d in range(3):
+                        r = (acc[i, d] - a0[i, d]) * _R[sub, 0]
+                        for j in range(1, sub):
+                            r = (r - g[j - 1, i, d]) * _R[sub, j]
+                        dg = r - g[sub - 1, i, d]
+                        g[sub - 1, i, d] = r
+                        for m in range(sub):
+                            b[m, i, d] += _C[m, sub - 1] * dg
+                        if sub == 7:
+                            db = abs(dg)
+                            if db > maxdb6 or not db == db:
+                                maxdb6 = db
+                            aa = abs(acc[i, d])
+                            if aa > maxa:
+                                maxa = aa
+            counts[2] += 7
+            err = maxdb6 / maxa if maxa > 0.0 else maxdb6
+            if not math.isfinite(err):
+                break
+            if err < PC_TOLERANCE or (it >= 1 and err >= err_last):
+                break
+            err_last = err
+
+        # step control: the global criterion always, the per-body timescale on top
+        worst = -1
+        maxb6 = 0.0
+        maxa = 0.0
+        for i in range(n):
+            for d in range(3):
+                bb = abs(b[6, i, d])
+                if bb > maxb6 or not bb == bb:
+                    maxb6 = bb
+                    worst = i
+                aa = abs(acc[i, d])
+                if aa > maxa:
+                    maxa = aa
+        # zero acceleration everywhere, or a polynomial acceleration that the
+        # step resolves exactly: nothing limits the step
+        if maxa > 0.0 and maxb6 > 0.0:
+            dt_new = dt * eps7 / (maxb6 / maxa) ** (1.0 / 7.0)
+        elif maxb6 == maxb6:
+            dt_new = dt / SAFETY
+        else:
+            dt_new = math.nan
+        if mode == MODE_PRS24 and dt_new == dt_new:
+            tau2 = math.inf
+            worst_prs = -1
+            for i in range(n):
+                y2 = 0.0
+                y3 = 0.0
+                y4 = 0.0
+                for d in range(3):
+                    a1 = a0[i, d] + (b[0, i, d] + b[1, i, d] + b[2, i, d] + b[3, i, d]
+                                     + b[4, i, d] + b[5, i, d] + b[6, i, d])
+                    j1 = (b[0, i, d] + 2.0 * b[1, i, d] + 3.0 * b[2, i, d] + 4.0 * b[3, i, d]
+                          + 5.0 * b[4, i, d] + 6.0 * b[5, i, d] + 7.0 * b[6, i, d])
+                    s1 = (2.0 * b[1, i, d] + 6.0 * b[2, i, d] + 12.0 * b[3, i, d]
+                          + 20.0 * b[4, i, d] + 30.0 * b[5, i, d] + 42.0 * b[6, i, d])
+                    y2 += a1 * a1
+                    y3 += j1 * j1
+                    y4 += s1 * s1
+                den = y3 + math.sqrt(y2 * y4)
+                # a body with no acceleration, or one whose acceleration the step
+                # resolves exactly, sets no timescale
+                if y2 > 0.0 and den > 0.0:
+                    tau = 2.0 * y2 / den
+                    if tau < tau2:
+                        tau2 = tau
+                        worst_prs = i
+            if tau2 < math.inf:
+                dt_prs = dt * math.sqrt(tau2) * prs7
+                # A body's timescale goes to zero as its acceleration passes
+                # through zero (a body crossing a symmetry point, the figure-eight's
+                # centre): steps would shrink geometrically towards that instant
+                # and never reach it.  The global criterion, which measures every
+                # body's error against the largest acceleration, does not see such
+                # a point, so it bounds the step from below.
+                if dt_prs > dt_new or not dt_prs >= 0.0:
+                    dt_new = dt_prs
+                    worst = worst_prs
+            else:
+                dt_new = dt / SAFETY
+        if not math.isfinite(dt_new):
+            info[0] = worst
+            return Status.NON_FINITE, t, n_mon
+
+        if abs(dt_new) < SAFETY * abs(dt):
+            # rejected: redo from the same state with the smaller step
+            counts[1] += 1
+            dtp[0] = dt_new
+            if abs(dt_new) < min_dt or t + dt_new == t:
+                info[0] = worst
+                return Status.STEP_UNDERFLOW, t, n_mon
+            continue
+        if abs(dt_new) > abs(dt) / SAFETY:
+            dt_new = dt / SAFETY
+
+        # accept: increments first, so that a non-finite one leaves (x, v) untouched
+        s = 0.0
+        for i in range(n):
+            for d in range(3):
+                # smallest terms first, so that they are not lost against a0
+                dx = dt * (v[i, d] + dt * (
+                    b[6, i, d] / 72.0 + b[5, i, d] / 56.0 + b[4, i, d] / 42.0
+                    + b[3, i, d] / 30.0 + b[2, i, d] / 20.0 + b[1, i, d] / 12.0
+                    + b[0, i, d] / 6.0 + a0[i, d] / 2.0))
+                dv = dt * (b[6, i, d] / 8.0 + b[5, i, d] / 7.0 + b[4, i, d] / 6.0
+                           + b[3, i, d] / 5.0 + b[2, i, d] / 4.0 + b[1, i, d] / 3.0
+                           + b[0, i, d] / 2.0 + a0[i, d])
+                xs[i, d] = dx
+                vs[i, d] = dv
+                s += dx + dv
+        if not math.isfinite(s):
+            return Status.NON_FINITE, t, n_mon
+        for i in range(n):
+            for d in range(3):
+                y = xs[i, d] + csx[i, d]
+                xn = x[i, d] + y
+                csx[i, d] = y - (xn - x[i, d])
+                x[i, d] = xn
+                y = vs[i, d] + csv[i, d]
+                vn = v[i, d] + y
+                csv[i, d] = y - (vn - v[i, d])
+                v[i, d] = vn
+        flags[0] = 0
+        t = t_end if trimmed else t + dt
+        counts[0] += 1
+        # a shortened last step leaves the proposed step as it was
+        if not trimmed:
+            proposed = dt_new
+        dtp[0] = proposed
+
+        # keep this step as the reference for extrapolation if it reaches the
+        # next step with the shorter stretch (in units of its own length)
+        if flags[1] == 0 or 1.0 + abs(proposed / dt) <= abs((ref[1] + dt + proposed) / ref[0]):
+            for m in range(7):
+                for i in range(n):
+                    for d in range(3):
+                        br[m, i, d] = b[m, i, d]
+                        er[m, i, d] = e[m, i, d] if predicted else b[m, i, d]
+            ref[0] = dt
+            ref[1] = dt
+            flags[1] = 1
+        else:
+            ref[1] += dt
+
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
+            mon_t[n_mon] = t
+            monitor_row(x, v, mon[2], mon[3], mon[4], mon[5], mon[1], mon_out[n_mon])
+            n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+        if stop != 0:
+            sinfo = sargs[6]
+            info[0] = sinfo[0]
+            info[1] = sinfo[1]
+            return stop, t, n_mon
+        if abs(proposed) < min_dt:
+            info[0] = worst
+            return Status.STEP_UNDERFLOW, t, n_mon
+        if t == t_end:
+            return Status.OK, t, n_mon
+
+
+def _first_step(x, a0, span):
+    # 1 % of sqrt(size / acceleration): the free-fall time across the system
+    # scaled down; the step control corrects it within a few steps
+    n = x.shape[0]
+    cx = 0.0
+    cy = 0.0
+    cz = 0.0
+    for i in range(n):
+        cx += x[i, 0]
+        cy += x[i, 1]
+        cz += x[i, 2]
+    cx /= n
+    cy /= n
+    cz /= n
+    size = 0.0
+    amax = 0.0
+    for i in range(n):
+        r = math.sqrt((x[i, 0] - cx) ** 2 + (x[i, 1] - cy) ** 2 + (x[i, 2] - cz) ** 2)
+        a = math.sqrt(a0[i, 0] ** 2 + a0[i, 1] ** 2 + a0[i, 2] ** 2)
+        size = max(size, r)
+        amax = max(amax, a)
+    if size > 0.0 and amax > 0.0:
+        return min(0.01 * math.sqrt(size / amax), abs(span))
+    return abs(span)
+
+
+_JITTED = {"_predict": njit(_predict), "_g_from_b": njit(_g_from_b),
+           "_first_step": njit(_first_step)}
+
+
+def ias15_loop(force, stop=False):
+    """The IAS15 loop compiled for a :class:`~orbits._kernels.stepping.ForceKernel`.
+
+    ``stop`` compiles in the stopping conditions of :mod:`.stopping`.
+    Velocities are predicted at the substeps only for forces that read them
+    (gravity does not).
+
+    The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
+    dt, ref, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs,
+    max_steps, epsilon, min_dt, mode)`` with the arrays of
+    :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
+    t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
+    """
+    predict_v = not force.key.startswith("gravity")
+    helpers = _JITTED if force.jit else {}
+    suffix = f"{force.key}{'_stop' if stop else ''}"
+    return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,
+                      force=force.kernel, stop_check=check_stop if stop else no_stop,
+                      PREDICT_V=predict_v, monitor_row=monitor_row, **helpers)
