@@ -16,7 +16,7 @@ import astropy.units as u
 import numpy as np
 
 from ._kernels import kepler as _kepler
-from .errors import (BodyError, BodyUnitsError, CoincidentBodiesError, DuplicateBodyError,
+from .errors import (BodyError, CoincidentBodiesError, DuplicateBodyError,
                      ElementsError, NoMassiveBodyError, UnknownBodyError)
 from .units import UnitSystem
 

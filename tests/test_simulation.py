@@ -1,6 +1,5 @@
 """Simulation.run: outputs, continuation, failures and bad input."""
 
-import math
 
 import astropy.units as u
 import numpy as np

@@ -13,7 +13,7 @@ evaluations a step (the first stage is shared).
 import math
 
 from ._jit import specialize
-from .embedded import FAC_MAX, FAC_MIN, SAFETY
+from .embedded import FAC_MAX, FAC_MIN, SAFETY, initial_step
 from .status import Status
 from .stepping import _record
 from .stopping import check_stop, no_stop
@@ -71,18 +71,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         fsal[0] = 1
     h_prop = dtbox[0]
     if h_prop <= 0.0:
-        d0 = 0.0
-        d1 = 0.0
-        for i in range(n):
-            for d in range(3):
-                sx = atol + rtol * abs(x[i, d])
-                sv = atol + rtol * abs(v[i, d])
-                d0 += (x[i, d] / sx) ** 2 + (v[i, d] / sv) ** 2
-                d1 += (k0x[i, d] / sx) ** 2 + (k0v[i, d] / sv) ** 2
-        d0 = math.sqrt(d0 / ncomp)
-        d1 = math.sqrt(d1 / ncomp)
-        h_prop = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-        h_prop = min(h_prop, t_end - t)
+        h_prop = initial_step(x, v, k0x, k0v, rtol, atol, t_end - t)
     status = Status.OK
     while steps < max_steps and t < t_end:
         h = h_prop

@@ -18,17 +18,35 @@ the step sequence.
 
 import math
 
-from ._jit import specialize
+from ._jit import njit, specialize
 from .status import Status
 from .stepping import _record
 from .stopping import check_stop, no_stop
 
-__all__ = ["embedded_loop", "SAFETY", "FAC_MIN", "FAC_MAX"]
+__all__ = ["embedded_loop", "initial_step", "SAFETY", "FAC_MIN", "FAC_MAX"]
 
 SAFETY = 0.9   # step-size safety factor (HNW II.4)
 FAC_MIN = 0.2  # a rejected step shrinks by at most 5
 FAC_MAX = 10.0  # an accepted step grows by at most 10
 _EPS = 2.220446049250313e-16
+
+
+@njit
+def initial_step(x, v, fx, fv, rtol, atol, span):
+    """A first step size from the sizes of y and y' in the error norm (HNW II.4)."""
+    n = x.shape[0]
+    d0 = 0.0
+    d1 = 0.0
+    for i in range(n):
+        for d in range(3):
+            sx = atol + rtol * abs(x[i, d])
+            sv = atol + rtol * abs(v[i, d])
+            d0 += (x[i, d] / sx) ** 2 + (v[i, d] / sv) ** 2
+            d1 += (fx[i, d] / sx) ** 2 + (fv[i, d] / sv) ** 2
+    d0 = math.sqrt(d0 / (6 * n))
+    d1 = math.sqrt(d1 / (6 * n))
+    h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    return min(h, span)
 
 
 def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
@@ -53,19 +71,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
         fsal[0] = 1
     h_prop = dtbox[0]
     if h_prop <= 0.0:
-        # starting step (HNW II.4): from the sizes of y and y' in the error norm
-        d0 = 0.0
-        d1 = 0.0
-        for i in range(n):
-            for d in range(3):
-                sx = atol + rtol * abs(x[i, d])
-                sv = atol + rtol * abs(v[i, d])
-                d0 += (x[i, d] / sx) ** 2 + (v[i, d] / sv) ** 2
-                d1 += (kx[0, i, d] / sx) ** 2 + (kv[0, i, d] / sv) ** 2
-        d0 = math.sqrt(d0 / ncomp)
-        d1 = math.sqrt(d1 / ncomp)
-        h_prop = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-        h_prop = min(h_prop, t_end - t)
+        h_prop = initial_step(x, v, kx[0], kv[0], rtol, atol, t_end - t)
     status = Status.OK
     while steps < max_steps and t < t_end:
         h = h_prop

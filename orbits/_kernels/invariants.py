@@ -7,7 +7,6 @@ the sum to about one rounding error whatever N is.
 
 import math
 
-import numpy as np
 
 from ._jit import njit
 

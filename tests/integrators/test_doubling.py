@@ -6,36 +6,14 @@ import numpy as np
 import pytest
 
 import orbits
-from orbits._kernels import stepping
-from orbits._kernels.gravity import pair_workspace
 
-from helpers import kepler_bodies
-
-
-def one_orbit(n, e=0.2):
-    # loose tolerances: every step accepted, so the steps are exactly 2 pi / n
-    integ = orbits.integrators.get("rk4-doubling", rtol=1e6, atol=1e6)
-    b = kepler_bodies(e=e)
-    x, v = b.positions.value.copy(), b.velocities.value.copy()
-    x0, v0 = x.copy(), v.copy()
-    m = b.masses.value
-    ws = integ.workspace(2, 2 * math.pi / n)
-    fargs = (m.copy(), 1, 0.0, pair_workspace(2, 1))
-    force = stepping.gravity_force("small")
-    mon = (0, 0, m, 1.0, 1, 0.0)
-    t = 0.0
-    for k in range(n):
-        status, t, acc, rej, fev, _ = integ.advance_to(
-            ws, x, v, t, (k + 1) * 2 * math.pi / n, force, fargs, mon, k, np.empty(0),
-            np.zeros((0, 10)), None, 10)
-        assert status == 0 and acc == 1 and rej == 0 and fev in (11, 12)
-    return np.abs(x - x0).max() + np.abs(v - v0).max()
+from helpers import adaptive_fixed_steps_error, kepler_bodies
 
 
 def test_order_four_with_fixed_steps():
     # the kept result is two RK4 half steps: fourth order (no extrapolation);
     # 100..400 steps per orbit at e = 0.2 are in the asymptotic range
-    errs = [one_orbit(n) for n in (100, 200, 400)]
+    errs = [adaptive_fixed_steps_error("rk4-doubling", n) for n in (100, 200, 400)]
     orders = [math.log2(errs[i] / errs[i + 1]) for i in range(2)]
     assert all(abs(p - 4) < 0.2 for p in orders), (orders, errs)
 

@@ -6,11 +6,9 @@ import numpy as np
 import pytest
 
 import orbits
-from orbits._kernels import stepping
-from orbits._kernels.gravity import pair_workspace
 from orbits.errors import IntegratorOptionError
 
-from helpers import kepler_bodies
+from helpers import adaptive_fixed_steps_error, kepler_bodies
 
 PAIRS = ["dopri5", "dop853"]
 
@@ -27,29 +25,6 @@ def test_table_algebra(name):
     assert np.all(np.triu(A) == 0)
 
 
-def fixed_step_error(name, n, e=0.5):
-    """Global error after one orbit taken in n equal steps (tolerances so loose
-    that every step is accepted and the controller only proposes longer ones)."""
-    integ = orbits.integrators.get(name, rtol=1e6, atol=1e6)
-    b = kepler_bodies(e=e)
-    x, v = b.positions.value.copy(), b.velocities.value.copy()
-    x0, v0 = x.copy(), v.copy()
-    m = b.masses.value
-    ws = integ.workspace(2, 2 * math.pi / n)
-    fargs = (m.copy(), 1, 0.0, pair_workspace(2, 1))
-    force = stepping.gravity_force("small")
-    mon = (0, 0, m, 1.0, 1, 0.0)
-    t = 0.0
-    h = 2 * math.pi / n
-    for k in range(n):
-        t_end = (k + 1) * h
-        status, t, acc, rej, fev, _ = integ.advance_to(ws, x, v, t, t_end, force, fargs, mon,
-                                                       k, np.empty(0), np.zeros((0, 10)),
-                                                       None, 10)
-        assert status == 0 and acc == 1 and rej == 0
-    return np.abs(x - x0).max() + np.abs(v - v0).max()
-
-
 @pytest.mark.parametrize("name, steps", [("dopri5", (100, 200, 400)),
                                          ("dop853", (20, 40, 80))])
 def test_fixed_step_order(name, steps):
@@ -58,7 +33,7 @@ def test_fixed_step_order(name, steps):
     # (smallest errors 8e-10 and 1e-12; at e = 0.5 the asymptotic range is
     # reached only just above the rounding floor)
     declared = orbits.integrators.get(name).order
-    errs = [fixed_step_error(name, n, e=0.2) for n in steps]
+    errs = [adaptive_fixed_steps_error(name, n, e=0.2) for n in steps]
     orders = [math.log2(errs[i] / errs[i + 1]) for i in range(len(errs) - 1)]
     assert all(abs(p - declared) < 0.3 for p in orders), (orders, errs)
 
