@@ -319,8 +319,12 @@ def local_cluster(n_workers=None):
     n = os.cpu_count() if n_workers is None else int(n_workers)
     if n < 1:
         raise ValueError(f"n_workers must be >= 1, got {n_workers}")
+    # no dashboard; the scheduler's small HTTP endpoint (health, metrics) takes a
+    # free loopback port rather than 8787, so that two sweeps at once do not clash
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                            host="127.0.0.1", dashboard_address=None,
+                           scheduler_kwargs={"dashboard": False,
+                                             "dashboard_address": "127.0.0.1:0"},
                            env=dict(WORKER_ENVIRONMENT))
     return Client(cluster)
 
@@ -342,7 +346,7 @@ def run_one(build, params, index, spec, path=None):
     Failures of the run become its outcome; an :class:`~orbits.errors.OrbitsError`
     from ``build`` is the outcome ``"invalid"``.
     """
-    _limit_numba_threads()
+    _sync_numba_config()
     row = {"run": index}
     for k, val in params.items():
         if isinstance(val, u.Quantity):
@@ -380,14 +384,25 @@ def run_one(build, params, index, spec, path=None):
     return row
 
 
-def _limit_numba_threads():
-    # A worker whose script imported numba before the nanny set the worker's
-    # environment has numba's default pool size; keep to what the environment says.
-    want = os.environ.get("NUMBA_NUM_THREADS")
-    if want and want.isdigit() and int(want) >= 1:
+def _sync_numba_config():
+    """Keep this task to the numba threads its environment allows.
+
+    On a worker whose script imported orbits at the top, numba read its
+    environment before the nanny set the worker's (``NUMBA_NUM_THREADS=1``):
+    its thread pool has the machine's size, fixed at import.  Re-read the
+    environment now, before the pool starts, or the first compilation after it
+    started would fail on the changed setting; and use no more threads than the
+    environment says.
+    """
+    from numba.core import config
+    from numba.np.ufunc import parallel
+    try:
+        config.reload_config()
+    except RuntimeError:       # the pool already runs with another size: leave it
+        return
+    if config.NUMBA_NUM_THREADS < parallel.NUM_THREADS:
         import numba
-        if numba.get_num_threads() > int(want):
-            numba.set_num_threads(int(want))
+        numba.set_num_threads(config.NUMBA_NUM_THREADS)   # this thread's share
 
 
 def _advance(sim, spec, path):

@@ -1,5 +1,7 @@
 """Ensembles on Dask: rows, outcomes, perturbations, resuming, and serial == cluster."""
 
+import pathlib
+import runpy
 import subprocess
 import sys
 
@@ -250,23 +252,49 @@ def test_an_existing_cluster_by_client_or_address(serial):
             assert df.drop(columns=WHERE).equals(serial.iloc[:4].drop(columns=WHERE))
         assert client.status == "running"      # a cluster it was given, it leaves open
         assert set(client.run(numba.get_num_threads).values()) == {1}   # one per process
+        # nothing listens beyond the loopback interface
+        info = client.scheduler_info()
+        assert all(a.startswith("tcp://127.0.0.1:") for a in
+                   [client.scheduler.address, *info["workers"]])
     finally:
         client.close()
         client.cluster.close()
 
 
-def test_a_task_keeps_to_the_numba_threads_its_environment_allows(monkeypatch):
-    # a worker started by a script that imports orbits has numba imported before
-    # the nanny sets NUMBA_NUM_THREADS; the task itself then limits the threads
-    before = numba.get_num_threads()
-    if numba.config.NUMBA_NUM_THREADS < 2:
-        pytest.skip("numba has one thread here anyway")
-    monkeypatch.setenv("NUMBA_NUM_THREADS", "1")
+WORKER_SCRIPT = """
+import astropy.units as u
+import numba
+import orbits                       # imported by each worker before its environment is set
+from orbits.ensemble import local_cluster
+
+def build(e):
+    return orbits.Simulation(orbits.scenes.kepler(e=e), integrator="leapfrog", dt=1 * u.day)
+
+def compile_something():
+    return numba.njit(lambda x: x + 1)(1)
+
+if __name__ == "__main__":
+    client = local_cluster(1)
     try:
-        Ensemble(planet, SWEEP[:1]).run(100 * u.yr, client="serial", progress=False)
-        assert numba.get_num_threads() == 1
+        orbits.Ensemble(build, [{"e": 0.1}, {"e": 0.2}]).run(1 * u.yr, client=client,
+                                                              progress=False)
+        print(client.submit(numba.get_num_threads, pure=False).result(),
+              client.submit(compile_something, pure=False).result())
     finally:
-        numba.set_num_threads(before)
+        client.close()
+        client.cluster.close()
+"""
+
+
+def test_workers_use_one_numba_thread_even_if_the_script_imported_numba_first(tmp_path):
+    # the worker's task thread uses one numba thread, and compiling after the
+    # pool started still works (numba refuses a thread count changed under it)
+    script = tmp_path / "sweep.py"
+    script.write_text(WORKER_SCRIPT)
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         cwd=tmp_path, timeout=120)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert out.stdout.strip().splitlines()[-1] == "1 2"
 
 
 def test_import_orbits_imports_neither_dask_nor_pandas():
@@ -303,17 +331,27 @@ def test_the_readme_commands_for_an_existing_cluster(serial, tmp_path):
     try:
         time.sleep(2)
         procs.append(subprocess.Popen(["dask", "worker", "tcp://127.0.0.1:8786", "--nworkers",
-                                       "2", "--nthreads", "1", "--no-dashboard"], env=env,
+                                       "-1", "--nthreads", "1", "--no-dashboard"], env=env,
                                       cwd=tmp_path, stdout=subprocess.DEVNULL,
                                       stderr=subprocess.DEVNULL))
         from distributed import Client
         with Client("tcp://127.0.0.1:8786", timeout=30) as client:
-            client.wait_for_workers(2, timeout=60)
+            client.wait_for_workers(os.cpu_count(), timeout=60)   # one per core
         df = Ensemble(planet, SWEEP).run(UNTIL, client="tcp://127.0.0.1:8786",
                                          progress=False)
         assert df.drop(columns=WHERE).equals(serial.drop(columns=WHERE))
-        assert df.groupby("worker").ngroups == 2
+        assert df.groupby("worker").ngroups == min(2, os.cpu_count())
     finally:
         for p in reversed(procs):
             p.terminate()
             p.wait(timeout=30)
+
+
+def test_stability_map_example(tmp_path, capsys):
+    example = pathlib.Path(__file__).resolve().parents[1] / "examples" / "stability_map.py"
+    mod = runpy.run_path(str(example))
+    df = mod["main"](n=3, until=300 * u.yr, client="serial", png=tmp_path / "map.png")
+    assert len(df) == 9 and (tmp_path / "map.png").stat().st_size > 10_000
+    # a = 5.9 au with e = 0.5 crosses Jupiter's orbit: an encounter within 300 yr
+    assert df.loc[2].outcome == "close-encounter"
+    assert "9 runs to 300 yr" in capsys.readouterr().out
