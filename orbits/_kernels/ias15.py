@@ -141,6 +141,9 @@ _D = D_TABLE
 _R = R_TABLE
 # binomial(k + 1, m + 1) for the extrapolation of b to the next step
 _BINOM = np.array([[float(math.comb(k + 1, m + 1)) for k in range(7)] for m in range(7)])
+# 1 / ((k + 2) (k + 3)) and 1 / (k + 2): the predictor's integration weights
+_X0, _X1, _X2, _X3, _X4, _X5, _X6 = (1.0 / ((k + 2) * (k + 3)) for k in range(7))
+_V0, _V1, _V2, _V3, _V4, _V5, _V6 = (1.0 / (k + 2) for k in range(7))
 # 7! = 5040: the Taylor coefficient of the seventh derivative (Pham et al. 2024)
 _FACT7 = 5040.0
 
@@ -149,10 +152,16 @@ def _predict(b, e, br, er, u, q, P):
     # The reference step's polynomial a(h), h in units of its length, re-expanded
     # about h = u with the new step's scale q:
     # e_m = q^(m+1) sum_{k >= m} binom(k+1, m+1) u^(k-m) br_k;  b = e + (br - er).
+    qm = 1.0
     for m in range(7):
-        qm = q ** (m + 1)
+        qm *= q
+        uk = qm
         for k in range(7):
-            P[m, k] = qm * _BINOM[m, k] * u ** (k - m) if k >= m else 0.0
+            if k >= m:
+                P[m, k] = _BINOM[m, k] * uk
+                uk *= u
+            else:
+                P[m, k] = 0.0
     n = b.shape[1]
     for i in range(n):
         for d in range(3):
@@ -242,16 +251,16 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 for i in range(n):
                     for d in range(3):
                         xs[i, d] = x[i, d] + (csx[i, d] + hdt * (v[i, d] + hdt * (
-                            a0[i, d] / 2.0 + h * (b[0, i, d] / 6.0 + h * (
-                                b[1, i, d] / 12.0 + h * (b[2, i, d] / 20.0 + h * (
-                                    b[3, i, d] / 30.0 + h * (b[4, i, d] / 42.0 + h * (
-                                        b[5, i, d] / 56.0 + h * b[6, i, d] / 72.0)))))))))
+                            a0[i, d] * 0.5 + h * (b[0, i, d] * _X0 + h * (
+                                b[1, i, d] * _X1 + h * (b[2, i, d] * _X2 + h * (
+                                    b[3, i, d] * _X3 + h * (b[4, i, d] * _X4 + h * (
+                                        b[5, i, d] * _X5 + h * b[6, i, d] * _X6)))))))))
                         if PREDICT_V:  # noqa: F821 - bound by specialize
                             vs[i, d] = v[i, d] + (csv[i, d] + hdt * (a0[i, d] + h * (
-                                b[0, i, d] / 2.0 + h * (b[1, i, d] / 3.0 + h * (
-                                    b[2, i, d] / 4.0 + h * (b[3, i, d] / 5.0 + h * (
-                                        b[4, i, d] / 6.0 + h * (b[5, i, d] / 7.0 + h * (
-                                            b[6, i, d] / 8.0)))))))))
+                                b[0, i, d] * _V0 + h * (b[1, i, d] * _V1 + h * (
+                                    b[2, i, d] * _V2 + h * (b[3, i, d] * _V3 + h * (
+                                        b[4, i, d] * _V4 + h * (b[5, i, d] * _V5 + h * (
+                                            b[6, i, d] * _V6)))))))))
                 force(xs, vs, t + hdt, fargs, acc)  # noqa: F821
                 for i in range(n):
                     for d in range(3):
