@@ -27,6 +27,25 @@ it (the leapfrog's two half drifts become one), and :func:`synchronize` applies
 it to a copy when the inertial state is wanted.  The Jacobi state and the
 deferred drift live in the workspace between calls.
 
+Symplectic correctors (Wisdom, Holman & Touma 1996 [4]; Wisdom 2006 [5]).  The
+map ``K = K(h/2) I(h) K(h/2)`` is, to first order in the mass ratio, conjugate
+to the true flow ``T``: ``T = C K C^-1`` with a near-identity ``C`` built
+from the stages ::
+
+    Z(a, b) = K(a) I(-b) K(-2a) I(b) K(a)      (applied left to right)
+
+(``I(b) = exp(b L_B)`` transported along the Kepler flow, whose first-order
+generator is ``2 b sinh(a ad_A) H_int``).  ``C`` applies ``Z(a_m, b_m)``
+first and ``Z(a_1, b_1)`` last; ``C^-1`` applies ``Z(-a_1, b_1)`` first,
+the exact inverse stage by stage.  The loop starts from ``C^-1`` of the
+initial state (:func:`apply_corrector` with ``inverse``) and the output is
+``C`` of the mapping state, so the error of the output is that of ``T``
+up to ``O(epsilon h^(n+1) + epsilon^2 h^2)``.  ``C`` is applied only to the
+copy that :func:`synchronize` makes; the mapping state goes on untouched.
+The corrector of ``K(h)`` also conjugates ``K(-h) = K(h)^-1``, so it is
+built from ``|h|``: a run backwards keeps the mapping state, and reversing
+a corrected run returns to its start up to rounding.
+
 References
 ----------
 .. [1] Wisdom, J. & Holman, M. 1991, "Symplectic maps for the N-body
@@ -35,6 +54,10 @@ References
    of a symplectic Wisdom-Holman integrator for long-term gravitational
    simulations", MNRAS 452, 376 (lazy synchronisation).
 .. [3] Laskar, J. & Robutel, P. 2001, Celest. Mech. Dyn. Astron. 80, 39.
+.. [4] Wisdom, J., Holman, M. & Touma, J. 1996, "Symplectic correctors",
+   Fields Institute Communications 10, 217.
+.. [5] Wisdom, J. 2006, "Symplectic correctors for canonical heliocentric
+   coordinates", AJ 131, 2294.
 """
 
 import math
@@ -45,7 +68,8 @@ from .kepler import kepler_drift
 from .status import Status
 from .stepping import DRIFT, _record, state_is_finite
 
-__all__ = ["wh_loop", "interaction_kick", "kepler_drift_all", "synchronize"]
+__all__ = ["wh_loop", "interaction_kick", "kepler_drift_all", "synchronize",
+           "apply_corrector"]
 
 
 @njit(inline="always")
@@ -126,28 +150,69 @@ def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
 
 
 @njit
-def synchronize(xj, vj, gm, eta, owed, xs, vs, x, v):
+def apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse):
+    """Apply the symplectic corrector ``C`` (or ``C^-1`` if ``inverse``) for the
+    step ``h`` to the Jacobi state ``xj``, ``vj`` in place.
+
+    ``corr`` (shape (m, 2)) holds the stages' ``(a_i, b_i)`` in units of the
+    step; ``x`` and ``acc`` (shape (N, 3)) are scratch.  See the module notes.
+    """
+    m = corr.shape[0]
+    for k in range(m):
+        if inverse:
+            a = -corr[k, 0] * h
+            b = corr[k, 1] * h
+        else:
+            a = corr[m - 1 - k, 0] * h
+            b = corr[m - 1 - k, 1] * h
+        kepler_drift_all(xj, vj, eta, a)
+        interaction_kick(xj, vj, x, acc, gm, eta, n_active, -b)
+        kepler_drift_all(xj, vj, eta, -2.0 * a)
+        interaction_kick(xj, vj, x, acc, gm, eta, n_active, b)
+        kepler_drift_all(xj, vj, eta, a)
+
+
+@njit
+def synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
     """Inertial ``x``, ``v`` at the current time: the Jacobi state with the
-    deferred drift ``owed`` applied to a copy (``xs``, ``vs``)."""
+    deferred drift ``owed`` and then the corrector ``corr`` for the step ``h``
+    (none if it has no rows) applied to a copy (``xs``, ``vs``); ``acc`` is
+    scratch."""
     xs[...] = xj
     vs[...] = vj
     if owed != 0.0:
         kepler_drift_all(xs, vs, eta, owed)
+    if corr.shape[0] > 0:
+        apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, False)
     from_jacobi(xs, vs, gm, eta, x, v)
 
 
 def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
-             mon, step0, mon_t, mon_out, check_every):
+             corr, cdt, mon, step0, mon_t, mon_out, check_every):
     # state[0]: xj, vj hold the current state (else start from x, v);
     # owed_box[0]: the drift the Jacobi state still owes, deferred from the
-    # last step's closing drift.
+    # last step's closing drift; cdt[0]: the step the mapping state's
+    # corrector belongs to (corr has no rows without corrector).
     n = x.shape[0]
     every = mon[0]
     n_mon = 0
+    corrected = corr.shape[0] > 0
     if state[0] == 0:
         to_jacobi(x, v, gm, eta, xj, vj)
         state[0] = 1
         owed_box[0] = 0.0
+        if corrected:
+            apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True)
+            cdt[0] = abs(dt)
+    elif corrected and cdt[0] != abs(dt):
+        # a new step size (a shorter last step): through the true state to the
+        # mapping state of the new step's corrector
+        if owed_box[0] != 0.0:
+            kepler_drift_all(xj, vj, eta, owed_box[0])
+            owed_box[0] = 0.0
+        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], False)
+        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True)
+        cdt[0] = abs(dt)
     owed = owed_box[0]
     n_ops = len(KINDS)  # noqa: F821 - bound by specialize
     defer = KINDS[n_ops - 1] == DRIFT  # noqa: F821
@@ -175,7 +240,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         until_record -= 1
         if until_record == 0:
             until_record = every
-            synchronize(xj, vj, gm, eta, owed, xs, vs, x, v)
+            synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0])
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1
     owed_box[0] = owed

@@ -10,6 +10,7 @@ two operators with more stages, bringing the error to
 ``O(epsilon h^(2n) + epsilon^2 h^2)``.
 """
 
+import math
 import warnings
 
 import numpy as np
@@ -22,7 +23,8 @@ from . import tableaux
 from .base import Integrator
 
 __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
-           "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS"]
+           "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS", "CORRECTOR_SPACING",
+           "corrector_stages"]
 
 #: Above this ratio of the largest other mass to the central one the split's
 #: premise fails: the kicks are no longer small against the Kepler drifts and
@@ -33,9 +35,36 @@ MASS_RATIO_LIMIT = 0.01
 #: coordinate systems: name -> implemented
 COORDINATES = {"jacobi": True, "democratic-heliocentric": False}
 
-#: symplectic corrector orders (Wisdom, Holman & Touma 1996; Wisdom 2006):
-#: order -> implemented
-CORRECTORS = {0: True, 3: False, 5: False, 7: False, 11: False, 17: False}
+#: Spacing of the corrector stages: stage i is ``Z(a_i h, b_i h)`` with
+#: ``a_i = i * CORRECTOR_SPACING`` (Wisdom, Holman & Touma 1996; Wisdom 2006).
+CORRECTOR_SPACING = math.sqrt(7.0 / 40.0)
+
+#: symplectic correctors (Wisdom, Holman & Touma 1996; Wisdom 2006): order ->
+#: the stage weights ``b_i`` (i = 1, 2, ...).  The corrector of order
+#: ``n = 2m + 1`` has m stages whose first-order generator
+#: ``sum_i 2 b_i sinh(a_i L)`` (``L = h ad_{H_Kepler}``) matches that of the
+#: conjugating map, ``1 / (2 sinh(L/2)) - 1/L = -L/24 + 7 L^3/5760 - ...``,
+#: through ``L^(2m-1)``: a Vandermonde system in the ``a_i^(2k-1)``, solved in
+#: 60-digit arithmetic (tests/integrators/test_wisdom_holman.py checks it).
+CORRECTORS = {
+    0: (),
+    3: (-0.0498011920555997349987,),
+    5: (-0.0830019867593328916645, 0.0166003973518665783329),
+    7: (-0.107928798186254997444, 0.0365418464934042629561, -0.00498536228538442115581),
+    11: (-0.145186789497685477349, 0.0762432273625773010173, -0.0246181571840398926351,
+         0.00469744305845907083766, -0.000407231592957093026033),
+    17: (-0.186112207542851917183, 0.130385727152755787317, -0.0648443977294271605874,
+         0.0241435216446845821249, -0.0066265154138761311311, 0.00127199966151635317966,
+         -0.000152872710455871476726, 0.00000866948309467471603813),
+}
+
+
+def corrector_stages(order):
+    """The corrector of ``order`` as an array of ``(a_i, b_i)`` rows, shape (m, 2),
+    in units of the step (no rows for order 0)."""
+    b = CORRECTORS[order]
+    return np.array([[(i + 1) * CORRECTOR_SPACING, bi] for i, bi in enumerate(b)],
+                    dtype=np.float64).reshape(len(b), 2)
 
 
 class NoDominantBodyWarning(UserWarning):
@@ -51,8 +80,18 @@ class WisdomHolman(Integrator):
         The split.  Only ``"jacobi"`` is implemented so far; the other is
         refused with an error that says so.
     corrector : {0, 3, 5, 7, 11, 17}
-        Order of the symplectic corrector.  Only 0 (none) is implemented so
-        far; the others are refused with an error that says so.
+        Order of the symplectic corrector (0: none; only for ``wh`` itself,
+        not SABA).  The map then runs from ``C^-1`` of the initial state and
+        every output and monitor sees ``C`` of the mapping state, computed on
+        a copy, so the trajectory of the map is the same however often it is
+        looked at.  On the outer solar system at 1/20 of Jupiter's period
+        the energy error falls from 2.4e-6 to 1.5e-7 (3), 1.9e-8 (5) and
+        4e-9 (7 to 17), where the ``epsilon^2 h^2`` error that a first-order
+        corrector cannot remove is left.  The corrector costs ``4 m`` Kepler
+        drift sets and ``2 m`` kicks an output (``m = (order - 1) / 2``),
+        nothing a step.  A step of another size (a shorter last step) passes
+        through the corrected state, which moves the mapping state by the
+        correctors' second-order difference.
 
     Notes
     -----
@@ -73,7 +112,8 @@ class WisdomHolman(Integrator):
     without softening can be split this way.
 
     State kept between calls (lazy synchronisation, Rein & Tamayo 2015): the
-    Jacobi positions and velocities and the closing half drift still owed.
+    Jacobi positions and velocities, the closing half drift still owed and the
+    step the corrector was built for.
     Consecutive steps merge their half drifts into one, and the inertial
     state in ``x``, ``v`` is brought up to date only by :meth:`synchronize`
     (which outputs and monitors call), on a copy, so that the merged drifts
@@ -84,6 +124,8 @@ class WisdomHolman(Integrator):
     Wisdom, J. & Holman, M. 1991, "Symplectic maps for the N-body problem",
     AJ 102, 1528.  Rein, H. & Tamayo, D. 2015, "WHFAST: a fast and unbiased
     implementation of a symplectic Wisdom-Holman integrator", MNRAS 452, 376.
+    Wisdom, J., Holman, M. & Touma, J. 1996, "Symplectic correctors", Fields
+    Inst. Commun. 10, 217.  Wisdom, J. 2006, AJ 131, 2294.
 
     Examples
     --------
@@ -137,11 +179,11 @@ class WisdomHolman(Integrator):
             raise IntegratorOptionError(
                 f"{self.name}: unknown corrector order {corr!r}; valid: "
                 f"{', '.join(map(str, CORRECTORS))}")
-        if not CORRECTORS[corr]:
+        if corr and self.operators != tableaux.WH_DKD:
             raise IntegratorOptionError(
-                f"{self.name}: the symplectic corrector of order {corr} is not implemented "
-                f"yet; implemented: "
-                f"{', '.join(str(c) for c, ok in CORRECTORS.items() if ok)}")
+                f"{self.name}: the symplectic correctors belong to the Wisdom-Holman "
+                "map K(h/2) I(h) K(h/2); use 'wh', or corrector=0")
+        self._corr = corrector_stages(corr)
 
     def workspace(self, n):
         return {"xj": np.zeros((n, 3)), "vj": np.zeros((n, 3)),
@@ -149,7 +191,9 @@ class WisdomHolman(Integrator):
                 "gm": np.zeros(n), "eta": np.zeros(n),
                 # [Jacobi state current, system checked]
                 "state": np.zeros(2, dtype=np.int64),
-                "owed": np.zeros(1)}
+                "owed": np.zeros(1),
+                # the step whose corrector the Jacobi state carries, and N_active
+                "cdt": np.zeros(1), "n_active": np.zeros(1, dtype=np.int64)}
 
     def _check_system(self, ws, force, fargs):
         if not force.key.startswith("gravity"):
@@ -178,6 +222,7 @@ class WisdomHolman(Integrator):
                     "encounters) or 'verlet'/'leapfrog' with a small step.",
                     NoDominantBodyWarning, stacklevel=4)
         ws["gm"][:] = gm
+        ws["n_active"][0] = n_active
         _coordinates.interior_gm(gm, ws["eta"])
         ws["state"][1] = 1
 
@@ -188,15 +233,16 @@ class WisdomHolman(Integrator):
         gm, n_active = fargs[0], fargs[1]
         loop = _wh.wh_loop(self.name, self._kinds, self._coefs)
         return loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
-                    ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], mon, step0,
-                    mon_t, mon_out, check_every)
+                    ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
+                    ws["cdt"], mon, step0, mon_t, mon_out, check_every)
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
         its owed drift are kept, so that the following steps go on unchanged."""
         if ws["state"][0]:
             _wh.synchronize(ws["xj"], ws["vj"], ws["gm"], ws["eta"],
-                            ws["owed"][0], ws["xs"], ws["vs"], x, v)
+                            ws["owed"][0], ws["xs"], ws["vs"], x, v, ws["acc"],
+                            int(ws["n_active"][0]), self._corr, ws["cdt"][0])
 
     def invalidate(self, ws):
         """The state was changed from outside: start again from ``x``, ``v``."""

@@ -175,17 +175,16 @@ def test_no_warning_with_a_dominant_body():
         run(orbits.scenes.earth_moon(), "wh", 1 * u.hour, 10 * u.hour)
 
 
-def test_unknown_and_unimplemented_options_are_errors():
+def test_unknown_options_are_errors():
     with pytest.raises(IntegratorOptionError, match="'jacobi', 'democratic-heliocentric'"):
         orbits.integrators.get("wh", coordinates="heliocentric")
     with pytest.raises(IntegratorOptionError, match="0, 3, 5, 7, 11, 17"):
         orbits.integrators.get("wh", corrector=4)
-    # valid but not implemented: said so, never silently ignored
-    for corr in (3, 5, 7, 11, 17):
-        with pytest.raises(IntegratorOptionError, match="not implemented"):
-            orbits.integrators.get("wh", corrector=corr)
-    with pytest.raises(IntegratorOptionError, match="not implemented"):
-        orbits.integrators.get("wh", coordinates="democratic-heliocentric")
+    with pytest.raises(IntegratorOptionError, match="0, 3, 5, 7, 11, 17"):
+        orbits.integrators.get("wh", corrector=True)
+    # the correctors belong to the WH kernel, not to SABA's
+    with pytest.raises(IntegratorOptionError, match="corrector=0"):
+        orbits.integrators.get("saba2", corrector=3)
 
 
 def test_refuses_softening_and_other_forces():
@@ -214,3 +213,144 @@ def test_massless_bodies():
         r = run(tp, "wh", 50 * u.day, 50_000 * u.day, monitors=())
         final.append(r.positions.to_value(u.au)[-1])
     assert np.abs(final[0] - final[1]).max() < 1e-12 * np.abs(final[0]).max()
+
+
+# -- symplectic correctors ---------------------------------------------------------
+
+P_JUPITER = 4332.59  # days
+
+
+def wh(corrector=0, **kw):
+    return orbits.integrators.get("wh", corrector=corrector, **kw)
+
+
+@pytest.mark.parametrize("order", [3, 5, 7, 11, 17])
+def test_corrector_coefficients_solve_their_conditions(order):
+    # the first-order generator of the stages, sum_i 2 b_i sinh(a_i L), must
+    # match 1/(2 sinh(L/2)) - 1/L = sum_k B_2k(1/2) L^(2k-1) / (2k)! through
+    # L^(order-2); checked in 40-digit arithmetic for the table's doubles, to
+    # their rounding (2^-53 of each term)
+    mpmath = pytest.importorskip("mpmath")
+    from orbits.integrators.wisdom_holman import CORRECTORS, CORRECTOR_SPACING
+    mpmath.mp.dps = 40
+    alpha = mpmath.sqrt(mpmath.mpf(7) / 40)
+    assert float(alpha) == CORRECTOR_SPACING
+    b = [mpmath.mpf(str(x)) for x in CORRECTORS[order]]
+    assert len(b) == (order - 1) // 2
+    for k in range(1, len(b) + 1):
+        terms = [2 * bi * ((i + 1) * alpha) ** (2 * k - 1) / mpmath.factorial(2 * k - 1)
+                 for i, bi in enumerate(b)]
+        rhs = mpmath.bernpoly(2 * k, mpmath.mpf(1) / 2) / mpmath.factorial(2 * k)
+        assert abs(sum(terms) - rhs) < 2.0 ** -52 * sum(abs(t) for t in terms), (k, rhs)
+
+
+def energy_error(corrector, years, outputs=201):
+    b = orbits.scenes.outer_solar_system()
+    r = run(b, wh(corrector), P_JUPITER / 20 * u.day, years * u.yr, outputs=outputs,
+            monitors=("energy",))
+    return r.energy_error
+
+
+# Energy error over 1e4 years at dt = P_Jupiter / 20 (maximum over 200
+# outputs), measured against REBOUND's WHFast with the same corrector:
+#   order   0        3        5        7        11       17
+#   ours    2.37e-6  1.49e-7  1.92e-8  3.16e-9  3.73e-9  3.95e-9
+#   REBOUND 2.37e-6  1.49e-7  1.92e-8  3.14e-9  3.63e-9  3.75e-9
+# Each order removes the next epsilon h^k term until, from order 7 on, the
+# epsilon^2 h^2 error that no first-order corrector touches is left (about
+# 4e-9 here for both codes).  The 1e-9 for order 17 is below that
+# floor at this step and is out of reach of the method, not of the code;
+# the bounds are the measured values with a margin of 1.5-2.
+CORRECTED_ENERGY_BOUND = {0: 5e-6, 3: 3e-7, 5: 4e-8, 7: 8e-9, 11: 8e-9, 17: 8e-9}
+
+
+def test_correctors_reduce_the_energy_error():
+    errs = {k: energy_error(k, 1e4).max() for k in CORRECTED_ENERGY_BOUND}
+    for k, bound in CORRECTED_ENERGY_BOUND.items():
+        assert errs[k] < bound, errs
+    # far below the uncorrected map; each of 3, 5, 7 a clear step down
+    assert errs[17] < errs[0] / 300
+    assert errs[0] > 5 * errs[3] > 25 * errs[5] > 100 * errs[7]
+
+
+@pytest.mark.slow
+def test_order_17_corrector_for_a_million_years():
+    # measured over 1e6 years (2000 outputs): 4.9e-9, first and last tenth
+    # 4.24e-9 and 4.21e-9; REBOUND's WHFast with corrector 17: 4.2e-9 (3.5e-9
+    # and 4.0e-9).  Without corrector both give 2.6-2.9e-6.  Bounded, no
+    # secular trend; see CORRECTED_ENERGY_BOUND for why not 1e-9.
+    err = energy_error(17, 1e6, outputs=2001)
+    assert err.max() < CORRECTED_ENERGY_BOUND[17]
+    tenth = len(err) // 10
+    assert err[-tenth:].max() < 1.5 * err[1:tenth].max()
+
+
+@pytest.mark.parametrize("dt, bound", [(10.0, 1e-11), (P_JUPITER / 20, 2e-8)])
+def test_corrected_positions_match_rebound_whfast(dt, bound):
+    # REBOUND's WHFast with the order-17 corrector, the same bodies and step:
+    # after 10,000 steps measured 1.9e-12 relative at dt = 10 days (rounding)
+    # and 5e-9 at P_Jupiter / 20, where the two correctors, equal to first
+    # order in the mass ratio, differ at second order (1.3e-10 after one
+    # step) and the difference drifts in phase.  The correction itself is
+    # 1e-4 there, so the agreement checks the corrector, not only the map.
+    rebound = pytest.importorskip("rebound")
+    bodies = orbits.scenes.outer_solar_system()
+    n = 10_000
+    x = run(bodies, wh(17), dt * u.day, n * dt * u.day, monitors=()).positions
+    x = x.to_value(u.au)[-1]
+    x0 = run(bodies, wh(0), dt * u.day, n * dt * u.day, monitors=()).positions
+    x0 = x0.to_value(u.au)[-1]
+    reb = bodies.to_rebound()
+    reb.integrator = "whfast"
+    reb.integrator.safe_mode = 0
+    reb.integrator.corrector = 17
+    reb.dt = dt
+    reb.steps(n)
+    reb.synchronize()
+    xr = np.array([p.xyz for p in reb.particles])
+    rel = np.linalg.norm(x - xr, axis=1) / np.linalg.norm(xr, axis=1)
+    assert rel.max() < bound, rel
+    shift = np.linalg.norm(x0 - xr, axis=1) / np.linalg.norm(xr, axis=1)
+    assert shift[1:].min() > 100 * rel.max()
+
+
+def test_corrector_outputs_do_not_disturb_the_run():
+    b = orbits.scenes.outer_solar_system()
+    few = run(b, wh(17), 20 * u.day, 20_000 * u.day, outputs=2, monitors=())
+    many = run(b, wh(17), 20 * u.day, 20_000 * u.day, outputs=101, monitor_every=7)
+    assert np.array_equal(few.positions[-1], many.positions[-1])
+    assert np.array_equal(few.velocities[-1], many.velocities[-1])
+
+
+@pytest.mark.parametrize("order", [3, 17])
+def test_corrected_run_is_time_reversible(order):
+    # forward n steps, backward n steps, back to the start to rounding: the
+    # corrector of K(h) also conjugates K(-h) = K(h)^-1 and is kept.  (Built
+    # from the signed step, C(-h) differs from C(h) at second order in the
+    # masses, and the return missed by 2.5e-12 with order 17.)
+    b = orbits.scenes.outer_solar_system()
+    sim = orbits.Simulation(b, integrator=wh(order), dt=50 * u.day, monitors=())
+    integ, ws = sim.integrator, sim._ws
+    x, v = sim._x, sim._v
+    x0, v0 = x.copy(), v.copy()
+    mon = (0, 0, sim._m, 1.0, sim._n_active, 0.0)
+    args = (sim._force, sim._fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+    for h in (50.0, -50.0):
+        status, _, _ = integ.advance(ws, x, v, 0.0, h, 300, *args)
+        assert status == 0
+    integ.synchronize(ws, x, v)
+    assert np.abs(x - x0).max() < 1e-13 * np.abs(x0).max()
+    assert np.abs(v - v0).max() < 1e-13 * np.abs(v0).max()
+
+
+def test_corrected_run_continued_from_a_file_is_bit_identical(tmp_path):
+    path = tmp_path / "run.h5"
+    b = orbits.scenes.outer_solar_system()
+    ref = orbits.Simulation(b, integrator=wh(17), dt=10 * u.day)
+    ref.run(until=20_000 * u.day, outputs=2, progress=False)
+    first = orbits.Simulation(b, integrator=wh(17), dt=10 * u.day)
+    first.run(until=8_000 * u.day, outputs=5, output=path, progress=False)
+    again = orbits.Simulation.from_file(path)
+    assert again.integrator.config["corrector"] == 17
+    again.run(until=20_000 * u.day, outputs=5, output=path, progress=False)
+    assert np.array_equal(again._x, ref._x) and np.array_equal(again._v, ref._v)
