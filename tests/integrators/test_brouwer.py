@@ -1,7 +1,6 @@
 """Long-horizon energy error growth of ias15 against REBOUND's IAS15 (slow)."""
 
 import astropy.units as u
-import numpy as np
 import pytest
 
 import orbits
