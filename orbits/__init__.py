@@ -13,9 +13,9 @@ from importlib.metadata import PackageNotFoundError, version as _version
 from . import errors, integrators, io, monitors, scenes
 from .bodies import BodySet
 from .custom import Trajectory, integrate
-from .errors import (BodyError, BodyUnitsError, CloseEncounter, ElementsError, Escape,
-                     IntegratorOptionError, NonFiniteState, OrbitsError, StepSizeUnderflow,
-                     UnknownIntegratorError)
+from .errors import (BodyError, BodyUnitsError, CloseEncounter, ConvergenceFailure,
+                     ElementsError, Escape, IntegratorOptionError, NonFiniteState,
+                     OrbitsError, StepSizeUnderflow, UnknownIntegratorError)
 from .result import Result
 from .simulation import Simulation
 from .units import UnitSystem
@@ -29,7 +29,7 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
 __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajectory",
            "scenes", "integrators", "monitors", "errors", "OrbitsError", "BodyError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
-           "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow",
+           "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow", "ConvergenceFailure",
            "CloseEncounter", "Escape", "load", "io", "Ensemble", "__version__"]
 
 

@@ -14,9 +14,10 @@ import numpy as np
 
 from . import integrators as _integrators
 from ._driver import advance_checked
+from ._kernels import implicit as _implicit
 from ._kernels import stepping as _stepping
 from ._kernels.status import Status
-from .errors import IntegratorOptionError, NonFiniteState
+from .errors import ConvergenceFailure, IntegratorOptionError, NonFiniteState
 
 __all__ = ["integrate", "Trajectory"]
 
@@ -47,7 +48,7 @@ def _is_jitted(func):
 
 
 def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
-              velocity_dependent=False):
+              velocity_dependent=False, jacobian=None):
     """Integrate ``x'' = accel(x, v, t)`` with a registered fixed-step method.
 
     Parameters
@@ -70,6 +71,19 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
     velocity_dependent : bool
         Say True if ``accel`` depends on ``v`` (drag, ...): splitting methods
         then re-evaluate it after every kick instead of reusing it.
+    jacobian : callable, optional
+        For the implicit methods (``"implicit-euler"``, ``"implicit-midpoint"``;
+        the others ignore it): ``jacobian(x, v, t)`` returning the pair
+        ``(da/dx, da/dv)``, each a 2-D array of shape ``(x0.size, x0.size)``
+        over the flattened (C-order) state: entry ``[p, q]`` is the derivative
+        of component ``p`` of ``accel(x, v, t).ravel()`` with respect to
+        component ``q`` of ``x.ravel()`` (or ``v.ravel()``).  Return zeros for
+        ``da/dv`` if ``accel`` does not depend on ``v``.  A ``numba.njit``
+        function runs compiled, like ``accel``.  Without it the implicit
+        methods use central differences of ``accel`` (relative step
+        ``eps**(1/3)``, see :mod:`orbits._kernels.implicit`), which cost
+        ``2 x0.size`` evaluations of ``accel`` (twice that with
+        ``velocity_dependent``) per Jacobian.
 
     Returns
     -------
@@ -81,6 +95,9 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
     NonFiniteState
         The state became NaN or infinite; ``.result`` is the trajectory up to
         the last good step, which it ends with.
+    ConvergenceFailure
+        An implicit method's Newton iteration did not converge in a step;
+        ``.result`` as for ``NonFiniteState``.
 
     Examples
     --------
@@ -122,6 +139,10 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
     v.ravel()[:size] = v0.ravel()
 
     force = _stepping.user_force(accel, jit=_is_jitted(accel))
+    if jacobian is not None:
+        _check_jacobian(jacobian, x0, v0, t0, size)
+        force = force._replace(jacobian=_implicit.user_jacobian(jacobian, _is_jitted(jacobian)),
+                               key=f"{force.key}_jac{id(jacobian)}")
     fargs = (size, tuple(int(s) for s in shape))
     ws = integ.workspace(rows)
     mon = (0, 0, np.zeros(rows), 0.0, 0, 0.0)
@@ -151,6 +172,12 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
             xs.append(x.ravel()[:size].copy())
             vs.append(v.ravel()[:size].copy())
             t_bad = t0 + done * dt
+            if status == Status.NO_CONVERGENCE:
+                raise ConvergenceFailure(
+                    f"the Newton iteration of {integ.name!r} did not converge in step "
+                    f"{done + 1} (from t = {t_bad:.10g}); try a smaller dt; the trajectory "
+                    f"up to the last good step {done} is kept on .result",
+                    time=t_bad, step=done, result=trajectory("no convergence"))
             raise NonFiniteState(
                 f"the state became non-finite in step {done + 1} (from t = {t_bad:.10g}); "
                 f"the trajectory up to the last good step {done} is kept on .result",
@@ -159,3 +186,19 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
         xs.append(x.ravel()[:size].copy())
         vs.append(v.ravel()[:size].copy())
     return trajectory("completed")
+
+
+def _check_jacobian(jacobian, x0, v0, t0, size):
+    # one call up front, so that a wrong shape is a clear error and not an
+    # index error (or silent garbage) inside the compiled loop
+    shape = x0.shape if x0.ndim else (1,)
+    try:
+        out = jacobian(x0.reshape(shape).copy(), v0.reshape(shape).copy(), float(t0))
+        dadx, dadv = (np.asarray(a, dtype=np.float64) for a in out)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"jacobian(x, v, t) must return a pair (da/dx, da/dv) of "
+                        f"({size}, {size}) arrays: {exc}") from None
+    for name, arr in (("da/dx", dadx), ("da/dv", dadv)):
+        if arr.shape != (size, size):
+            raise ValueError(f"jacobian(x, v, t) returned {name} of shape {arr.shape}; "
+                             f"expected ({size}, {size}), over the flattened state")

@@ -22,6 +22,7 @@ __all__ = [
     "SimulationStopped",
     "NonFiniteState",
     "StepSizeUnderflow",
+    "ConvergenceFailure",
     "CloseEncounter",
     "Escape",
 ]
@@ -133,6 +134,14 @@ class NonFiniteState(RunError):
 
 class StepSizeUnderflow(RunError):
     """An adaptive integrator's step size collapsed below its minimum."""
+
+
+class ConvergenceFailure(RunError):
+    """An implicit integrator's Newton iteration did not converge in a step.
+
+    The step was too large for the iteration (a close encounter, a force that
+    changes too fast): a smaller step usually cures it.
+    """
 
 
 class CloseEncounter(SimulationStopped):

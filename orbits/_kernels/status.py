@@ -16,3 +16,4 @@ class Status(IntEnum):
     STEP_UNDERFLOW = 2
     CLOSE_ENCOUNTER = 3
     ESCAPE = 4
+    NO_CONVERGENCE = 5  # an implicit method's Newton iteration did not converge

@@ -96,6 +96,9 @@ class ForceKernel(NamedTuple):
     key: str       # names the loops compiled for it
     jit: bool      # False: everything runs as plain Python (a user's Python function)
     cache: bool    # False where the force cannot be cached on disk (a user's function)
+    # its Jacobian kernel, for implicit methods (orbits._kernels.implicit); None:
+    # the analytic one for gravity, central differences for other forces
+    jacobian: Callable = None
 
 
 _PAIR_KERNELS = {

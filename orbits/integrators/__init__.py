@@ -16,6 +16,7 @@ from .doubling import RK4Doubling
 from .embedded import DOP853, Dopri5
 from .euler import Euler, SymplecticEuler
 from .ias15 import IAS15
+from .implicit import ImplicitEuler, ImplicitMidpoint
 from .leapfrog import Leapfrog, Verlet
 from .runge_kutta import RK2, RK4
 from .scipy_ivp import LSODA, Radau
@@ -47,7 +48,7 @@ def register(cls):
 
 for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
              Yoshida8, WisdomHolman, SABA2, SABA3, SABA4, Dopri5, DOP853,
-             RK4Doubling, Radau, LSODA, IAS15):
+             RK4Doubling, Radau, LSODA, IAS15, ImplicitEuler, ImplicitMidpoint):
     register(_cls)
 
 

@@ -1,0 +1,405 @@
+"""The compiled loop of the implicit one-stage methods, solved by Newton's method.
+
+Implicit Euler and the implicit midpoint rule are the one-leg theta-methods
+``y1 = y0 + h f(t0 + theta h, y0 + theta (y1 - y0))`` with ``theta = 1`` and
+``theta = 1/2`` (Hairer & Wanner 1996, *Solving ODEs II*, section IV.3; Hairer,
+Lubich & Wanner 2006, *Geometric Numerical Integration*, section I.1 and
+VI.3).  For ``y = (x, v)``, ``y' = (v, a(x, v, t))`` they read
+
+    W  = h a(x*, v*, t0 + theta h),   v* = v0 + theta W,   x* = x0 + theta h v*,
+    v1 = v0 + W,                      x1 = x0 + h v*.
+
+The positions at the stage point are an explicit linear function of the
+velocity increment ``W``, so the implicit system is solved for ``W`` alone:
+3N unknowns for every force, velocity dependent or not.  The (x, v) system of
+6N unknowns would cost eight times as much to factor for nothing: eliminating
+x is exact.  Newton's method on ``R(W) = W - h a(x*(W), v*(W)) = 0`` uses
+
+    J = I - theta^2 h^2 da/dx - theta h da/dv
+
+(the da/dv term only for velocity-dependent forces), factored by dense LU
+with partial pivoting (:func:`lu_factor`, :func:`lu_solve`; no LAPACK, so no
+scipy at run time).  The iteration is a simplified Newton method (Hairer &
+Wanner, section IV.8): ``J`` is computed at the first iterate of a step and
+kept while the updates contract by at least :data:`REFRESH`; otherwise it is
+recomputed at the current iterate, which makes hard steps full Newton steps.
+
+Convergence: the update is at most :data:`NEWTON_ULPS` units in the last
+place of the size of the velocities and of ``W`` (max norm), or, once the
+updates have stopped decreasing while below :data:`ROUNDOFF_ULPS` such units,
+the iteration has reached the round-off level of the residual (the criterion
+of Hairer, Lubich & Wanner, section VIII.5: stop when the increment no longer
+decreases).  After :data:`NEWTON_MAX_ITER` iterations without either, the
+loop returns ``Status.NO_CONVERGENCE`` with the state of the last good step.
+A non-finite iterate ends it with ``Status.NON_FINITE``, the state again that
+of the last good step.
+
+The step itself is taken with the accelerations at the last stage point, so
+that ``v1 - v0 = h a*`` and ``x1 - x0 = h (v0 + theta h a*)`` hold as written;
+those accelerations also predict the next step's ``W`` (``W = h a``), and a
+flag in ``cache`` says whether they belong to the current state (a
+restart keeps both; ``invalidate`` clears the flag and the prediction falls
+back to ``W = 0``).
+
+Jacobians have the signature ``jacobian(x, v, t, fargs, jx, jv)`` and write
+``da/dx`` and ``da/dv`` over the flattened (N, 3) state into the (3N, 3N)
+arrays ``jx`` and ``jv``: :func:`gravity_jacobian` for pairwise gravity, a
+user's function through :func:`user_jacobian`, and central differences of the
+force otherwise (:func:`finite_difference_jacobian`).
+"""
+
+import math
+
+import numpy as np
+
+from ._jit import njit, specialize
+from .status import Status
+from .stepping import _record, state_is_finite
+from .stopping import check_stop, no_stop
+
+__all__ = ["implicit_loop", "gravity_jacobian", "user_jacobian",
+           "finite_difference_jacobian", "jacobian_for", "lu_factor", "lu_solve",
+           "NEWTON_MAX_ITER", "NEWTON_ULPS", "ROUNDOFF_ULPS", "REFRESH", "FD_STEP"]
+
+_EPS = 2.220446049250313e-16
+_TINY = 2.2250738585072014e-308  # smallest normal number: below it no ulps to count
+
+#: Newton iterations allowed per step before the step is declared a failure.
+#: Converging iterations need 2 to 5 (a linear force: 2); 50 leaves room for
+#: slow contraction after a Jacobian refresh without hiding divergence.
+NEWTON_MAX_ITER = 50
+#: converged: the update is at most this many ulps of max(|v|, |W|)
+NEWTON_ULPS = 4.0
+#: stalled updates below this many ulps are taken as round-off, not divergence
+ROUNDOFF_ULPS = 1024.0
+#: recompute the Jacobian when an update shrinks by less than this factor
+REFRESH = 0.25
+#: relative step of the central differences, eps^(1/3): it balances the
+#: truncation error (~ step^2) against round-off (~ eps / step), as in
+#: scipy.optimize.approx_derivative's 3-point rule
+FD_STEP = _EPS ** (1.0 / 3.0)
+
+
+# -- linear algebra ---------------------------------------------------------------------
+
+@njit
+def lu_factor(a, piv):
+    """Factor the square matrix ``a`` in place as ``P a = L U`` (partial pivoting).
+
+    ``L`` (unit diagonal, not stored) is left below the diagonal of ``a`` and
+    ``U`` on and above it; ``piv[k]`` is the row swapped with row ``k`` at
+    step ``k``.  Returns False if a pivot is zero or not finite (singular).
+    """
+    m = a.shape[0]
+    for k in range(m):
+        p = k
+        big = abs(a[k, k])
+        for i in range(k + 1, m):
+            if abs(a[i, k]) > big:
+                big = abs(a[i, k])
+                p = i
+        piv[k] = p
+        if not (big > 0.0 and big < math.inf):
+            return False
+        if p != k:
+            for j in range(m):
+                tmp = a[k, j]
+                a[k, j] = a[p, j]
+                a[p, j] = tmp
+        inv = 1.0 / a[k, k]
+        for i in range(k + 1, m):
+            lik = a[i, k] * inv
+            a[i, k] = lik
+            if lik != 0.0:
+                for j in range(k + 1, m):
+                    a[i, j] -= lik * a[k, j]
+    return True
+
+
+@njit
+def lu_solve(a, piv, b):
+    """Solve ``A y = b`` in place in ``b`` (1-D) from :func:`lu_factor`'s output."""
+    m = a.shape[0]
+    for k in range(m):
+        p = piv[k]
+        if p != k:
+            tmp = b[k]
+            b[k] = b[p]
+            b[p] = tmp
+    for i in range(m):
+        s = b[i]
+        for j in range(i):
+            s -= a[i, j] * b[j]
+        b[i] = s
+    for i in range(m - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, m):
+            s -= a[i, j] * b[j]
+        b[i] = s / a[i, i]
+
+
+# -- Jacobians ---------------------------------------------------------------------------
+
+@njit
+def gravity_jacobian(x, v, t, fargs, jx, jv):
+    """``da/dx`` of pairwise gravity (``fargs`` as the gravity force's); ``jv`` untouched.
+
+    Notes
+    -----
+    With ``r = x_i - x_j`` and ``s^2 = |r|^2 + eps2``, the block of body i's
+    acceleration against body j's position is, for ``j != i``,
+
+        dA_i/dx_j = G m_j (I / s^3 - 3 r r^T / s^5),
+
+    and the diagonal block is minus the sum of the others in its row (the
+    acceleration depends on differences of positions only).  Each pair is
+    visited once, as in the force kernels: the block is symmetric in ``r``.
+    Test particles (``i >= n_active``, zero mass) pair with the massive
+    bodies only.
+    """
+    gm, n_active, eps2, _work = fargs
+    n = x.shape[0]
+    m = 3 * n
+    for p in range(m):
+        for q in range(m):
+            jx[p, q] = 0.0
+    d = np.empty(3)
+    for i in range(1, n):
+        for j in range(min(i, n_active)):
+            d[0] = x[i, 0] - x[j, 0]
+            d[1] = x[i, 1] - x[j, 1]
+            d[2] = x[i, 2] - x[j, 2]
+            r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2
+            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+            inv_r5 = inv_r3 / r2
+            gj = gm[j]
+            gi = gm[i] if i < n_active else 0.0
+            for a in range(3):
+                for b in range(3):
+                    mab = -3.0 * d[a] * d[b] * inv_r5
+                    if a == b:
+                        mab += inv_r3
+                    jx[3 * i + a, 3 * j + b] += gj * mab
+                    jx[3 * i + a, 3 * i + b] -= gj * mab
+                    if gi != 0.0:
+                        jx[3 * j + a, 3 * i + b] += gi * mab
+                        jx[3 * j + a, 3 * j + b] -= gi * mab
+
+
+def _user_jacobian(x, v, t, fargs, jx, jv):
+    # the user's (size, size) matrices fill the top-left of the (3N, 3N)
+    # arrays; rows and columns of the padding stay zero
+    size, shape = fargs
+    xu = x.ravel()[:size].reshape(shape)
+    vu = v.ravel()[:size].reshape(shape)
+    dadx, dadv = user_jac(xu, vu, t)  # noqa: F821 - bound by specialize
+    jxu = np.asarray(dadx)
+    jvu = np.asarray(dadv)
+    for p in range(size):
+        for q in range(size):
+            jx[p, q] = jxu[p, q]
+            jv[p, q] = jvu[p, q]
+
+
+def user_jacobian(jac, jit):
+    """A Jacobian kernel from a user's ``jac(x, v, t) -> (da/dx, da/dv)``.
+
+    ``jac`` takes and returns arrays as the user's ``accel`` does: ``x`` and
+    ``v`` of the shape of ``x0``, and two (size, size) matrices over the
+    flattened (C-order) state.  Compiled if ``jac`` is a numba function.
+    """
+    return specialize(_user_jacobian, f"userjac{id(jac)}", jit=jit, cache=False,
+                      user_jac=jac)
+
+
+def _finite_difference_jacobian(x, v, t, fargs, jx, jv):
+    # central differences, column by column: component q of the state moves by
+    # +-delta with delta = FD_STEP * max(|y_q|, 1); the difference of the two
+    # perturbed values (exact in binary) is the divisor
+    n = x.shape[0]
+    m = 3 * n
+    xp = x.copy()
+    vp = v.copy()
+    # zeros: a user's force writes only its own components, not the padding
+    ap = np.zeros((n, 3))
+    am = np.zeros((n, 3))
+    for q in range(m):
+        i = q // 3
+        d = q % 3
+        delta = FD_STEP * max(abs(x[i, d]), 1.0)
+        hi = x[i, d] + delta
+        lo = x[i, d] - delta
+        xp[i, d] = hi
+        force(xp, v, t, fargs, ap)  # noqa: F821 - bound by specialize
+        xp[i, d] = lo
+        force(xp, v, t, fargs, am)  # noqa: F821
+        xp[i, d] = x[i, d]
+        inv = 1.0 / (hi - lo)
+        for p in range(m):
+            jx[p, q] = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
+    if VELOCITY:  # noqa: F821 - bound by specialize
+        for q in range(m):
+            i = q // 3
+            d = q % 3
+            delta = FD_STEP * max(abs(v[i, d]), 1.0)
+            hi = v[i, d] + delta
+            lo = v[i, d] - delta
+            vp[i, d] = hi
+            force(x, vp, t, fargs, ap)  # noqa: F821
+            vp[i, d] = lo
+            force(x, vp, t, fargs, am)  # noqa: F821
+            vp[i, d] = v[i, d]
+            inv = 1.0 / (hi - lo)
+            for p in range(m):
+                jv[p, q] = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
+
+
+def finite_difference_jacobian(force, velocity_dependent):
+    """Central-difference Jacobian of a :class:`~.stepping.ForceKernel`'s force.
+
+    Costs ``6N`` force evaluations (``12N`` with ``velocity_dependent``, which
+    also differentiates in ``v``); the relative step is :data:`FD_STEP` times
+    ``max(|y_q|, 1)`` for each state component ``y_q``.  Its error, about
+    ``FD_STEP^2`` relative, only slows Newton's convergence: the converged
+    solution does not depend on it.
+    """
+    key = f"fd_{force.key}{'_v' if velocity_dependent else ''}"
+    return specialize(_finite_difference_jacobian, key, jit=force.jit, cache=force.cache,
+                      force=force.kernel, VELOCITY=bool(velocity_dependent))
+
+
+#: keys of the gravity forces (stepping.gravity_force)
+_GRAVITY_KEYS = ("gravity_small", "gravity_serial", "gravity_parallel")
+
+
+def jacobian_for(force, velocity_dependent):
+    """The Jacobian kernel of a force and the key naming it.
+
+    The force's own (``force.jacobian``, a user's) if it has one, the analytic
+    one of gravity for the gravity forces, central differences otherwise.
+    """
+    own = getattr(force, "jacobian", None)
+    if own is not None:
+        return own, f"own{id(own)}"
+    if force.key in _GRAVITY_KEYS:
+        return gravity_jacobian, "gravity"
+    return finite_difference_jacobian(force, velocity_dependent), "fd"
+
+
+# -- the loop ---------------------------------------------------------------------------
+
+def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, piv, newton,
+                   fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every, sargs):
+    # theta bound by specialize: 1.0 implicit Euler, 0.5 implicit midpoint.
+    # w: the unknown velocity increment W; dw: residual, then Newton update;
+    # xs, vs: stage point; acc: accelerations there (kept for the next
+    # prediction, valid when cache[0] == 1); newton[0] counts iterations.
+    n = x.shape[0]
+    m = 3 * n
+    th = THETA  # noqa: F821 - bound by specialize
+    cx = th * th * dt * dt
+    cv = th * dt
+    dwf = dw.reshape(m)
+    every = mon[0]
+    n_mon = 0
+    until_check = check_every
+    until_record = every - step0 % every if every > 0 else -1
+    for k in range(nsteps):
+        ts = t + k * dt + th * dt
+        predicted = cache[0] != 0
+        for i in range(n):
+            for d in range(3):
+                w[i, d] = dt * acc[i, d] if predicted else 0.0
+        refresh = True
+        prev = math.inf
+        converged = False
+        for it in range(NEWTON_MAX_ITER):
+            for i in range(n):
+                for d in range(3):
+                    vsid = v[i, d] + th * w[i, d]
+                    vs[i, d] = vsid
+                    xs[i, d] = x[i, d] + th * dt * vsid
+            force(xs, vs, ts, fargs, acc)  # noqa: F821 - bound by specialize
+            for i in range(n):
+                for d in range(3):
+                    dw[i, d] = dt * acc[i, d] - w[i, d]
+            if refresh:
+                jacobian(xs, vs, ts, fargs, jx, jv)  # noqa: F821 - bound by specialize
+                for p in range(m):
+                    for q in range(m):
+                        lu[p, q] = -cx * jx[p, q]
+                    lu[p, p] += 1.0
+                if velocity_dependent:
+                    for p in range(m):
+                        for q in range(m):
+                            lu[p, q] -= cv * jv[p, q]
+                if not lu_factor(lu, piv):
+                    if not state_is_finite(xs, acc):
+                        cache[0] = 0
+                        newton[0] += it + 1
+                        return Status.NON_FINITE, k, n_mon
+                    break
+                refresh = False
+            lu_solve(lu, piv, dwf)
+            dnorm = 0.0
+            scale = 0.0
+            for i in range(n):
+                for d in range(3):
+                    w[i, d] += dw[i, d]
+                    dnorm = max(dnorm, abs(dw[i, d]))
+                    scale = max(scale, abs(v[i, d]), abs(w[i, d]))
+            if not math.isfinite(dnorm):
+                cache[0] = 0
+                newton[0] += it + 1
+                return Status.NON_FINITE, k, n_mon
+            tol = max(_EPS * scale, _TINY)
+            if dnorm <= NEWTON_ULPS * tol or (dnorm >= prev and dnorm <= ROUNDOFF_ULPS * tol):
+                converged = True
+                newton[0] += it + 1
+                break
+            if dnorm > REFRESH * prev:
+                refresh = True
+            prev = dnorm
+        if not converged:
+            cache[0] = 0
+            return Status.NO_CONVERGENCE, k, n_mon
+        # the step, with the accelerations at the last stage point
+        for i in range(n):
+            for d in range(3):
+                hv = dt * acc[i, d]
+                x[i, d] += dt * (v[i, d] + th * hv)
+                v[i, d] += hv
+        cache[0] = 1
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
+            if not state_is_finite(x, v):
+                cache[0] = 0
+                return Status.NON_FINITE, k, n_mon
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
+            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
+            n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+        if stop != 0:
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
+            return stop, k + 1, n_mon
+    return Status.OK, nsteps, n_mon
+
+
+def implicit_loop(force, name, theta, velocity_dependent, stop=False):
+    """The Newton loop of a one-leg theta-method compiled for a :class:`~.stepping.ForceKernel`.
+
+    ``theta`` is 1.0 (implicit Euler) or 0.5 (implicit midpoint); ``name``
+    names the method; the Jacobian is :func:`jacobian_for`'s; ``stop``
+    compiles in the stopping conditions of :mod:`.stopping`.
+    """
+    jac, jkey = jacobian_for(force, velocity_dependent)
+    if jkey == "fd" and velocity_dependent:
+        jkey = "fd_v"
+    return specialize(_implicit_loop, f"{name}_{force.key}_{jkey}{'_stop' if stop else ''}",
+                      jit=force.jit, cache=force.cache and not jkey.startswith("own"),
+                      force=force.kernel, jacobian=jac, stop_check=check_stop if stop else no_stop,
+                      THETA=float(theta))
