@@ -15,11 +15,12 @@ Its columns:
 parameters
     One column per parameter; a Quantity ``x`` becomes ``x_<unit>``.
 ``outcome``
-    ``"completed"``, ``"close-encounter"``, ``"escape"``,
-    ``"non-finite-state"``, ``"step-size-underflow"``, ``"stopped"`` (another
-    stopping condition), ``"run-error"`` (another failure during the run) or
-    ``"invalid"`` (``build`` or the simulation rejected the parameters with an
-    :class:`~orbits.errors.OrbitsError`).
+    ``"completed"``; for a run that failed, the name of the
+    :class:`~orbits.errors.RunError` it raised in lower case with hyphens:
+    ``"close-encounter"``, ``"escape"``, ``"non-finite-state"``,
+    ``"step-size-underflow"``, ...; ``"invalid"`` where ``build`` or the
+    simulation rejected the parameters with another
+    :class:`~orbits.errors.OrbitsError`.
 ``message``, ``stop_bodies``
     The exception's text and the bodies it names (comma-separated); empty for
     a completed run.
@@ -62,8 +63,7 @@ import astropy.units as u
 import numpy as np
 
 from . import integrators as _integrators
-from .errors import (CloseEncounter, Escape, NonFiniteState, OrbitsError, RunError,
-                     SimulationStopped, StepSizeUnderflow)
+from .errors import OrbitsError, RunError
 
 __all__ = ["Ensemble", "local_cluster", "INDEX_FILE", "SWEEP_FILE", "ELEMENTS_MAX_BODIES",
            "PROGRESS_DELAY", "WORKER_ENVIRONMENT"]
@@ -89,9 +89,6 @@ PROGRESS_DELAY = 3.0
 WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
                       "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
 
-_OUTCOMES = ((CloseEncounter, "close-encounter"), (Escape, "escape"),
-             (NonFiniteState, "non-finite-state"), (StepSizeUnderflow, "step-size-underflow"),
-             (SimulationStopped, "stopped"), (RunError, "run-error"))
 
 
 class Ensemble:
@@ -411,9 +408,16 @@ def _advance(sim, spec, path):
         result = sim.run(spec.until, outputs=spec.outputs, progress=False, output=path,
                          overwrite=True)
     except RunError as exc:
-        outcome = next(name for cls, name in _OUTCOMES if isinstance(exc, cls))
-        return outcome, exc, _time.perf_counter() - wall0, exc.result
+        return _outcome(exc), exc, _time.perf_counter() - wall0, exc.result
     return "completed", None, _time.perf_counter() - wall0, result
+
+
+def _outcome(exc):
+    """The exception's class name in lower case with hyphens: ``CloseEncounter``
+    -> ``"close-encounter"``, so that every kind of failure has its own outcome."""
+    name = type(exc).__name__
+    return "".join(("-" + ch.lower()) if ch.isupper() and k else ch.lower()
+                   for k, ch in enumerate(name))
 
 
 def _final_elements(sim, names):
@@ -544,8 +548,6 @@ def _simulation_options(sim):
 
 def _open_out_dir(out_dir, fingerprint):
     """Create ``out_dir`` or check it holds this sweep; the rows already finished."""
-    import pandas as pd
-
     out_dir.mkdir(parents=True, exist_ok=True)
     sweep = out_dir / SWEEP_FILE
     if sweep.exists():

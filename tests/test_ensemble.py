@@ -151,14 +151,16 @@ def test_perturbed_shifts_positions_by_the_relative_amount_reproducibly():
     assert len({s.tobytes() for s in shifts}) == 5
 
 
-def test_perturbed_copies_keep_the_simulation_options():
+@pytest.mark.parametrize("a, e, stop", [(6.5, 0.2, orbits.CloseEncounter),
+                                        (60.0, 0.8, orbits.Escape)])
+def test_perturbed_copies_keep_the_simulation_options(a, e, stop):
     # scale 0: each copy must run exactly as the original, stopping conditions included
-    sim = planet(6.5, 0.2)
+    sim = planet(a, e)
     df = Ensemble.perturbed(sim, n=2, scale=0.0).run(UNTIL, client="serial", progress=False)
-    with pytest.raises(orbits.CloseEncounter) as exc:
+    with pytest.raises(stop) as exc:
         sim.run(UNTIL, outputs=100, progress=False)
     for k in range(2):
-        assert df.loc[k].outcome == "close-encounter"
+        assert df.loc[k].outcome == ("escape" if stop is orbits.Escape else "close-encounter")
         assert df.loc[k].t_stop_day == exc.value.time.to_value(u.day)
         assert df.loc[k].planet_a_au == sim.bodies.elements("planet", "Sun")["a"].value
     assert df.loc[0].member == 0 and df.loc[1].member == 1
