@@ -23,7 +23,7 @@ from ._jit import njit, njit_parallel
 
 __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_reference",
            "pair_workspace", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
-           "accelerate_pairwise_small"]
+           "accelerate_pairwise_small", "accelerate_pairwise_rebound"]
 
 
 #: Up to this many massive bodies the plain double loop
@@ -139,6 +139,66 @@ def accelerate_pairwise_small(x, gm, n_active, eps2, acc, work):
         acc[i, 0] += axi
         acc[i, 1] += ayi
         acc[i, 2] += azi
+    return 0
+
+
+@njit(inline="always")
+def accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc):
+    """The j < i pair loop in REBOUND's floating-point operations, for bit-for-bit
+    agreement with its ``leapfrog`` (basic gravity, serial build).
+
+    Parameters
+    ----------
+    x : ndarray, shape (N, 3)
+        Positions.
+    G : float
+        The gravitational constant.
+    m : ndarray, shape (N,)
+        Masses (not ``G m``: the rounding of ``G m`` differs).
+    n_active, eps2, acc
+        As :func:`accelerate_pairwise`.
+
+    Notes
+    -----
+    Per pair, in this order and with no fused multiply-add (fastmath is off
+    in every kernel, so LLVM does not contract)::
+
+        d = x_i - x_j,   r = sqrt(dx dx + dy dy + dz dz + eps2)
+        p = G / (r r r),   a_i += (-p m_j) d,   a_j += (p m_i) d
+
+    with ``a_i`` accumulated in place, row i before the later rows that add
+    to it.  :func:`accelerate_pairwise_small` rounds differently
+    (``G m_j / (r^2 sqrt(r^2))``), by an ulp or so per pair; the two agree to
+    rounding.  Test particles pull nothing back, as REBOUND's default
+    ``testparticle_type = 0``.
+
+    References
+    ----------
+    REBOUND's documentation of ``gravity = "basic"`` (Rein & Liu 2012, A&A
+    537, A128, sect. 4.1: direct summation over pairs).
+    """
+    n = x.shape[0]
+    for i in range(n):
+        acc[i, 0] = 0.0
+        acc[i, 1] = 0.0
+        acc[i, 2] = 0.0
+    for i in range(1, n):
+        mi = m[i]
+        for j in range(min(i, n_active)):
+            dx = x[i, 0] - x[j, 0]
+            dy = x[i, 1] - x[j, 1]
+            dz = x[i, 2] - x[j, 2]
+            r = math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+            p = G / (r * r * r)
+            pj = -p * m[j]
+            acc[i, 0] += pj * dx
+            acc[i, 1] += pj * dy
+            acc[i, 2] += pj * dz
+            if i < n_active:
+                pi = p * mi
+                acc[j, 0] += pi * dx
+                acc[j, 1] += pi * dy
+                acc[j, 2] += pi * dz
     return 0
 
 
