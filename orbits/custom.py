@@ -17,7 +17,8 @@ from ._driver import advance_checked
 from ._kernels import implicit as _implicit
 from ._kernels import stepping as _stepping
 from ._kernels.status import Status
-from .errors import ConvergenceFailure, IntegratorOptionError, NonFiniteState
+from .errors import (ConvergenceFailure, IntegratorOptionError, NonFiniteState,
+                     StepSizeUnderflow)
 
 __all__ = ["integrate", "Trajectory"]
 
@@ -47,9 +48,14 @@ def _is_jitted(func):
     return isinstance(func, numba.core.registry.CPUDispatcher)
 
 
-def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
-              velocity_dependent=False, jacobian=None):
-    """Integrate ``x'' = accel(x, v, t)`` with a registered fixed-step method.
+def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, every=1,
+              velocity_dependent=False, jacobian=None, until=None, outputs=101):
+    """Integrate ``x'' = accel(x, v, t)`` with any registered method.
+
+    Fixed-step methods take ``dt`` and ``steps``; adaptive ones (``dop853``,
+    ``ias15``, ``radau``, ``lsoda``, ...; configure them with
+    ``orbits.integrators.get(name, rtol=...)``) take ``until`` and ``outputs``,
+    and ``dt`` as their first step if given.
 
     Parameters
     ----------
@@ -60,9 +66,10 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
         Initial position and velocity (any shape, the same for both; a scalar
         is passed to ``accel`` as an array of shape (1,)).
     dt : float
-        Step (may be negative to integrate backwards).
+        Step (may be negative to integrate backwards); for adaptive methods
+        the first step to try (optional).
     steps : int
-        Number of steps.
+        Number of steps (fixed-step methods).
     method : str
         Registry name, e.g. ``"euler"``, ``"symplectic-euler"``, ``"verlet"``, ``"rk4"``.
     t0 : float
@@ -84,6 +91,12 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
         ``eps**(1/3)``, see :mod:`orbits._kernels.implicit`), which cost
         ``2 x0.size`` evaluations of ``accel`` (twice that with
         ``velocity_dependent``) per Jacobian.
+
+    until : float
+        End time (adaptive methods).
+    outputs : int
+        Number of evenly spaced times, ``t0`` and ``until`` included, at which
+        an adaptive method records the state (hit exactly).
 
     Returns
     -------
@@ -110,9 +123,6 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
     (1001,)
     """
     integ = _integrators.get(method)
-    if integ.adaptive:
-        raise IntegratorOptionError(f"integrate() takes fixed-step methods; {integ.name!r} "
-                                    "is adaptive")
     x0 = np.asarray(x0, dtype=np.float64)
     v0 = np.asarray(v0, dtype=np.float64)
     if x0.shape != v0.shape:
@@ -120,14 +130,25 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
     for name, arr in (("x0", x0), ("v0", v0)):
         if not np.all(np.isfinite(arr)):
             raise ValueError(f"{name} must be finite, got {arr}")
-    dt = float(dt)
-    if not (math.isfinite(dt) and dt != 0.0):
-        raise IntegratorOptionError(f"dt must be finite and non-zero, got {dt}")
-    if int(steps) != steps or steps < 0:
-        raise ValueError(f"steps must be a whole number >= 0, got {steps}")
-    if int(every) != every or every < 1:
-        raise ValueError(f"every must be a whole number >= 1, got {every}")
-    steps, every = int(steps), int(every)
+    if integ.adaptive:
+        if until is None or not (math.isfinite(float(until)) and float(until) > t0):
+            raise ValueError(f"{integ.name!r} is adaptive: give until (> t0 = {t0}), and "
+                             f"optionally outputs and a first step dt; got until={until}")
+        if int(outputs) != outputs or outputs < 2:
+            raise ValueError(f"outputs must be a whole number >= 2, got {outputs}")
+        if dt is not None and not (math.isfinite(float(dt)) and float(dt) > 0):
+            raise IntegratorOptionError(f"dt (the first step) must be positive, got {dt}")
+    else:
+        if dt is None or steps is None:
+            raise IntegratorOptionError(f"{integ.name!r} takes fixed steps: give dt and steps")
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt != 0.0):
+            raise IntegratorOptionError(f"dt must be finite and non-zero, got {dt}")
+        if int(steps) != steps or steps < 0:
+            raise ValueError(f"steps must be a whole number >= 0, got {steps}")
+        if int(every) != every or every < 1:
+            raise ValueError(f"every must be a whole number >= 1, got {every}")
+        steps, every = int(steps), int(every)
     scalar = x0.ndim == 0
     shape = (1,) if scalar else x0.shape
     size = int(np.prod(shape))
@@ -144,8 +165,12 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
         force = force._replace(jacobian=_implicit.user_jacobian(jacobian, _is_jitted(jacobian)),
                                key=f"{force.key}_jac{id(jacobian)}")
     fargs = (size, tuple(int(s) for s in shape))
-    ws = integ.workspace(rows)
     mon = (0, 0, np.zeros(rows), 0.0, 0, 0.0)
+    if integ.adaptive:
+        return _integrate_adaptive(integ, force, fargs, mon, x, v, size, shape, scalar,
+                                   float(t0), float(until), int(outputs),
+                                   0.0 if dt is None else float(dt))
+    ws = integ.workspace(rows)
     ts, xs, vs = [t0], [x.ravel()[:size].copy()], [v.ravel()[:size].copy()]
     wall0 = _time.perf_counter()
     done = 0
@@ -183,6 +208,46 @@ def integrate(accel, x0, v0, *, dt, steps, method="verlet", t0=0.0, every=1,
                 f"the trajectory up to the last good step {done} is kept on .result",
                 time=t_bad, step=done, result=trajectory("non-finite state"))
         ts.append(t0 + done * dt)
+        xs.append(x.ravel()[:size].copy())
+        vs.append(v.ravel()[:size].copy())
+    return trajectory("completed")
+
+
+def _integrate_adaptive(integ, force, fargs, mon, x, v, size, shape, scalar, t0, until,
+                        outputs, first_step):
+    ws = integ.workspace(x.shape[0], first_step)
+    ts, xs, vs = [t0], [x.ravel()[:size].copy()], [v.ravel()[:size].copy()]
+    wall0 = _time.perf_counter()
+    t = t0
+    steps = 0
+
+    def trajectory(status):
+        out_shape = (len(ts),) + (() if scalar else shape)
+        return Trajectory(np.array(ts), np.array(xs).reshape(out_shape),
+                          np.array(vs).reshape(out_shape), steps, integ.name,
+                          _time.perf_counter() - wall0, status)
+
+    for k in range(1, outputs):
+        t_out = until if k == outputs - 1 else t0 + k * (until - t0) / (outputs - 1)
+        while t < t_out:
+            status, t, acc, _, _, _ = integ.advance_to(
+                ws, x, v, t, t_out, force, fargs, mon, steps, np.empty(0), np.zeros((0, 10)),
+                None, 1 << 40)
+            steps += int(acc)
+            if status != Status.OK:
+                ts.append(t)
+                xs.append(x.ravel()[:size].copy())
+                vs.append(v.ravel()[:size].copy())
+                if status == Status.STEP_UNDERFLOW:
+                    raise StepSizeUnderflow(
+                        f"the step size of {integ.name!r} collapsed at t = {t:.10g} (step "
+                        f"{steps}); the trajectory up to there is kept on .result",
+                        time=t, step=steps, result=trajectory("step-size underflow"))
+                raise NonFiniteState(
+                    f"the state became non-finite after t = {t:.10g} (step {steps}); the "
+                    f"trajectory up to the last good step is kept on .result",
+                    time=t, step=steps, result=trajectory("non-finite state"))
+        ts.append(t)
         xs.append(x.ravel()[:size].copy())
         vs.append(v.ravel()[:size].copy())
     return trajectory("completed")

@@ -94,3 +94,26 @@ def test_bad_arguments():
         orbits.integrate(spring, np.nan, 0.0, dt=0.01, steps=10)
     with pytest.raises(ValueError, match="dt"):
         orbits.integrate(spring, 1.0, 0.0, dt=0.0, steps=10)
+
+
+def test_adaptive_methods_for_a_stiff_user_problem():
+    # the stiff spring (k = 1e4) that defeats every explicit fixed-step method
+    # at dt = 0.1: scipy's radau and lsoda, and our adaptive methods, follow
+    # it to their tolerance; exact solution x = cos(100 t)
+    def stiff_py(x, v, t):
+        return -1.0e4 * x
+
+    for name, tol in (("radau", 1e-5), ("lsoda", 1e-4)):
+        integ = orbits.integrators.get(name, rtol=1e-8, atol=1e-10)
+        tr = orbits.integrate(stiff_py, 1.0, 0.0, method=integ, until=1.0, outputs=11)
+        assert tr.x.shape == (11,) and tr.t[-1] == 1.0
+        # global error of a 1e-8 local tolerance over 16 periods: measured
+        # 2e-7 (radau) and 1e-6 (lsoda)
+        np.testing.assert_allclose(tr.x, np.cos(100 * tr.t), atol=tol)
+
+
+def test_adaptive_arguments_are_checked():
+    with pytest.raises(ValueError, match="adaptive: give until"):
+        orbits.integrate(spring, 1.0, 0.0, method="dop853")
+    with pytest.raises(orbits.IntegratorOptionError, match="give dt and steps"):
+        orbits.integrate(spring, 1.0, 0.0, method="rk4", until=1.0)
