@@ -524,23 +524,12 @@ class _Perturbation:
 
 def _simulation_options(sim):
     """The keyword arguments that make a simulation like ``sim`` from its bodies."""
-    units = sim.units
     options = dict(dt=sim.dt, monitors=tuple(sim.monitors), monitor_every=sim.monitor_every,
                    parallel=sim.parallel)
-    if sim._eps2 > 0:   # sqrt(eps*eps) == eps exactly, so the copy has the same eps2
-        options["softening"] = units.quantity(math.sqrt(sim._eps2), "length")
-    stop = getattr(sim, "_stop", None)
-    if stop is not None:
-        from ._kernels import stopping as _s
-        mask, d2, hill_k, esc2 = stop[:4]
-        if mask & _s.ENCOUNTER_DISTANCE:
-            options["encounter_distance"] = units.quantity(math.sqrt(d2), "length")
-        if mask & _s.ENCOUNTER_HILL:
-            options["encounter_hill"] = float(hill_k)
-        if mask & _s.ESCAPE:
-            options["escape_distance"] = units.quantity(math.sqrt(esc2), "length")
-        if mask & _s.UNBOUND:
-            options["escape_unbound"] = True
+    if sim.softening is not None:
+        options["softening"] = sim.softening
+    options.update({k: val for k, val in sim.stop_conditions.items()
+                    if val is not None and val is not False})
     return options
 
 

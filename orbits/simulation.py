@@ -155,6 +155,7 @@ class Simulation:
         if not (eps >= 0 and math.isfinite(eps)):
             raise IntegratorOptionError(f"softening must be a finite length >= 0, got {softening}")
         self._eps2 = eps * eps
+        self._softening = None if softening is None else self.units.quantity(eps, "length")
         n = len(self._m)
         self.parallel = (n >= PARALLEL_THRESHOLD) if parallel is None else bool(parallel)
         kind = ("parallel" if self.parallel else
@@ -188,6 +189,21 @@ class Simulation:
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
 
+    @property
+    def stop_conditions(self):
+        """The stopping conditions as the keyword arguments that set them (Quantities)."""
+        c = self._stop_config
+        q = lambda val: None if val is None else self.units.quantity(val, "length")  # noqa: E731
+        return {"encounter_distance": q(c["encounter_distance"]),
+                "encounter_hill": c["encounter_hill"],
+                "escape_distance": q(c["escape_distance"]),
+                "escape_unbound": c["escape_unbound"]}
+
+    @property
+    def softening(self):
+        """The softening length (Quantity), or None."""
+        return self._softening
+
     def _positive_length(self, value, field):
         d = float(self.units.to_internal(value, "length", bare_ok=self._bare_ok, field=field))
         if not (d > 0 and math.isfinite(d)):
@@ -201,7 +217,8 @@ class Simulation:
         k = 0.0
         if distance is not None:
             mask |= _s.ENCOUNTER_DISTANCE
-            d2 = self._positive_length(distance, "encounter_distance") ** 2
+            d = self._positive_length(distance, "encounter_distance")
+            d2 = d * d
         if hill is not None:
             k = float(hill)
             if not (k > 0 and math.isfinite(k)):
@@ -210,15 +227,16 @@ class Simulation:
             mask |= _s.ENCOUNTER_HILL
         if escape is not None:
             mask |= _s.ESCAPE
-            esc2 = self._positive_length(escape, "escape_distance") ** 2
+            e = self._positive_length(escape, "escape_distance")
+            esc2 = e * e
         if unbound:
             if escape is None:
                 raise ValueError("escape_unbound needs escape_distance (the radius beyond "
                                  "which an unbound body counts as escaped)")
             mask |= _s.UNBOUND
-        self._stop_config = {"encounter_distance": math.sqrt(d2) if d2 else None,
+        self._stop_config = {"encounter_distance": d if distance is not None else None,
                              "encounter_hill": k or None,
-                             "escape_distance": math.sqrt(esc2) if esc2 else None,
+                             "escape_distance": e if escape is not None else None,
                              "escape_unbound": bool(unbound)}
         if not mask:
             return None
