@@ -138,7 +138,8 @@ class Simulation:
         self.integrator = _integrators.get(integrator)
         adaptive = self.integrator.adaptive
         self._dt = 0.0 if (adaptive and dt is None) else self._time_value(dt, "dt")
-        if not ((self._dt > 0 or (adaptive and dt is None)) and math.isfinite(self._dt)):
+        # an adaptive method's dt is only its first step; 0 lets it choose
+        if not ((self._dt > 0 or (adaptive and self._dt == 0)) and math.isfinite(self._dt)):
             raise IntegratorOptionError(f"dt must be a positive finite time, got {dt}")
 
         # massive bodies first (stable), as the gravity kernels expect
