@@ -24,7 +24,8 @@ import sys
 import time
 
 HERE = pathlib.Path(__file__).resolve().parent
-BENCHMARKS = ("bench_fixed_step", "bench_gravity", "bench_monitors")
+BENCHMARKS = ("bench_fixed_step", "bench_gravity", "bench_monitors", "bench_ias15", "bench_wh",
+              "bench_adaptive", "bench_ensemble")
 
 
 def cpu_model():
