@@ -6,7 +6,7 @@ import numpy as np
 
 import orbits
 from orbits._kernels import stepping
-from orbits._kernels.gravity import pair_workspace
+from orbits._kernels.gravity import gravity_args
 
 #: an orbit started well away from an apsis, so that errors in position and
 #: velocity both show (at an apsis some error terms vanish by symmetry)
@@ -32,7 +32,7 @@ def adaptive_fixed_steps_error(name, n, e=0.2):
     x0, v0 = x.copy(), v.copy()
     m = b.masses.value
     ws = integ.workspace(2, 2 * math.pi / n)
-    fargs = (m.copy(), 1, 0.0, pair_workspace(2, 1))
+    fargs = gravity_args(1.0, m, 1, 0.0)
     force = stepping.gravity_force("small")
     mon = (0, 0, m, 1.0, 1, 0.0)
     t = 0.0

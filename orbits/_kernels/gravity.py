@@ -22,7 +22,7 @@ import numba
 from ._jit import njit, njit_parallel
 
 __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_reference",
-           "pair_workspace", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
+           "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
            "accelerate_pairwise_small", "accelerate_pairwise_rebound"]
 
 
@@ -36,6 +36,18 @@ SMALL_N = 8
 #: Pairs handled per batch by the serial kernel: enough to fill the vector
 #: units, small enough that the batch stays in L1 cache (4 arrays x 8 bytes).
 PAIR_BATCH = 1024
+
+
+def gravity_args(G, m, n_active, eps2, parallel=False):
+    """The ``fargs`` tuple of the gravity forces: ``(G m, n_active, eps2, work, G, m)``.
+
+    ``m`` is in the internal order (massive bodies first).  Both ``G m`` and
+    ``G`` with ``m`` are carried: the batched and threaded kernels use the
+    product, the few-body kernel REBOUND's rounding, which needs the factors.
+    """
+    m = np.ascontiguousarray(m, dtype=np.float64)
+    return (G * m, int(n_active), float(eps2), pair_workspace(len(m), n_active, parallel),
+            float(G), m)
 
 
 def pair_workspace(n, n_active, parallel=False):
@@ -166,8 +178,8 @@ def accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc):
         d = x_i - x_j,   r = sqrt(dx dx + dy dy + dz dz + eps2)
         p = G / (r r r),   a_i += (-p m_j) d,   a_j += (p m_i) d
 
-    with ``a_i`` accumulated in place, row i before the later rows that add
-    to it.  :func:`accelerate_pairwise_small` rounds differently
+    with row i's terms summed in order from zero before the later rows add
+    their reactions to it, as in REBOUND.  :func:`accelerate_pairwise_small` rounds differently
     (``G m_j / (r^2 sqrt(r^2))``), by an ulp or so per pair; the two agree to
     rounding.  Test particles pull nothing back, as REBOUND's default
     ``testparticle_type = 0``.
@@ -182,23 +194,43 @@ def accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc):
         acc[i, 0] = 0.0
         acc[i, 1] = 0.0
         acc[i, 2] = 0.0
+    # Row i's own sum can be kept in registers: nothing has been added to
+    # acc[i] before row i (earlier rows only reach j < their own index), so
+    # 0 + a_1 + a_2 ... in a register rounds exactly as in memory.
     for i in range(1, n):
         mi = m[i]
-        for j in range(min(i, n_active)):
-            dx = x[i, 0] - x[j, 0]
-            dy = x[i, 1] - x[j, 1]
-            dz = x[i, 2] - x[j, 2]
-            r = math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
-            p = G / (r * r * r)
-            pj = -p * m[j]
-            acc[i, 0] += pj * dx
-            acc[i, 1] += pj * dy
-            acc[i, 2] += pj * dz
-            if i < n_active:
+        axi = 0.0
+        ayi = 0.0
+        azi = 0.0
+        if i < n_active:
+            for j in range(i):
+                dx = x[i, 0] - x[j, 0]
+                dy = x[i, 1] - x[j, 1]
+                dz = x[i, 2] - x[j, 2]
+                r = math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+                p = G / (r * r * r)
+                pj = -p * m[j]
+                axi += pj * dx
+                ayi += pj * dy
+                azi += pj * dz
                 pi = p * mi
                 acc[j, 0] += pi * dx
                 acc[j, 1] += pi * dy
                 acc[j, 2] += pi * dz
+        else:
+            for j in range(n_active):
+                dx = x[i, 0] - x[j, 0]
+                dy = x[i, 1] - x[j, 1]
+                dz = x[i, 2] - x[j, 2]
+                r = math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+                p = G / (r * r * r)
+                pj = -p * m[j]
+                axi += pj * dx
+                ayi += pj * dy
+                azi += pj * dz
+        acc[i, 0] = axi
+        acc[i, 1] = ayi
+        acc[i, 2] = azi
     return 0
 
 

@@ -157,7 +157,7 @@ def gravity_jacobian(x, v, t, fargs, jx, jv):
     Test particles (``i >= n_active``, zero mass) pair with the massive
     bodies only.
     """
-    gm, n_active, eps2, _work = fargs
+    gm, n_active, eps2 = fargs[0], fargs[1], fargs[2]
     n = x.shape[0]
     m = 3 * n
     for p in range(m):

@@ -37,7 +37,7 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
-                      accelerate_pairwise_small)
+                      accelerate_pairwise_rebound, accelerate_pairwise_small)
 from .invariants import monitor_row
 from .status import Status
 from .stopping import check_stop, no_stop
@@ -73,8 +73,14 @@ def _record(x, v, t, mon, n_mon, mon_t, mon_out):
 # -- forces ------------------------------------------------------------------------
 
 def _gravity_force(x, v, t, fargs, acc):
-    gm, n_active, eps2, work = fargs
+    gm, n_active, eps2, work, G, m = fargs
     pair_kernel(x, gm, n_active, eps2, acc, work)  # noqa: F821 - bound by specialize
+
+
+def _gravity_force_exact(x, v, t, fargs, acc):
+    # few bodies: REBOUND's arithmetic, so that leapfrog matches it bit for bit
+    gm, n_active, eps2, work, G, m = fargs
+    accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc)
 
 
 def _user_force(x, v, t, fargs, acc):
@@ -109,9 +115,12 @@ _PAIR_KERNELS = {
 
 
 def gravity_force(kind):
-    """The pairwise-gravity force: ``kind`` is ``"small"``, ``"serial"`` or ``"parallel"``
-    (see :mod:`orbits._kernels.gravity`)."""
+    """The pairwise-gravity force: ``kind`` is ``"small"``, ``"serial"``, ``"parallel"``
+    or ``"rebound"`` (REBOUND's arithmetic; see :mod:`orbits._kernels.gravity`)."""
     key = f"gravity_{kind}"
+    if kind == "rebound":
+        kernel = specialize(_gravity_force_exact, key, inline=True)
+        return ForceKernel(kernel, key, True, True)
     kernel = specialize(_gravity_force, key, inline=True, pair_kernel=_PAIR_KERNELS[kind])
     return ForceKernel(kernel, key, True, True)
 

@@ -70,7 +70,7 @@ class IAS15(AdaptiveIntegrator):
     --------
     >>> import numpy as np
     >>> from orbits.integrators import get
-    >>> from orbits._kernels.gravity import pair_workspace
+    >>> from orbits._kernels.gravity import gravity_args
     >>> from orbits._kernels.stepping import gravity_force
     >>> integ = get("ias15", epsilon=1e-9)
     >>> x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])   # G = 1, circular orbit
@@ -79,7 +79,7 @@ class IAS15(AdaptiveIntegrator):
     >>> ws = integ.workspace(2)
     >>> status, t, *_ = integ.advance_to(
     ...     ws, x, v, 0.0, 2 * np.pi, gravity_force("small"),
-    ...     (gm, 1, 0.0, pair_workspace(2, 1)), (0, 0, gm, 1.0, 1, 0.0), 0,
+    ...     gravity_args(1.0, gm, 1, 0.0), (0, 0, gm, 1.0, 1, 0.0), 0,
     ...     np.empty(0), np.zeros((0, 10)), None, 10**6)
     >>> int(status), t == 2 * np.pi, bool(np.allclose(x[1], [1.0, 0.0, 0.0], atol=1e-12))
     (0, True, True)

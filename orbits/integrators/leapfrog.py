@@ -58,18 +58,19 @@ class Leapfrog(SplittingMethod):
 
     Exactness with REBOUND.  REBOUND's ``leapfrog`` takes the same drift
     ``x += (h/2) v``, kick ``v += h a`` and drift, with its serial pair loop
-    over j < i.  Our drifts and kicks round as its do; the pair loop does not
-    yet: REBOUND forms ``(G / r^3) m_j`` with ``r^3 = (r r) r``, while our
-    force receives ``G m`` only and forms ``G m_j / (r^2 sqrt(r^2))``, which
-    differs by an ulp or so per pair, so the two trajectories part at rounding
+    over j < i, and our drifts and kicks round as its do.  Its pair term is
+    ``(G / ((r r) r)) m_j``; the default kernels form ``G m_j / (r^2
+    sqrt(r^2))``, an ulp or so apart, so the trajectories part at rounding
     level (1e-11 au after 10,000 steps of the outer solar system).
-    :func:`orbits._kernels.gravity.accelerate_pairwise_rebound` computes
-    REBOUND's expression; a drift-kick-drift loop over it, started from
-    ``BodySet.to_rebound()``'s floats and G, is bit-identical to REBOUND after
-    1,000,000 steps (tests/integrators/test_leapfrog_rebound.py), at 0.6 of
-    REBOUND's time.  Using it here needs ``G`` and the masses passed to the
-    force separately.  Neither loop may contain a fused multiply-add:
-    kernels are compiled with fastmath off, which keeps LLVM from contracting.
+    ``Simulation(..., rebound_arithmetic=True)`` switches to
+    :func:`orbits._kernels.gravity.accelerate_pairwise_rebound`, which
+    computes REBOUND's expression in REBOUND's order; from
+    ``BodySet.to_rebound()``'s floats and G, ``leapfrog`` is then bit-identical
+    to REBOUND after 1,000,000 steps of the outer solar system
+    (tests/integrators/test_leapfrog_rebound.py), at 0.61 of REBOUND's time
+    per step for N = 6 (0.59 with the default kernel).  No loop may contain a
+    fused multiply-add: kernels are compiled with fastmath off, which keeps
+    LLVM from contracting (tested on the compiled code).
 
     References
     ----------

@@ -201,7 +201,7 @@ class WisdomHolman(Integrator):
                 f"{self.name} splits Newtonian gravity into Kepler drifts and kicks and "
                 "cannot integrate another force; use a general method such as 'leapfrog' "
                 "or 'yoshida4'")
-        gm, n_active, eps2, _ = fargs
+        gm, n_active, eps2 = fargs[0], fargs[1], fargs[2]
         if eps2 != 0.0:
             raise IntegratorOptionError(
                 f"{self.name} needs unsoftened gravity (its Kepler drifts are exact "

@@ -343,6 +343,7 @@ def _create(path, sim):
         "monitor_every": sim.monitor_every or 0,
         "parallel": bool(sim.parallel),
         "stop_conditions": json.dumps(sim._stop_config),
+        "rebound_arithmetic": bool(sim.rebound_arithmetic),
         "bodies_history": json.dumps(sim._history, default=str),
     }
     for k, v in meta.items():
@@ -538,7 +539,8 @@ def restore(path):
                          encounter_distance=length(stop["encounter_distance"]),
                          encounter_hill=stop["encounter_hill"],
                          escape_distance=length(stop["escape_distance"]),
-                         escape_unbound=stop["escape_unbound"])
+                         escape_unbound=stop["escape_unbound"],
+                         rebound_arithmetic=bool(par.attrs.get("rebound_arithmetic", False)))
         if not np.array_equal(sim._order, order):
             raise OrbitsFileError(f"{path}: the stored body order does not match the masses")
         clock = r["clock"][slot]

@@ -10,7 +10,7 @@ from numpy.polynomial import polynomial as npoly
 
 import orbits
 from orbits._kernels import ias15 as K
-from orbits._kernels.gravity import pair_workspace
+from orbits._kernels.gravity import gravity_args
 from orbits._kernels.invariants import energy
 from orbits._kernels.status import Status
 from orbits._kernels.stepping import gravity_force, user_force
@@ -38,7 +38,7 @@ class Run:
         self.integ = get("ias15", **options)
         self.ws = self.integ.workspace(n, initial_step)
         self.force = gravity_force("small")
-        self.fargs = (self.G * self.m, self.na, 0.0, pair_workspace(n, self.na))
+        self.fargs = gravity_args(self.G, self.m, self.na, 0.0)
         self.t = 0.0
         self.steps = 0
 

@@ -100,7 +100,7 @@ def _two_body():
     x = np.ascontiguousarray(b.positions.value)
     v = np.ascontiguousarray(b.velocities.value)
     gm = np.array([1.0, 0.3])
-    return x, v, (gm, 2, 0.0, gravity.pair_workspace(2, 2))
+    return x, v, gravity.gravity_args(1.0, gm, 2, 0.0)
 
 
 def _advance(name, x, v, dt, n, fargs):

@@ -86,15 +86,29 @@ def test_no_fused_multiply_add_in_the_exact_loop():
     assert "vfmadd" not in asm and "vfmsub" not in asm and "vfnmadd" not in asm
 
 
-@pytest.mark.xfail(strict=True, reason="the public force gets G m, not G and m: "
-                   "Simulation must pass both for REBOUND's rounding")
 def test_public_leapfrog_is_bit_identical():
     b = orbits.scenes.outer_solar_system()
     reb = b.to_rebound()
     reb.integrator = "leapfrog"
     reb.dt = DT
     reb.steps(10_000)
-    sim = orbits.Simulation(b, integrator="leapfrog", dt=DT * u.day, monitors=())
+    sim = orbits.Simulation(b, integrator="leapfrog", dt=DT * u.day, monitors=(),
+                            rebound_arithmetic=True)
     sim.run(until=10_000 * DT * u.day, outputs=2, progress=False)
+    xr, vr = state(reb)
+    assert np.array_equal(sim._x, xr) and np.array_equal(sim._v, vr)
+
+
+@pytest.mark.slow
+def test_public_leapfrog_is_bit_identical_after_a_million_steps():
+    # the criterion: 1,000,000 steps of the outer solar system
+    b = orbits.scenes.outer_solar_system()
+    reb = b.to_rebound()
+    reb.integrator = "leapfrog"
+    reb.dt = DT
+    reb.steps(1_000_000)
+    sim = orbits.Simulation(b, integrator="leapfrog", dt=DT * u.day, monitors=(),
+                            rebound_arithmetic=True)
+    sim.run(until=1_000_000 * DT * u.day, outputs=2, progress=False)
     xr, vr = state(reb)
     assert np.array_equal(sim._x, xr) and np.array_equal(sim._v, vr)
