@@ -87,7 +87,10 @@ PROGRESS_DELAY = 3.0
 #: process: the workers already use every core, and threads on top of them
 #: would only compete (the threaded gravity kernel starts at 72 bodies).
 WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                      "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+                      "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+                      # the worker's statistical profiler samples every 10 ms in a
+                      # thread of its own, which shares the core with the run
+                      "DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False"}
 
 
 

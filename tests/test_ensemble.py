@@ -326,7 +326,8 @@ def test_the_readme_commands_for_an_existing_cluster(serial, tmp_path):
     import os
     import time
 
-    env = dict(os.environ, NUMBA_NUM_THREADS="1")
+    env = dict(os.environ, NUMBA_NUM_THREADS="1",
+               DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED="False")
     procs = [subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", "8786",
                                "--no-dashboard"], env=env, cwd=tmp_path,
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
