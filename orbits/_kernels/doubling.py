@@ -13,14 +13,13 @@ evaluations a step (the first stage is shared).
 import math
 
 from ._jit import specialize
-from .embedded import FAC_MAX, FAC_MIN, SAFETY, initial_step
+from .embedded import initial_step, next_step, step_underflow
 from .status import Status
 from .stepping import _record
 from .stopping import check_stop, no_stop
 
 __all__ = ["doubling_loop"]
 
-_EPS = 2.220446049250313e-16
 
 
 def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs):
@@ -111,8 +110,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                     k0x[i, d] = v[i, d]
             steps += 1
             if not shortened:
-                fac = FAC_MAX if err == 0.0 else SAFETY * err ** (-0.2)
-                h_prop = h * min(FAC_MAX, max(FAC_MIN, fac))
+                h_prop = next_step(h, err, 4.0)
             until_record -= 1
             if until_record == 0:
                 until_record = every
@@ -126,9 +124,8 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                 break
         else:
             rejected += 1
-            fac = 0.0 if err == math.inf else SAFETY * err ** (-0.2)
-            h_prop = h * max(FAC_MIN, fac)
-            if h_prop <= 4.0 * _EPS * max(abs(t), abs(t_end)):
+            h_prop = next_step(h, err, 4.0)
+            if step_underflow(h_prop, t, t_end):
                 status = Status.STEP_UNDERFLOW
                 break
     dtbox[0] = h_prop

@@ -23,7 +23,8 @@ from .status import Status
 from .stepping import _record
 from .stopping import check_stop, no_stop
 
-__all__ = ["embedded_loop", "initial_step", "SAFETY", "FAC_MIN", "FAC_MAX"]
+__all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
+           "FAC_MIN", "FAC_MAX"]
 
 SAFETY = 0.9   # step-size safety factor (HNW II.4)
 FAC_MIN = 0.2  # a rejected step shrinks by at most 5
@@ -47,6 +48,25 @@ def initial_step(x, v, fx, fv, rtol, atol, span):
     d1 = math.sqrt(d1 / (6 * n))
     h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     return min(h, span)
+
+
+@njit
+def next_step(h, err, q):
+    """The step after one of size ``h`` with error ``err`` (<= 1: accepted), for an
+    error estimate of order ``q``: ``h * SAFETY * err^(-1/(q+1))``, kept within
+    ``[FAC_MIN, FAC_MAX]`` times ``h``; an overflowed step (``err = inf``)
+    shrinks by ``FAC_MIN``."""
+    if err == 0.0:
+        return h * FAC_MAX
+    if err == math.inf:
+        return h * FAC_MIN
+    return h * min(FAC_MAX, max(FAC_MIN, SAFETY * err ** (-1.0 / (q + 1))))
+
+
+@njit
+def step_underflow(h, t, t_end):
+    """True when a step no longer moves ``t`` by more than a few roundings."""
+    return h <= 4.0 * _EPS * max(abs(t), abs(t_end))
 
 
 def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
@@ -141,8 +161,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             t = t_end if shortened else t + h
             steps += 1
             if not shortened:
-                fac = FAC_MAX if err == 0.0 else SAFETY * err ** (-1.0 / (q + 1))
-                h_prop = h * min(FAC_MAX, max(FAC_MIN, fac))
+                h_prop = next_step(h, err, q)
             until_record -= 1
             if until_record == 0:
                 until_record = every
@@ -156,9 +175,8 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
                 break
         else:
             rejected += 1
-            fac = 0.0 if err == math.inf else SAFETY * err ** (-1.0 / (q + 1))
-            h_prop = h * max(FAC_MIN, fac)
-            if h_prop <= 4.0 * _EPS * max(abs(t), abs(t_end)):
+            h_prop = next_step(h, err, q)
+            if step_underflow(h_prop, t, t_end):
                 status = Status.STEP_UNDERFLOW
                 break
     dtbox[0] = h_prop
