@@ -15,7 +15,8 @@ from .bodies import BodySet
 from .custom import Trajectory, integrate
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, ConvergenceFailure,
                      ElementsError, Escape, IntegratorOptionError, NonFiniteState,
-                     OrbitsError, StepSizeUnderflow, UnknownIntegratorError)
+                     OrbitsError, StepSizeUnderflow, UnknownIntegratorError,
+                     WallTimeExceeded)
 from .result import Result
 from .simulation import Simulation
 from .units import UnitSystem
@@ -30,7 +31,7 @@ __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajec
            "scenes", "integrators", "monitors", "errors", "OrbitsError", "BodyError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow", "ConvergenceFailure",
-           "CloseEncounter", "Escape", "load", "io", "Ensemble", "__version__"]
+           "CloseEncounter", "Escape", "WallTimeExceeded", "load", "io", "Ensemble", "__version__"]
 
 
 def __getattr__(name):

@@ -23,6 +23,7 @@ __all__ = [
     "NonFiniteState",
     "StepSizeUnderflow",
     "ConvergenceFailure",
+    "WallTimeExceeded",
     "CloseEncounter",
     "Escape",
 ]
@@ -141,6 +142,14 @@ class ConvergenceFailure(RunError):
 
     The step was too large for the iteration (a close encounter, a force that
     changes too fast): a smaller step usually cures it.
+    """
+
+
+class WallTimeExceeded(RunError):
+    """A run took longer than the wall-clock limit it was given (``wall_limit=``).
+
+    The simulation is left at the last state reached, which ``result`` ends
+    with, so the run can be continued with another :meth:`~orbits.Simulation.run`.
     """
 
 

@@ -19,7 +19,8 @@ from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import (BodyUnitsError, CloseEncounter, ConvergenceFailure, Escape,
-                     IntegratorOptionError, NonFiniteState, StepSizeUnderflow)
+                     IntegratorOptionError, NonFiniteState, StepSizeUnderflow,
+                     WallTimeExceeded)
 from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
                        vector_relative_error)
 from .result import Result
@@ -339,7 +340,7 @@ class Simulation:
 
     # -- running ------------------------------------------------------------------------
     def run(self, until, outputs=500, progress=None, output=None, overwrite=False,
-            checkpoint_interval=None):
+            checkpoint_interval=None, wall_limit=None):
         """Advance to ``until``, recording ``outputs`` evenly spread states.
 
         Parameters
@@ -369,6 +370,11 @@ class Simulation:
             Seconds of wall time between restart checkpoints in the file
             (default :data:`orbits.io.hdf5.CHECKPOINT_SECONDS`); 0 writes one
             at every output.  One is always written at the end.
+        wall_limit : float, optional
+            Seconds of wall-clock time after which the run stops with
+            :class:`~orbits.errors.WallTimeExceeded` (checked about every
+            ``CHUNK_SECONDS``), for sweeps in which some runs may need far more
+            steps than expected.  Default: no limit.
 
         Returns
         -------
@@ -382,6 +388,10 @@ class Simulation:
             good state; the simulation is left at that state.
         """
         plan = self._plan(self._time_value(until, "until"), outputs, until)
+        if wall_limit is not None and not float(wall_limit) > 0:
+            raise ValueError(f"wall_limit must be a positive number of seconds, "
+                             f"got {wall_limit}")
+        self._wall_limit = None if wall_limit is None else float(wall_limit)
         if output is None:
             rec = _Recorder(self, initial=plan.outputs > 1)
         else:
@@ -487,6 +497,7 @@ class Simulation:
                 self._chunk *= 4
             elif elapsed > CHUNK_SECONDS:
                 self._chunk = max(16, self._chunk // 2)
+            self._check_wall(rec, wall0)
 
     def _advance_to(self, done, target, rec, bar, wall0):
         # the loop returns to Python about every CHUNK_SECONDS (progress bar);
@@ -503,7 +514,20 @@ class Simulation:
                     self._chunk *= 4
                 elif elapsed > CHUNK_SECONDS:
                     self._chunk = max(1, self._chunk // 2)
+            self._check_wall(rec, wall0)
         return done
+
+    def _check_wall(self, rec, wall0):
+        limit = getattr(self, "_wall_limit", None)
+        if limit is None or _time.perf_counter() - wall0 <= limit:
+            return
+        rec.output(self, final=True)
+        rec.close()
+        result = rec.result(self, _time.perf_counter() - wall0, status="wall-time limit")
+        raise WallTimeExceeded(
+            f"the run passed its wall-time limit of {limit:g} s at t = {self.time:.10g} "
+            f"(step {self.steps}); the result up to here is kept on .result and the "
+            f"simulation was left there", time=self.time, step=self.steps, result=result)
 
     def _advance(self, n, rec, wall0, dt=None):
         dt = self._dt if dt is None else dt
