@@ -1,4 +1,4 @@
-"""Inertial <-> Jacobi coordinates on plain float64 arrays.
+"""Inertial <-> Jacobi and democratic heliocentric coordinates on plain float64 arrays.
 
 Jacobi coordinates (Plummer 1918; Wisdom & Holman 1991, sect. 3) measure each
 body from the centre of mass of the bodies before it::
@@ -12,11 +12,24 @@ linear and the same matrix maps all three).  Only mass ratios enter, so the
 kernels take ``gm = G m`` as the stepping loops do.  Massless bodies are
 allowed after a massive first body: their Jacobi coordinate is relative to
 the centre of mass of the bodies before them, and they move nothing.
+
+Democratic heliocentric coordinates (Duncan, Levison & Lee 1998, sect. 2;
+"canonical heliocentric" in Wisdom 2006) take positions relative to the
+central body and velocities relative to the centre of mass::
+
+    Q_0 = X,  V_0 = V                    (centre of mass of all, and its velocity)
+    Q_i = x_i - x_0,  V_i = v_i - V,     i >= 1
+
+The momenta conjugate to ``Q_i`` are ``m_i V_i``, so the transformation is
+canonical with the masses unchanged.  Inverting it needs the masses once
+more: ``x_0 = X - sum_i m_i Q_i / M`` and ``v_0 = V - sum_i m_i V_i / m_0``
+(the barycentric momenta sum to zero).
 """
 
 from ._jit import njit
 
-__all__ = ["interior_gm", "to_jacobi", "from_jacobi", "to_jacobi_one", "from_jacobi_one"]
+__all__ = ["interior_gm", "to_jacobi", "from_jacobi", "to_jacobi_one", "from_jacobi_one",
+           "to_democratic_heliocentric", "from_democratic_heliocentric"]
 
 
 @njit
@@ -99,3 +112,99 @@ def from_jacobi(xj, vj, gm, eta, x, v):
     """Inertial ``x``, ``v`` from Jacobi ``xj``, ``vj``; arguments as :func:`to_jacobi`."""
     from_jacobi_one(xj, gm, eta, x)
     from_jacobi_one(vj, gm, eta, v)
+
+
+@njit
+def to_democratic_heliocentric(x, v, gm, xh, vb):
+    """Democratic heliocentric positions ``xh`` and barycentric velocities ``vb``
+    from inertial ``x``, ``v``.
+
+    Parameters
+    ----------
+    x, v : ndarray, shape (N, 3)
+        Inertial positions and velocities; body 0 is the central body.
+    gm : ndarray, shape (N,)
+        G times the masses; ``gm[0] > 0``, zeros allowed for the others.
+    xh, vb : ndarray, shape (N, 3)
+        Written: row 0 the centre of mass and its velocity, row ``i >= 1``
+        ``x_i - x_0`` and ``v_i - V``.
+
+    References
+    ----------
+    Duncan, M. J., Levison, H. F. & Lee, M. H. 1998, AJ 116, 2067, sect. 2.
+    """
+    n = x.shape[0]
+    mtot = 0.0
+    cx = 0.0
+    cy = 0.0
+    cz = 0.0
+    cvx = 0.0
+    cvy = 0.0
+    cvz = 0.0
+    for i in range(n):
+        mtot += gm[i]
+        cx += gm[i] * x[i, 0]
+        cy += gm[i] * x[i, 1]
+        cz += gm[i] * x[i, 2]
+        cvx += gm[i] * v[i, 0]
+        cvy += gm[i] * v[i, 1]
+        cvz += gm[i] * v[i, 2]
+    cx /= mtot
+    cy /= mtot
+    cz /= mtot
+    cvx /= mtot
+    cvy /= mtot
+    cvz /= mtot
+    for i in range(1, n):
+        xh[i, 0] = x[i, 0] - x[0, 0]
+        xh[i, 1] = x[i, 1] - x[0, 1]
+        xh[i, 2] = x[i, 2] - x[0, 2]
+        vb[i, 0] = v[i, 0] - cvx
+        vb[i, 1] = v[i, 1] - cvy
+        vb[i, 2] = v[i, 2] - cvz
+    xh[0, 0] = cx
+    xh[0, 1] = cy
+    xh[0, 2] = cz
+    vb[0, 0] = cvx
+    vb[0, 1] = cvy
+    vb[0, 2] = cvz
+
+
+@njit
+def from_democratic_heliocentric(xh, vb, gm, x, v):
+    """Inertial ``x``, ``v`` from democratic heliocentric ``xh``, ``vb``;
+    arguments as :func:`to_democratic_heliocentric`."""
+    n = xh.shape[0]
+    mtot = 0.0
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for i in range(1, n):
+        mtot += gm[i]
+        sx += gm[i] * xh[i, 0]
+        sy += gm[i] * xh[i, 1]
+        sz += gm[i] * xh[i, 2]
+    mtot += gm[0]
+    x0 = xh[0, 0] - sx / mtot
+    y0 = xh[0, 1] - sy / mtot
+    z0 = xh[0, 2] - sz / mtot
+    for i in range(1, n):
+        x[i, 0] = xh[i, 0] + x0
+        x[i, 1] = xh[i, 1] + y0
+        x[i, 2] = xh[i, 2] + z0
+    x[0, 0] = x0
+    x[0, 1] = y0
+    x[0, 2] = z0
+    px = 0.0
+    py = 0.0
+    pz = 0.0
+    for i in range(1, n):
+        px += gm[i] * vb[i, 0]
+        py += gm[i] * vb[i, 1]
+        pz += gm[i] * vb[i, 2]
+        v[i, 0] = vb[i, 0] + vb[0, 0]
+        v[i, 1] = vb[i, 1] + vb[0, 1]
+        v[i, 2] = vb[i, 2] + vb[0, 2]
+    v[0, 0] = vb[0, 0] - px / gm[0]
+    v[0, 1] = vb[0, 1] - py / gm[0]
+    v[0, 2] = vb[0, 2] - pz / gm[0]

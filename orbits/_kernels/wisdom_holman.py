@@ -20,11 +20,41 @@ where ``a`` are the inertial accelerations of all pairs except (0, 1) and
 (0, 1) and the Kepler term of body 1 cancel exactly and are left out, so a
 two-body problem is integrated exactly up to the Kepler solver.
 
+Democratic heliocentric coordinates (Duncan, Levison & Lee 1998 [6]; "canonical
+heliocentric" in Wisdom 2006 [5]): heliocentric positions ``Q_i`` and their
+conjugate barycentric momenta ``P_i = m_i V_i`` (:mod:`orbits._kernels.coordinates`)
+split the Hamiltonian three ways, besides the centre of mass, which drifts::
+
+    H_Kepler      = sum_{i>=1} [ |P_i|^2 / (2 m_i) - G m_0 m_i / |Q_i| ]
+    H_interaction = - sum_{1<=j<i} G m_i m_j / |Q_i - Q_j|
+    H_jump        = |sum_{i>=1} P_i|^2 / (2 m_0)
+
+``H_Kepler`` moves every body on its orbit about ``G m_0`` (the same
+:func:`kepler_drift_all`, with ``mu_i = G m_0``); ``H_interaction`` kicks the
+velocities by the planets' mutual pull only (the star's pull is all in the
+Kepler part); ``H_jump`` shifts every heliocentric position by
+``h sum_i m_i V_i / m_0`` (:func:`jump`).  Test particles feel the planets and
+jump with them but move nothing.  The interaction and the jump commute:
+the jump moves all ``Q_i`` by one vector and leaves the differences that
+``H_interaction`` depends on alone, and the kicks, pairwise equal and
+opposite, leave ``sum P_i`` alone.  So ``J(h/2) I(h) J(h/2)`` is the exact
+flow of ``H_interaction + H_jump`` (:func:`jump_interaction_kick`), and the
+Wisdom-Holman map in these coordinates is the same table as in Jacobi ones,
+``K(h/2) [J(h/2) I(h) J(h/2)] K(h/2)``, the order REBOUND's WHFast uses in
+this mode (the tests compare the two; Hernandez & Dehnen 2017 [7] analyse
+the split's errors).  The perturbation ``H_interaction + H_jump`` is of order ``epsilon``
+as in Jacobi coordinates, so the map's error is ``O(epsilon h^2)`` again
+and the correctors below apply unchanged (they need only the exact flows
+of the two parts).  What differs: every body, test particles included, is
+treated alike whatever its order, but a lone massive companion is no
+longer integrated exactly (its jump is part of the perturbation), and on
+the outer solar system the position errors are a few times larger.
+
 A step is a table of Kepler drifts and interaction kicks, bound as constant
 tuples (``KINDS``, ``COEFS``) by :func:`orbits._kernels._jit.specialize`.  A
 table that ends with a drift defers it: the next step's first drift absorbs
 it (the leapfrog's two half drifts become one), and :func:`synchronize` applies
-it to a copy when the inertial state is wanted.  The Jacobi state and the
+it to a copy when the inertial state is wanted.  The internal state and the
 deferred drift live in the workspace between calls.
 
 Symplectic correctors (Wisdom, Holman & Touma 1996 [4]; Wisdom 2006 [5]).  The
@@ -37,8 +67,9 @@ from the stages ::
 (``I(b) = exp(b L_B)`` transported along the Kepler flow, whose first-order
 generator is ``2 b sinh(a ad_A) H_int``).  ``C`` applies ``Z(a_m, b_m)``
 first and ``Z(a_1, b_1)`` last; ``C^-1`` applies ``Z(-a_1, b_1)`` first,
-the exact inverse stage by stage.  The loop starts from ``C^-1`` of the
-initial state (:func:`apply_corrector` with ``inverse``) and the output is
+the exact inverse stage by stage (``I`` is the perturbation step of the
+coordinate system, ``J(h/2) I(h) J(h/2)`` in democratic heliocentric ones).
+The loop starts from ``C^-1`` of the initial state (:func:`apply_corrector` with ``inverse``) and the output is
 ``C`` of the mapping state, so the error of the output is that of ``T``
 up to ``O(epsilon h^(n+1) + epsilon^2 h^2)``.  ``C`` is applied only to the
 copy that :func:`synchronize` makes; the mapping state goes on untouched.
@@ -58,24 +89,31 @@ References
    Fields Institute Communications 10, 217.
 .. [5] Wisdom, J. 2006, "Symplectic correctors for canonical heliocentric
    coordinates", AJ 131, 2294.
+.. [6] Duncan, M. J., Levison, H. F. & Lee, M. H. 1998, "A multiple time step
+   symplectic algorithm for integrating close encounters", AJ 116, 2067.
+.. [7] Hernandez, D. M. & Dehnen, W. 2017, "A study of symplectic
+   integrators for planetary system problems: error analysis and
+   comparisons", MNRAS 468, 2614.
 """
 
 import math
 
 from ._jit import njit, specialize
-from .coordinates import from_jacobi, from_jacobi_one, to_jacobi
+from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
+                          to_democratic_heliocentric, to_jacobi)
 from .kepler import kepler_drift
 from .status import Status
 from .stepping import DRIFT, _record, state_is_finite
 
-__all__ = ["wh_loop", "interaction_kick", "kepler_drift_all", "synchronize",
-           "apply_corrector"]
+__all__ = ["wh_loop", "synchronizer", "interaction_kick", "jump",
+           "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
+           "synchronize", "apply_corrector", "COORDINATE_SYSTEMS"]
 
 
 @njit(inline="always")
 def kepler_drift_all(xj, vj, mu, h):
-    """Drift every Jacobi coordinate by ``h``: body i on its orbit about ``mu[i]``,
-    the centre of mass (row 0) in a straight line."""
+    """Drift every row by ``h``: row i >= 1 on its orbit about ``mu[i]``, the
+    centre of mass (row 0) in a straight line."""
     xj[0, 0] += h * vj[0, 0]
     xj[0, 1] += h * vj[0, 1]
     xj[0, 2] += h * vj[0, 2]
@@ -149,10 +187,93 @@ def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
         vj[i, 2] += h * az
 
 
-@njit
-def apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse):
+@njit(inline="always")
+def jump(xh, vb, gm, n_active, h):
+    """Shift every heliocentric position ``xh[1:]`` by ``h`` times
+    ``sum_i m_i V_i / m_0`` (the flow of ``H_jump``); ``vb`` barycentric."""
+    px = 0.0
+    py = 0.0
+    pz = 0.0
+    for i in range(1, n_active):
+        px += gm[i] * vb[i, 0]
+        py += gm[i] * vb[i, 1]
+        pz += gm[i] * vb[i, 2]
+    s = h / gm[0]
+    px *= s
+    py *= s
+    pz *= s
+    for i in range(1, xh.shape[0]):
+        xh[i, 0] += px
+        xh[i, 1] += py
+        xh[i, 2] += pz
+
+
+@njit(inline="always")
+def heliocentric_interaction_kick(xh, vb, acc, gm, n_active, h):
+    """Kick the barycentric velocities ``vb[1:]`` by ``h`` times the pull of
+    the other bodies except the central one (the flow of ``H_interaction``);
+    ``acc`` (shape (N, 3)) is scratch."""
+    n = xh.shape[0]
+    for i in range(n):
+        acc[i, 0] = 0.0
+        acc[i, 1] = 0.0
+        acc[i, 2] = 0.0
+    for i in range(2, n):
+        xi = xh[i, 0]
+        yi = xh[i, 1]
+        zi = xh[i, 2]
+        gmi = gm[i]
+        axi = 0.0
+        ayi = 0.0
+        azi = 0.0
+        for j in range(1, min(i, n_active)):
+            dx = xi - xh[j, 0]
+            dy = yi - xh[j, 1]
+            dz = zi - xh[j, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+            sj = gm[j] * inv_r3
+            axi -= sj * dx
+            ayi -= sj * dy
+            azi -= sj * dz
+            if i < n_active:
+                si = gmi * inv_r3
+                acc[j, 0] += si * dx
+                acc[j, 1] += si * dy
+                acc[j, 2] += si * dz
+        acc[i, 0] += axi
+        acc[i, 1] += ayi
+        acc[i, 2] += azi
+    for i in range(1, n):
+        vb[i, 0] += h * acc[i, 0]
+        vb[i, 1] += h * acc[i, 1]
+        vb[i, 2] += h * acc[i, 2]
+
+
+@njit(inline="always")
+def jump_interaction_kick(xh, vb, x, acc, gm, mu, n_active, h):
+    """The perturbation step in democratic heliocentric coordinates,
+    ``J(h/2) I(h) J(h/2)``: the exact flow of ``H_interaction + H_jump`` for
+    ``h``, as the two commute (see the module notes).  Arguments as
+    :func:`interaction_kick`; ``x`` and ``mu`` are not used."""
+    jump(xh, vb, gm, n_active, 0.5 * h)
+    heliocentric_interaction_kick(xh, vb, acc, gm, n_active, h)
+    jump(xh, vb, gm, n_active, 0.5 * h)
+
+
+@njit(inline="always")
+def _to_heliocentric(x, v, gm, mu, xh, vb):
+    to_democratic_heliocentric(x, v, gm, xh, vb)
+
+
+@njit(inline="always")
+def _from_heliocentric(xh, vb, gm, mu, x, v):
+    from_democratic_heliocentric(xh, vb, gm, x, v)
+
+
+def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse):
     """Apply the symplectic corrector ``C`` (or ``C^-1`` if ``inverse``) for the
-    step ``h`` to the Jacobi state ``xj``, ``vj`` in place.
+    step ``h`` to the internal state ``xj``, ``vj`` in place.
 
     ``corr`` (shape (m, 2)) holds the stages' ``(a_i, b_i)`` in units of the
     step; ``x`` and ``acc`` (shape (N, 3)) are scratch.  See the module notes.
@@ -166,15 +287,14 @@ def apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse):
             a = corr[m - 1 - k, 0] * h
             b = corr[m - 1 - k, 1] * h
         kepler_drift_all(xj, vj, eta, a)
-        interaction_kick(xj, vj, x, acc, gm, eta, n_active, -b)
+        perturbation(xj, vj, x, acc, gm, eta, n_active, -b)  # noqa: F821 - bound by specialize
         kepler_drift_all(xj, vj, eta, -2.0 * a)
-        interaction_kick(xj, vj, x, acc, gm, eta, n_active, b)
+        perturbation(xj, vj, x, acc, gm, eta, n_active, b)  # noqa: F821
         kepler_drift_all(xj, vj, eta, a)
 
 
-@njit
-def synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
-    """Inertial ``x``, ``v`` at the current time: the Jacobi state with the
+def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
+    """Inertial ``x``, ``v`` at the current time: the internal state with the
     deferred drift ``owed`` and then the corrector ``corr`` for the step ``h``
     (none if it has no rows) applied to a copy (``xs``, ``vs``); ``acc`` is
     scratch."""
@@ -184,21 +304,22 @@ def synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
         kepler_drift_all(xs, vs, eta, owed)
     if corr.shape[0] > 0:
         apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, False)
-    from_jacobi(xs, vs, gm, eta, x, v)
+    from_internal(xs, vs, gm, eta, x, v)  # noqa: F821 - bound by specialize
 
 
 def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
              corr, cdt, mon, step0, mon_t, mon_out, check_every):
+    # xj, vj: the internal (Jacobi or democratic heliocentric) state;
+    # eta: G times the mass each row's Kepler drift orbits.
     # state[0]: xj, vj hold the current state (else start from x, v);
-    # owed_box[0]: the drift the Jacobi state still owes, deferred from the
+    # owed_box[0]: the drift the internal state still owes, deferred from the
     # last step's closing drift; cdt[0]: the step the mapping state's
     # corrector belongs to (corr has no rows without corrector).
-    n = x.shape[0]
     every = mon[0]
     n_mon = 0
     corrected = corr.shape[0] > 0
     if state[0] == 0:
-        to_jacobi(x, v, gm, eta, xj, vj)
+        to_internal(x, v, gm, eta, xj, vj)  # noqa: F821 - bound by specialize
         state[0] = 1
         owed_box[0] = 0.0
         if corrected:
@@ -230,7 +351,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                 else:
                     kepler_drift_all(xj, vj, eta, h)
             else:
-                interaction_kick(xj, vj, xs, acc, gm, eta, n_active, h)
+                perturbation(xj, vj, xs, acc, gm, eta, n_active, h)  # noqa: F821
         until_check -= 1
         if until_check == 0 or k + 1 == nsteps:
             until_check = check_every
@@ -247,8 +368,41 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
     return Status.OK, nsteps, n_mon
 
 
-def wh_loop(name, kinds, coefs):
+#: coordinate system -> (to internal, from internal, perturbation step); each
+#: takes ``(.., gm, eta, ..)`` with ``eta`` the rows' Kepler ``G M``
+COORDINATE_SYSTEMS = {
+    "jacobi": (to_jacobi, from_jacobi, interaction_kick),
+    "democratic-heliocentric": (_to_heliocentric, _from_heliocentric,
+                                jump_interaction_kick),
+}
+
+
+def _kernels(coordinates):
+    to_internal, from_internal, perturbation = COORDINATE_SYSTEMS[coordinates]
+    corrector = specialize(_apply_corrector, f"corrector_{coordinates}",
+                           perturbation=perturbation)
+    sync = specialize(_synchronize, f"synchronize_{coordinates}", from_internal=from_internal,
+                      apply_corrector=corrector)
+    return to_internal, perturbation, corrector, sync
+
+
+def synchronizer(coordinates):
+    """The compiled :func:`synchronize` for ``coordinates``."""
+    return _kernels(coordinates)[3]
+
+
+def wh_loop(name, kinds, coefs, coordinates="jacobi"):
     """The Wisdom-Holman loop compiled for one table of Kepler drifts (DRIFT) and
-    interaction kicks (KICK); ``name`` names the table."""
-    return specialize(_wh_loop, f"wh_{name}", KINDS=tuple(int(k) for k in kinds),
-                      COEFS=tuple(float(c) for c in coefs))
+    perturbation steps (KICK) in ``coordinates`` (a key of
+    :data:`COORDINATE_SYSTEMS`); ``name`` names the table."""
+    to_internal, perturbation, corrector, sync = _kernels(coordinates)
+    return specialize(_wh_loop, f"wh_{name}_{coordinates}",
+                      KINDS=tuple(int(k) for k in kinds),
+                      COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
+                      perturbation=perturbation, apply_corrector=corrector,
+                      synchronize=sync)
+
+
+#: the Jacobi versions, compiled on first use
+apply_corrector = _kernels("jacobi")[2]
+synchronize = _kernels("jacobi")[3]

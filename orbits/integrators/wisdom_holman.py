@@ -1,4 +1,5 @@
-"""The Wisdom-Holman map in Jacobi coordinates, and the SABA methods.
+"""The Wisdom-Holman map in Jacobi or democratic heliocentric coordinates, and
+the SABA methods.
 
 Planetary systems are nearly Keplerian: each planet moves on an ellipse about
 the star, perturbed by the others.  The Wisdom-Holman map splits the motion
@@ -32,8 +33,8 @@ __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
 #: planets have 1e-3; a binary companion or a cluster member has ~1.)
 MASS_RATIO_LIMIT = 0.01
 
-#: coordinate systems: name -> implemented
-COORDINATES = {"jacobi": True, "democratic-heliocentric": False}
+#: coordinate systems of the split (see :mod:`orbits._kernels.wisdom_holman`)
+COORDINATES = ("jacobi", "democratic-heliocentric")
 
 #: Spacing of the corrector stages: stage i is ``Z(a_i h, b_i h)`` with
 #: ``a_i = i * CORRECTOR_SPACING`` (Wisdom, Holman & Touma 1996; Wisdom 2006).
@@ -72,13 +73,24 @@ class NoDominantBodyWarning(UserWarning):
 
 
 class WisdomHolman(Integrator):
-    """Wisdom-Holman map in Jacobi coordinates, with lazy synchronisation.
+    """Wisdom-Holman map in Jacobi or democratic heliocentric coordinates, with
+    lazy synchronisation.
 
     Options
     -------
     coordinates : {"jacobi", "democratic-heliocentric"}
-        The split.  Only ``"jacobi"`` is implemented so far; the other is
-        refused with an error that says so.
+        The split.  ``"jacobi"`` (default): each body orbits the interior
+        mass ``G eta_i`` of the bodies before it; a two-body problem is
+        exact.  ``"democratic-heliocentric"`` (Duncan, Levison & Lee 1998):
+        heliocentric positions, barycentric velocities, every body orbits
+        ``G m_0``, and the perturbation adds a "jump" of the positions by
+        the planets' total momentum over ``m_0``; every body is treated
+        alike whatever its order, but a massive companion's own Kepler
+        problem is no longer exact (error proportional to its mass ratio).
+        On the outer solar system at 1/20 of Jupiter's period the energy
+        error is about that of Jacobi coordinates (1.9e-6 against 2.4e-6),
+        the position error after 200 steps four times larger, and the
+        corrected energy error levels off higher (1.4e-8 against 4e-9).
     corrector : {0, 3, 5, 7, 11, 17}
         Order of the symplectic corrector (0: none; only for ``wh`` itself,
         not SABA).  The map then runs from ``C^-1`` of the initial state and
@@ -92,6 +104,11 @@ class WisdomHolman(Integrator):
         nothing a step.  A step of another size (a shorter last step) passes
         through the corrected state, which moves the mapping state by the
         correctors' second-order difference.
+        In democratic heliocentric coordinates the same correctors apply,
+        to first order in the mass ratio as in Jacobi ones, because the
+        perturbation step is the exact flow of the whole perturbation
+        (interaction and jump commute; Wisdom 2006): there the energy error
+        falls from 1.9e-6 to 1.3e-7 (3), 2.1e-8 (5) and 1.4e-8 (7 to 17).
 
     Notes
     -----
@@ -100,6 +117,11 @@ class WisdomHolman(Integrator):
     interaction kick ``I(h)``, one step is::
 
         Phi(h) = K(h/2) I(h) K(h/2)
+
+    In democratic heliocentric coordinates ``K(h)`` moves every body on its
+    orbit about ``G m_0`` and ``I(h)`` becomes ``J(h/2) I(h) J(h/2)``, the
+    planet-planet kick between two half jumps (the order REBOUND's WHFast
+    uses; the jump and the kick commute, so this is the exact flow of both).
 
     Symplectic, time-symmetric, second order in ``h`` with an error
     proportional to the mass ratio ``epsilon`` of the perturbers to the
@@ -112,7 +134,7 @@ class WisdomHolman(Integrator):
     without softening can be split this way.
 
     State kept between calls (lazy synchronisation, Rein & Tamayo 2015): the
-    Jacobi positions and velocities, the closing half drift still owed and the
+    Jacobi (or democratic heliocentric) positions and velocities, the closing half drift still owed and the
     step the corrector was built for.
     Consecutive steps merge their half drifts into one, and the inertial
     state in ``x``, ``v`` is brought up to date only by :meth:`synchronize`
@@ -125,7 +147,10 @@ class WisdomHolman(Integrator):
     AJ 102, 1528.  Rein, H. & Tamayo, D. 2015, "WHFAST: a fast and unbiased
     implementation of a symplectic Wisdom-Holman integrator", MNRAS 452, 376.
     Wisdom, J., Holman, M. & Touma, J. 1996, "Symplectic correctors", Fields
-    Inst. Commun. 10, 217.  Wisdom, J. 2006, AJ 131, 2294.
+    Inst. Commun. 10, 217.  Wisdom, J. 2006, "Symplectic correctors for
+    canonical heliocentric coordinates", AJ 131, 2294.  Duncan, M. J.,
+    Levison, H. F. & Lee, M. H. 1998, AJ 116, 2067 (democratic heliocentric
+    coordinates).
 
     Examples
     --------
@@ -144,7 +169,8 @@ class WisdomHolman(Integrator):
     time_symmetric = True
     needs_central_body = True
     options = {"coordinates": "jacobi", "corrector": 0}
-    summary = "Wisdom-Holman map, Kepler drifts and interaction kicks in Jacobi coordinates"
+    summary = ("Wisdom-Holman map, Kepler drifts and interaction kicks in Jacobi or "
+               "democratic heliocentric coordinates")
     #: the step as a table of Kepler drifts ("drift") and interaction kicks ("kick")
     operators = tableaux.WH_DKD
     forces_per_step = 1
@@ -170,10 +196,6 @@ class WisdomHolman(Integrator):
             raise IntegratorOptionError(
                 f"{self.name}: unknown coordinates {coords!r}; valid: "
                 f"{', '.join(map(repr, COORDINATES))}")
-        if not COORDINATES[coords]:
-            raise IntegratorOptionError(
-                f"{self.name}: coordinates={coords!r} is not implemented yet; "
-                f"implemented: {', '.join(repr(c) for c, ok in COORDINATES.items() if ok)}")
         corr = self.config["corrector"]
         if isinstance(corr, bool) or corr not in CORRECTORS:
             raise IntegratorOptionError(
@@ -189,7 +211,7 @@ class WisdomHolman(Integrator):
         return {"xj": np.zeros((n, 3)), "vj": np.zeros((n, 3)),
                 "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3)), "acc": np.zeros((n, 3)),
                 "gm": np.zeros(n), "eta": np.zeros(n),
-                # [Jacobi state current, system checked]
+                # [internal state current, system checked]
                 "state": np.zeros(2, dtype=np.int64),
                 "owed": np.zeros(1),
                 # the step whose corrector the Jacobi state carries, and N_active
@@ -223,7 +245,11 @@ class WisdomHolman(Integrator):
                     NoDominantBodyWarning, stacklevel=4)
         ws["gm"][:] = gm
         ws["n_active"][0] = n_active
-        _coordinates.interior_gm(gm, ws["eta"])
+        if self.config["coordinates"] == "jacobi":
+            _coordinates.interior_gm(gm, ws["eta"])
+        else:
+            # every body orbits the central one alone (row 0 is not a Kepler orbit)
+            ws["eta"][:] = gm[0]
         ws["state"][1] = 1
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
@@ -231,7 +257,7 @@ class WisdomHolman(Integrator):
         if ws["state"][1] == 0:
             self._check_system(ws, force, fargs)
         gm, n_active = fargs[0], fargs[1]
-        loop = _wh.wh_loop(self.name, self._kinds, self._coefs)
+        loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"])
         return loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
                     ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
                     ws["cdt"], mon, step0, mon_t, mon_out, check_every)
@@ -240,9 +266,9 @@ class WisdomHolman(Integrator):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
         its owed drift are kept, so that the following steps go on unchanged."""
         if ws["state"][0]:
-            _wh.synchronize(ws["xj"], ws["vj"], ws["gm"], ws["eta"],
-                            ws["owed"][0], ws["xs"], ws["vs"], x, v, ws["acc"],
-                            int(ws["n_active"][0]), self._corr, ws["cdt"][0])
+            sync = _wh.synchronizer(self.config["coordinates"])
+            sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],
+                 x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0])
 
     def invalidate(self, ws):
         """The state was changed from outside: start again from ``x``, ``v``."""
