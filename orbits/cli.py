@@ -1,4 +1,4 @@
-"""Command line: ``orbits run | resume | info | plot | scenes | integrators``.
+"""Command line: ``orbits run | resume | info | plot | validate | scenes | integrators``.
 
 ``main(argv=None)`` only parses arguments and calls the library; the tests
 call it with a list.
@@ -69,6 +69,22 @@ def _parser():
     plot.add_argument("file")
     plot.add_argument("-o", "--output", help="PNG path (default: next to the file)")
 
+    val = sub.add_parser("validate", help="run the validation report (accuracy against "
+                                          "REBOUND, work-precision, drift, stress suite) "
+                                          "and write it as Markdown with plots")
+    val.add_argument("--quick", action="store_true",
+                     help="shorter runs and sweeps: a few minutes on two cores")
+    val.add_argument("--out", default="validation-report",
+                     help="folder for report.md and its PNGs (default ./validation-report)")
+    val.add_argument("--workers", type=int, default=None,
+                     help="worker processes (default: one per core; 1: this process only)")
+    val.add_argument("--scheduler", default=None,
+                     help="address of an existing Dask scheduler to run on")
+    val.add_argument("--only", nargs="+", default=None, metavar="SECTION",
+                     help="run only these sections: accuracy work_precision drift stress "
+                          "guide")
+    val.add_argument("--no-progress", action="store_true")
+
     sub.add_parser("scenes", help="list the built-in scenes")
     sub.add_parser("integrators", help="list the integrators")
     return p
@@ -118,6 +134,8 @@ def main(argv=None):
             print(result.summary())
         elif args.command == "info":
             print(orbits.io.describe(args.file))
+        elif args.command == "validate":
+            return _validate(args)
         elif args.command == "plot":
             from orbits.plotting import plot_file
             path = plot_file(args.file, args.output)
@@ -125,6 +143,26 @@ def main(argv=None):
     except (OrbitsError, ValueError, u.UnitsError) as exc:
         print(f"orbits: error: {exc}", file=sys.stderr)
         return 2
+    return 0
+
+
+def _validate(args):
+    from orbits import validation
+    client = None
+    if args.scheduler:
+        from distributed import Client
+        client = Client(args.scheduler)
+    try:
+        path = validation.validate(out=args.out, quick=args.quick, n_workers=args.workers,
+                                   client=client, progress=not args.no_progress,
+                                   sections=args.only or validation.SECTIONS)
+    except validation.ValidationError as exc:
+        print(f"orbits: error: {exc}", file=sys.stderr)
+        return 2
+    finally:
+        if client is not None:
+            client.close()
+    print(f"wrote {path}")
     return 0
 
 

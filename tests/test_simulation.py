@@ -181,3 +181,23 @@ def test_softening_changes_the_force():
     assert not np.allclose(r0.positions.value[-1], r1.positions.value[-1], atol=1e-6)
     with pytest.raises(IntegratorOptionError, match="softening"):
         orbits.Simulation(b, dt=0.01, softening=-1.0)
+
+
+def test_wall_limit_stops_with_the_state_kept():
+    import astropy.units as u
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "leapfrog", dt=1 * u.day)
+    sim.run(until=10 * u.day, outputs=2, progress=False)          # compiled before timing
+    with pytest.raises(orbits.WallTimeExceeded, match="wall-time limit of 0.2 s") as info:
+        sim.run(until=1e9 * u.yr, outputs=5, wall_limit=0.2, progress=False)
+    exc = info.value
+    assert exc.result.status == "wall-time limit"
+    assert sim.steps == exc.step > 10
+    # the result ends with the state the simulation was left at, and it goes on
+    assert np.array_equal(exc.result.positions[-1].value, sim.bodies.positions.value)
+    sim.run(until=sim.time + 10 * u.day, outputs=2, progress=False)
+
+
+def test_wall_limit_must_be_positive():
+    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * orbits.scenes.u.day)
+    with pytest.raises(ValueError, match="wall_limit"):
+        sim.run(until=10 * orbits.scenes.u.day, outputs=2, wall_limit=0)

@@ -32,7 +32,11 @@ def _call(task):
     _sync_numba_config()
     module, name = task.function.split(":")
     func = getattr(importlib.import_module(module), name)
-    return func(**task.kwargs)
+    t0 = time.perf_counter()
+    row = func(**task.kwargs)
+    if isinstance(row, dict):   # compilation and warm-up included: what the task cost
+        row["task_seconds"] = time.perf_counter() - t0
+    return row
 
 
 class Pool:

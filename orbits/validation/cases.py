@@ -37,8 +37,10 @@ PYTHON_FORCE = ("radau", "lsoda")
 #: First-order explicit methods, left out of long runs.
 DIVERGENT = ("euler",)
 
-#: Above this many fixed steps a Python-force method would take minutes.
-PYTHON_FORCE_STEPS = 50_000
+#: Above this many orbits of the shortest period, a Python-force method
+#: (about 200 microseconds a step for scipy's Radau, some hundred steps an
+#: orbit at its default tolerance) would take more than about a minute.
+PYTHON_FORCE_ORBITS = 2_000
 
 _YEAR = 365.25
 
@@ -59,7 +61,8 @@ class Problem(NamedTuple):
 
     ``until`` and ``until_quick`` are the run lengths of the full and the
     quick report, ``dt`` the fixed methods' step, all in the scene's time
-    unit; ``period`` is the shortest orbital period, for the text.
+    unit; ``period`` is the shortest orbital period (for the Pythagorean
+    problem the time its bodies take to fall together, about 1).
     """
 
     key: str
@@ -97,7 +100,7 @@ PROBLEMS = (
     Problem("sun-8-planets", "Sun and eight planets (J2000)", "solar-system", {"moon": False},
             1e3 * _YEAR, 1e2 * _YEAR, 1.0, 87.969, "day", "au", "1000 years", "100 years"),
     Problem("pythagorean", "Pythagorean three-body problem", "pythagorean", {},
-            70.0, 20.0, 1e-4, math.nan, "N-body", "N-body", "t = 0 to 70", "t = 0 to 20"),
+            70.0, 20.0, 1e-4, 1.0, "N-body", "N-body", "t = 0 to 70", "t = 0 to 20"),
     Problem("figure-eight", "figure-eight choreography", "figure-eight", {},
             100 * _scenes.FIGURE_EIGHT_PERIOD, 10 * _scenes.FIGURE_EIGHT_PERIOD,
             _scenes.FIGURE_EIGHT_PERIOD / 1000, _scenes.FIGURE_EIGHT_PERIOD, "N-body", "N-body",
@@ -136,11 +139,11 @@ def applies(prob, name, quick=False, body_set=None):
                     f"{MASS_RATIO_LIMIT:g}): the Wisdom-Holman split assumes Kepler orbits "
                     f"about one body")
     if name in PYTHON_FORCE:
-        n = prob.steps(quick)
-        if n > PYTHON_FORCE_STEPS:
-            return (f"scipy's solver calls the force from Python; a run as long as {n:,} "
-                    f"fixed steps would take minutes (a reference for stiff user problems: "
-                    f"see the stress suite's spring sweep)")
+        n = prob.length(quick) / prob.period
+        if n > PYTHON_FORCE_ORBITS:
+            return (f"scipy's solver calls the force from Python: {n:,.0f} orbits of the "
+                    f"shortest period would take minutes (it is a reference for stiff user "
+                    f"problems, in the stress suite's spring sweep)")
     return None
 
 
