@@ -37,10 +37,11 @@ PYTHON_FORCE = ("radau", "lsoda")
 #: First-order explicit methods, left out of long runs.
 DIVERGENT = ("euler",)
 
-#: Above this many orbits of the shortest period, a Python-force method
-#: (about 200 microseconds a step for scipy's Radau, some hundred steps an
-#: orbit at its default tolerance) would take more than about a minute.
-PYTHON_FORCE_ORBITS = 2_000
+#: Above this many orbits of the shortest period (full report, quick report)
+#: a Python-force method takes longer than the rest of a problem's rows
+#: together: scipy's Radau was measured at 0.2 to 0.4 s an orbit at its
+#: default tolerance (some 400 steps of about 0.5 ms).
+PYTHON_FORCE_ORBITS = (150, 30)
 
 _YEAR = 365.25
 
@@ -140,7 +141,7 @@ def applies(prob, name, quick=False, body_set=None):
                     f"about one body")
     if name in PYTHON_FORCE:
         n = prob.length(quick) / prob.period
-        if n > PYTHON_FORCE_ORBITS:
+        if n > PYTHON_FORCE_ORBITS[1 if quick else 0]:
             return (f"scipy's solver calls the force from Python: {n:,.0f} orbits of the "
                     f"shortest period would take minutes (it is a reference for stiff user "
                     f"problems, in the stress suite's spring sweep)")

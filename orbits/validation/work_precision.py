@@ -12,8 +12,6 @@ it in the least wall time.
 import math
 import pathlib
 
-import numpy as np
-
 from . import cases
 from ._format import fmt_time
 from ._measure import run_orbits, run_rebound
@@ -136,12 +134,11 @@ def tasks(quick):
 
 def _attach_errors(rows):
     """Add ``position_error`` (against the reference) to every row."""
+    from .accuracy import position_error
     refs = {r["problem"]: r for r in rows if r["series"] == "reference"}
     for r in rows:
-        ref = refs.get(r["problem"])
-        ok = (ref is not None and r["outcome"] == "completed" and r["x"] is not None)
-        r["position_error"] = (float(np.abs(np.asarray(r["x"]) - np.asarray(ref["x"])).max())
-                               if ok and r is not ref else math.nan)
+        r["position_error"] = (math.nan if r is refs.get(r["problem"]) else
+                               position_error(r, refs.get(r["problem"]), r["problem"]))
     return refs
 
 
@@ -204,8 +201,10 @@ def _plot(rows, prob, path, quick):
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="center right", fontsize=8, frameon=False)
     length = SWEEP[prob.key][1 if quick else 0]
+    against = ("the exact Kepler orbit" if prob.scene == "kepler"
+               else "REBOUND IAS15 (epsilon 1e-9)")
     fig.suptitle(f"{prob.title}: {length / prob.period:.0f} orbits of the shortest period; "
-                 f"error against REBOUND IAS15 (epsilon 1e-9)")
+                 f"error against {against}")
     fig.subplots_adjust(right=0.82, wspace=0.08, hspace=0.25)
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -218,8 +217,9 @@ def section(rows, out_dir, quick):
              f"({', '.join(f'{f:g}' for f in DT_FACTORS[1 if quick else 0])} times it); "
              "the embedded and step-doubling methods sweep rtol (atol = rtol / 1000); "
              "the IAS15s sweep epsilon. REBOUND's leapfrog, WHFast and IAS15 are on the "
-             "same axes (grey, dashed). Errors are against REBOUND's IAS15 at epsilon "
-             "1e-9; wall times are of one core, compilation excluded, the shortest of up "
+             "same axes (grey, dashed). Position errors are against the exact orbit for "
+             "the Kepler problem and against REBOUND's IAS15 at epsilon 1e-9 otherwise; "
+             "wall times are of one core, compilation excluded, the shortest of up "
              f"to {REPEATS} repetitions for runs under {SHORT_RUN:g} s. Failed runs "
              "(named errors) are not drawn.", ""]
     for key in SWEEP:
