@@ -156,6 +156,7 @@ def section(rows, out_dir, quick):
              "untimed run; those of the implicit methods are nominal (two per step; "
              "Newton's iterations cost more). A failed run shows its named error and "
              "its errors up to the last good state.", ""]
+    lines += _problems_table(quick)
     for prob in cases.PROBLEMS:
         prows = by_problem.get(prob.key, [])
         if not prows:
@@ -191,6 +192,27 @@ def section(rows, out_dir, quick):
         lines += [f"| {p} | {n} | {why} |" for p, n, why in skipped]
         lines.append("")
     return "\n".join(lines)
+
+
+def _problems_table(quick):
+    """Which checks each problem takes, and how many integrators it leaves out."""
+    from . import work_precision
+    skipped = {}
+    for key, name, _ in left_out(quick):
+        skipped.setdefault(key, []).append(name)
+    lines = ["| problem | bodies | run | fixed step | checks | left out (reasons below) |",
+             "|---|---|---|---|---|---|"]
+    for prob in cases.PROBLEMS:
+        checks = ["accuracy"]
+        if prob.key in work_precision.SWEEP:
+            checks.append("work-precision")
+        if prob.scene == "outer-solar-system":
+            checks.append("long-horizon drift (centre-of-mass frame)")
+        names = ", ".join(f"`{n}`" for n in skipped.get(prob.key, [])) or "none"
+        lines.append(f"| {prob.title} | {len(cases.bodies(prob))} | "
+                     f"{prob.span_quick if quick else prob.span} | {prob.dt:.4g} "
+                     f"{prob.time_unit} | {', '.join(checks)} | {names} |")
+    return lines + [""]
 
 
 def _side_by_side(by_problem):

@@ -130,9 +130,10 @@ def mass_ratio(body_set):
     return float(m[1:].max() / m[0]) if len(m) > 1 and m[0] > 0 else math.inf
 
 
-def applies(prob, name, quick=False, body_set=None):
+def applies(prob, name, quick=False, body_set=None, length=None):
     """None if integrator ``name`` (ours or ``"rebound-whfast"``, ...) applies to
-    ``prob``, else the reason it is left out (a sentence)."""
+    ``prob`` run for ``length`` (default: the problem's own), else the reason
+    it is left out (a sentence)."""
     if name in WISDOM_HOLMAN or name == "rebound-whfast":
         ratio = mass_ratio(body_set if body_set is not None else bodies(prob))
         if ratio > MASS_RATIO_LIMIT:
@@ -140,11 +141,11 @@ def applies(prob, name, quick=False, body_set=None):
                     f"{MASS_RATIO_LIMIT:g}): the Wisdom-Holman split assumes Kepler orbits "
                     f"about one body")
     if name in PYTHON_FORCE:
-        n = prob.length(quick) / prob.period
+        n = (prob.length(quick) if length is None else length) / prob.period
         if n > PYTHON_FORCE_ORBITS[1 if quick else 0]:
             return (f"scipy's solver calls the force from Python: {n:,.0f} orbits of the "
-                    f"shortest period would take minutes (it is a reference for stiff user "
-                    f"problems, in the stress suite's spring sweep)")
+                    f"shortest period would take minutes; it is a reference for stiff user "
+                    f"problems, run in the stress suite's spring sweep")
     return None
 
 
