@@ -79,6 +79,8 @@ __all__ = [
     "state_to_elements_many",
     "stumpff",
     "kepler_drift",
+    "short_step_anomaly",
+    "advance_by_anomaly",
     "DRIFT_MAX_ITER",
 ]
 
@@ -892,6 +894,11 @@ def state_to_elements_many(mu, pos, vel, out, status):
 _STUMPFF_DIRECT_Z = 4.0
 # |z| < 0.1: the series below to z^6 is exact to 0.1^7 / 17! ~ 3e-22.
 _STUMPFF_SERIES_Z = 0.1
+# |z| < 2e-3 (a step of up to 0.045 rad of eccentric anomaly: the steps of a
+# planetary integration): four terms suffice, the first omitted one being
+# (2e-3)^4 / 10! ~ 4e-18 against c2 = 1/2.
+_STUMPFF_SHORT_Z = 2e-3
+_SIXTH = 1.0 / 6.0
 
 # Bounded iterations of the universal Kepler equation: Danby's quartic
 # iteration from the starters below needs 2-4 on the steps of a planetary
@@ -901,6 +908,52 @@ DRIFT_MAX_ITER = 200
 
 # stop when a correction is below this many ulps of the iterate
 _DRIFT_STEP_TOL = 2.0 * _EPS
+
+# The short-step path of the drift (the steps of a planetary integration):
+# taken when |dt| |v0| < _SHORT_STEP r0 and the starter spans |beta s^2| <=
+# _SHORT_STEP_Z (an eccentric anomaly of at most 1 rad), else the bracketed
+# solver.  From the third-order Taylor starter Danby's quartic iteration runs
+# without a bracket; a correction d with |d| <= _SHORT_STEP_TOL |s| leaves an
+# error ~(d/s)^4 <= 1e-18 relative, below rounding, so s + d is taken as the
+# root.  After _SHORT_STEP_ITER iterations without that the bracketed solver
+# starts again from the beginning (it has never been needed on the
+# benchmark scenes, where the starter is good to 1e-6 and one iteration does).
+_SHORT_STEP = 0.5
+_SHORT_STEP_Z = 1.0
+_SHORT_STEP_TOL = 3e-5
+_SHORT_STEP_ITER = 3
+
+
+@njit(inline="always")
+def _stumpff_series(z):
+    """Stumpff functions from their series, for ``|z| <= _STUMPFF_SERIES_Z``."""
+    # c2 = 1/2! - z/4! + z^2/6! - ..., c3 = 1/3! - z/5! + z^2/7! - ... (Horner)
+    c2 = (1.0 / 2 - z * (1.0 / 24 - z * (1.0 / 720 - z * (1.0 / 40320 - z * (
+        1.0 / 3628800 - z * (1.0 / 479001600 - z * (1.0 / 87178291200)))))))
+    c3 = (1.0 / 6 - z * (1.0 / 120 - z * (1.0 / 5040 - z * (1.0 / 362880 - z * (
+        1.0 / 39916800 - z * (1.0 / 6227020800 - z * (1.0 / 1307674368000)))))))
+    return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+
+
+@njit(inline="always")
+def _stumpff_inline(z):
+    """:func:`stumpff`, with its most common case (``|z|`` small) inlined."""
+    if -_STUMPFF_SERIES_Z <= z <= _STUMPFF_SERIES_Z:
+        return _stumpff_series(z)
+    return stumpff(z)
+
+
+@njit(inline="always")
+def _stumpff_short(z):
+    """:func:`stumpff` for the short steps of a planetary integration: for
+    ``|z| <= _STUMPFF_SHORT_Z`` four terms of each series, in Estrin's form
+    (two independent halves, for a shorter chain of dependent operations)."""
+    if -_STUMPFF_SHORT_Z <= z <= _STUMPFF_SHORT_Z:
+        z2 = z * z
+        c2 = (0.5 - z * (1.0 / 24)) + z2 * ((1.0 / 720) - z * (1.0 / 40320))
+        c3 = (1.0 / 6 - z * (1.0 / 120)) + z2 * ((1.0 / 5040) - z * (1.0 / 362880))
+        return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+    return _stumpff_inline(z)
 
 
 @njit
@@ -948,13 +1001,7 @@ def stumpff(z):
     while abs(z) > _STUMPFF_SERIES_Z:
         z *= 0.25
         n += 1
-    # c2 = 1/2! - z/4! + z^2/6! - ..., c3 = 1/3! - z/5! + z^2/7! - ... (Horner)
-    c2 = (1.0 / 2 - z * (1.0 / 24 - z * (1.0 / 720 - z * (1.0 / 40320 - z * (
-        1.0 / 3628800 - z * (1.0 / 479001600 - z * (1.0 / 87178291200)))))))
-    c3 = (1.0 / 6 - z * (1.0 / 120 - z * (1.0 / 5040 - z * (1.0 / 362880 - z * (
-        1.0 / 39916800 - z * (1.0 / 6227020800 - z * (1.0 / 1307674368000)))))))
-    c0 = 1.0 - z * c2
-    c1 = 1.0 - z * c3
+    c0, c1, c2, c3 = _stumpff_series(z)
     for _ in range(n):
         c3 = 0.25 * (c2 + c0 * c3)
         c2 = 0.5 * c1 * c1
@@ -962,6 +1009,88 @@ def stumpff(z):
         c0 = 1.0 - z * c2
         c1 = 1.0 - z * c3
     return c0, c1, c2, c3
+
+
+@njit(inline="always")
+def short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
+    """The universal anomaly of a step short against the orbit, or NaN.
+
+    The first half of :func:`kepler_drift`'s short-step path (see there):
+    for the relative state ``x0 .. vz0`` and a step ``dt`` with ``|dt| |v0|
+    < r0 / 2`` and less than a radian of eccentric anomaly, the root ``s``
+    of the universal Kepler equation from the third-order Taylor starter
+    and at most three unbracketed quartic iterations; with it ``r0``, ``1 /
+    r0``, ``beta`` and ``zeta`` for :func:`advance_by_anomaly`.  ``s`` is
+    NaN where this does not apply or has not converged (and for
+    non-finite input, ``r0 = 0``, ``mu <= 0`` or ``dt = 0``): then the
+    bracketed solver must be used.
+    """
+    r2 = x0 * x0 + y0 * y0 + z0 * z0
+    v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
+    r0 = math.sqrt(r2)
+    ir0 = 1.0 / r0
+    eta = x0 * vx0 + y0 * vy0 + z0 * vz0
+    beta = 2.0 * mu * ir0 - v2
+    zeta = mu - beta * r0
+    # NaN, r0 = 0 and dt = 0 fail these tests
+    if not (dt * dt * v2 < (_SHORT_STEP * _SHORT_STEP) * r2 and mu > 0.0 and dt != 0.0):
+        return math.nan, r0, ir0, beta, zeta
+    w = dt * ir0
+    s = w * (1.0 + w * (-0.5 * eta * ir0
+                        + w * ((3.0 * eta * eta * ir0 * ir0 - zeta * ir0) * _SIXTH)))
+    if not (abs(beta * s * s) <= _SHORT_STEP_Z):
+        return math.nan, r0, ir0, beta, zeta
+    for _ in range(_SHORT_STEP_ITER):
+        c0, c1, c2, c3 = _stumpff_short(beta * s * s)
+        G1 = s * c1
+        G2 = s * s * c2
+        G3 = s * s * s * c3
+        f = r0 * s + eta * G2 + zeta * G3 - dt
+        ir = 1.0 / (r0 + eta * G1 + zeta * G2)
+        # Danby's quartic step as a series in the Newton step d1:
+        # d + a d^2 + b d^3 = d1 with a = f2 / (2 r), b = f3 / (6 r), fk the
+        # k-th derivative of f
+        d1 = -f * ir
+        a = 0.5 * (eta * c0 + zeta * G1) * ir
+        b = (zeta * c0 - beta * eta * G1) * ir * _SIXTH
+        d = d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - b)))
+        s += d
+        if abs(d) <= _SHORT_STEP_TOL * abs(s):
+            return s, r0, ir0, beta, zeta
+    return math.nan, r0, ir0, beta, zeta
+
+
+@njit(inline="always")
+def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
+    """Advance row ``i`` of ``x``, ``v`` by the universal anomaly ``s`` (the
+    f and g functions of :func:`kepler_drift`); the other arguments from
+    :func:`short_step_anomaly`.  False, and nothing written, if the radius
+    at the end is not positive."""
+    x0 = x[i, 0]
+    y0 = x[i, 1]
+    z0 = x[i, 2]
+    vx0 = v[i, 0]
+    vy0 = v[i, 1]
+    vz0 = v[i, 2]
+    eta = x0 * vx0 + y0 * vy0 + z0 * vz0
+    c0, c1, c2, c3 = _stumpff_short(beta * s * s)
+    G1 = s * c1
+    G2 = s * s * c2
+    r = r0 + eta * G1 + zeta * G2
+    if not (r > 0.0):
+        return False
+    ir = 1.0 / r
+    fm1 = -mu * G2 * ir0
+    g = r0 * G1 + eta * G2
+    fdot = -mu * G1 * ir0 * ir
+    gdm1 = -mu * G2 * ir
+    x[i, 0] = x0 + (fm1 * x0 + g * vx0)
+    x[i, 1] = y0 + (fm1 * y0 + g * vy0)
+    x[i, 2] = z0 + (fm1 * z0 + g * vz0)
+    v[i, 0] = vx0 + (fdot * x0 + gdm1 * vx0)
+    v[i, 1] = vy0 + (fdot * y0 + gdm1 * vy0)
+    v[i, 2] = vz0 + (fdot * z0 + gdm1 * vz0)
+    return True
 
 
 @njit
@@ -1007,12 +1136,23 @@ def kepler_drift(mu, x, v, i, dt):
     hyperbolae.  On an ellipse ``dt`` is first reduced modulo the period, so
     that a step of many periods costs no more than one.  The equation is
     solved by Danby's quartic iteration (Newton with the second and third
-    derivatives), kept inside a bracket that shrinks with every residual
-    evaluated and replaced by bisection when it would leave it; ``f`` is
-    increasing in ``s``, so the bracket always holds the root.  The
-    starters: the Taylor series ``s = dt / r0 - eta dt^2 / (2 r0^3)`` for
-    steps short against the orbit, the mean anomaly for long elliptic ones
-    and the asymptotic growth of ``G_3`` for long hyperbolic ones.
+    derivatives).  A step short against the orbit (``|dt| |v0| < r0 / 2``
+    and less than a radian of eccentric anomaly) starts from the Taylor
+    series ::
+
+        s = w (1 - w eta / (2 r0) + w^2 (3 eta^2 / r0^2 - zeta / r0) / 6),  w = dt / r0
+
+    (``ds/dt = 1/r``, ``d^2s/dt^2 = -eta / r^3``, ``d^3s/dt^3 = 3 eta^2 /
+    r^5 - zeta / r^4``), whose error is of fourth order in the step, and
+    stops as soon as a correction is below ``3e-5`` of ``s``, which leaves
+    ``(3e-5)^4`` after it: one iteration and two evaluations of the
+    Stumpff functions on the steps of a planetary integration.  Any other
+    step, or a short one that has not converged in three iterations, is
+    solved inside a bracket that shrinks with every residual evaluated, with
+    bisection when an iterate would leave it; ``f`` is increasing in ``s``,
+    so the bracket always holds the root.  Its starters: the second-order
+    Taylor series, the mean anomaly for long elliptic steps and the
+    asymptotic growth of ``G_3`` for long hyperbolic ones.
 
     References
     ----------
@@ -1022,6 +1162,16 @@ def kepler_drift(mu, x, v, i, dt):
     Wisdom, J. & Holman, M. 1991, AJ 102, 1528 (its use in mixed-variable
     symplectic maps).
     """
+    s, r0, ir0, beta, zeta = short_step_anomaly(mu, x[i, 0], x[i, 1], x[i, 2],
+                                                v[i, 0], v[i, 1], v[i, 2], dt)
+    if s == s and advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
+        return STATUS_OK
+    return _kepler_drift_bracketed(mu, x, v, i, dt)
+
+
+@njit
+def _kepler_drift_bracketed(mu, x, v, i, dt):
+    """:func:`kepler_drift` by the bracketed solver, for any step."""
     x0 = x[i, 0]
     y0 = x[i, 1]
     z0 = x[i, 2]

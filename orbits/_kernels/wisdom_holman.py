@@ -101,7 +101,7 @@ import math
 from ._jit import njit, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
                           to_democratic_heliocentric, to_jacobi)
-from .kepler import kepler_drift
+from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, _record, state_is_finite
 
@@ -111,14 +111,36 @@ __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jump",
 
 
 @njit(inline="always")
-def kepler_drift_all(xj, vj, mu, h):
+def kepler_drift_all(xj, vj, mu, h, w1, w2):
     """Drift every row by ``h``: row i >= 1 on its orbit about ``mu[i]``, the
-    centre of mass (row 0) in a straight line."""
+    centre of mass (row 0) in a straight line.  ``w1``, ``w2`` (shape (N, 3))
+    are scratch.
+
+    The drifts are independent, and each is a long chain of dependent
+    operations, so they are done in two passes over the bodies (the
+    universal anomaly of every short step, then every state from its
+    anomaly) that the processor can overlap, rather than one body after
+    the other: 1.4 times faster for the four giant planets.  Steps that are not
+    short take :func:`~orbits._kernels.kepler.kepler_drift`'s bracketed
+    solver.
+    """
     xj[0, 0] += h * vj[0, 0]
     xj[0, 1] += h * vj[0, 1]
     xj[0, 2] += h * vj[0, 2]
-    for i in range(1, xj.shape[0]):
-        kepler_drift(mu[i], xj, vj, i, h)
+    n = xj.shape[0]
+    for i in range(1, n):
+        s, r0, ir0, beta, zeta = short_step_anomaly(
+            mu[i], xj[i, 0], xj[i, 1], xj[i, 2], vj[i, 0], vj[i, 1], vj[i, 2], h)
+        w1[i, 0] = s
+        w1[i, 1] = r0
+        w1[i, 2] = ir0
+        w2[i, 0] = beta
+        w2[i, 1] = zeta
+    for i in range(1, n):
+        s = w1[i, 0]
+        if not (s == s and advance_by_anomaly(mu[i], xj, vj, i, s, w1[i, 1], w1[i, 2],
+                                              w2[i, 0], w2[i, 1])):
+            kepler_drift(mu[i], xj, vj, i, h)
 
 
 @njit(inline="always")
@@ -129,6 +151,10 @@ def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
     accelerations.  See the module notes for the formula.
     """
     n = xj.shape[0]
+    if n <= 2:
+        # only the pair (0, 1), which the Kepler drift holds entirely: the
+        # kick is zero (and a third of a two-body step)
+        return
     from_jacobi_one(xj, gm, eta, x)
     for i in range(n):
         acc[i, 0] = 0.0
@@ -286,11 +312,11 @@ def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse):
         else:
             a = corr[m - 1 - k, 0] * h
             b = corr[m - 1 - k, 1] * h
-        kepler_drift_all(xj, vj, eta, a)
+        kepler_drift_all(xj, vj, eta, a, x, acc)
         perturbation(xj, vj, x, acc, gm, eta, n_active, -b)  # noqa: F821 - bound by specialize
-        kepler_drift_all(xj, vj, eta, -2.0 * a)
+        kepler_drift_all(xj, vj, eta, -2.0 * a, x, acc)
         perturbation(xj, vj, x, acc, gm, eta, n_active, b)  # noqa: F821
-        kepler_drift_all(xj, vj, eta, a)
+        kepler_drift_all(xj, vj, eta, a, x, acc)
 
 
 def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
@@ -298,10 +324,12 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
     deferred drift ``owed`` and then the corrector ``corr`` for the step ``h``
     (none if it has no rows) applied to a copy (``xs``, ``vs``); ``acc`` is
     scratch."""
-    xs[...] = xj
-    vs[...] = vj
+    for i in range(xj.shape[0]):
+        for d in range(3):
+            xs[i, d] = xj[i, d]
+            vs[i, d] = vj[i, d]
     if owed != 0.0:
-        kepler_drift_all(xs, vs, eta, owed)
+        kepler_drift_all(xs, vs, eta, owed, x, acc)
     if corr.shape[0] > 0:
         apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, False)
     from_internal(xs, vs, gm, eta, x, v)  # noqa: F821 - bound by specialize
@@ -329,7 +357,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         # a new step size (a shorter last step): through the true state to the
         # mapping state of the new step's corrector
         if owed_box[0] != 0.0:
-            kepler_drift_all(xj, vj, eta, owed_box[0])
+            kepler_drift_all(xj, vj, eta, owed_box[0], xs, vs)
             owed_box[0] = 0.0
         apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], False)
         apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True)
@@ -349,7 +377,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                 if op == n_ops - 1 and defer:
                     owed = h
                 else:
-                    kepler_drift_all(xj, vj, eta, h)
+                    kepler_drift_all(xj, vj, eta, h, xs, vs)
             else:
                 perturbation(xj, vj, xs, acc, gm, eta, n_active, h)  # noqa: F821
         until_check -= 1
@@ -379,10 +407,13 @@ COORDINATE_SYSTEMS = {
 
 def _kernels(coordinates):
     to_internal, from_internal, perturbation = COORDINATE_SYSTEMS[coordinates]
-    corrector = specialize(_apply_corrector, f"corrector_{coordinates}",
+    # without numba's runtime: these allocate nothing, and the reference
+    # counts of the inlined kernels' array arguments would cost more than a
+    # two-body step's kick (see orbits._kernels._jit)
+    corrector = specialize(_apply_corrector, f"corrector_{coordinates}", nrt=False,
                            perturbation=perturbation)
-    sync = specialize(_synchronize, f"synchronize_{coordinates}", from_internal=from_internal,
-                      apply_corrector=corrector)
+    sync = specialize(_synchronize, f"synchronize_{coordinates}", nrt=False,
+                      from_internal=from_internal, apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
 
 
@@ -396,7 +427,7 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi"):
     perturbation steps (KICK) in ``coordinates`` (a key of
     :data:`COORDINATE_SYSTEMS`); ``name`` names the table."""
     to_internal, perturbation, corrector, sync = _kernels(coordinates)
-    return specialize(_wh_loop, f"wh_{name}_{coordinates}",
+    return specialize(_wh_loop, f"wh_{name}_{coordinates}", nrt=False,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
                       perturbation=perturbation, apply_corrector=corrector,

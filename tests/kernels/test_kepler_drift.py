@@ -169,3 +169,52 @@ def test_invalid_input_gives_status_and_nan():
     assert np.all(np.isnan(x)) and np.all(np.isnan(v))
     x, v = np.ones((1, 3)), np.ones((1, 3))
     assert K.kepler_drift(-1.0, x, v, 0, 0.1) == K.STATUS_INVALID_STATE
+
+
+def short_cases():
+    # steps short against the orbit, |dt| |v| / r0 from 1e-4 to 0.45, where
+    # kepler_drift takes its unbracketed short-step path: ellipses, near-
+    # parabolic orbits on both sides and hyperbolae, anywhere on the orbit
+    rng = np.random.default_rng(11)
+    out = []
+    for e in (0.0, 0.3, 0.9, 1 - 1e-9, 1 + 1e-9, 1.5, 30.0):
+        for _ in range(5):
+            q = 10 ** rng.uniform(-2, 0.5)
+            a = q / (1 - e) if e != 1 else q
+            f = rng.uniform(-2.5, 2.5)
+            if e > 1:
+                f = rng.uniform(-0.9, 0.9) * math.acos(-1 / e)
+            x, v = np.zeros(3), np.zeros(3)
+            assert K.elements_to_state(1.0, a, e, 0.4, 1.0, 2.0, f, x, v) == 0
+            dt = 10 ** rng.uniform(-4, math.log10(0.45)) * np.linalg.norm(x) \
+                / np.linalg.norm(v) * rng.choice([-1, 1])
+            out.append((f"e={e:g}", x, v, dt))
+    return out
+
+
+@pytest.mark.parametrize("case", short_cases(), ids=lambda c: f"{c[0]}-{c[3]:.3g}")
+def test_short_step_path_against_mpmath_and_the_bracketed_solver(case):
+    label, x, v, dt = case
+    xs, vs = x[None].copy(), v[None].copy()
+    assert K.kepler_drift(1.0, xs, vs, 0, dt) == K.STATUS_OK
+    xr, vr = mp_drift(1.0, x, v, dt)
+    # as in test_drift_against_mpmath (a single period at most here)
+    tol = 1e-13 * max(1.0, np.linalg.norm(x) / np.linalg.norm(xr))
+    assert np.linalg.norm(xs[0] - xr) <= tol * np.linalg.norm(xr)
+    assert np.linalg.norm(vs[0] - vr) <= tol * max(np.linalg.norm(vr), np.linalg.norm(v))
+    # the two solvers find the same root: a few ulps (measured 2e-16)
+    xb, vb = x[None].copy(), v[None].copy()
+    assert K._kepler_drift_bracketed(1.0, xb, vb, 0, dt) == K.STATUS_OK
+    np.testing.assert_allclose(xs, xb, rtol=0, atol=2e-15 * np.linalg.norm(xb))
+    np.testing.assert_allclose(vs, vb, rtol=0, atol=2e-15 * max(np.linalg.norm(vb),
+                                                                np.linalg.norm(v)))
+
+
+def test_short_step_anomaly_declines_what_it_cannot_do():
+    # long steps, dt = 0, r = 0, mu <= 0 and NaN: NaN, the bracketed solver's case
+    x, v = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    ok = K.short_step_anomaly(1.0, *x, *v, 0.1)[0]
+    assert math.isfinite(ok)
+    for mu, xx, dt in [(1.0, x, 2.0), (1.0, x, 0.0), (1.0, 0 * x, 0.1), (0.0, x, 0.1),
+                       (-1.0, x, 0.1), (1.0, x * math.nan, 0.1), (1.0, x, math.nan)]:
+        assert math.isnan(K.short_step_anomaly(mu, *xx, *v, dt)[0]), (mu, xx, dt)
