@@ -219,8 +219,10 @@ MASS_RATIO_STEPS_PER_ORBIT = 200     # cases' e = 0.5 step
 MASS_RATIO_ECCENTRICITY = 0.5
 KEPLER_ORBITS = {True: 2.5, False: 10.5}
 
-# outer solar system: run length in years (quick, full)
-STEP_YEARS = {True: 100.0, False: 1000.0}
+# outer solar system: run length in Jupiter periods (quick, full: about 95
+# and 950 years), a whole number so that every step P_J/N of the sweep ends
+# the run exactly on the reference's end time
+STEP_ORBITS = {True: 8, False: 80}
 _P_JUPITER = 4332.59                  # days
 
 # close encounters: planets of an Earth mass each on a 1 au orbit, meeting at
@@ -481,7 +483,7 @@ def _mass_ratio_cell(name, options, q, quick):
 
 def _step_cell(name, options, value, quick):
     bodies = _scenes.outer_solar_system(com=True)
-    until = STEP_YEARS[quick] * 365.25
+    until = STEP_ORBITS[quick] * _P_JUPITER
     if _adaptive(name):
         row = _measure.run_orbits(bodies, name, {**options, **_tolerance_options(name, value)},
                                   until=until,
@@ -591,7 +593,7 @@ def reference(sweep, quick):
     spec = SWEEPS[sweep]
     if sweep == "step":
         bodies = _scenes.outer_solar_system(com=True)
-        row = _measure.run_rebound(bodies, "ias15", until=STEP_YEARS[quick] * 365.25,
+        row = _measure.run_rebound(bodies, "ias15", until=STEP_ORBITS[quick] * _P_JUPITER,
                                    outputs=2, wall_limit=_measure.WALL_LIMIT)
         return {"kind": "reference", "sweep": sweep, "outcome": row["outcome"],
                 "x": np.asarray(row["x"]).tolist()}
@@ -807,8 +809,8 @@ vector against the analytic orbit (Kepler's equation solved by
 `orbits._kernels.kepler`, no integrator involved), in units of a.""",
     "step": """\
 The outer solar system (Hairer, Lubich & Wanner: Sun, four giant planets,
-Pluto) for {years:g} years.  Fixed-step methods sweep the step (P_J = {pj:g}
-days, Jupiter's period); adaptive methods have no step to set and sweep their
+Pluto) for {jorb} periods of Jupiter (P_J = {pj:g} days; {years:.0f} years).
+Fixed-step methods sweep the step; adaptive methods have no step to set and sweep their
 tolerance instead (rtol = tol, atol = 1e-3 tol; IAS15 epsilon = tol).  Error:
 the worst planet's final heliocentric position against REBOUND's IAS15
 (default epsilon), over its heliocentric distance.""",
@@ -847,7 +849,7 @@ largest |x(t) - cos(sqrt(k) t)| over the run (amplitude 1).""",
 
 def _sweep_text(key, quick):
     return _SWEEP_TEXT[key].format(
-        orbits=KEPLER_ORBITS[quick], kn=KEPLER_STEPS_PER_ORBIT, years=STEP_YEARS[quick],
+        orbits=KEPLER_ORBITS[quick], kn=KEPLER_STEPS_PER_ORBIT, jorb=STEP_ORBITS[quick], years=STEP_ORBITS[quick] * _P_JUPITER / 365.25,
         pj=_P_JUPITER, me=MASS_RATIO_ECCENTRICITY, mn=MASS_RATIO_STEPS_PER_ORBIT,
         em=ENCOUNTER_MASS, vinf=round(ENCOUNTER_SPEED * 1.495978707e8 / 86400, 1),
         te=ENCOUNTER_TIME, te2=2 * ENCOUNTER_TIME, edt=ENCOUNTER_DT,
