@@ -161,7 +161,7 @@ def test_eccentric_kepler_energy_and_position_against_rebound(e):
     xr = np.array([p.xyz for p in sim.particles])
     theirs = np.abs(xr[1] - xr[0] - rel0).max()
     # after 100 orbits the relative orbit is back where it began; both errors are
-    # random walks of rounding (measured ours/theirs: 0.5, 0.4, 0.2), so allow 2x
+    # random walks of rounding (measured ours/theirs: 1.4, 0.1, 0.3), so allow 2x
     assert ours <= 2 * theirs + 1e-15
 
 
