@@ -63,6 +63,11 @@ def test_verdict_ranges():
     assert stress._verdict(labels, classes, outcomes) == (
         "accurate at e = 0 to e = 0.9; degraded at e = 0.99; "
         "fails at e = 0.9999 (NonFiniteState)")
+    # failed columns grouped by how they failed, the named error after its own
+    classes = [stress.DEGRADED, stress.FAILED, stress.FAILED, stress.FAILED, stress.FAILED]
+    outcomes = ["completed", "completed", "completed", "StepSizeUnderflow", "NonFiniteState"]
+    assert stress._describe(labels, classes, outcomes)[stress.FAILED] == (
+        "e = 0.5 to e = 0.9, e = 0.99 (StepSizeUnderflow), e = 0.9999 (NonFiniteState)")
 
 
 def test_every_integrator_in_every_sweep():

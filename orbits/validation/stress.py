@@ -54,9 +54,10 @@ from . import _measure, cases
 from ._runner import Task
 
 __all__ = ["TITLE", "tasks", "section", "classify", "abbreviation", "encounter_bodies",
-           "kepler_reference", "measure", "reference", "SWEEPS", "ACCURATE", "DEGRADED",
-           "FAILED", "LEFT_OUT", "ACCURATE_POSITION", "FAILED_POSITION", "ACCURATE_ENERGY",
-           "FAILED_ENERGY"]
+           "pass_distance", "kepler_reference", "measure", "reference", "Sweep", "SWEEPS",
+           "VARIANTS", "ACCURATE", "DEGRADED", "FAILED", "LEFT_OUT", "ACCURATE_POSITION",
+           "FAILED_POSITION", "ACCURATE_ENERGY", "FAILED_ENERGY", "WALL_LIMIT_QUICK",
+           "WALL_LIMIT_FULL"]
 
 TITLE = "Stress suite"
 
@@ -84,8 +85,8 @@ _THRESHOLDS = {"position": (ACCURATE_POSITION, FAILED_POSITION),
                "energy": (ACCURATE_ENERGY, FAILED_ENERGY)}
 
 #: Seconds a cell may run (quick, full) before it is stopped as
-#: WallTimeExceeded.  The quick limit keeps the whole quick section near two
-#: core-minutes even where a method crawls; the full one is half of
+#: WallTimeExceeded.  The quick limit keeps a crawling cell from holding up
+#: the five-minute quick report (its cells take 0.01-1 s); the full one is half of
 #: :data:`_measure.WALL_LIMIT`: no cell of the full sweeps needs more than a
 #: few seconds except scipy's solvers (Python force calls) at the hardest
 #: columns.
@@ -140,7 +141,8 @@ def _cell_text(cls, outcome, error):
         return "inf"
     if error <= 0:
         return "0"
-    return f"{math.log10(error):.1f}"
+    text = f"{math.log10(error):.1f}"
+    return "0.0" if text == "-0.0" else text
 
 
 # -- the sweeps ---------------------------------------------------------------------
@@ -228,8 +230,9 @@ _P_JUPITER = 4332.59                  # days
 # close encounters: planets of an Earth mass each on a 1 au orbit, meeting at
 # 5 km/s relative speed (faster than the mutual escape speed at the Hill
 # radius, so the pass is a clean hyperbola); the pass is at ENCOUNTER_TIME,
-# the run ends at twice that; fixed step 1e-3 day resolves the 1e-3 au pass
-# with hundreds of steps and the 1e-5 au pass with none.
+# the run ends at twice that; the fixed step of 1e-3 day puts about 300 steps
+# into the 1e-3 au pass (d / v_p = 0.3 day) and less than one into the
+# 1e-5 au pass (5e-4 day).
 ENCOUNTER_MASS = 3.0e-6               # Msun
 ENCOUNTER_SPEED = 2.9e-3              # au/day at infinity, relative
 ENCOUNTER_TIME = 5.0                  # days
@@ -243,10 +246,10 @@ SPRING_STEPS = 1000
 SPRING_SEGMENTS = 10                  # wall-time checks per run
 SPRING_OUTPUTS = 100                  # adaptive samples over the run
 
-#: Tolerance to option map of the adaptive methods: rtol = tol and atol = 1e-3
-#: tol (their default ratio), IAS15's epsilon = tol.
 def _tolerance_options(name, tol):
-    if name == "ias15":
+    """An adaptive method's options for tolerance ``tol``: rtol = tol and
+    atol = 1e-3 tol (their default ratio), IAS15's epsilon = tol."""
+    if "epsilon" in _integrators.get(name).options:
         return {"epsilon": tol}
     return {"rtol": tol, "atol": 1e-3 * tol}
 
@@ -531,10 +534,12 @@ _CELLS = {"eccentricity": _eccentricity_cell, "step": _step_cell,
 VARIANTS = {"mass-ratio": (("wh (democratic-heliocentric)", "wh",
                             {"coordinates": "democratic-heliocentric"}),)}
 
-#: Sweeps whose runs are long enough that scipy's Radau (the force and the
-#: step called from Python, about 0.5 ms a step) is left out of the quick
-#: report; the full report runs it there too.
-RADAU_QUICK = ("encounter", "spring")
+#: Integrators left out of the quick report's long sweeps: scipy's Radau
+#: calls the force and takes each step from Python (about 0.5 ms a step,
+#: seconds a cell); it runs in the quick sweeps of :data:`SLOW_QUICK_SWEEPS`
+#: and everywhere in the full report.
+SLOW_IN_QUICK = ("radau",)
+SLOW_QUICK_SWEEPS = ("encounter", "spring")
 
 
 def _rows(sweep):
@@ -548,7 +553,7 @@ def _left_out(sweep, name, quick):
         reason = cases.applies(cases.problem("pythagorean"), name, quick)
         if reason is not None:
             return reason
-    if quick and name == "radau" and sweep not in RADAU_QUICK:
+    if quick and name in SLOW_IN_QUICK and sweep not in SLOW_QUICK_SWEEPS:
         return ("quick mode: scipy's Radau calls the force and takes each step from Python "
                 "(about 0.5 ms a step, seconds a cell here); the full report runs it")
     return None
@@ -668,21 +673,23 @@ def _ranges(labels, idx):
 
 
 def _describe(labels, classes, outcomes):
-    """For the summary table: where a row is accurate, degraded, failed."""
+    """For the summary table: where a row is accurate, degraded, failed.  Failed
+    columns are grouped by how they failed, each named error after its
+    columns ("e = 0.5 to e = 0.99, e = 0.9999 (NonFiniteState)")."""
     out = {}
     for cls in (ACCURATE, DEGRADED, FAILED):
         idx = [i for i, c in enumerate(classes) if c == cls]
         if not idx:
             out[cls] = "-"
-            continue
-        if cls == FAILED:
-            named = sorted({outcomes[i] for i in idx if outcomes[i] != "completed"})
-            text = _ranges(labels, idx)
-            if named:
-                text += f" ({', '.join(named)})"
-            out[cls] = text
-        else:
+        elif cls != FAILED:
             out[cls] = _ranges(labels, idx)
+        else:
+            parts = []
+            for outcome in dict.fromkeys(outcomes[i] for i in idx):
+                sub = [i for i in idx if outcomes[i] == outcome]
+                text = _ranges(labels, sub)
+                parts.append(text if outcome == "completed" else f"{text} ({outcome})")
+            out[cls] = ", ".join(parts)
     return out
 
 
@@ -817,9 +824,10 @@ the worst planet's final heliocentric position against REBOUND's IAS15
     "mass-ratio": """\
 Two bodies, m2/m1 = q with m1 = 1 Msun, e = {me:g}, a = 1 au, for {orbits:g} orbits
 at dt = P/{mn} (fixed-step methods).  Error: the final relative vector
-against the analytic orbit, in units of a.  At q = 1 no body dominates and
-the Wisdom-Holman family warns, but with two bodies the Jacobi split is still
-exact (one Kepler orbit, no interaction).""",
+against the analytic orbit, in units of a.  With two bodies the Jacobi split
+of the Wisdom-Holman family is exact at any q (one Kepler orbit, no
+interaction term); democratic heliocentric coordinates, added as a row, keep
+the star's reflex motion as a separate term whose error grows with q.""",
     "encounter": """\
 A Sun-mass star and two planets of {em:g} Msun each on a 1 au orbit, meeting
 at {vinf:g} km/s at infinity, passing at the column's distance at t = {te:g} days;
@@ -849,7 +857,8 @@ largest |x(t) - cos(sqrt(k) t)| over the run (amplitude 1).""",
 
 def _sweep_text(key, quick):
     return _SWEEP_TEXT[key].format(
-        orbits=KEPLER_ORBITS[quick], kn=KEPLER_STEPS_PER_ORBIT, jorb=STEP_ORBITS[quick], years=STEP_ORBITS[quick] * _P_JUPITER / 365.25,
+        orbits=KEPLER_ORBITS[quick], kn=KEPLER_STEPS_PER_ORBIT, jorb=STEP_ORBITS[quick],
+        years=STEP_ORBITS[quick] * _P_JUPITER / 365.25,
         pj=_P_JUPITER, me=MASS_RATIO_ECCENTRICITY, mn=MASS_RATIO_STEPS_PER_ORBIT,
         em=ENCOUNTER_MASS, vinf=round(ENCOUNTER_SPEED * 1.495978707e8 / 86400, 1),
         te=ENCOUNTER_TIME, te2=2 * ENCOUNTER_TIME, edt=ENCOUNTER_DT,
