@@ -65,17 +65,18 @@ from the stages ::
     Z(a, b) = K(a) I(-b) K(-2a) I(b) K(a)      (applied left to right)
 
 (``I(b) = exp(b L_B)`` transported along the Kepler flow, whose first-order
-generator is ``2 b sinh(a ad_A) H_int``).  ``C`` applies ``Z(a_m, b_m)``
-first and ``Z(a_1, b_1)`` last; ``C^-1`` applies ``Z(-a_1, b_1)`` first,
-the exact inverse stage by stage (``I`` is the perturbation step of the
-coordinate system, ``J(h/2) I(h) J(h/2)`` in democratic heliocentric ones).
-The loop starts from ``C^-1`` of the initial state (:func:`apply_corrector` with ``inverse``) and the output is
-``C`` of the mapping state, so the error of the output is that of ``T``
-up to ``O(epsilon h^(n+1) + epsilon^2 h^2)``.  ``C`` is applied only to the
-copy that :func:`synchronize` makes; the mapping state goes on untouched.
-The corrector of ``K(h)`` also conjugates ``K(-h) = K(h)^-1``, so it is
-built from ``|h|``: a run backwards keeps the mapping state, and reversing
-a corrected run returns to its start up to rounding.
+generator is ``2 b sinh(a ad_A) H_int``).  ``C`` applies ``Z(a_m, b_m)`` first
+and ``Z(a_1, b_1)`` last; ``C^-1`` applies ``Z(-a_1, b_1)`` first, the exact
+inverse stage by stage (``I`` is the perturbation step of the coordinate
+system, ``J(h/2) I(h) J(h/2)`` in democratic heliocentric ones).  The loop
+starts from ``C^-1`` of the initial state (:func:`apply_corrector` with
+``inverse``) and the output is ``C`` of the mapping state, so the error of
+the output is that of ``T`` up to ``O(epsilon h^(n+1) + epsilon^2 h^2)``.
+``C`` is applied only to the copy that :func:`synchronize` makes; the
+mapping state goes on untouched.  The corrector of ``K(h)`` also conjugates
+``K(-h) = K(h)^-1``, so it is built from ``|h|``: a run backwards keeps the
+mapping state, and reversing a corrected run returns to its start up to
+rounding.
 
 References
 ----------
@@ -120,8 +121,8 @@ def kepler_drift_all(xj, vj, mu, h, w1, w2):
     operations, so they are done in two passes over the bodies (the
     universal anomaly of every short step, then every state from its
     anomaly) that the processor can overlap, rather than one body after
-    the other: 1.4 times faster for the four giant planets.  Steps that are not
-    short take :func:`~orbits._kernels.kepler.kepler_drift`'s bracketed
+    the other: 1.4 times faster for the four giant planets.  Steps that are
+    not short take :func:`~orbits._kernels.kepler.kepler_drift`'s bracketed
     solver.
     """
     xj[0, 0] += h * vj[0, 0]

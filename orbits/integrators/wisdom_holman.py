@@ -134,8 +134,8 @@ class WisdomHolman(Integrator):
     without softening can be split this way.
 
     State kept between calls (lazy synchronisation, Rein & Tamayo 2015): the
-    Jacobi (or democratic heliocentric) positions and velocities, the closing half drift still owed and the
-    step the corrector was built for.
+    Jacobi (or democratic heliocentric) positions and velocities, the closing
+    half drift still owed and the step the corrector was built for.
     Consecutive steps merge their half drifts into one, and the inertial
     state in ``x``, ``v`` is brought up to date only by :meth:`synchronize`
     (which outputs and monitors call), on a copy, so that the merged drifts
