@@ -385,7 +385,9 @@ def pass_distance(bodies):
 def _spring_force(x, v, t):
     # k travels in the state as component 1, with zero velocity and zero
     # acceleration, so it stays exactly k: one compiled force for every k,
-    # where a closure over k would compile the stepping loop again for each
+    # where a closure over k would compile the stepping loop again for each.
+    # Component 2 (always 0) fills the state's row of three, so that no
+    # padding the force does not write enters a solver
     a = np.zeros_like(x)
     a[0] = -x[1] * x[0]
     return a
@@ -405,14 +407,14 @@ def _spring(name, k, wall_limit):
     adaptive = _adaptive(name)
     force = _spring_force if adaptive else _spring_force.py_func
     until = SPRING_DT * SPRING_STEPS
-    x, v = np.array([1.0, k]), np.zeros(2)
+    x, v = np.array([1.0, k, 0.0]), np.zeros(3)
     ts, xs, vs = [0.0], [1.0], [0.0]
     cell = {"outcome": "completed", "message": "", "warning": "", "steps": 0}
     per = SPRING_STEPS // SPRING_SEGMENTS
     try:
         if adaptive:
-            integrate(force, np.array([1.0, 1.0]), np.zeros(2), method=name, until=1e-3,
-                      outputs=2)
+            integrate(force, np.array([1.0, 1.0, 0.0]), np.zeros(3), method=name,
+                      until=1e-3, outputs=2)
     except (RunError, IntegratorOptionError):
         pass
     t_start = time.perf_counter()
@@ -849,7 +851,7 @@ methods take dt = {sdt:g} for {sn} steps (the integrator-choice guide's step;
 sqrt(k) dt runs from 0.01 to 10), adaptive ones cover the same t = 0 to {su:g} at
 their default tolerance.  One compiled force serves every k: k travels in
 the state as a second component with zero velocity and acceleration (it
-stays exactly k).  Runs are made of {seg} pieces with a wall-time check
+stays exactly k), and a third, zero, fills the state's row of three.  Runs are made of {seg} pieces with a wall-time check
 between them (adaptive ones restart their step control at each).  Error: the
 largest |x(t) - cos(sqrt(k) t)| over the run (amplitude 1).""",
 }
