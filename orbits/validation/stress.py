@@ -87,9 +87,8 @@ _THRESHOLDS = {"position": (ACCURATE_POSITION, FAILED_POSITION),
 #: Seconds a cell may run (quick, full) before it is stopped as
 #: WallTimeExceeded.  The quick limit keeps a crawling cell from holding up
 #: the five-minute quick report (its cells take 0.01-1 s); the full one is half of
-#: :data:`_measure.WALL_LIMIT`: no cell of the full sweeps needs more than a
-#: few seconds except scipy's solvers (Python force calls) at the hardest
-#: columns.
+#: :data:`_measure.WALL_LIMIT`, enough for scipy's Radau on the k = 1e5 spring
+#: (about 25 s); a cell whose step collapses without underflowing stops there.
 WALL_LIMIT_QUICK = 3.0
 WALL_LIMIT_FULL = 0.5 * _measure.WALL_LIMIT
 
