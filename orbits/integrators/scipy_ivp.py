@@ -48,7 +48,7 @@ class ScipyIntegrator(AdaptiveIntegrator):
             raise IntegratorOptionError(f"integrator {self.name!r} records no in-loop "
                                         "monitors; drop monitor_every")
         n = x.shape[0]
-        acc = np.empty((n, 3))
+        acc = np.zeros((n, 3))      # a user state pads its last row: those entries stay 0
 
         def rhs(time, y):
             xs = np.ascontiguousarray(y[:3 * n].reshape(n, 3))
