@@ -200,10 +200,14 @@ def _b_from_g(g, b):
 
 
 def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, dtp, ref,
-                flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
+                tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
                 epsilon, min_dt, mode):
     # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
     # ref = (length of the reference step, time from its start to now).
+    # tc = (time, the part of it that t + dt rounded away): the time is carried
+    # as t + ct, summed with compensation like x and v, so that after 1e6 steps
+    # the state is still at the time it is labelled with.  The compensation is
+    # used only when the loop is called again at the time it returned.
     # counts: (accepted, rejected, force evaluations) of this call.
     n = x.shape[0]
     every = mon[0]
@@ -218,6 +222,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     if t == t_end:
         return Status.OK, t, n_mon
     direction = 1.0 if t_end > t else -1.0
+    ct = tc[1] if t == tc[0] else 0.0
     eps7 = epsilon ** (1.0 / 7.0)
     prs7 = (_FACT7 * epsilon) ** (1.0 / 7.0)
     while True:
@@ -239,7 +244,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         if proposed == 0.0 or not math.isfinite(proposed):
             proposed = _first_step(x, a0, t_end - t)
         proposed = abs(proposed) * direction
-        remaining = t_end - t
+        remaining = (t_end - t) - ct
         trimmed = abs(proposed) >= abs(remaining)
         dt = remaining if trimmed else proposed
         if not trimmed and (abs(dt) < min_dt or t + dt == t):
@@ -276,7 +281,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                                     b[2, i, d] * _V2 + h * (b[3, i, d] * _V3 + h * (
                                         b[4, i, d] * _V4 + h * (b[5, i, d] * _V5 + h * (
                                             b[6, i, d] * _V6)))))))))
-                force(xs, vs, t + hdt, fargs, acc)  # noqa: F821
+                force(xs, vs, t + (ct + hdt), fargs, acc)  # noqa: F821
                 for i in range(n):
                     for d in range(3):
                         r = (acc[i, d] - a0[i, d]) * _R[sub, 0]
@@ -415,7 +420,19 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 csv[i, d] = y - (vn - v[i, d])
                 v[i, d] = vn
         flags[0] = 0
-        t = t_end if trimmed else t + dt
+        if trimmed:
+            t = t_end
+            ct = 0.0
+        else:
+            # t + (dt + ct) and what its rounding lost, exactly (Knuth's two-sum:
+            # t may be smaller than the step at the start)
+            y = dt + ct
+            tn = t + y
+            yb = tn - t
+            ct = (t - (tn - yb)) + (y - yb)
+            t = tn
+        tc[0] = t
+        tc[1] = ct
         counts[0] += 1
         # a shortened last step leaves the proposed step as it was
         if not trimmed:
@@ -493,7 +510,7 @@ def ias15_loop(force, stop=False):
     (gravity does not).
 
     The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
-    dt, ref, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs,
+    dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs,
     max_steps, epsilon, min_dt, mode)`` with the arrays of
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.

@@ -43,18 +43,22 @@ class IAS15(AdaptiveIntegrator):
         v(1) = v0 + dt (a0 + b0/2 + b1/3 + ... + b6/8)
 
     The ``b`` are found by a predictor-corrector iteration (7 force
-    evaluations per iteration, usually two iterations, plus one at the start
+    evaluations per iteration, two or three iterations, plus one at the start
     of the step).  The step is accepted unless the step it implies is below
-    ``0.25 dt``; the next step is at most ``4 dt``.  Positions and velocities
-    are summed with compensation, so the energy error of a smooth problem
-    grows as a random walk of rounding errors (Brouwer's law).  The update
-    equations and step control are written out in :mod:`orbits._kernels.ias15`.
+    ``0.25 dt``; the next step is at most ``4 dt``.  Positions, velocities and
+    the time are summed with compensation, and the ``b`` a step ends with are
+    computed from that step's forces alone (not carried over from the
+    prediction), so the rounding errors of successive steps are independent
+    and the energy error of a smooth problem grows as their random walk, as
+    ``t^0.5`` (Brouwer's law; ``validation/brouwer.py`` measures it beside
+    REBOUND).  The update equations and step control are written out in
+    :mod:`orbits._kernels.ias15`.
 
     The workspace holds, besides the coefficients ``b``, ``g`` and the
     extrapolation ``e``, ``br``, ``er``, the compensation terms ``csx``,
-    ``csv``, the acceleration ``a0`` at the current state, the proposed step
-    ``dt`` and the reference step ``ref``: everything a bit-exact restart
-    needs.
+    ``csv`` and ``tc`` (of the time), the acceleration ``a0`` at the current
+    state, the proposed step ``dt`` and the reference step ``ref``: everything
+    a bit-exact restart needs.
 
     References
     ----------
@@ -121,6 +125,7 @@ class IAS15(AdaptiveIntegrator):
             "br": coef(), "er": coef(),                     # reference step: b and guess
             "csx": np.zeros((n, 3)), "csv": np.zeros((n, 3)),  # compensation of x, v
             "ref": np.zeros(2),            # reference step length, time since its start
+            "tc": np.zeros(2),             # time reached, and its compensation
             # a0 is current; a reference step exists
             "flags": np.zeros(2, dtype=np.int64),
             # scratch: substep state and force, extrapolation matrix, counters
@@ -134,7 +139,7 @@ class IAS15(AdaptiveIntegrator):
         status, t_reached, n_mon = loop(
             x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
             ws["er"], ws["csx"], ws["csv"], ws["xs"], ws["vs"], ws["acc"], ws["P"],
-            ws["dt"], ws["ref"], ws["flags"], ws["info"], ws["counts"], fargs, mon,
+            ws["dt"], ws["ref"], ws["tc"], ws["flags"], ws["info"], ws["counts"], fargs, mon,
             int(step0), mon_t, mon_out, NO_STOP_ARGS if stop is None else stop,
             int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
             ADAPTIVE_MODES[self.config["adaptive_mode"]])
