@@ -23,7 +23,7 @@ from ._jit import njit, njit_parallel
 
 __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_reference",
            "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
-           "accelerate_pairwise_small", "accelerate_pairwise_rebound"]
+           "accelerate_pairwise_small", "accelerate_pairwise_rebound", "pair_accelerations"]
 
 
 #: Up to this many massive bodies the plain double loop
@@ -120,12 +120,24 @@ def accelerate_pairwise(x, gm, n_active, eps2, acc, work):
 def accelerate_pairwise_small(x, gm, n_active, eps2, acc, work):
     """The plain j < i double loop, fastest for a few bodies; arguments as
     :func:`accelerate_pairwise` (``work`` is not used)."""
+    pair_accelerations(x, gm, n_active, eps2, acc, 0, False)
+    return 0
+
+
+@njit(inline="always")
+def pair_accelerations(x, gm, n_active, eps2, acc, first, skip_first_pair):
+    """``acc`` = the pull within every pair ``first <= j < i`` (j active), each
+    pair once (Newton's third law); bodies before ``first`` feel and exert
+    none, and ``skip_first_pair`` leaves out the pair ``(first, first + 1)``
+    too.  The plain double loop of :func:`accelerate_pairwise_small`, and the
+    interaction kicks of the Wisdom-Holman maps, which leave out the central
+    body's pulls (democratic heliocentric) or the innermost pair (Jacobi)."""
     n = x.shape[0]
     for i in range(n):
         acc[i, 0] = 0.0
         acc[i, 1] = 0.0
         acc[i, 2] = 0.0
-    for i in range(1, n):
+    for i in range(first + 1, n):
         xi = x[i, 0]
         yi = x[i, 1]
         zi = x[i, 2]
@@ -133,7 +145,8 @@ def accelerate_pairwise_small(x, gm, n_active, eps2, acc, work):
         axi = 0.0
         ayi = 0.0
         azi = 0.0
-        for j in range(min(i, n_active)):
+        for j in range(first + 1 if (skip_first_pair and i == first + 1) else first,
+                       min(i, n_active)):
             dx = xi - x[j, 0]
             dy = yi - x[j, 1]
             dz = zi - x[j, 2]
@@ -151,7 +164,6 @@ def accelerate_pairwise_small(x, gm, n_active, eps2, acc, work):
         acc[i, 0] += axi
         acc[i, 1] += ayi
         acc[i, 2] += azi
-    return 0
 
 
 @njit(inline="always")

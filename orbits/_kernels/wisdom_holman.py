@@ -102,6 +102,7 @@ import math
 from ._jit import njit, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
                           to_democratic_heliocentric, to_jacobi)
+from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, _record, state_is_finite
@@ -157,36 +158,8 @@ def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
         # kick is zero (and a third of a two-body step)
         return
     from_jacobi_one(xj, gm, eta, x)
-    for i in range(n):
-        acc[i, 0] = 0.0
-        acc[i, 1] = 0.0
-        acc[i, 2] = 0.0
-    for i in range(1, n):
-        xi = x[i, 0]
-        yi = x[i, 1]
-        zi = x[i, 2]
-        gmi = gm[i]
-        axi = 0.0
-        ayi = 0.0
-        azi = 0.0
-        for j in range(1 if i == 1 else 0, min(i, n_active)):
-            dx = xi - x[j, 0]
-            dy = yi - x[j, 1]
-            dz = zi - x[j, 2]
-            r2 = dx * dx + dy * dy + dz * dz
-            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
-            sj = gm[j] * inv_r3
-            axi -= sj * dx
-            ayi -= sj * dy
-            azi -= sj * dz
-            if i < n_active:
-                si = gmi * inv_r3
-                acc[j, 0] += si * dx
-                acc[j, 1] += si * dy
-                acc[j, 2] += si * dz
-        acc[i, 0] += axi
-        acc[i, 1] += ayi
-        acc[i, 2] += azi
+    # every pair but (0, 1), whose pull the Kepler drift of body 1 holds
+    pair_accelerations(x, gm, n_active, 0.0, acc, 0, True)
     # to Jacobi components, with the Kepler terms i >= 2; row 0 (the centre
     # of mass) feels no internal force
     sx = acc[0, 0]
@@ -241,36 +214,8 @@ def heliocentric_interaction_kick(xh, vb, acc, gm, n_active, h):
     the other bodies except the central one (the flow of ``H_interaction``);
     ``acc`` (shape (N, 3)) is scratch."""
     n = xh.shape[0]
-    for i in range(n):
-        acc[i, 0] = 0.0
-        acc[i, 1] = 0.0
-        acc[i, 2] = 0.0
-    for i in range(2, n):
-        xi = xh[i, 0]
-        yi = xh[i, 1]
-        zi = xh[i, 2]
-        gmi = gm[i]
-        axi = 0.0
-        ayi = 0.0
-        azi = 0.0
-        for j in range(1, min(i, n_active)):
-            dx = xi - xh[j, 0]
-            dy = yi - xh[j, 1]
-            dz = zi - xh[j, 2]
-            r2 = dx * dx + dy * dy + dz * dz
-            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
-            sj = gm[j] * inv_r3
-            axi -= sj * dx
-            ayi -= sj * dy
-            azi -= sj * dz
-            if i < n_active:
-                si = gmi * inv_r3
-                acc[j, 0] += si * dx
-                acc[j, 1] += si * dy
-                acc[j, 2] += si * dz
-        acc[i, 0] += axi
-        acc[i, 1] += ayi
-        acc[i, 2] += azi
+    # the planets' mutual pulls: every pair without the central body
+    pair_accelerations(xh, gm, n_active, 0.0, acc, 1, False)
     for i in range(1, n):
         vb[i, 0] += h * acc[i, 0]
         vb[i, 1] += h * acc[i, 1]
