@@ -10,7 +10,7 @@ import numpy as np
 from ._kernels import invariants as _inv
 
 __all__ = ["MONITORS", "DEFAULT_MONITORS", "monitor_mask", "relative_error",
-           "vector_relative_error", "growth_exponent"]
+           "vector_relative_error", "growth_exponent", "ensemble_growth_exponent"]
 
 #: monitor name -> bit of the kernel mask
 MONITORS = {
@@ -69,3 +69,52 @@ def growth_exponent(t, err):
     lo = np.exp(np.log(t[0]) + 0.1 * (np.log(t[-1]) - np.log(t[0])))
     sel = t >= lo
     return float(np.polyfit(np.log(t[sel]), np.log(err[sel]), 1)[0])
+
+
+def ensemble_growth_exponent(t, errors, t_from, boots=400, seed=1):
+    """Growth exponent of the RMS over an ensemble of runs, and its uncertainty.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Output times, > 0 (best spread evenly in ``log t``).
+    errors : ndarray, shape (members, n)
+        Signed errors (e.g. ``E / E0 - 1``) of each run at the times.
+    t_from : float
+        Fit only ``t >= t_from``: leave out the early part, where the bounded
+        error of single steps, not accumulated rounding, dominates.
+
+    Returns
+    -------
+    exponent : float
+        Slope of ``log RMS`` against ``log t``: 0.5 for independent rounding
+        errors (a random walk, Brouwer's law), 1 for an error of a persistent sign.
+    spread : float
+        Standard deviation of the exponent over ``boots`` resamplings of the
+        members with replacement.  For a random walk it is about
+        ``1 / (sqrt(members) ln(t_end / t_from))`` (the RMS of M members
+        scatters by ``1 / sqrt(2 M)`` at each end of the fit): 0.05 for 16
+        members over 2.4 decades.
+
+    Notes
+    -----
+    One run's exponent scatters by about +-0.25 (its single random walk);
+    the RMS over independent runs narrows that, which is why the exponent is
+    fitted to the ensemble.  ``abs(errors.mean(axis=0))`` against the RMS tells
+    a common drift (truncation, or rounding with a bias) from a random walk:
+    for M independent runs it stays near ``RMS / sqrt(M)``.
+    """
+    t = np.asarray(t, dtype=float)
+    errors = np.atleast_2d(np.asarray(errors, dtype=float))
+    sel = t >= t_from
+
+    def fit(e):
+        rms = np.sqrt(np.mean(e[:, sel] ** 2, axis=0))
+        ok = rms > 0
+        return float(np.polyfit(np.log(t[sel][ok]), np.log(rms[ok]), 1)[0])
+
+    exponent = fit(errors)
+    rng = np.random.default_rng(seed)
+    m = errors.shape[0]
+    draws = [fit(errors[rng.integers(0, m, m)]) for _ in range(boots)]
+    return exponent, float(np.std(draws))
