@@ -378,3 +378,36 @@ def test_simulation_step_underflow():
     sim = orbits.Simulation(_near_collision(1e-7), integrator=get("ias15", min_dt=1e-6))
     with pytest.raises(StepSizeUnderflow, match="collapsed"):
         sim.run(until=10.0, outputs=2, progress=False)
+
+
+@pytest.mark.parametrize("distance", [1e-4, 1e-6, 1e-8])
+def test_close_encounter_does_not_stall_the_global_criterion(distance):
+    # Two Earth-mass planets meeting at `distance` au near 1 au from the star:
+    # below a step of ~1e-3 day b6 is set by the rounding of the positions
+    # (~1e-16 au, magnified ~4500-fold by the divided difference), not by the
+    # step, so chasing it shrank the step towards zero (9.6 million steps in
+    # 20 s without reaching the pass).  REBOUND's IAS15 takes 116-431 steps
+    # here (prs23); measured for ours: 263 / 1518 / 11395 steps.
+    from orbits.validation.stress import encounter_bodies
+    bodies = encounter_bodies(distance)
+    sim = orbits.Simulation(bodies, "ias15")
+    result = sim.run(until=10 * u.day, outputs=2, wall_limit=60, progress=False)
+    assert sim.steps < 20_000
+    # energy error measured 3.5e-16 / 2.9e-11 / 1.1e-8, REBOUND's 1.6e-15 /
+    # 1.9e-11 / 9.4e-8: an encounter at 1e-8 au is resolved to round-off of
+    # the pair's relative position (1e-16 au in 1e-8 au)
+    assert result.max_energy_error() < {1e-4: 1e-14, 1e-6: 1e-9, 1e-8: 1e-6}[distance]
+
+
+@pytest.mark.parametrize("scene, epsilon, until",
+                         [("pythagorean", 1e-12, 70.0), ("outer-solar-system", 1e-13, 36525.0)])
+def test_epsilon_below_round_off_does_not_stall(scene, epsilon, until):
+    # an epsilon the rounding of the accelerations cannot meet: the step stops
+    # shrinking at the rounding level (it underflowed at t = 1.87 on the
+    # Pythagorean problem, and crawled at ~1e-5 day on the outer solar system)
+    bodies = orbits.scenes.get(scene)
+    sim = orbits.Simulation(bodies, orbits.integrators.get("ias15", epsilon=epsilon))
+    result = sim.run(until=bodies.units.quantity(until, "time"), outputs=2, wall_limit=60,
+                     progress=False)
+    assert sim.steps < 200_000          # measured 75,634 and 2,410
+    assert result.max_energy_error() < 1e-11   # measured 1.0e-12 and 2.1e-16
