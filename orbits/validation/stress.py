@@ -460,29 +460,27 @@ def _from_row(row, error=None, keep_x=False):
     return cell
 
 
-def _eccentricity_cell(name, options, e, quick):
-    bodies = _scenes.kepler(e=e)
+def _kepler_cell(bodies, name, options, steps_per_orbit, quick):
+    """A two-body run of ``KEPLER_ORBITS`` orbits (a = 1 au) against the
+    analytic orbit."""
     mu = bodies.units.G * float(bodies._m.sum())
     period = 2 * math.pi / math.sqrt(mu)                       # a = 1 au
-    dt = None if _adaptive(name) else period / KEPLER_STEPS_PER_ORBIT
+    dt = None if _adaptive(name) else period / steps_per_orbit
     row = _measure.run_orbits(bodies, name, options, dt=dt,
                               until=KEPLER_ORBITS[quick] * period, outputs=2,
                               wall_limit=_wall(quick))
     err = _kepler_error(bodies, row, 1.0) if row["outcome"] == "completed" else None
     return _from_row(row, err)
+
+
+def _eccentricity_cell(name, options, e, quick):
+    return _kepler_cell(_scenes.kepler(e=e), name, options, KEPLER_STEPS_PER_ORBIT, quick)
 
 
 def _mass_ratio_cell(name, options, q, quick):
     import astropy.units as u
     bodies = _scenes.kepler(e=MASS_RATIO_ECCENTRICITY, m_orbiter=q * u.Msun)
-    mu = bodies.units.G * float(bodies._m.sum())
-    period = 2 * math.pi / math.sqrt(mu)
-    dt = None if _adaptive(name) else period / MASS_RATIO_STEPS_PER_ORBIT
-    row = _measure.run_orbits(bodies, name, options, dt=dt,
-                              until=KEPLER_ORBITS[quick] * period, outputs=2,
-                              wall_limit=_wall(quick))
-    err = _kepler_error(bodies, row, 1.0) if row["outcome"] == "completed" else None
-    return _from_row(row, err)
+    return _kepler_cell(bodies, name, options, MASS_RATIO_STEPS_PER_ORBIT, quick)
 
 
 def _step_cell(name, options, value, quick):
