@@ -4,7 +4,7 @@ The same as ``orbits validate --out validation/report`` (the measurements live
 in the package, :mod:`orbits.validation`, so that any user can rerun them);
 this script only fixes where the committed copy goes.
 
-    python validation/make_report.py            # the full report (about half an hour on 2 cores)
+    python validation/make_report.py            # the full report (about ten minutes on 2 cores)
     python validation/make_report.py --quick    # a few minutes, into validation/report-quick
 """
 

@@ -4,7 +4,7 @@ long-horizon drift, a stress suite and a check of a published guide.
 ``orbits validate [--quick] [--out DIR]`` (or :func:`validate`) runs it on
 this machine's cores and writes ``report.md`` with its PNG plots into ``DIR``.
 REBOUND is needed (``pip install -e ".[test]"``), and matplotlib for the
-plots.  The full report takes of the order of half an hour on two cores, the
+plots.  The full report takes about ten minutes on two cores, the
 quick one a few minutes; the committed full report is in the repository's
 ``validation/report/``.
 

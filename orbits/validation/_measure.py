@@ -197,6 +197,10 @@ def run_rebound(bodies, integrator, options=None, *, dt=None, until, outputs=2, 
     options = dict(options or {})
     label = label or f"REBOUND {integrator}"
     until = float(on_steps([until], dt)[-1])
+    if integrator == "whfast":
+        # synchronise (and apply a corrector) only when an output needs it, as
+        # our wh does; REBOUND's default safe mode does it after every step
+        options.setdefault("safe_mode", 0)
     row = row_template(label, integrator=f"rebound-{integrator}", options=options, dt=dt)
     sim = bodies.to_rebound()
     sim.gravity = "basic"
