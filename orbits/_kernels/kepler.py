@@ -1061,6 +1061,20 @@ def short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
 
 
 @njit(inline="always")
+def _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1):
+    """Row ``i`` of ``x``, ``v`` from its start ``(x0, v0)`` and the Lagrange
+    coefficients, written as increments (``f - 1``, ``g dot - 1``) so that a
+    short step loses no digits of the start: ``x = x0 + ((f - 1) x0 + g v0)``,
+    ``v = v0 + (f dot x0 + (g dot - 1) v0)``."""
+    x[i, 0] = x0 + (fm1 * x0 + g * vx0)
+    x[i, 1] = y0 + (fm1 * y0 + g * vy0)
+    x[i, 2] = z0 + (fm1 * z0 + g * vz0)
+    v[i, 0] = vx0 + (fdot * x0 + gdm1 * vx0)
+    v[i, 1] = vy0 + (fdot * y0 + gdm1 * vy0)
+    v[i, 2] = vz0 + (fdot * z0 + gdm1 * vz0)
+
+
+@njit(inline="always")
 def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
     """Advance row ``i`` of ``x``, ``v`` by the universal anomaly ``s`` (the
     f and g functions of :func:`kepler_drift`); the other arguments from
@@ -1084,12 +1098,7 @@ def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
     g = r0 * G1 + eta * G2
     fdot = -mu * G1 * ir0 * ir
     gdm1 = -mu * G2 * ir
-    x[i, 0] = x0 + (fm1 * x0 + g * vx0)
-    x[i, 1] = y0 + (fm1 * y0 + g * vy0)
-    x[i, 2] = z0 + (fm1 * z0 + g * vz0)
-    v[i, 0] = vx0 + (fdot * x0 + gdm1 * vx0)
-    v[i, 1] = vy0 + (fdot * y0 + gdm1 * vy0)
-    v[i, 2] = vz0 + (fdot * z0 + gdm1 * vz0)
+    _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
     return True
 
 
@@ -1291,10 +1300,5 @@ def _kepler_drift_bracketed(mu, x, v, i, dt):
     g = r0 * G1 + eta * G2
     fdot = -mu * G1 / (r * r0)
     gdm1 = -mu * G2 / r
-    x[i, 0] = x0 + (fm1 * x0 + g * vx0)
-    x[i, 1] = y0 + (fm1 * y0 + g * vy0)
-    x[i, 2] = z0 + (fm1 * z0 + g * vz0)
-    v[i, 0] = vx0 + (fdot * x0 + gdm1 * vx0)
-    v[i, 1] = vy0 + (fdot * y0 + gdm1 * vy0)
-    v[i, 2] = vz0 + (fdot * z0 + gdm1 * vz0)
+    _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
     return STATUS_OK
