@@ -214,32 +214,22 @@ def accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc):
         axi = 0.0
         ayi = 0.0
         azi = 0.0
-        if i < n_active:
-            for j in range(i):
-                dx = x[i, 0] - x[j, 0]
-                dy = x[i, 1] - x[j, 1]
-                dz = x[i, 2] - x[j, 2]
-                r = math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
-                p = G / (r * r * r)
-                pj = -p * m[j]
-                axi += pj * dx
-                ayi += pj * dy
-                azi += pj * dz
+        # a test particle (i >= n_active) feels the active bodies and pulls none
+        for j in range(min(i, n_active)):
+            dx = x[i, 0] - x[j, 0]
+            dy = x[i, 1] - x[j, 1]
+            dz = x[i, 2] - x[j, 2]
+            r = math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+            p = G / (r * r * r)
+            pj = -p * m[j]
+            axi += pj * dx
+            ayi += pj * dy
+            azi += pj * dz
+            if i < n_active:
                 pi = p * mi
                 acc[j, 0] += pi * dx
                 acc[j, 1] += pi * dy
                 acc[j, 2] += pi * dz
-        else:
-            for j in range(n_active):
-                dx = x[i, 0] - x[j, 0]
-                dy = x[i, 1] - x[j, 1]
-                dz = x[i, 2] - x[j, 2]
-                r = math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
-                p = G / (r * r * r)
-                pj = -p * m[j]
-                axi += pj * dx
-                ayi += pj * dy
-                azi += pj * dz
         acc[i, 0] = axi
         acc[i, 1] = ayi
         acc[i, 2] = azi
