@@ -10,11 +10,12 @@
 
 from importlib.metadata import PackageNotFoundError, version as _version
 
-from . import errors, integrators, io, monitors, scenes
+from . import errors, forces, integrators, io, monitors, scenes
 from .bodies import BodySet
 from .custom import Trajectory, integrate
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, ConvergenceFailure,
-                     ElementsError, Escape, IntegratorOptionError, NonFiniteState,
+                     ElementsError, Escape, ForceTermError, IntegratorOptionError,
+                     NonFiniteState,
                      OrbitsError, StepSizeUnderflow, UnknownIntegratorError,
                      WallTimeExceeded)
 from .result import Result
@@ -28,7 +29,8 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0+unknown"
 
 __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajectory",
-           "scenes", "integrators", "monitors", "errors", "OrbitsError", "BodyError",
+           "scenes", "integrators", "monitors", "errors", "forces", "OrbitsError",
+           "BodyError", "ForceTermError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow", "ConvergenceFailure",
            "CloseEncounter", "Escape", "WallTimeExceeded", "load", "io", "Ensemble", "__version__"]

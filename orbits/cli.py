@@ -9,6 +9,7 @@ import re
 import sys
 
 import astropy.units as u
+import numpy as np
 
 __all__ = ["main", "parse_quantity"]
 
@@ -33,6 +34,23 @@ def parse_quantity(text, physical_type="time"):
     return q
 
 
+def _dominant(bodies):
+    return bodies.names[int(np.argmax(bodies.masses.value))]
+
+
+#: ``--gr`` choice -> the term it adds for a body set
+GR_TERMS = {
+    "sun": lambda b: _forces().GR(_dominant(b)),
+    "potential": lambda b: _forces().GRPotential(_dominant(b)),
+    "full": lambda b: _forces().GRFull(),
+}
+
+
+def _forces():
+    from orbits import forces
+    return forces
+
+
 def _parser():
     p = argparse.ArgumentParser(prog="orbits", description="N-body orbital mechanics.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -46,6 +64,10 @@ def _parser():
     run.add_argument("--until", type=parse_quantity, required=True,
                      help="end time, e.g. 1000yr")
     run.add_argument("--outputs", type=int, default=500, help="number of outputs (500)")
+    run.add_argument("--gr", choices=sorted(GR_TERMS),
+                     help="general relativity: 'sun' (1PN correction from the most massive "
+                          "body, velocity-dependent), 'potential' (its potential form, which "
+                          "wh takes) or 'full' (Einstein-Infeld-Hoffmann among all bodies)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
     run.add_argument("--out", help="stream outputs and checkpoints to this HDF5 file")
     run.add_argument("--force", action="store_true", help="overwrite an existing --out file")
@@ -107,7 +129,9 @@ def main(argv=None):
                       f"{str(info.adaptive):8s} {info.summary}")
         elif args.command == "run":
             bodies = orbits.scenes.get(args.scene)
-            sim = orbits.Simulation(bodies, integrator=args.integrator, dt=args.dt)
+            forces = [] if args.gr is None else [GR_TERMS[args.gr](bodies)]
+            sim = orbits.Simulation(bodies, integrator=args.integrator, dt=args.dt,
+                                    forces=forces)
             result = sim.run(until=args.until, outputs=args.outputs,
                              progress=False if args.no_progress else None,
                              output=args.out, overwrite=args.force,

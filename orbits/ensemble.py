@@ -496,8 +496,7 @@ class _Perturbation:
 
     def __init__(self, sim, scale, seed):
         self.bodies = sim.bodies
-        self.integrator = (sim.integrator.name, dict(sim.integrator.config))
-        self.options = _simulation_options(sim)
+        self.config = sim.config
         self.scale = scale
         self.seed = seed
 
@@ -512,28 +511,16 @@ class _Perturbation:
         bodies._x = x + (self.scale * r)[:, None] * direction
         bodies.history.append({"from": "perturbed", "scale": self.scale, "seed": self.seed,
                                "member": int(member)})
-        name, config = self.integrator
-        return Simulation(bodies, integrator=_integrators.get(name, **config), **self.options)
+        return Simulation.from_config(bodies, self.config)
 
     def fingerprint(self):
         b = self.bodies
         h = hashlib.sha1()
         for a in (b._m, b._x, b._v):
             h.update(np.ascontiguousarray(a).tobytes())
-        h.update(repr((b.names, self.integrator, sorted(self.options.items(), key=str),
-                       self.scale, self.seed)).encode())
+        h.update(json.dumps([b.names, self.config.to_dict(), self.scale, self.seed],
+                            sort_keys=True, default=str).encode())
         return h.digest()
-
-
-def _simulation_options(sim):
-    """The keyword arguments that make a simulation like ``sim`` from its bodies."""
-    options = dict(dt=sim.dt, monitors=tuple(sim.monitors), monitor_every=sim.monitor_every,
-                   parallel=sim.parallel)
-    if sim.softening is not None:
-        options["softening"] = sim.softening
-    options.update({k: val for k, val in sim.stop_conditions.items()
-                    if val is not None and val is not False})
-    return options
 
 
 # -- output directory ---------------------------------------------------------------------

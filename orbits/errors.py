@@ -18,6 +18,7 @@ __all__ = [
     "NoMassiveBodyError",
     "UnknownIntegratorError",
     "IntegratorOptionError",
+    "ForceTermError",
     "RunError",
     "SimulationStopped",
     "NonFiniteState",
@@ -93,6 +94,26 @@ class UnknownIntegratorError(OrbitsError, ValueError):
 
 class IntegratorOptionError(OrbitsError, ValueError):
     """An integrator option that is unknown, or whose value is not acceptable."""
+
+
+class ForceTermError(OrbitsError, ValueError):
+    """A force term (:mod:`orbits.forces`) whose parameters are not acceptable, or
+    that does not fit the body set: an unknown source body, a negative radius,
+    a user force of the wrong shape.
+
+    Attributes
+    ----------
+    term : str
+        The term concerned, as written (``"GR('Sun')"``).
+    field : str or None
+        Its parameter concerned: ``"source"``, ``"radius"``, ``"func"``, ...
+    """
+
+    def __init__(self, message, term=None, field=None):
+        self.term = term
+        self.field = field
+        where = ", ".join(p for p in (term, f"parameter {field!r}" if field else None) if p)
+        super().__init__(f"{where}: {message}" if where else message)
 
 
 class RunError(OrbitsError, RuntimeError):

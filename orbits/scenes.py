@@ -37,6 +37,7 @@ __all__ = [
     "kepler",
     "outer_solar_system",
     "solar_system",
+    "de421",
     "pythagorean",
     "figure_eight",
     "plummer",
@@ -45,6 +46,7 @@ __all__ = [
     "describe",
     "FIGURE_EIGHT_PERIOD",
     "HLW_G",
+    "DE421_AU",
     "J2000_OBLIQUITY",
     "MOON_SEMI_MAJOR_AXIS",
     "MOON_ECCENTRICITY",
@@ -535,6 +537,170 @@ def solar_system(epoch="2000-01-01 12:00:00", moon=True, frame="ecliptic"):
                    gm=_DE440_REFERENCE)
 
 
+# The constants of DE421 itself, from the ephemeris's header as the de421
+# package ships it (de421/constants.npy: DENUM = 421, AU, EMRAT, GM1 ... GM9,
+# GMB, GMS), and listed in Folkner, Williams & Boggs 2008 (IPN Progress Report
+# 42-178).  GM values are in (DE421 au)^3 / day^2; the planets other than the
+# Earth are planet-plus-satellites systems ("GMB" is the Earth and the Moon
+# together, split by EMRAT = M_earth / M_moon).  tests/test_scenes.py checks
+# that these equal the package's header to the last bit.
+_GM_DE421 = {
+    "GMS": 0.0002959122082855911,
+    "GM1": 4.91254957186794e-11,
+    "GM2": 7.243452332698441e-10,
+    "GMB": 8.997011408268049e-10,
+    "GM4": 9.54954869562239e-11,
+    "GM5": 2.82534584085505e-07,
+    "GM6": 8.459706073308477e-08,
+    "GM7": 1.29202482579265e-08,
+    "GM8": 1.52435910924974e-08,
+    "GM9": 2.17844105199052e-12,
+}
+_EMRAT_DE421 = 81.3005690699153
+
+#: The astronomical unit of DE421, an estimated parameter of the fit (the
+#: header's "AU"); it is 0.37 m shorter than the IAU 2012 au that astropy's
+#: ``u.au`` is (149,597,870.700 km exactly).
+DE421_AU = 149_597_870.6996262 * u.km
+
+#: The epoch of the :func:`de421` scene: J2000.0, JD 2451545.0 TDB.
+_J2000_JD_TDB = 2451545.0
+
+# Scene name -> (the de421 package's series, the header's GM key).  DE421's
+# "mercury" and "venus" are the planets themselves (they have no moons) and
+# "mars" ... "pluto" are the barycentres of the planet systems; "earthmoon" is
+# the Earth-Moon barycentre and "moon" the geocentric Moon, from which the
+# Earth and the Moon are made below.
+_DE421_BODIES = {
+    "Sun": ("sun", "GMS"), "Mercury": ("mercury", "GM1"), "Venus": ("venus", "GM2"),
+    "Earth": (None, None), "Moon": (None, None), "Mars": ("mars", "GM4"),
+    "Jupiter": ("jupiter", "GM5"), "Saturn": ("saturn", "GM6"),
+    "Uranus": ("uranus", "GM7"), "Neptune": ("neptune", "GM8"), "Pluto": ("pluto", "GM9"),
+}
+
+
+def _de421_ephemeris():
+    """The DE421 ephemeris of the ``de421`` package, read by ``jplephem``."""
+    try:
+        import de421 as package
+        from jplephem.ephem import Ephemeris
+    except ImportError as exc:
+        raise ImportError(
+            "the de421 scene reads the JPL DE421 ephemeris with the jplephem and de421 "
+            'packages; install them with: pip install "orbits[ephemeris]"') from exc
+    return Ephemeris(package)
+
+
+def de421(com=False):
+    """The Sun, the planets, the Moon and Pluto at J2000.0 from the JPL DE421 ephemeris.
+
+    Positions and velocities at JD 2451545.0 TDB (2000 January 1, 12:00 TDB)
+    in the barycentric ICRF axes of DE421 (equatorial), evaluated from the
+    Chebyshev series that the ``de421`` package installs with ``jplephem``:
+    nothing is downloaded and nothing touches the network.  Masses and G are
+    DE421's own GM values, so the set is the ephemeris's dynamical model
+    restricted to these eleven bodies.
+
+    Parameters
+    ----------
+    com : bool
+        Move to the centre of mass of the eleven bodies.  Default False: keep
+        the solar-system barycentre of DE421, whose model also has 343
+        asteroids (about 1e-9 solar masses) that are not in this set; there
+        the centre of mass of the set is 1.6e-9 au from the origin and its
+        momentum is 3.6e-7 of ``sum m |v|``.
+
+    Returns
+    -------
+    BodySet
+        ``"Sun"``, ``"Mercury"``, ``"Venus"``, ``"Earth"``, ``"Moon"``,
+        ``"Mars"``, ``"Jupiter"``, ``"Saturn"``, ``"Uranus"``, ``"Neptune"``,
+        ``"Pluto"``, in au (IAU 2012), solar masses and days.  G is DE421's
+        GM_sun (``GMS = 2.959122082855911e-4`` (DE421 au)^3/day^2, with
+        1 DE421 au = :data:`DE421_AU`) per solar mass, so the Sun's mass is
+        exactly 1 Msun and each other mass is ``GM / GMS``.  Mars to Pluto are
+        the barycentres of the planets' systems, with the systems' masses; the
+        Earth and the Moon are separate bodies, their GMs split from DE421's
+        Earth-Moon GM by ``EMRAT = 81.3005690699153``.
+
+    Raises
+    ------
+    ImportError
+        ``jplephem`` or ``de421`` is not installed; the message says
+        ``pip install "orbits[ephemeris]"``.
+
+    Notes
+    -----
+    The ``de421`` package (2008.1) holds the ephemeris as NumPy arrays of
+    Chebyshev coefficients in the original JPL body order, not as an SPK
+    ``de421.bsp`` file, and is read with ``jplephem.ephem.Ephemeris``, whose
+    positions are in km and velocities in km/day.  The Earth and the Moon are
+    ``EMB - moon / (1 + EMRAT)`` and ``EMB + moon EMRAT / (1 + EMRAT)``, as in
+    SPK segments ``[3, 399]`` and ``[3, 301]``.  The ``de421`` package's
+    description quotes DE421 as good to 200 m for Venus and 300 m for the
+    Earth and Mars over the decade before 2008.
+
+    References
+    ----------
+    .. [1] Folkner, W. M., Williams, J. G. & Boggs, D. H. 2008, "The Planetary
+       and Lunar Ephemeris DE 421", IPN Progress Report 42-178 (GM values,
+       EMRAT and AU from the ephemeris's header as distributed in the ``de421``
+       package: ``GM1 ... GM9``, ``GMB``, ``GMS``).
+    .. [2] Rhodes, B., ``jplephem`` and ``de421`` (PyPI), MIT licence.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits import scenes
+    >>> bodies = scenes.de421()
+    >>> bodies.names[3:5]
+    ['Earth', 'Moon']
+    >>> r = bodies.positions[3] - bodies.positions[0]     # Earth - Sun, near perihelion
+    >>> print(np.round(np.linalg.norm(r), 5))
+    0.98333 AU
+    """
+    ephemeris = _de421_ephemeris()
+    au_per_km = (1 * u.km).to_value(u.au)
+
+    def state(series):
+        # (3, 1) arrays in km and km/day, for the one epoch.
+        x, v = ephemeris.position_and_velocity(series, _J2000_JD_TDB)
+        return x[:, 0] * au_per_km, v[:, 0] * au_per_km
+
+    x_emb, v_emb = state("earthmoon")
+    x_moon, v_moon = state("moon")          # geocentric
+    earth_share = 1.0 / (1.0 + _EMRAT_DE421)
+    moon_share = _EMRAT_DE421 / (1.0 + _EMRAT_DE421)
+    names = list(_DE421_BODIES)
+    gm = np.empty(len(names))
+    x = np.empty((len(names), 3))
+    v = np.empty((len(names), 3))
+    for i, name in enumerate(names):
+        series, key = _DE421_BODIES[name]
+        if name == "Earth":
+            gm[i] = _GM_DE421["GMB"] * moon_share
+            x[i], v[i] = x_emb - earth_share * x_moon, v_emb - earth_share * v_moon
+        elif name == "Moon":
+            gm[i] = _GM_DE421["GMB"] * earth_share
+            x[i], v[i] = x_emb + moon_share * x_moon, v_emb + moon_share * v_moon
+        else:
+            gm[i] = _GM_DE421[key]
+            x[i], v[i] = state(series)
+
+    # G * (1 Msun) = GMS, carried from DE421's au to the IAU au of u.au
+    # (a factor 1 - 7.5e-12) so that G m equals the header's GM in km^3/day^2.
+    G = _GM_DE421["GMS"] * DE421_AU ** 3 / (u.day ** 2 * u.Msun)
+    units = UnitSystem(length=u.au, mass=u.Msun, time=u.day, G=G,
+                       name="au-Msun-day (DE421 GM_sun)",
+                       G_source="GMS of JPL DE421 (Folkner, Williams & Boggs 2008)")
+    bodies = BodySet.from_arrays(gm / _GM_DE421["GMS"], x, v, names=names, units=units)
+    if com:
+        bodies.move_to_com()
+    return _record(bodies, "de421", com=bool(com), epoch="2000-01-01T12:00:00.000 TDB",
+                   frame="icrs", ephemeris="JPL DE421 (jplephem, de421 package)",
+                   gm="JPL DE421 header (Folkner, Williams & Boggs 2008)")
+
+
 def pythagorean():
     """Burrau's Pythagorean three-body problem.
 
@@ -735,6 +901,7 @@ SCENES = {
     "kepler": kepler,
     "outer-solar-system": outer_solar_system,
     "solar-system": solar_system,
+    "de421": de421,
     "pythagorean": pythagorean,
     "figure-eight": figure_eight,
     "plummer": plummer,

@@ -9,6 +9,7 @@ import math
 import time as _time
 from typing import NamedTuple
 
+import astropy.units as u
 import numpy as np
 
 from . import integrators as _integrators
@@ -25,7 +26,8 @@ from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
                        vector_relative_error)
 from .result import Result
 
-__all__ = ["Simulation", "RunPlan", "PARALLEL_THRESHOLD"]
+__all__ = ["Simulation", "SimulationConfig", "SimulationState", "Snapshot", "RunPlan",
+           "PARALLEL_THRESHOLD"]
 
 #: Bodies from which the threaded gravity kernel is used.  Measured with
 #: benchmarks/bench_gravity.py on the 2-core reference machine (whole leapfrog
@@ -71,8 +73,74 @@ class RunPlan(NamedTuple):
             yield min(int(round(k * self.ratio / (self.outputs - 1))), self.n_full)
 
 
+class SimulationConfig(NamedTuple):
+    """Everything but the bodies that makes a :class:`Simulation`: one object that
+    output files store and ensembles ship, so that a simulation is rebuilt with
+    :meth:`Simulation.from_config` rather than by re-listing its arguments.
+
+    Quantities stay Quantities; :meth:`to_dict` gives plain JSON-able values.
+    """
+
+    integrator: str
+    integrator_options: dict
+    dt: object              # Quantity (time) or None
+    forces: tuple           # ForceTerm dictionaries, the Gravity term first
+    monitors: tuple
+    monitor_every: object   # int or None
+    stop_conditions: dict   # Simulation keyword -> value
+
+    def to_dict(self):
+        """Plain values: Quantities as ``[value, unit]``."""
+        from .forces import _quantity_dict
+        return {"integrator": self.integrator,
+                "integrator_options": dict(self.integrator_options),
+                "dt": _quantity_dict(self.dt), "forces": list(self.forces),
+                "monitors": list(self.monitors), "monitor_every": self.monitor_every,
+                "stop_conditions": {k: (_quantity_dict(v) if isinstance(v, u.Quantity) else v)
+                                    for k, v in self.stop_conditions.items()}}
+
+    @classmethod
+    def from_dict(cls, d):
+        from .forces import _quantity_from
+        return cls(d["integrator"], dict(d["integrator_options"]), _quantity_from(d["dt"]),
+                   tuple(d["forces"]), tuple(d["monitors"]), d["monitor_every"],
+                   {k: _quantity_from(v) for k, v in d["stop_conditions"].items()})
+
+
+class SimulationState(NamedTuple):
+    """A simulation's dynamical state, exactly: what a restart checkpoint saves
+    and :meth:`Simulation.set_state` puts back (bit for bit).
+
+    Arrays are in the simulation's internal order (massive bodies first,
+    ``order[i]`` the body set's row of internal row ``i``) and units.
+    """
+
+    x: np.ndarray                # (N, 3), the integrator's current positions
+    v: np.ndarray                # (N, 3)
+    order: np.ndarray            # (N,) int64
+    t_base: float                # time = t_base + steps_since_base * dt
+    steps_since_base: int
+    steps: int                   # accepted steps since the simulation was made
+    force_evaluations: int
+    steps_rejected: int
+    workspace: dict              # the integrator's arrays (name -> ndarray)
+    reference: np.ndarray        # the monitors' reference row (errors are against it)
+    scales: tuple                # (energy scale, angular momentum scale)
+
+
+class Snapshot(NamedTuple):
+    """One output: time, step count, and the state in the body set's order."""
+
+    t: float
+    steps: int
+    x: np.ndarray
+    v: np.ndarray
+    monitors: np.ndarray         # one monitor row (orbits._kernels.invariants layout)
+
+
 class Simulation:
-    """A body set evolving under Newtonian gravity with a chosen integrator.
+    """A body set evolving under Newtonian gravity and added force terms with a
+    chosen integrator.
 
     Parameters
     ----------
@@ -134,13 +202,16 @@ class Simulation:
     (31, 2, 3)
     """
 
-    def __init__(self, bodies, integrator="verlet", dt=None, *, monitors=DEFAULT_MONITORS,
-                 monitor_every=None, softening=None, parallel=None, encounter_distance=None,
-                 encounter_hill=None, escape_distance=None, escape_unbound=False,
-                 rebound_arithmetic=False):
+    def __init__(self, bodies, integrator="verlet", dt=None, *, forces=(),
+                 monitors=DEFAULT_MONITORS, monitor_every=None, softening=None, parallel=None,
+                 encounter_distance=None, encounter_hill=None, escape_distance=None,
+                 escape_unbound=False, rebound_arithmetic=False):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
+        terms, gravity = _split_forces(forces, softening, parallel, rebound_arithmetic)
+        softening, parallel = gravity.softening, gravity.parallel
+        rebound_arithmetic = gravity.rebound_arithmetic
         self.units = bodies.units
         self._bare_ok = bodies._bare_ok
         self._names = bodies.names
@@ -159,6 +230,7 @@ class Simulation:
         self._x = np.ascontiguousarray(bodies._x[self._order])
         self._v = np.ascontiguousarray(bodies._v[self._order])
         self._n_active = int(np.count_nonzero(self._m > 0))
+        self._inverse = np.argsort(self._order)
         eps = 0.0 if softening is None else float(
             self.units.to_internal(softening, "length", bare_ok=self._bare_ok,
                                    field="softening"))
@@ -175,6 +247,11 @@ class Simulation:
         self._fargs = _gravity.gravity_args(self.units.G, self._m, self._n_active, self._eps2,
                                             self.parallel)
         self._gm = self._fargs[0]
+        self._terms = terms
+        self._eargs = None
+        if terms:
+            self.integrator.check_terms(terms)
+            self._bind_terms(bodies)
 
         self.monitors = tuple(monitors)
         self._mask = monitor_mask(self.monitors)
@@ -189,6 +266,7 @@ class Simulation:
                                      escape_unbound)
         self._ws = (self.integrator.workspace(n, self._dt) if adaptive
                     else self.integrator.workspace(n))
+        self.integrator.bind(self._ws, self._force, self._fargs)
         self.steps_rejected = 0
         self._t_base = 0.0          # time = t_base + steps_since_base * dt
         self._steps_since_base = 0
@@ -200,6 +278,61 @@ class Simulation:
         self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
+
+    def _bind_terms(self, bodies):
+        """Compile gravity and the added terms into one force (see :mod:`orbits.forces`)."""
+        from . import forces as _forces
+        from ._kernels import terms as _kterms
+        ctx = _forces.Context([self._names[k] for k in self._order], self._m, self._gm,
+                              self._n_active, self.units, self._bare_ok, self._order,
+                              np.ascontiguousarray(bodies._x), np.ascontiguousarray(bodies._v))
+        bound = [term.bind(ctx) for term in self._terms]
+        chain = _kterms.chain([b.kernel for b in bound])
+        self._force = _stepping.with_terms(self._force, chain,
+                                           any(t.velocity_dependent for t in self._terms))
+        self._fargs = (self._fargs, _kterms.nest([b.args for b in bound]))
+        self._eargs = _kterms.nest([b.energy_args for b in bound])
+
+    @property
+    def config(self):
+        """The :class:`SimulationConfig` that rebuilds this simulation from its bodies."""
+        return SimulationConfig(
+            self.integrator.name, dict(self.integrator.config),
+            None if (self.integrator.adaptive and self._dt == 0) else self.dt,
+            tuple([self.gravity.to_dict()] + [t.to_dict() for t in self._terms]),
+            tuple(self.monitors), self.monitor_every,
+            {k: v for k, v in self.stop_conditions.items() if v is not None and v is not False})
+
+    @classmethod
+    def from_config(cls, bodies, config):
+        """A simulation of ``bodies`` made as ``config`` (a :class:`SimulationConfig`
+        or its :meth:`~SimulationConfig.to_dict`) says."""
+        from . import forces as _forces
+        if isinstance(config, dict):
+            config = SimulationConfig.from_dict(config)
+        integ = _integrators.get(config.integrator, **config.integrator_options)
+        terms = [t if isinstance(t, _forces.ForceTerm) else _forces.from_dict(t)
+                 for t in config.forces]
+        return cls(bodies, integ, dt=config.dt, forces=terms, monitors=config.monitors,
+                   monitor_every=config.monitor_every, **config.stop_conditions)
+
+    @property
+    def forces(self):
+        """The force terms added to Newtonian gravity (a tuple, maybe empty)."""
+        return self._terms
+
+    @property
+    def gravity(self):
+        """The gravity term with this simulation's options (:class:`orbits.forces.Gravity`)."""
+        from .forces import Gravity
+        return Gravity(softening=self._softening, parallel=self.parallel,
+                       rebound_arithmetic=self.rebound_arithmetic)
+
+    def _mon(self, every):
+        # the monitors' arguments of the compiled loops; with terms, their
+        # energy arguments too (orbits._kernels.stepping.with_terms)
+        mon = (every, self._mask, self._m, self.units.G, self._n_active, self._eps2)
+        return mon if self._eargs is None else mon + (self._eargs,)
 
     @property
     def stop_conditions(self):
@@ -318,6 +451,44 @@ class Simulation:
         bs.history = list(self._history)
         return bs
 
+    @property
+    def state(self):
+        """The :class:`SimulationState` (copies), as a checkpoint stores it."""
+        return SimulationState(
+            self._x.copy(), self._v.copy(), self._order.copy(), self._t_base,
+            self._steps_since_base, self.steps, self.force_evaluations, self.steps_rejected,
+            {k: a.copy() for k, a in self._ws.items() if isinstance(a, np.ndarray)},
+            self._reference.copy(), (self._E_scale, self._L_scale))
+
+    def set_state(self, state):
+        """Put back a :class:`SimulationState` taken from a simulation made alike
+        (same bodies' order, integrator and forces)."""
+        if not np.array_equal(self._order, state.order):
+            raise ValueError("the state's body order does not match this simulation's "
+                             "masses")
+        self._x[...] = state.x
+        self._v[...] = state.v
+        self._t_base = float(state.t_base)
+        self._steps_since_base = int(state.steps_since_base)
+        self.steps = int(state.steps)
+        self.force_evaluations = int(state.force_evaluations)
+        self.steps_rejected = int(state.steps_rejected)
+        for name, arr in state.workspace.items():
+            if name in self._ws:
+                self._ws[name][...] = arr
+        self._reference = np.array(state.reference, dtype=float)
+        self._E_scale, self._L_scale = (float(s) for s in state.scales)
+
+    def snapshot(self):
+        """The current output (:class:`Snapshot`): the integrator synchronised, the
+        state in the body set's order, and the monitors asked for."""
+        self.integrator.synchronize(self._ws, self._x, self._v)
+        row = np.zeros(10)
+        if self._mask:
+            self._monitor_row(row)
+        inv = self._inverse
+        return Snapshot(self._now(), self.steps, self._x[inv], self._v[inv], row)
+
     def _now(self):
         return self._t_base + self._steps_since_base * self._dt
 
@@ -336,6 +507,8 @@ class Simulation:
     def _monitor_row(self, row):
         _inv.monitor_row(self._x, self._v, self._m, self.units.G, self._n_active, self._eps2,
                          self._mask, row)
+        if self._eargs is not None and self._mask & _inv.ENERGY:
+            row[0] += self._force.terms.energy(self._x, self._v, self._eargs)
         return row
 
     # -- running ------------------------------------------------------------------------
@@ -477,7 +650,7 @@ class Simulation:
             size = n // every + 1 if every else 0
             mon_t = np.empty(size)
             mon_out = np.zeros((size, 10))
-            mon = (every, self._mask, self._m, self.units.G, self._n_active, self._eps2)
+            mon = self._mon(every)
             t0 = _time.perf_counter()
             status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
                 self._ws, self._x, self._v, self._t_base, t_end, self._force, self._fargs,
@@ -539,7 +712,7 @@ class Simulation:
             size = 0
         mon_t = np.empty(size)
         mon_out = np.zeros((size, 10))
-        mon = (every, self._mask, self._m, self.units.G, self._n_active, self._eps2)
+        mon = self._mon(every)
         status, steps, n_mon, self._ws = advance_checked(
             self.integrator, self._ws, self._x, self._v, self._now(), dt, n, self._force,
             self._fargs, mon, self.steps, mon_t, mon_out, stop=self._stop)
@@ -613,6 +786,32 @@ class Simulation:
                 f"dt={self.dt:.6g}, t={self.time:.6g}>")
 
 
+def _split_forces(forces, softening, parallel, rebound_arithmetic):
+    """The added terms and the gravity term (with the keywords' options) of ``forces``."""
+    from .forces import ForceTerm, Gravity
+    if isinstance(forces, ForceTerm):
+        forces = (forces,)
+    try:
+        forces = tuple(forces)
+    except TypeError:
+        raise TypeError(f"forces must be a sequence of force terms (orbits.forces), "
+                        f"got {forces!r}") from None
+    for term in forces:
+        if not isinstance(term, ForceTerm):
+            raise TypeError(f"forces must hold force terms of orbits.forces (GR, "
+                            f"GRPotential, GRFull, ZonalHarmonics, UserForce, Gravity); "
+                            f"got {term!r}")
+    gravities = [t for t in forces if isinstance(t, Gravity)]
+    if len(gravities) > 1:
+        raise ValueError("forces holds more than one Gravity term; give one")
+    keywords = softening is not None or parallel is not None or rebound_arithmetic
+    if gravities and keywords:
+        raise ValueError("gravity's options are given twice: set softening, parallel and "
+                         "rebound_arithmetic either on the Gravity term or as keywords")
+    gravity = gravities[0] if gravities else Gravity(softening, parallel, rebound_arithmetic)
+    return tuple(t for t in forces if not isinstance(t, Gravity)), gravity
+
+
 def _increasing(marks, total):
     last = 0
     for mark in marks:
@@ -647,12 +846,12 @@ class _Recorder:
         """Nothing to release for a run kept in memory."""
 
     def output(self, sim, final=False):
-        sim.integrator.synchronize(sim._ws, sim._x, sim._v)
-        self.t.append(sim._now())
-        self.x.append(sim._x[self.inv].copy())
-        self.v.append(sim._v[self.inv].copy())
+        snap = sim.snapshot()
+        self.t.append(snap.t)
+        self.x.append(snap.x)
+        self.v.append(snap.v)
         if sim._mask:
-            self.rows.append(sim._monitor_row(np.zeros(10)))
+            self.rows.append(snap.monitors)
 
     def monitor_rows(self, t, rows):
         self.mon_t.append(t.copy())

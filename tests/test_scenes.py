@@ -289,17 +289,21 @@ def test_solar_system_epoch_as_string_or_time(j2000):
         scenes.solar_system(2451545.0)
 
 
+# Run in a fresh interpreter after this, so that nothing cached by other tests
+# (leap seconds, IERS tables, ephemeris files) can hide a download.
+NO_NETWORK = textwrap.dedent("""
+    import socket
+    def refuse(*args, **kwargs):
+        raise OSError("network access attempted")
+    class NoNetwork(socket.socket):
+        connect = connect_ex = sendto = refuse
+    socket.socket = NoNetwork
+    socket.create_connection = socket.getaddrinfo = refuse
+""")
+
+
 def test_solar_system_never_touches_the_network():
-    # A fresh interpreter, so that nothing cached by other tests (leap seconds,
-    # IERS tables) can hide a download.
-    script = textwrap.dedent("""
-        import socket
-        def refuse(*args, **kwargs):
-            raise OSError("network access attempted")
-        class NoNetwork(socket.socket):
-            connect = connect_ex = sendto = refuse
-        socket.socket = NoNetwork
-        socket.create_connection = socket.getaddrinfo = refuse
+    script = NO_NETWORK + textwrap.dedent("""
         from astropy.time import Time
         from orbits import scenes
         a = scenes.solar_system("2024-03-01 00:00:00")
@@ -310,6 +314,106 @@ def test_solar_system_never_touches_the_network():
                          text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["10", "10"]
+
+
+# -- the solar system from JPL DE421 --------------------------------------------------------
+DE421_NAMES = ["Sun", "Mercury", "Venus", "Earth", "Moon", "Mars", "Jupiter", "Saturn",
+               "Uranus", "Neptune", "Pluto"]
+
+
+@pytest.fixture(scope="module")
+def de421():
+    pytest.importorskip("jplephem")
+    pytest.importorskip("de421")
+    return scenes.de421()
+
+
+def test_de421_bodies_and_units(de421):
+    assert de421.names == DE421_NAMES
+    assert de421.units.length == u.au and de421.units.time == u.day
+    assert de421.masses[0] == 1 * u.Msun
+    # G m gives back DE421's GM values in km^3/s^2, which the header stores in
+    # (DE421 au)^3/day^2: these round decimals come back to ~1e-15, so the
+    # 7.5e-12 of using the IAU au for DE421's would show.
+    gm = ((de421.units.G * de421.masses.value) << (u.au ** 3 / u.day ** 2)).to_value(
+        u.km ** 3 / u.s ** 2)
+    published = {0: 132712440040.944, 1: 22032.09, 2: 324858.592, 5: 42828.375214,
+                 6: 126712764.8, 7: 37940585.2, 8: 5794548.6, 9: 6836535.0, 10: 977.0}
+    for i, value in published.items():
+        assert gm[i] == pytest.approx(value, rel=1e-13), de421.names[i]
+    assert gm[3] / gm[4] == pytest.approx(81.3005690699153, rel=1e-14)  # EMRAT
+
+
+def test_de421_constants_are_the_ephemeris_header():
+    pytest.importorskip("jplephem")
+    de421_package = pytest.importorskip("de421")
+    from jplephem.ephem import Ephemeris
+
+    header = Ephemeris(de421_package)
+    assert header.DENUM == 421
+    for key, value in scenes._GM_DE421.items():
+        assert value == getattr(header, key), key
+    assert scenes._EMRAT_DE421 == header.EMRAT
+    assert scenes.DE421_AU.to_value(u.km) == header.AU
+
+
+def test_de421_geometry_at_j2000(de421):
+    # Perihelion was on 2000 January 3 at 0.98329 au; 1.5 days before it the
+    # distance differs by < 1e-5 au.
+    assert _distance(de421, "Earth", "Sun").to_value(u.au) == pytest.approx(0.98329,
+                                                                           abs=1e-4)
+    # The Sun's barycentric wobble is ~0.01 au; at J2000 it was 0.0077 au.
+    assert np.linalg.norm(de421.positions[0]).to_value(u.au) < 0.01
+    assert 356_000 < _distance(de421, "Moon", "Earth").to_value(u.km) < 407_000
+    # The xy plane is the equator: the Earth is ~0.38 au north of it at J2000.
+    assert de421.positions[3, 2].to_value(u.au) == pytest.approx(0.384, abs=1e-3)
+
+
+def test_de421_agrees_with_astropy_builtin_earth(de421):
+    # ERFA's epv00 gives the Earth to ~5 km (its documentation, against DE405);
+    # DE421 and epv00 differed by 4.2 km and 1 cm/s at J2000.  A km/au or
+    # day/second slip, or a wrong Earth-Moon split (~4,700 km), would be far off.
+    icrs = scenes.solar_system(frame="icrs")
+    earth = icrs.index("Earth")
+    r = de421.positions[3] - de421.positions[0]
+    w = de421.velocities[3] - de421.velocities[0]
+    assert np.linalg.norm(r - (icrs.positions[earth] - icrs.positions[0])).to_value(u.km) < 20
+    assert np.linalg.norm(w - (icrs.velocities[earth] - icrs.velocities[0])).to_value(
+        u.m / u.s) < 0.1
+
+
+def test_de421_momentum_is_that_of_the_barycentre(de421):
+    m = de421.masses.value
+    v = de421.velocities.value
+    # DE421's barycentre also holds 343 asteroids, ~1e-9 Msun at ~0.01 au/day:
+    # ~1e-11 Msun au/day against sum m|v| = 1.9e-5, so 3.6e-7 remains.  A
+    # mass or velocity wrong by 1% for any planet would give > 1e-4.
+    assert np.linalg.norm(momentum(de421)) / np.sum(m * np.linalg.norm(v, axis=1)) < 1e-6
+    assert np.linalg.norm(de421.center_of_mass()[0].to_value(u.au)) < 1e-8
+    moved = scenes.de421(com=True)
+    assert np.allclose(momentum(moved), 0, atol=1e-19)  # ~1e-5 Msun au/day * 1e-14
+    assert moved.history[-1] == {**de421.history[-1], "com": True}
+
+
+def test_de421_never_touches_the_network():
+    pytest.importorskip("jplephem")
+    pytest.importorskip("de421")
+    script = NO_NETWORK + textwrap.dedent("""
+        from orbits import scenes
+        print(len(scenes.de421()))
+    """)
+    out = subprocess.run([sys.executable, "-c", script], cwd=REPO, capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["11"]
+
+
+@pytest.mark.parametrize("missing", ["jplephem", "de421"])
+def test_de421_without_its_packages_names_the_extra(monkeypatch, missing):
+    monkeypatch.setitem(sys.modules, missing, None)
+    monkeypatch.delitem(sys.modules, "jplephem.ephem", raising=False)
+    with pytest.raises(ImportError, match=r'pip install "orbits\[ephemeris\]"'):
+        scenes.de421()
 
 
 # -- N-body units ------------------------------------------------------------------------

@@ -137,5 +137,6 @@ def doubling_loop(force, stop=False):
     key = f"{force.key}{'_stop' if stop else ''}"
     step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel)
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
+                      _record=force.recorder,
                       force=force.kernel, rk4_step=step,
                       stop_check=check_stop if stop else no_stop)

@@ -187,5 +187,6 @@ def embedded_loop(force, has_e3, stop=False):
     """The adaptive embedded Runge-Kutta loop compiled for a force and an estimator."""
     key = f"{force.key}{'_e3' if has_e3 else ''}{'_stop' if stop else ''}"
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
+                      _record=force.recorder,
                       force=force.kernel, has_e3=bool(has_e3),
                       stop_check=check_stop if stop else no_stop)

@@ -55,8 +55,8 @@ from fractions import Fraction
 import numpy as np
 
 from ._jit import njit, specialize
-from .invariants import monitor_row
 from .status import Status
+from .stepping import _record  # noqa: F401 - the default recorder of the template
 from .stopping import check_stop, no_stop
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -507,8 +507,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         until_record -= 1
         if until_record == 0:
             until_record = every
-            mon_t[n_mon] = t
-            monitor_row(x, v, mon[2], mon[3], mon[4], mon[5], mon[1], mon_out[n_mon])
+            _record(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
             n_mon += 1
         stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
         if stop != 0:
@@ -566,9 +565,9 @@ def ias15_loop(force, stop=False):
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
-    predict_v = not force.key.startswith("gravity")
+    predict_v = force.velocity_dependent or not force.jit or force.key.startswith("user")
     helpers = _JITTED if force.jit else {}
     suffix = f"{force.key}{'_stop' if stop else ''}"
     return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,
                       force=force.kernel, stop_check=check_stop if stop else no_stop,
-                      PREDICT_V=predict_v, monitor_row=monitor_row, **helpers)
+                      PREDICT_V=predict_v, _record=force.recorder, **helpers)

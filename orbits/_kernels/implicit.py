@@ -272,12 +272,28 @@ def finite_difference_jacobian(force, velocity_dependent):
 _GRAVITY_KEYS = ("gravity_small", "gravity_serial", "gravity_parallel")
 
 
+def _jacobian_with_terms(x, v, t, fargs, jx, jv):
+    base_jacobian(x, v, t, fargs[0], jx, jv)  # noqa: F821 - bound by specialize
+    if VELOCITY:  # noqa: F821 - bound by specialize
+        for p in range(jv.shape[0]):
+            for q in range(jv.shape[1]):
+                jv[p, q] = 0.0
+    extra(x, v, t, fargs[1], jx, jv)  # noqa: F821
+
+
 def jacobian_for(force, velocity_dependent):
     """The Jacobian kernel of a force and the key naming it.
 
     The force's own (``force.jacobian``, a user's) if it has one, the analytic
-    one of gravity for the gravity forces, central differences otherwise.
+    one of gravity for the gravity forces, gravity's plus each added term's
+    for gravity with terms, central differences otherwise.
     """
+    if force.terms is not None:
+        base, bkey = jacobian_for(force.base, False)
+        key = f"{bkey}+{force.terms.key}"
+        return specialize(_jacobian_with_terms, key, cache=force.cache, base_jacobian=base,
+                          extra=force.terms.jacobian,
+                          VELOCITY=bool(velocity_dependent)), key
     own = getattr(force, "jacobian", None)
     if own is not None:
         return own, f"own{id(own)}"
@@ -401,5 +417,5 @@ def implicit_loop(force, name, theta, velocity_dependent, stop=False):
         jkey = "fd_v"
     return specialize(_implicit_loop, f"{name}_{force.key}_{jkey}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache and not jkey.startswith("own"),
-                      force=force.kernel, jacobian=jac, stop_check=check_stop if stop else no_stop,
+                      force=force.kernel, jacobian=jac, _record=force.recorder, stop_check=check_stop if stop else no_stop,
                       THETA=float(theta))

@@ -38,12 +38,12 @@ import numpy as np
 from ._jit import njit, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
                       accelerate_pairwise_rebound, accelerate_pairwise_small)
-from .invariants import monitor_row
+from .invariants import ENERGY, monitor_row
 from .status import Status
 from .stopping import check_stop, no_stop
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
-           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS"]
+           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms"]
 
 #: the stopping arguments of a loop compiled without conditions
 NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
@@ -105,6 +105,20 @@ class ForceKernel(NamedTuple):
     # its Jacobian kernel, for implicit methods (orbits._kernels.implicit); None:
     # the analytic one for gravity, central differences for other forces
     jacobian: Callable = None
+    # whether the accelerations read the velocities (the loops then predict or
+    # iterate them)
+    velocity_dependent: bool = False
+    # the monitor recorder of the compiled loops (None: _record, gravity's energy)
+    record: Callable = None
+    # for gravity with added terms (with_terms): the gravity force alone and the
+    # terms' TermKernel; fargs is then (gravity fargs, terms' args)
+    base: "ForceKernel" = None
+    terms: object = None
+
+    @property
+    def recorder(self):
+        """The monitor recorder the compiled loops call."""
+        return _record if self.record is None else self.record
 
 
 _PAIR_KERNELS = {
@@ -125,6 +139,34 @@ def gravity_force(kind):
     return ForceKernel(kernel, key, True, True)
 
 
+def _forced(x, v, t, fargs, acc):
+    base(x, v, t, fargs[0], acc)  # noqa: F821 - bound by specialize
+    extra(x, v, t, fargs[1], acc)  # noqa: F821
+
+
+def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
+    # mon carries the terms' energy arguments as its seventh item
+    every, which, m, G, n_active, eps2, eargs = mon
+    mon_t[n_mon] = t
+    row = mon_out[n_mon]
+    monitor_row(x, v, m, G, n_active, eps2, which, row)
+    if which & ENERGY:
+        row[0] += extra_energy(x, v, eargs)  # noqa: F821 - bound by specialize
+
+
+def with_terms(base, terms, velocity_dependent):
+    """Gravity ``base`` (a :class:`ForceKernel`) plus the terms of a
+    :class:`~orbits._kernels.terms.TermKernel`: ``fargs = (base fargs, terms' args)``,
+    and monitors ``mon`` with the terms' energy arguments as a seventh item."""
+    key = f"{base.key}+{terms.key}"
+    cache = base.cache and terms.cache
+    kernel = specialize(_forced, key, cache=cache, inline=True, base=base.kernel,
+                        extra=terms.accel)
+    record = specialize(_record_terms, key, cache=cache, extra_energy=terms.energy)
+    return ForceKernel(kernel, key, True, cache, velocity_dependent=bool(velocity_dependent),
+                       record=record, base=base, terms=terms)
+
+
 def user_force(accel, jit):
     """A force from a user's ``accel(x, v, t)``; compiled if ``accel`` is a numba function."""
     key = f"user{id(accel)}"
@@ -134,15 +176,17 @@ def user_force(accel, jit):
 
 # -- splitting methods --------------------------------------------------------------
 
-def _splitting_loop(x, v, t, dt, nsteps, acc, cache, fargs, velocity_dependent, mon, step0,
-                    mon_t, mon_out, check_every, sargs):
+def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_dependent, mon,
+                    step0, mon_t, mon_out, check_every, sargs):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
     # (v += c dt a(x)), the table KINDS/COEFS bound by specialize as constant
     # tuples, so that the compiler unrolls it.  The acceleration depends only
     # on positions (unless velocity_dependent), so it is recomputed only after
     # a drift: velocity Verlet's closing kick and the next step's opening kick
     # share one force evaluation.  `fresh` (kept in cache[0] between calls)
-    # says whether acc belongs to the current positions.
+    # says whether acc belongs to the current positions.  A velocity-dependent
+    # force is kicked with the implicit midpoint velocity (implicit_kick), so
+    # the kick stays symmetric; vm is its scratch.
     n = x.shape[0]
     every = mon[0]
     n_mon = 0
@@ -160,16 +204,17 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, cache, fargs, velocity_dependent, 
                     x[i, 2] += h * v[i, 2]
                 tx += h
                 fresh = False
+            elif velocity_dependent:
+                implicit_kick(x, v, tx, h, fargs, acc, vm)
+                fresh = False
             else:
                 if not fresh:
                     force(x, v, tx, fargs, acc)  # noqa: F821 - bound by specialize
-                    fresh = not velocity_dependent
+                    fresh = True
                 for i in range(n):
                     v[i, 0] += h * acc[i, 0]
                     v[i, 1] += h * acc[i, 1]
                     v[i, 2] += h * acc[i, 2]
-                if velocity_dependent:
-                    fresh = False
         until_check -= 1
         if until_check == 0 or k + 1 == nsteps:
             until_check = check_every
@@ -191,6 +236,39 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, cache, fargs, velocity_dependent, 
     return Status.OK, nsteps, n_mon
 
 
+#: iterations of the implicit kick before it settles for the last one; the
+#: fixed-point map contracts by about h |da/dv| / 2 a pass (1e-8 for GR on
+#: Mercury at a day), so round-off is reached in two to four
+KICK_MAX_ITER = 30
+
+
+def _implicit_kick(x, v, t, h, fargs, acc, vm):
+    # v' = v + h a(x, (v + v') / 2, t), solved by fixed-point iteration to
+    # round-off: a symmetric map (its inverse is the kick of -h), so a
+    # symmetric table keeps its order with velocity-dependent forces
+    n = x.shape[0]
+    for i in range(n):
+        for d in range(3):
+            vm[i, d] = v[i, d]
+    prev = math.inf
+    for it in range(KICK_MAX_ITER):
+        force(x, vm, t, fargs, acc)  # noqa: F821 - bound by specialize
+        change = 0.0
+        scale = 0.0
+        for i in range(n):
+            for d in range(3):
+                new = v[i, d] + 0.5 * h * acc[i, d]
+                change = max(change, abs(new - vm[i, d]))
+                scale = max(scale, abs(new))
+                vm[i, d] = new
+        if change <= 2.0 * 2.220446049250313e-16 * scale or change >= prev:
+            break
+        prev = change
+    for i in range(n):
+        for d in range(3):
+            v[i, d] += h * acc[i, d]
+
+
 def splitting_loop(force, name, kinds, coefs, stop=False):
     """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
 
@@ -199,6 +277,10 @@ def splitting_loop(force, name, kinds, coefs, stop=False):
     """
     return specialize(_splitting_loop, f"{name}_{force.key}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache, force=force.kernel,
+                      _record=force.recorder,
+                      implicit_kick=specialize(_implicit_kick, force.key, jit=force.jit,
+                                               cache=force.cache, inline=True,
+                                               force=force.kernel),
                       stop_check=check_stop if stop else no_stop,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs))
@@ -265,4 +347,5 @@ def runge_kutta_loop(force, stop=False):
     (``stop``: with the stopping conditions of :mod:`.stopping`)."""
     return specialize(_runge_kutta_loop, f"{force.key}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache, force=force.kernel,
+                      _record=force.recorder,
                       stop_check=check_stop if stop else no_stop)

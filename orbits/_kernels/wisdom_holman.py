@@ -243,7 +243,7 @@ def _from_heliocentric(xh, vb, gm, mu, x, v):
     from_democratic_heliocentric(xh, vb, gm, x, v)
 
 
-def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse):
+def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs):
     """Apply the symplectic corrector ``C`` (or ``C^-1`` if ``inverse``) for the
     step ``h`` to the internal state ``xj``, ``vj`` in place.
 
@@ -259,13 +259,13 @@ def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse):
             a = corr[m - 1 - k, 0] * h
             b = corr[m - 1 - k, 1] * h
         kepler_drift_all(xj, vj, eta, a, x, acc)
-        perturbation(xj, vj, x, acc, gm, eta, n_active, -b)  # noqa: F821 - bound by specialize
+        perturbation(xj, vj, x, acc, gm, eta, n_active, -b, targs)  # noqa: F821 - bound
         kepler_drift_all(xj, vj, eta, -2.0 * a, x, acc)
-        perturbation(xj, vj, x, acc, gm, eta, n_active, b)  # noqa: F821
+        perturbation(xj, vj, x, acc, gm, eta, n_active, b, targs)  # noqa: F821
         kepler_drift_all(xj, vj, eta, a, x, acc)
 
 
-def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
+def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs):
     """Inertial ``x``, ``v`` at the current time: the internal state with the
     deferred drift ``owed`` and then the corrector ``corr`` for the step ``h``
     (none if it has no rows) applied to a copy (``xs``, ``vs``); ``acc`` is
@@ -277,12 +277,12 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h):
     if owed != 0.0:
         kepler_drift_all(xs, vs, eta, owed, x, acc)
     if corr.shape[0] > 0:
-        apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, False)
+        apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, False, targs)
     from_internal(xs, vs, gm, eta, x, v)  # noqa: F821 - bound by specialize
 
 
 def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
-             corr, cdt, mon, step0, mon_t, mon_out, check_every):
+             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs):
     # xj, vj: the internal (Jacobi or democratic heliocentric) state;
     # eta: G times the mass each row's Kepler drift orbits.
     # state[0]: xj, vj hold the current state (else start from x, v);
@@ -297,7 +297,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         state[0] = 1
         owed_box[0] = 0.0
         if corrected:
-            apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True)
+            apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True, targs)
             cdt[0] = abs(dt)
     elif corrected and cdt[0] != abs(dt):
         # a new step size (a shorter last step): through the true state to the
@@ -305,8 +305,8 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         if owed_box[0] != 0.0:
             kepler_drift_all(xj, vj, eta, owed_box[0], xs, vs)
             owed_box[0] = 0.0
-        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], False)
-        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True)
+        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], False, targs)
+        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True, targs)
         cdt[0] = abs(dt)
     owed = owed_box[0]
     n_ops = len(KINDS)  # noqa: F821 - bound by specialize
@@ -325,7 +325,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                 else:
                     kepler_drift_all(xj, vj, eta, h, xs, vs)
             else:
-                perturbation(xj, vj, xs, acc, gm, eta, n_active, h)  # noqa: F821
+                perturbation(xj, vj, xs, acc, gm, eta, n_active, h, targs)  # noqa: F821
         until_check -= 1
         if until_check == 0 or k + 1 == nsteps:
             until_check = check_every
@@ -335,49 +335,164 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         until_record -= 1
         if until_record == 0:
             until_record = every
-            synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0])
+            synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0],
+                        targs)
             _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
             n_mon += 1
     owed_box[0] = owed
     return Status.OK, nsteps, n_mon
 
 
-#: coordinate system -> (to internal, from internal, perturbation step); each
-#: takes ``(.., gm, eta, ..)`` with ``eta`` the rows' Kepler ``G M``
+def _jacobi_term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs):
+    # the added terms' kick in Jacobi coordinates: inertial positions (left in
+    # x by the interaction kick, which returns before computing them for two
+    # bodies), the terms' inertial accelerations, and their Jacobi transform,
+    # row 0 (the centre of mass) taking their mean
+    n = xj.shape[0]
+    if n <= 2:
+        from_jacobi_one(xj, gm, eta, x)
+    for i in range(n):
+        acc[i, 0] = 0.0
+        acc[i, 1] = 0.0
+        acc[i, 2] = 0.0
+    extra(x, x, 0.0, targs, acc)  # noqa: F821 - bound by specialize
+    sx = acc[0, 0]
+    sy = acc[0, 1]
+    sz = acc[0, 2]
+    for i in range(1, n):
+        ax = acc[i, 0] - sx
+        ay = acc[i, 1] - sy
+        az = acc[i, 2] - sz
+        w = gm[i] / eta[i]
+        sx += w * ax
+        sy += w * ay
+        sz += w * az
+        vj[i, 0] += h * ax
+        vj[i, 1] += h * ay
+        vj[i, 2] += h * az
+    vj[0, 0] += h * sx
+    vj[0, 1] += h * sy
+    vj[0, 2] += h * sz
+
+
+def _heliocentric_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
+    # the added terms' kick in democratic heliocentric coordinates: with
+    # x_0 = X - sum_k m_k Q_k / M, the kick of P_i = m_i V_i (i >= 1) is
+    # F_i - (m_i / M) sum_k F_k, and the centre of mass takes sum_k F_k / M
+    n = xh.shape[0]
+    mt = 0.0
+    cx = 0.0
+    cy = 0.0
+    cz = 0.0
+    for i in range(n_active):
+        mt += gm[i]
+    for i in range(1, n_active):
+        cx += gm[i] * xh[i, 0]
+        cy += gm[i] * xh[i, 1]
+        cz += gm[i] * xh[i, 2]
+    x[0, 0] = xh[0, 0] - cx / mt
+    x[0, 1] = xh[0, 1] - cy / mt
+    x[0, 2] = xh[0, 2] - cz / mt
+    for i in range(1, n):
+        x[i, 0] = xh[i, 0] + x[0, 0]
+        x[i, 1] = xh[i, 1] + x[0, 1]
+        x[i, 2] = xh[i, 2] + x[0, 2]
+    for i in range(n):
+        acc[i, 0] = 0.0
+        acc[i, 1] = 0.0
+        acc[i, 2] = 0.0
+    extra(x, x, 0.0, targs, acc)  # noqa: F821 - bound by specialize
+    fx = 0.0
+    fy = 0.0
+    fz = 0.0
+    for i in range(n_active):
+        fx += gm[i] * acc[i, 0]
+        fy += gm[i] * acc[i, 1]
+        fz += gm[i] * acc[i, 2]
+    fx /= mt
+    fy /= mt
+    fz /= mt
+    for i in range(1, n):
+        vb[i, 0] += h * (acc[i, 0] - fx)
+        vb[i, 1] += h * (acc[i, 1] - fy)
+        vb[i, 2] += h * (acc[i, 2] - fz)
+    vb[0, 0] += h * fx
+    vb[0, 1] += h * fy
+    vb[0, 2] += h * fz
+
+
+def _plain_perturbation(xj, vj, x, acc, gm, eta, n_active, h, targs):
+    step(xj, vj, x, acc, gm, eta, n_active, h)  # noqa: F821 - bound by specialize
+
+
+def _perturbation_with_terms(xj, vj, x, acc, gm, eta, n_active, h, targs):
+    # gravity's perturbation step, then the terms' kick: both depend on
+    # positions only, so the kicks commute (in democratic heliocentric
+    # coordinates the terms kick between the two half jumps)
+    if HELIOCENTRIC:  # noqa: F821 - bound by specialize
+        jump(xj, vj, gm, n_active, 0.5 * h)
+        heliocentric_interaction_kick(xj, vj, acc, gm, n_active, h)
+        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+        jump(xj, vj, gm, n_active, 0.5 * h)
+    else:
+        interaction_kick(xj, vj, x, acc, gm, eta, n_active, h)
+        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+
+
+#: coordinate system -> (to internal, from internal, perturbation step, the
+#: added terms' kick); each takes ``(.., gm, eta, ..)`` with ``eta`` the rows'
+#: Kepler ``G M``
 COORDINATE_SYSTEMS = {
-    "jacobi": (to_jacobi, from_jacobi, interaction_kick),
+    "jacobi": (to_jacobi, from_jacobi, interaction_kick, _jacobi_term_kick),
     "democratic-heliocentric": (_to_heliocentric, _from_heliocentric,
-                                jump_interaction_kick),
+                                jump_interaction_kick, _heliocentric_term_kick),
 }
 
 
-def _kernels(coordinates):
-    to_internal, from_internal, perturbation = COORDINATE_SYSTEMS[coordinates]
+def _kernels(coordinates, terms=None):
+    """``terms``: a :class:`~orbits._kernels.terms.TermKernel` of position-only
+    terms added to the interaction step, or None."""
+    to_internal, from_internal, step, term_kick = COORDINATE_SYSTEMS[coordinates]
+    key = coordinates if terms is None else f"{coordinates}_{terms.key}"
+    cache = terms is None or terms.cache
     # without numba's runtime: these allocate nothing, and the reference
     # counts of the inlined kernels' array arguments would cost more than a
     # two-body step's kick (see orbits._kernels._jit)
-    corrector = specialize(_apply_corrector, f"corrector_{coordinates}", nrt=False,
+    if terms is None:
+        perturbation = specialize(_plain_perturbation, key, inline=True, nrt=False,
+                                  step=step)
+    else:
+        kick = specialize(term_kick, key, cache=cache, inline=True, nrt=False,
+                          extra=terms.accel)
+        perturbation = specialize(_perturbation_with_terms, key, cache=cache, inline=True,
+                                  nrt=False, term_kick=kick,
+                                  HELIOCENTRIC=coordinates != "jacobi")
+    corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=False,
                            perturbation=perturbation)
-    sync = specialize(_synchronize, f"synchronize_{coordinates}", nrt=False,
+    sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=False,
                       from_internal=from_internal, apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
 
 
-def synchronizer(coordinates):
-    """The compiled :func:`synchronize` for ``coordinates``."""
-    return _kernels(coordinates)[3]
+def synchronizer(coordinates, terms=None):
+    """The compiled :func:`synchronize` for ``coordinates`` (and added ``terms``)."""
+    return _kernels(coordinates, terms)[3]
 
 
-def wh_loop(name, kinds, coefs, coordinates="jacobi"):
+def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record):
     """The Wisdom-Holman loop compiled for one table of Kepler drifts (DRIFT) and
     perturbation steps (KICK) in ``coordinates`` (a key of
-    :data:`COORDINATE_SYSTEMS`); ``name`` names the table."""
-    to_internal, perturbation, corrector, sync = _kernels(coordinates)
-    return specialize(_wh_loop, f"wh_{name}_{coordinates}", nrt=False,
+    :data:`COORDINATE_SYSTEMS`); ``name`` names the table.  ``terms`` (a
+    :class:`~orbits._kernels.terms.TermKernel` of position-only terms) join
+    the perturbation step, and ``record`` records the monitors."""
+    to_internal, perturbation, corrector, sync = _kernels(coordinates, terms)
+    key = coordinates if terms is None else f"{coordinates}_{terms.key}"
+    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=False,
+                      cache=terms is None or terms.cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
                       perturbation=perturbation, apply_corrector=corrector,
-                      synchronize=sync)
+                      synchronize=sync, _record=record)
 
 
 #: the Jacobi versions, compiled on first use

@@ -83,6 +83,14 @@ class Integrator:
                 velocity_dependent=False, check_every=1, stop=None):
         raise NotImplementedError
 
+    def bind(self, ws, force, fargs):
+        """Called once a workspace meets its force (also after a restore); for
+        methods that keep something of the force beside their arrays."""
+
+    def check_terms(self, terms):
+        """Refuse, with :class:`~orbits.errors.IntegratorOptionError`, a force term
+        (of :mod:`orbits.forces`) this method cannot honour; every term by default."""
+
     def synchronize(self, ws, x, v):
         """Fixed-step methods here always end a step with x and v at one time."""
 
@@ -123,13 +131,16 @@ class SplittingMethod(Integrator):
             cls.forces_per_step = kinds.count("kick") - (kinds[0] == kinds[-1] == "kick")
 
     def workspace(self, n):
-        return {"acc": np.zeros((n, 3)), "cache": np.zeros(1, dtype=np.int64)}
+        # vm: the implicit kick's midpoint velocities (velocity-dependent forces)
+        return {"acc": np.zeros((n, 3)), "vm": np.zeros((n, 3)),
+                "cache": np.zeros(1, dtype=np.int64)}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs,
                                        stop=stop is not None)
-        return loop(x, v, t, dt, nsteps, ws["acc"], ws["cache"], fargs, velocity_dependent,
+        return loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
+                    velocity_dependent or force.velocity_dependent,
                     mon, step0, mon_t, mon_out, check_every,
                     stepping.NO_STOP_ARGS if stop is None else stop)
 

@@ -47,7 +47,8 @@ class ImplicitOneLeg(Integrator):
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
-        loop = implicit.implicit_loop(force, self.name, self.theta, bool(velocity_dependent),
+        velocity_dependent = bool(velocity_dependent or force.velocity_dependent)
+        loop = implicit.implicit_loop(force, self.name, self.theta, velocity_dependent,
                                       stop=stop is not None)
         status, done, n_mon = loop(
             x, v, t, dt, nsteps, ws["w"], ws["dw"], ws["xs"], ws["vs"], ws["acc"],

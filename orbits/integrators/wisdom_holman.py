@@ -217,7 +217,27 @@ class WisdomHolman(Integrator):
                 # the step whose corrector the Jacobi state carries, and N_active
                 "cdt": np.zeros(1), "n_active": np.zeros(1, dtype=np.int64)}
 
+    def check_terms(self, terms):
+        """Only terms that depend on positions alone and have a potential join the
+        interaction step; the map is then still symplectic."""
+        for term in terms:
+            if not term.wisdom_holman:
+                raise IntegratorOptionError(
+                    f"{self.name} cannot take the force term {term!r}: its interaction "
+                    f"step takes only conservative terms that depend on positions alone "
+                    f"({term.why_not_wisdom_holman}). Use 'ias15', 'leapfrog', "
+                    "'yoshida4', an embedded method such as 'dop853', or, for GR, the "
+                    "term GRPotential, which 'wh' takes.")
+
+    def bind(self, ws, force, fargs):
+        """Keep the added terms' kernel and arguments in the workspace (not an
+        array, so neither saved nor restored: rebound from the simulation)."""
+        if force.terms is not None:
+            ws["terms"] = (force.terms, fargs[1])
+
     def _check_system(self, ws, force, fargs):
+        if force.terms is not None:
+            force, fargs = force.base, fargs[0]
         if not force.key.startswith("gravity"):
             raise IntegratorOptionError(
                 f"{self.name} splits Newtonian gravity into Kepler drifts and kicks and "
@@ -256,19 +276,23 @@ class WisdomHolman(Integrator):
                 velocity_dependent=False, check_every=1):
         if ws["state"][1] == 0:
             self._check_system(ws, force, fargs)
-        gm, n_active = fargs[0], fargs[1]
-        loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"])
+        terms, targs = ws.get("terms", (None, ()))
+        gravity = fargs if terms is None else fargs[0]
+        gm, n_active = gravity[0], gravity[1]
+        loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"],
+                           terms, force.recorder)
         return loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
                     ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
-                    ws["cdt"], mon, step0, mon_t, mon_out, check_every)
+                    ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs)
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
         its owed drift are kept, so that the following steps go on unchanged."""
         if ws["state"][0]:
-            sync = _wh.synchronizer(self.config["coordinates"])
+            terms, targs = ws.get("terms", (None, ()))
+            sync = _wh.synchronizer(self.config["coordinates"], terms)
             sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],
-                 x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0])
+                 x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0], targs)
 
     def invalidate(self, ws):
         """The state was changed from outside: start again from ``x``, ``v``."""

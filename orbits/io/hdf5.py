@@ -180,12 +180,7 @@ class FileRecorder:
 
     # Recorder interface ----------------------------------------------------------------
     def output(self, sim, final=False):
-        sim.integrator.synchronize(sim._ws, sim._x, sim._v)
-        row = np.zeros(10)
-        if sim._mask:
-            sim._monitor_row(row)
-        self.last = (sim._now(), sim.steps, sim._x[self.inv].copy(), sim._v[self.inv].copy(),
-                     row)
+        self.last = tuple(sim.snapshot())
         self.buffer.append(self.last)
         self.outputs_written += 1
         if len(self.buffer) >= BUFFER_ROWS:
@@ -256,18 +251,18 @@ class FileRecorder:
         r = self.f["restart"]
         count = int(r["count"][()])
         slot = count % _SLOTS
-        r["x"][slot] = sim._x
-        r["v"][slot] = sim._v
-        r["clock"][slot] = (sim.steps, sim._steps_since_base, sim.force_evaluations, self.rows,
-                            sim.steps_rejected)
-        r["t_base"][slot] = sim._t_base
+        state = sim.state
+        r["x"][slot] = state.x
+        r["v"][slot] = state.v
+        r["clock"][slot] = (state.steps, state.steps_since_base, state.force_evaluations,
+                            self.rows, state.steps_rejected)
+        r["t_base"][slot] = state.t_base
         p = self.plan
         r["plan"][slot] = (p.until, p.outputs, p.ratio, p.n_full, float(p.has_partial),
                            p.start_step, p.start_time)
         r["progress"][slot] = (self.outputs_written, int(finished), self.end_status)
-        for name, arr in sim._ws.items():
-            if isinstance(arr, np.ndarray):
-                r["ws"][name][slot] = arr
+        for name, arr in state.workspace.items():
+            r["ws"][name][slot] = arr
         self.f.flush()
         r["count"][()] = count + 1
         r["count"].flush()
@@ -345,6 +340,9 @@ def _create(path, sim):
         "stop_conditions": json.dumps(sim._stop_config),
         "rebound_arithmetic": bool(sim.rebound_arithmetic),
         "bodies_history": json.dumps(sim._history, default=str),
+        # the one record that rebuilds the simulation from its bodies (restore)
+        "config": json.dumps(sim.config.to_dict()),
+        "forces": json.dumps([t.to_dict() for t in sim.forces]),
     }
     for k, v in meta.items():
         par.attrs[k] = v
@@ -484,6 +482,7 @@ def describe(path):
             f"outputs         {n_out}"
             + (f", t = {t[0]:g} .. {t[-1]:g} {tu}" if n_out else ""),
             f"monitors        {', '.join(json.loads(par.attrs['monitors'])) or 'none'}",
+            f"forces          {_describe_forces(par)}",
         ]
         count = int(f["restart/count"][()])
         if count:
@@ -497,6 +496,18 @@ def describe(path):
         return "\n".join(lines)
 
 
+def _describe_forces(par):
+    # Newtonian gravity and the added terms, as their constructors would be written
+    from .. import forces
+    text = ["Newtonian gravity"]
+    for d in json.loads(par.attrs.get("forces", "[]")):
+        try:
+            text.append(repr(forces.from_dict(d)))
+        except forces.ForceTermError:   # a user function that cannot be imported here
+            text.append(f"{d.get('type')}({d.get('func', '')})")
+    return " + ".join(text)
+
+
 @_damaged
 def restore(path):
     """The simulation at the file's last checkpoint, and the run it was in.
@@ -504,7 +515,7 @@ def restore(path):
     Returns ``(sim, plan, outputs_written, finished)``.
     """
     from ..bodies import BodySet
-    from ..simulation import RunPlan, Simulation
+    from ..simulation import RunPlan, Simulation, SimulationState
     from ..units import UnitSystem
 
     with _open_read(path) as f:
@@ -523,47 +534,49 @@ def restore(path):
         v = r["v"][slot]
         bodies = BodySet.from_arrays(m, x[inv], v[inv], names=names, units=units)
         bodies.history = json.loads(par.attrs["bodies_history"])
-        from .. import integrators
-        integ = integrators.get(par.attrs["integrator"],
-                                **json.loads(par.attrs["integrator_options"]))
-        soft = float(par.attrs["softening"])
-        stop = json.loads(par.attrs["stop_conditions"])
-        length = lambda val: None if val is None else val << units.length  # noqa: E731
-        dt = float(par.attrs["dt"])
-        sim = Simulation(bodies, integrator=integ,
-                         dt=(dt << units.time) if dt > 0 or not integ.adaptive else None,
-                         monitors=tuple(json.loads(par.attrs["monitors"])),
-                         monitor_every=int(par.attrs["monitor_every"]) or None,
-                         softening=(soft << units.length) if soft > 0 else None,
-                         parallel=bool(par.attrs["parallel"]),
-                         encounter_distance=length(stop["encounter_distance"]),
-                         encounter_hill=stop["encounter_hill"],
-                         escape_distance=length(stop["escape_distance"]),
-                         escape_unbound=stop["escape_unbound"],
-                         rebound_arithmetic=bool(par.attrs.get("rebound_arithmetic", False)))
-        if not np.array_equal(sim._order, order):
+        if "config" in par.attrs:
+            sim = Simulation.from_config(bodies, json.loads(par.attrs["config"]))
+        else:
+            sim = _legacy_simulation(par, bodies, units)
+        if not np.array_equal(sim.state.order, order):
             raise OrbitsFileError(f"{path}: the stored body order does not match the masses")
         clock = r["clock"][slot]
-        sim.steps = int(clock[0])
-        sim._steps_since_base = int(clock[1])
-        sim.force_evaluations = int(clock[2])
-        sim.steps_rejected = int(clock[4])
-        sim._t_base = float(r["t_base"][slot])
-        sim._x[...] = x
-        sim._v[...] = v
-        for name in sim._ws:
-            if name in r["ws"]:
-                sim._ws[name][...] = r["ws"][name][slot]
-        sim._reference = par["reference"][()].copy()
-        sim._E_scale, sim._L_scale = (float(s) for s in par["scales"][()])
+        sim.set_state(SimulationState(
+            x, v, order, float(r["t_base"][slot]), int(clock[1]), int(clock[0]),
+            int(clock[2]), int(clock[4]), {name: r["ws"][name][slot] for name in r["ws"]},
+            par["reference"][()], tuple(par["scales"][()])))
         p = r["plan"][slot]
         plan = RunPlan(float(p[0]), int(p[1]), float(p[2]), int(p[3]), bool(p[4]), int(p[5]),
                        float(p[6]))
         written, finished, _ = (int(a) for a in r["progress"][slot])
         rows = int(clock[3])
     sim._output_path = str(path)
-    sim._resume = ResumePoint(plan, written, bool(finished), rows,
-                              sim._t_base + sim._steps_since_base * sim._dt)
+    sim._resume = ResumePoint(plan, written, bool(finished), rows, sim.time.value)
+    return sim
+
+
+def _legacy_simulation(par, bodies, units):
+    # files written before the configuration record
+    from .. import integrators
+    from ..simulation import Simulation
+    integ = integrators.get(par.attrs["integrator"],
+                            **json.loads(par.attrs["integrator_options"]))
+    soft = float(par.attrs["softening"])
+
+    stop = json.loads(par.attrs["stop_conditions"])
+    length = lambda val: None if val is None else val << units.length  # noqa: E731
+    dt = float(par.attrs["dt"])
+    sim = Simulation(bodies, integrator=integ,
+                     dt=(dt << units.time) if dt > 0 or not integ.adaptive else None,
+                     monitors=tuple(json.loads(par.attrs["monitors"])),
+                     monitor_every=int(par.attrs["monitor_every"]) or None,
+                     softening=(soft << units.length) if soft > 0 else None,
+                     parallel=bool(par.attrs["parallel"]),
+                     encounter_distance=length(stop["encounter_distance"]),
+                     encounter_hill=stop["encounter_hill"],
+                     escape_distance=length(stop["escape_distance"]),
+                     escape_unbound=stop["escape_unbound"],
+                     rebound_arithmetic=bool(par.attrs.get("rebound_arithmetic", False)))
     return sim
 
 

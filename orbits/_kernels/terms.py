@@ -1,0 +1,559 @@
+"""Force terms beyond Newtonian point-mass gravity, on plain float64 arrays.
+
+Each term is three kernels over the bodies in the internal order (massive
+bodies first), with its parameters in one tuple ``args``:
+
+* ``accel(x, v, t, args, acc)`` *adds* the term's accelerations to ``acc``;
+* ``energy(x, v, args)`` returns its contribution to the conserved energy
+  (a potential, or the first post-Newtonian correction to the Hamiltonian),
+  so that the energy monitor measures integration error, not physics;
+* ``jacobian(x, v, t, args, jx, jv)`` *adds* ``da/dx`` and ``da/dv`` (shape
+  (3N, 3N), rows and columns ``3 i + d``) to ``jx`` and ``jv``.
+
+:func:`chain` joins the kernels of several terms into one kernel of each kind
+over a nested tuple of their ``args`` (``(args_1, (args_2, ()))``), compiled
+once per combination by :func:`orbits._kernels._jit.specialize`.
+
+``gm`` is ``G`` times the masses and ``m`` the masses, both in the internal
+order; ``inv_c2`` is ``1 / c^2`` in the simulation's units.
+
+References
+----------
+Anderson, J. D., Esposito, P. B., Martin, W., Thornton, C. L. & Muhleman,
+D. O. 1975, ApJ 200, 221 (the single-source 1PN correction).  Nobili, A. &
+Roxburgh, I. W. 1986, IAU Symp. 114, 105 (the GR potential).  Newhall, X X,
+Standish, E. M. & Williams, J. G. 1983, A&A 125, 150 (the Einstein-Infeld-
+Hoffmann equations of the JPL ephemerides).  Damour, T. & Deruelle, N. 1985
+and Will, C. M. 2014, Living Rev. Relativ. 17, 4 (the conserved 1PN energy).
+Murray, C. D. & Dermott, S. F. 1999, *Solar System Dynamics*, sect. 4.9 (the
+zonal harmonics).
+"""
+
+import math
+
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from ._jit import njit, specialize
+from .invariants import _add
+
+__all__ = ["TermKernel", "chain", "nest", "gr_accel", "gr_energy", "gr_jacobian",
+           "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
+           "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy",
+           "difference_jacobian"]
+
+
+class TermKernel(NamedTuple):
+    """The compiled kernels of one term and how loops that call them are compiled."""
+
+    accel: Callable
+    energy: Callable
+    jacobian: Callable
+    key: str          # names the loops compiled for it
+    cache: bool = True  # False for a user's function, which numba cannot cache
+
+
+# -- GR from one dominant body (Anderson et al. 1975) ------------------------------------
+
+@njit
+def gr_accel(x, v, t, args, acc):
+    """The 1PN correction of a test body orbiting ``src`` (harmonic gauge)::
+
+        a = mu / (c^2 r^3) [ (4 mu / r - v^2) r + 4 (r . v) v ]
+
+    with ``r``, ``v`` relative to the source and ``mu = G m_src``; the source
+    takes the reaction ``-(m_i / m_src) a_i`` so momentum is conserved.
+    ``args = (src, gm, inv_c2)``; O(N), test particles included.
+    """
+    src, gm, inv_c2 = args
+    mu = gm[src]
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for i in range(x.shape[0]):
+        if i == src:
+            continue
+        rx = x[i, 0] - x[src, 0]
+        ry = x[i, 1] - x[src, 1]
+        rz = x[i, 2] - x[src, 2]
+        ux = v[i, 0] - v[src, 0]
+        uy = v[i, 1] - v[src, 1]
+        uz = v[i, 2] - v[src, 2]
+        r2 = rx * rx + ry * ry + rz * rz
+        r = math.sqrt(r2)
+        u2 = ux * ux + uy * uy + uz * uz
+        rv = rx * ux + ry * uy + rz * uz
+        f = mu * inv_c2 / (r2 * r)
+        a = f * (4.0 * mu / r - u2)
+        b = 4.0 * f * rv
+        ax = a * rx + b * ux
+        ay = a * ry + b * uy
+        az = a * rz + b * uz
+        acc[i, 0] += ax
+        acc[i, 1] += ay
+        acc[i, 2] += az
+        w = gm[i] / mu
+        sx += w * ax
+        sy += w * ay
+        sz += w * az
+    acc[src, 0] -= sx
+    acc[src, 1] -= sy
+    acc[src, 2] -= sz
+
+
+@njit
+def gr_energy(x, v, args):
+    """The 1PN energy of each body about the source, whose Lagrangian gives
+    :func:`gr_accel`: ``m_i (3/8 v^4 + 3/2 mu v^2 / r + 1/2 mu^2 / r^2) / c^2``,
+    with ``m_i = gm_i / G`` carried as ``gm_i`` over ``G = gm / m`` (``args`` as
+    :func:`gr_accel`, plus the masses)."""
+    src, gm, inv_c2, m = args
+    mu = gm[src]
+    s = 0.0
+    c = 0.0
+    for i in range(x.shape[0]):
+        if i == src or m[i] == 0.0:
+            continue
+        rx = x[i, 0] - x[src, 0]
+        ry = x[i, 1] - x[src, 1]
+        rz = x[i, 2] - x[src, 2]
+        u2 = ((v[i, 0] - v[src, 0]) ** 2 + (v[i, 1] - v[src, 1]) ** 2
+              + (v[i, 2] - v[src, 2]) ** 2)
+        r = math.sqrt(rx * rx + ry * ry + rz * rz)
+        s, c = _add(s, c, m[i] * inv_c2 * (0.375 * u2 * u2 + 1.5 * mu * u2 / r
+                                           + 0.5 * mu * mu / (r * r)))
+    return s + c
+
+
+@njit
+def gr_jacobian(x, v, t, args, jx, jv):
+    """``da/dx`` and ``da/dv`` of :func:`gr_accel`, reaction included."""
+    src, gm, inv_c2 = args[0], args[1], args[2]
+    mu = gm[src]
+    k = mu * inv_c2
+    n = x.shape[0]
+    r = np.empty(3)
+    u = np.empty(3)
+    dx = np.empty((3, 3))
+    dv = np.empty((3, 3))
+    for i in range(n):
+        if i == src:
+            continue
+        for d in range(3):
+            r[d] = x[i, d] - x[src, d]
+            u[d] = v[i, d] - v[src, d]
+        r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        rr = math.sqrt(r2)
+        u2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
+        rv = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
+        # a = k [A(r, u) r + B(r, u) u] with A = (4 mu / r - u^2) / r^3, B = 4 rv / r^3
+        A = (4.0 * mu / rr - u2) / (r2 * rr)
+        B = 4.0 * rv / (r2 * rr)
+        # dA/dr_b = dA_dr r_b, dB/dr_b = dB_dr r_b + 4 u_b / r^3
+        dA_dr = -4.0 * mu / (r2 * r2 * r2) - 3.0 * A / r2
+        dB_dr = -3.0 * B / r2
+        for a in range(3):
+            for b in range(3):
+                # d/dr_b of A r_a + B u_a
+                gx = (dA_dr * r[b]) * r[a] + (dB_dr * r[b]) * u[a] + 4.0 * u[b] / (r2 * rr) * u[a]
+                if a == b:
+                    gx += A
+                # d/du_b: A depends on u through -u^2, B through rv
+                gv = (-2.0 * u[b] / (r2 * rr)) * r[a] + (4.0 * r[b] / (r2 * rr)) * u[a]
+                if a == b:
+                    gv += B
+                dx[a, b] = k * gx
+                dv[a, b] = k * gv
+        w = gm[i] / mu
+        for a in range(3):
+            for b in range(3):
+                jx[3 * i + a, 3 * i + b] += dx[a, b]
+                jx[3 * i + a, 3 * src + b] -= dx[a, b]
+                jv[3 * i + a, 3 * i + b] += dv[a, b]
+                jv[3 * i + a, 3 * src + b] -= dv[a, b]
+                if w != 0.0:
+                    jx[3 * src + a, 3 * i + b] -= w * dx[a, b]
+                    jx[3 * src + a, 3 * src + b] += w * dx[a, b]
+                    jv[3 * src + a, 3 * i + b] -= w * dv[a, b]
+                    jv[3 * src + a, 3 * src + b] += w * dv[a, b]
+
+
+# -- the GR potential (Nobili & Roxburgh 1986) ------------------------------------------
+
+@njit
+def gr_potential_accel(x, v, t, args, acc):
+    """``a = -6 mu^2 r / (c^2 r^4)`` about the source, from the potential
+    ``-3 mu^2 / (c^2 r^2)`` per unit mass; the source takes the reaction.
+    ``args = (src, gm, inv_c2)``."""
+    src, gm, inv_c2 = args[0], args[1], args[2]
+    mu = gm[src]
+    k = 6.0 * mu * mu * inv_c2
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for i in range(x.shape[0]):
+        if i == src:
+            continue
+        rx = x[i, 0] - x[src, 0]
+        ry = x[i, 1] - x[src, 1]
+        rz = x[i, 2] - x[src, 2]
+        r2 = rx * rx + ry * ry + rz * rz
+        f = -k / (r2 * r2)
+        acc[i, 0] += f * rx
+        acc[i, 1] += f * ry
+        acc[i, 2] += f * rz
+        w = gm[i] / mu
+        sx += w * f * rx
+        sy += w * f * ry
+        sz += w * f * rz
+    acc[src, 0] -= sx
+    acc[src, 1] -= sy
+    acc[src, 2] -= sz
+
+
+@njit
+def gr_potential_energy(x, v, args):
+    """``sum_i -3 mu^2 m_i / (c^2 r_i^2)``; ``args`` as :func:`gr_potential_accel`
+    plus the masses."""
+    src, gm, inv_c2, m = args
+    mu = gm[src]
+    s = 0.0
+    c = 0.0
+    for i in range(x.shape[0]):
+        if i == src or m[i] == 0.0:
+            continue
+        r2 = ((x[i, 0] - x[src, 0]) ** 2 + (x[i, 1] - x[src, 1]) ** 2
+              + (x[i, 2] - x[src, 2]) ** 2)
+        s, c = _add(s, c, -3.0 * mu * mu * inv_c2 * m[i] / r2)
+    return s + c
+
+
+@njit
+def gr_potential_jacobian(x, v, t, args, jx, jv):
+    """``da/dx`` of :func:`gr_potential_accel`: ``-k (I / r^4 - 4 r r^T / r^6)``."""
+    src, gm, inv_c2 = args[0], args[1], args[2]
+    mu = gm[src]
+    k = 6.0 * mu * mu * inv_c2
+    r = np.empty(3)
+    for i in range(x.shape[0]):
+        if i == src:
+            continue
+        for d in range(3):
+            r[d] = x[i, d] - x[src, d]
+        r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        inv4 = 1.0 / (r2 * r2)
+        w = gm[i] / mu
+        for a in range(3):
+            for b in range(3):
+                g = 4.0 * k * r[a] * r[b] * inv4 / r2
+                if a == b:
+                    g -= k * inv4
+                jx[3 * i + a, 3 * i + b] += g
+                jx[3 * i + a, 3 * src + b] -= g
+                if w != 0.0:
+                    jx[3 * src + a, 3 * i + b] -= w * g
+                    jx[3 * src + a, 3 * src + b] += w * g
+
+
+# -- Einstein-Infeld-Hoffmann among all massive bodies ----------------------------------
+
+@njit
+def _newtonian_and_potential(x, gm, n_active, an, pot):
+    # the Newtonian accelerations of every body and the potentials
+    # sum_k mu_k / r_ik, from the massive bodies only
+    n = x.shape[0]
+    for i in range(n):
+        an[i, 0] = 0.0
+        an[i, 1] = 0.0
+        an[i, 2] = 0.0
+        pot[i] = 0.0
+    for i in range(n):
+        for j in range(min(i, n_active)):
+            dx = x[j, 0] - x[i, 0]
+            dy = x[j, 1] - x[i, 1]
+            dz = x[j, 2] - x[i, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            r = math.sqrt(r2)
+            inv3 = 1.0 / (r2 * r)
+            an[i, 0] += gm[j] * dx * inv3
+            an[i, 1] += gm[j] * dy * inv3
+            an[i, 2] += gm[j] * dz * inv3
+            pot[i] += gm[j] / r
+            if i < n_active:
+                an[j, 0] -= gm[i] * dx * inv3
+                an[j, 1] -= gm[i] * dy * inv3
+                an[j, 2] -= gm[i] * dz * inv3
+                pot[j] += gm[i] / r
+
+
+@njit
+def gr_full_accel(x, v, t, args, acc):
+    """The 1PN part of the EIH accelerations (Newhall et al. 1983, eq. 1, less
+    the Newtonian term), with the Newtonian accelerations in the 1PN terms.
+    Massive bodies are the sources; test particles feel them.
+    ``args = (gm, n_active, inv_c2, an, pot)`` with scratch ``an`` (N, 3) and
+    ``pot`` (N,)."""
+    gm, n_active, inv_c2, an, pot = args[0], args[1], args[2], args[3], args[4]
+    n = x.shape[0]
+    _newtonian_and_potential(x, gm, n_active, an, pot)
+    for i in range(n):
+        vi2 = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2]
+        ax = 0.0
+        ay = 0.0
+        az = 0.0
+        for j in range(n_active):
+            if j == i:
+                continue
+            dx = x[j, 0] - x[i, 0]
+            dy = x[j, 1] - x[i, 1]
+            dz = x[j, 2] - x[i, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            r = math.sqrt(r2)
+            mu = gm[j]
+            inv3 = mu / (r2 * r)
+            vj2 = v[j, 0] * v[j, 0] + v[j, 1] * v[j, 1] + v[j, 2] * v[j, 2]
+            vij = v[i, 0] * v[j, 0] + v[i, 1] * v[j, 1] + v[i, 2] * v[j, 2]
+            # (x_i - x_j) . v_j / r_ij
+            nv = -(dx * v[j, 0] + dy * v[j, 1] + dz * v[j, 2]) / r
+            ra = dx * an[j, 0] + dy * an[j, 1] + dz * an[j, 2]
+            br = inv_c2 * (-4.0 * pot[i] - pot[j] + vi2 + 2.0 * vj2 - 4.0 * vij
+                           - 1.5 * nv * nv + 0.5 * ra)
+            ax += inv3 * dx * br
+            ay += inv3 * dy * br
+            az += inv3 * dz * br
+            # (x_i - x_j) . (4 v_i - 3 v_j) (v_i - v_j)
+            p = -(dx * (4.0 * v[i, 0] - 3.0 * v[j, 0]) + dy * (4.0 * v[i, 1] - 3.0 * v[j, 1])
+                  + dz * (4.0 * v[i, 2] - 3.0 * v[j, 2]))
+            q = inv_c2 * inv3 * p
+            ax += q * (v[i, 0] - v[j, 0])
+            ay += q * (v[i, 1] - v[j, 1])
+            az += q * (v[i, 2] - v[j, 2])
+            s = 3.5 * inv_c2 * mu / r
+            ax += s * an[j, 0]
+            ay += s * an[j, 1]
+            az += s * an[j, 2]
+        acc[i, 0] += ax
+        acc[i, 1] += ay
+        acc[i, 2] += az
+
+
+@njit
+def gr_full_energy(x, v, args):
+    """The 1PN correction to the energy of the EIH Lagrangian::
+
+        (1/c^2) [ sum_a 3/8 m_a v_a^4
+                  + 1/2 sum_a sum_{b != a} (G m_a m_b / r_ab)
+                        (3 v_a^2 - 7/2 v_a.v_b - 1/2 (n_ab.v_a)(n_ab.v_b))
+                  + 1/2 sum_a sum_{b != a} sum_{c != a} G^2 m_a m_b m_c / (r_ab r_ac) ]
+
+    ``args`` as :func:`gr_full_accel`, plus the masses.
+    """
+    gm, n_active, inv_c2, an, pot, m = args
+    n = x.shape[0]
+    _newtonian_and_potential(x, gm, n_active, an, pot)
+    s = 0.0
+    c = 0.0
+    for a in range(n_active):
+        va2 = v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1] + v[a, 2] * v[a, 2]
+        s, c = _add(s, c, 0.375 * m[a] * va2 * va2 + 0.5 * m[a] * pot[a] * pot[a])
+        for b in range(n_active):
+            if b == a:
+                continue
+            dx = x[a, 0] - x[b, 0]
+            dy = x[a, 1] - x[b, 1]
+            dz = x[a, 2] - x[b, 2]
+            r = math.sqrt(dx * dx + dy * dy + dz * dz)
+            na = (dx * v[a, 0] + dy * v[a, 1] + dz * v[a, 2]) / r
+            nb = (dx * v[b, 0] + dy * v[b, 1] + dz * v[b, 2]) / r
+            vab = v[a, 0] * v[b, 0] + v[a, 1] * v[b, 1] + v[a, 2] * v[b, 2]
+            s, c = _add(s, c, 0.5 * m[a] * gm[b] / r * (3.0 * va2 - 3.5 * vab - 0.5 * na * nb))
+    return (s + c) * inv_c2
+
+
+# -- zonal harmonics of one oblate body ----------------------------------------------------
+
+@njit
+def zonal_accel(x, v, t, args, acc):
+    """The J2 and J4 accelerations of the oblate body ``b`` on every other body
+    (Murray & Dermott 1999, eq. 4.134 ff.), with ``u = (r . pole) / r``::
+
+        a_2 = 3 k2 / (2 r^5) [ (5 u^2 - 1) r - 2 u r pole ]
+        a_4 = k4 / (8 r^7) [ (315 u^4 - 210 u^2 + 15) r - (140 u^3 - 60 u) r pole ]
+
+    where ``k2 = G m_b J2 R^2`` and ``k4 = G m_b J4 R^4``; the oblate body takes
+    the reaction.  ``args = (b, gm, k2, k4, pole)``.
+    """
+    b, gm, k2, k4, pole = args[0], args[1], args[2], args[3], args[4]
+    px = pole[0]
+    py = pole[1]
+    pz = pole[2]
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for i in range(x.shape[0]):
+        if i == b:
+            continue
+        rx = x[i, 0] - x[b, 0]
+        ry = x[i, 1] - x[b, 1]
+        rz = x[i, 2] - x[b, 2]
+        r2 = rx * rx + ry * ry + rz * rz
+        r = math.sqrt(r2)
+        u = (rx * px + ry * py + rz * pz) / r
+        u2 = u * u
+        inv5 = 1.0 / (r2 * r2 * r)
+        fr = 1.5 * k2 * inv5 * (5.0 * u2 - 1.0)
+        fp = -3.0 * k2 * inv5 * u * r
+        if k4 != 0.0:
+            inv7 = inv5 / r2
+            fr += 0.125 * k4 * inv7 * ((315.0 * u2 - 210.0) * u2 + 15.0)
+            fp -= 0.125 * k4 * inv7 * (140.0 * u2 - 60.0) * u * r
+        ax = fr * rx + fp * px
+        ay = fr * ry + fp * py
+        az = fr * rz + fp * pz
+        acc[i, 0] += ax
+        acc[i, 1] += ay
+        acc[i, 2] += az
+        w = gm[i] / gm[b]
+        sx += w * ax
+        sy += w * ay
+        sz += w * az
+    acc[b, 0] -= sx
+    acc[b, 1] -= sy
+    acc[b, 2] -= sz
+
+
+@njit
+def zonal_energy(x, v, args):
+    """``sum_i m_i Phi(r_i)`` with ``Phi = k2 P2(u) / r^3 + k4 P4(u) / r^5`` (the
+    monopole is gravity's); ``args`` as :func:`zonal_accel` plus the masses."""
+    b, gm, k2, k4, pole, m = args
+    s = 0.0
+    c = 0.0
+    for i in range(x.shape[0]):
+        if i == b or m[i] == 0.0:
+            continue
+        rx = x[i, 0] - x[b, 0]
+        ry = x[i, 1] - x[b, 1]
+        rz = x[i, 2] - x[b, 2]
+        r = math.sqrt(rx * rx + ry * ry + rz * rz)
+        u = (rx * pole[0] + ry * pole[1] + rz * pole[2]) / r
+        u2 = u * u
+        p2 = 0.5 * (3.0 * u2 - 1.0)
+        p4 = 0.125 * ((35.0 * u2 - 30.0) * u2 + 3.0)
+        s, c = _add(s, c, m[i] * (k2 * p2 / (r * r * r) + k4 * p4 / (r ** 5)))
+    return s + c
+
+
+# -- central differences of one term, for terms without an analytic Jacobian -----------
+
+#: relative step of :func:`difference_jacobian` (about the cube root of the
+#: machine epsilon, which balances truncation and rounding in a central difference)
+FD_STEP = 6.0e-6
+
+
+def _difference_jacobian(x, v, t, args, jx, jv):
+    # column by column: the term's accelerations at x +- delta e_q (and v +- ..)
+    n = x.shape[0]
+    m = 3 * n
+    xp = x.copy()
+    vp = v.copy()
+    ap = np.zeros((n, 3))
+    am = np.zeros((n, 3))
+    for half in range(2 if VELOCITY else 1):  # noqa: F821 - bound by specialize
+        src = x if half == 0 else v
+        dst = xp if half == 0 else vp
+        out = jx if half == 0 else jv
+        for q in range(m):
+            i = q // 3
+            d = q % 3
+            delta = FD_STEP * max(abs(src[i, d]), 1e-3 * _scale(src))
+            hi = src[i, d] + delta
+            lo = src[i, d] - delta
+            ap[...] = 0.0
+            am[...] = 0.0
+            dst[i, d] = hi
+            term(xp, vp, t, args, ap)  # noqa: F821 - bound by specialize
+            dst[i, d] = lo
+            term(xp, vp, t, args, am)  # noqa: F821
+            dst[i, d] = src[i, d]
+            inv = 1.0 / (hi - lo)
+            for p in range(m):
+                out[p, q] += (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
+
+
+@njit
+def _scale(a):
+    s = 0.0
+    for i in range(a.shape[0]):
+        for d in range(3):
+            s = max(s, abs(a[i, d]))
+    return s if s > 0.0 else 1.0
+
+
+def difference_jacobian(accel, key, velocity_dependent, cache=True):
+    """A central-difference Jacobian of one term's ``accel`` (6N or 12N calls)."""
+    return specialize(_difference_jacobian, f"fdterm_{key}", cache=cache, term=accel,
+                      VELOCITY=bool(velocity_dependent))
+
+
+# -- several terms as one ----------------------------------------------------------------
+
+def _none_accel(x, v, t, args, acc):
+    pass
+
+
+def _none_energy(x, v, args):
+    return 0.0
+
+
+def _none_jacobian(x, v, t, args, jx, jv):
+    pass
+
+
+def _chain_accel(x, v, t, args, acc):
+    head(x, v, t, args[0], acc)  # noqa: F821 - bound by specialize
+    tail(x, v, t, args[1], acc)  # noqa: F821
+
+
+def _chain_energy(x, v, args):
+    return head(x, v, args[0]) + tail(x, v, args[1])  # noqa: F821 - bound by specialize
+
+
+def _chain_jacobian(x, v, t, args, jx, jv):
+    head(x, v, t, args[0], jx, jv)  # noqa: F821 - bound by specialize
+    tail(x, v, t, args[1], jx, jv)  # noqa: F821
+
+
+NONE = TermKernel(specialize(_none_accel, "none", inline=True),
+                  specialize(_none_energy, "none", inline=True),
+                  specialize(_none_jacobian, "none", inline=True), "none")
+
+
+def chain(kernels):
+    """One :class:`TermKernel` for several, over nested ``args`` ``(a_1, (a_2, ()))``.
+
+    The energy kernels of the chain take ``(a_1e, (a_2e, ()))``, each term's
+    energy arguments; :func:`nest` builds both.
+    """
+    out = NONE
+    for k in reversed(list(kernels)):
+        key = f"{k.key}+{out.key}" if out is not NONE else k.key
+        cache = k.cache and out.cache
+        out = TermKernel(
+            specialize(_chain_accel, key, cache=cache, inline=True, head=k.accel,
+                       tail=out.accel),
+            specialize(_chain_energy, key, cache=cache, inline=True, head=k.energy,
+                       tail=out.energy),
+            specialize(_chain_jacobian, key, cache=cache, inline=True, head=k.jacobian,
+                       tail=out.jacobian),
+            key, cache)
+    return out
+
+
+def nest(items):
+    """``(a_1, (a_2, (..., ())))`` from a sequence, the argument layout of :func:`chain`."""
+    out = ()
+    for item in reversed(list(items)):
+        out = (item, out)
+    return out

@@ -1,0 +1,575 @@
+"""Force terms: physics beyond Newtonian point-mass gravity.
+
+A simulation integrates Newtonian gravity plus the terms it is given::
+
+    sim = orbits.Simulation(bodies, "ias15", forces=[orbits.forces.GR("Sun")])
+
+Every term is compiled into the same loop as gravity and reaches every
+integrator that can honour it, the energy monitor, output files, restarts
+and ensembles.  A term declares what the rest of the package needs to know,
+so that nothing downstream asks for its name:
+
+* ``velocity_dependent``: its accelerations read velocities (``ias15``
+  predicts them at its substeps; the leapfrog and its compositions solve
+  the kick implicitly);
+* its energy: the potential, or the first post-Newtonian correction to the
+  conserved energy, which the energy monitor adds, so that
+  ``result.energy_error`` measures the integration and not the physics;
+  ``conservative`` is False for a term without one;
+* its Jacobian ``da/dx``, ``da/dv``, for the implicit methods (analytic for
+  :class:`GR` and :class:`GRPotential`, central differences of the term alone
+  otherwise);
+* ``wisdom_holman``: whether the Wisdom-Holman map can take it in its
+  interaction step and stay symplectic (conservative, positions only).
+
+Which integrators take which term:
+
+==================  ===========================================  ==================
+term                Wisdom-Holman family (``wh``, ``saba*``)      every other method
+==================  ===========================================  ==================
+:class:`GRPotential`  yes, symplectic                             yes
+:class:`ZonalHarmonics`  yes, symplectic                          yes
+:class:`UserForce`  with ``potential`` and not velocity-dependent  yes
+:class:`GR`         no (velocities)                               yes
+:class:`GRFull`     no (velocities)                               yes
+==================  ===========================================  ==================
+
+With a velocity-dependent term the leapfrog, Verlet and the compositions
+kick with ``v' = v + h a(x, (v + v') / 2)``, solved by fixed-point
+iteration to round-off: the kick is then symmetric and the methods keep
+their order (2 for the leapfrog; measured in the tests), but they are no
+longer symplectic, and energy errors grow slowly.
+
+Parameters given as Quantities are converted once, through the body set's
+:class:`~orbits.units.UnitSystem`; the speed of light defaults to astropy's
+``c`` in those units.
+
+References
+----------
+Anderson et al. 1975, ApJ 200, 221 (:class:`GR`); Nobili & Roxburgh 1986,
+IAU Symp. 114, 105 (:class:`GRPotential`); Newhall, Standish & Williams 1983,
+A&A 125, 150 (:class:`GRFull`); Murray & Dermott 1999, *Solar System
+Dynamics*, sect. 4.9 (:class:`ZonalHarmonics`).
+"""
+
+import importlib
+import math
+from typing import NamedTuple
+
+import astropy.constants as const
+import astropy.units as u
+import numpy as np
+
+from ._kernels import terms as _k
+from ._kernels._jit import specialize
+from .errors import ForceTermError, UnknownBodyError
+
+__all__ = ["ForceTerm", "Gravity", "GR", "GRPotential", "GRFull", "ZonalHarmonics",
+           "UserForce", "from_dict", "BoundTerm"]
+
+
+class BoundTerm(NamedTuple):
+    """A term bound to one simulation's bodies: its kernels and arguments."""
+
+    kernel: _k.TermKernel
+    args: tuple       # of the accelerations and the Jacobian
+    energy_args: tuple
+
+
+class Context(NamedTuple):
+    """What a term sees of the simulation when it is bound."""
+
+    names: list         # body names, in the internal order (massive bodies first)
+    m: np.ndarray       # masses, internal order
+    gm: np.ndarray      # G times the masses
+    n_active: int
+    units: object       # the UnitSystem
+    bare_ok: bool       # plain numbers are read in the body set's units
+    order: np.ndarray   # internal row i is the body set's row order[i]
+    x_user: np.ndarray  # the initial state in the body set's order
+    v_user: np.ndarray
+
+    def index(self, name, term, field):
+        """The internal index of body ``name``, or a named error."""
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise UnknownBodyError(
+                f"{term} names body {name!r} as its {field}, but the body set has no "
+                f"such body (bodies: {', '.join(map(repr, self.names))})",
+                body=name, field=field) from None
+
+
+_REGISTRY = {}
+
+
+class ForceTerm:
+    """Base class of the force terms; see the module notes.
+
+    A subclass sets the class facts below and implements ``bind(ctx)``,
+    returning a :class:`BoundTerm`, and ``to_dict()``; it is registered by
+    name for :func:`from_dict` (output files and ensembles rebuild terms
+    from their dictionaries).
+    """
+
+    velocity_dependent = False
+    conservative = True
+    wisdom_holman = False
+    #: why the Wisdom-Holman interaction step cannot take it (for the error)
+    why_not_wisdom_holman = ""
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        _REGISTRY[cls.__name__] = cls
+
+    def bind(self, ctx):
+        raise NotImplementedError
+
+    def to_dict(self):
+        raise NotImplementedError
+
+    def __eq__(self, other):
+        return type(self) is type(other) and self.to_dict() == other.to_dict()
+
+    def __hash__(self):
+        return hash(repr(self))
+
+    def __repr__(self):
+        d = self.to_dict()
+        d.pop("type")
+        args = ", ".join(f"{k}={v!r}" for k, v in d.items() if v is not None)
+        return f"{type(self).__name__}({args})"
+
+
+def from_dict(d):
+    """The term a :meth:`ForceTerm.to_dict` dictionary describes."""
+    d = dict(d)
+    name = d.pop("type", None)
+    if name not in _REGISTRY:
+        raise ForceTermError(f"unknown force term type {name!r}; known: "
+                             f"{', '.join(sorted(_REGISTRY))}")
+    return _REGISTRY[name].from_dict(d)
+
+
+def _quantity_dict(value):
+    # a Quantity as [value, unit] for JSON; None and plain numbers as they are
+    if value is None:
+        return None
+    if isinstance(value, u.Quantity):
+        return [np.asarray(value.value).tolist(), value.unit.to_string()]
+    return float(value)
+
+
+def _quantity_from(value):
+    if isinstance(value, list) and len(value) == 2 and isinstance(value[1], str):
+        return u.Quantity(value[0], value[1])
+    return value
+
+
+class Gravity(ForceTerm):
+    """Newtonian point-mass gravity, every simulation's first term.
+
+    Give it in ``forces`` only to set its options; the keywords of
+    :class:`~orbits.Simulation` of the same names do the same.
+
+    Parameters
+    ----------
+    softening : Quantity (length), optional
+        Plummer softening length.
+    parallel : bool, optional
+        Force the threaded (True) or serial (False) kernel.
+    rebound_arithmetic : bool
+        REBOUND's floating-point operations (see :class:`~orbits.Simulation`).
+    """
+
+    def __init__(self, softening=None, parallel=None, rebound_arithmetic=False):
+        self.softening = softening
+        self.parallel = parallel
+        self.rebound_arithmetic = bool(rebound_arithmetic)
+
+    def to_dict(self):
+        return {"type": "Gravity", "softening": _quantity_dict(self.softening),
+                "parallel": self.parallel, "rebound_arithmetic": self.rebound_arithmetic}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(softening=_quantity_from(d.get("softening")), parallel=d.get("parallel"),
+                   rebound_arithmetic=d.get("rebound_arithmetic", False))
+
+
+class _SourceTerm(ForceTerm):
+    """A GR term about one dominant body, the ``source``."""
+
+    def __init__(self, source, c=None):
+        if not isinstance(source, str):
+            raise ForceTermError(f"source must be a body's name, got {source!r}",
+                                 term=type(self).__name__, field="source")
+        self.source = source
+        self.c = c
+
+    def to_dict(self):
+        return {"type": type(self).__name__, "source": self.source,
+                "c": _quantity_dict(self.c)}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(d["source"], c=_quantity_from(d.get("c")))
+
+    def _source(self, ctx):
+        i = ctx.index(self.source, repr(self), "source")
+        if not ctx.m[i] > 0:
+            raise ForceTermError(f"the source {self.source!r} has no mass", term=repr(self),
+                                 field="source")
+        return i
+
+    def _inv_c2(self, ctx):
+        return _inv_c2(self, self.c, ctx)
+
+
+def _inv_c2(term, c, ctx):
+    value = const.c if c is None else c
+    cv = float(ctx.units.to_internal(value, "velocity", bare_ok=ctx.bare_ok, field="c"))
+    if not (cv > 0 and math.isfinite(cv)):
+        raise ForceTermError(f"the speed of light must be a positive finite speed, got {c}",
+                             term=repr(term), field="c")
+    return 1.0 / (cv * cv)
+
+
+class GR(_SourceTerm):
+    """General relativity from one dominant body: the 1PN correction of
+    Anderson et al. (1975), as REBOUNDx's ``gr``.
+
+    Every other body, test particles included, feels ::
+
+        a = mu / (c^2 r^3) [ (4 mu / r - v^2) r + 4 (r . v) v ]
+
+    with ``r``, ``v`` relative to the source and ``mu = G m_source``; the
+    source takes the reaction, so momentum is conserved.  Cost O(N).
+    Velocity-dependent: not for the Wisdom-Holman family (use
+    :class:`GRPotential` there).  Its energy is the 1PN energy of each body
+    about the source, ``m (3/8 v^4 + 3/2 mu v^2 / r + 1/2 mu^2 / r^2) / c^2``.
+
+    Parameters
+    ----------
+    source : str
+        Name of the dominant body (the Sun).
+    c : Quantity (speed), optional
+        Speed of light; default astropy's ``c``.
+
+    Examples
+    --------
+    >>> import astropy.units as u, orbits
+    >>> sim = orbits.Simulation(orbits.scenes.solar_system(), "ias15",
+    ...                         forces=[orbits.forces.GR("Sun")])
+    >>> sim.forces
+    (GR(source='Sun'),)
+    """
+
+    velocity_dependent = True
+    why_not_wisdom_holman = "it depends on velocities"
+
+    def bind(self, ctx):
+        src = self._source(ctx)
+        ic2 = self._inv_c2(ctx)
+        return BoundTerm(_GR_KERNEL, (src, ctx.gm, ic2), (src, ctx.gm, ic2, ctx.m))
+
+
+class GRPotential(_SourceTerm):
+    """General relativity as a potential (Nobili & Roxburgh 1986), as
+    REBOUNDx's ``gr_potential``::
+
+        Phi = -3 (G m_source)^2 / (c^2 r^2)      per unit mass
+
+    about the source, which takes the reaction.  It gives the right perihelion
+    precession, is conservative, depends on positions only and joins the
+    interaction step of ``wh``, which stays symplectic.
+
+    Parameters
+    ----------
+    source : str
+        Name of the dominant body.
+    c : Quantity (speed), optional
+        Speed of light; default astropy's ``c``.
+    """
+
+    wisdom_holman = True
+
+    def bind(self, ctx):
+        src = self._source(ctx)
+        ic2 = self._inv_c2(ctx)
+        return BoundTerm(_GR_POTENTIAL_KERNEL, (src, ctx.gm, ic2), (src, ctx.gm, ic2, ctx.m))
+
+
+class GRFull(ForceTerm):
+    """The Einstein-Infeld-Hoffmann 1PN equations among all massive bodies, as
+    integrated for the JPL ephemerides (Newhall, Standish & Williams 1983).
+
+    Test particles feel the massive bodies and pull on none.  The 1PN terms
+    use the Newtonian accelerations.  Cost O(N_active N).  Its energy is the
+    1PN correction of the EIH Lagrangian's energy.  Velocity-dependent: not
+    for the Wisdom-Holman family.
+
+    Parameters
+    ----------
+    c : Quantity (speed), optional
+        Speed of light; default astropy's ``c``.
+    """
+
+    velocity_dependent = True
+    why_not_wisdom_holman = "it depends on velocities"
+
+    def __init__(self, c=None):
+        self.c = c
+
+    def to_dict(self):
+        return {"type": "GRFull", "c": _quantity_dict(self.c)}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(c=_quantity_from(d.get("c")))
+
+    def bind(self, ctx):
+        ic2 = _inv_c2(self, self.c, ctx)
+        n = len(ctx.m)
+        args = (ctx.gm, ctx.n_active, ic2, np.zeros((n, 3)), np.zeros(n))
+        return BoundTerm(_GR_FULL_KERNEL, args, args + (ctx.m,))
+
+
+class ZonalHarmonics(ForceTerm):
+    """The oblateness of one body (J2, J4) acting on every other body.
+
+    The potential beyond the point mass, per unit mass at ``r`` from the body
+    with ``u = (r . pole) / r``::
+
+        Phi = (G m / r) [ J2 (R / r)^2 P2(u) + J4 (R / r)^4 P4(u) ]
+
+    The oblate body takes the reaction, so momentum is conserved (its spin
+    axis is held fixed: the torque on it is not followed, so only the
+    component of angular momentum along ``pole`` is conserved).
+    Conservative and positions only: ``wh`` takes it.
+
+    Parameters
+    ----------
+    body : str
+        Name of the oblate body.
+    radius : Quantity (length)
+        Its equatorial (reference) radius ``R``; positive.
+    J2, J4 : float
+        Zonal coefficients (dimensionless).
+    pole : sequence of 3 floats
+        Direction of its spin axis in the simulation's frame (normalised
+        here); default the frame's z axis.
+
+    Examples
+    --------
+    >>> import astropy.units as u, orbits
+    >>> J2 = orbits.forces.ZonalHarmonics("Earth", 6378.137 * u.km, J2=1.08263e-3)
+    >>> J2.wisdom_holman
+    True
+    """
+
+    wisdom_holman = True
+
+    def __init__(self, body, radius, J2=0.0, J4=0.0, pole=(0.0, 0.0, 1.0)):
+        name = f"ZonalHarmonics({body!r})"
+        if not isinstance(body, str):
+            raise ForceTermError(f"body must be a body's name, got {body!r}", term=name,
+                                 field="body")
+        self.body = body
+        self.radius = radius
+        for field, value in (("J2", J2), ("J4", J4)):
+            try:
+                ok = math.isfinite(float(value))
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise ForceTermError(f"{field} must be a finite number, got {value!r}",
+                                     term=name, field=field)
+        self.J2 = float(J2)
+        self.J4 = float(J4)
+        p = np.asarray(pole, dtype=float)
+        norm = float(np.linalg.norm(p)) if p.shape == (3,) else 0.0
+        if not (norm > 0 and math.isfinite(norm)):
+            raise ForceTermError(f"pole must be a non-zero finite 3-vector, got {pole!r}",
+                                 term=name, field="pole")
+        self._pole_given = [float(c) for c in p]
+        self.pole = tuple(float(c) for c in p / norm)
+        if isinstance(radius, u.Quantity):
+            self._check_radius(radius.value, name)
+
+    @staticmethod
+    def _check_radius(value, name):
+        value = np.asarray(value, dtype=float)
+        if value.shape != () or not (value > 0 and math.isfinite(value)):
+            raise ForceTermError(f"radius must be a positive finite length, got {value}",
+                                 term=name, field="radius")
+
+    def to_dict(self):
+        return {"type": "ZonalHarmonics", "body": self.body,
+                "radius": _quantity_dict(self.radius), "J2": self.J2, "J4": self.J4,
+                "pole": self._pole_given}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(d["body"], _quantity_from(d["radius"]), J2=d["J2"], J4=d["J4"],
+                   pole=d["pole"])
+
+    def bind(self, ctx):
+        b = ctx.index(self.body, repr(self), "body")
+        if not ctx.m[b] > 0:
+            raise ForceTermError(f"the oblate body {self.body!r} has no mass",
+                                 term=repr(self), field="body")
+        R = float(ctx.units.to_internal(self.radius, "length", bare_ok=ctx.bare_ok,
+                                        field="radius"))
+        self._check_radius(R, repr(self))
+        gmb = float(ctx.gm[b])
+        args = (b, ctx.gm, gmb * self.J2 * R ** 2, gmb * self.J4 * R ** 4,
+                np.array(self.pole))
+        return BoundTerm(_ZONAL_KERNEL, args, args + (ctx.m,))
+
+
+class UserForce(ForceTerm):
+    """A force of your own, added to gravity and compiled into the same loop.
+
+    Parameters
+    ----------
+    func : numba-compiled function
+        ``func(x, v, t, m) -> a``: positions and velocities (shape (N, 3)),
+        time and masses (shape (N,)) in the body set's units and order, and
+        the accelerations of this term alone, shape (N, 3).  It must be
+        compiled with ``@numba.njit`` so that it runs inside the loop.
+    velocity_dependent : bool
+        Whether ``a`` reads ``v``.
+    potential : numba-compiled function, optional
+        ``potential(x, m) -> float``, the term's potential energy, whose
+        negative gradient divided by the masses is ``a``: the energy monitor
+        adds it, and with ``velocity_dependent=False`` the Wisdom-Holman
+        family can take the term.  Without it the term counts as
+        non-conservative and the energy monitor does not see it.
+
+    Raises
+    ------
+    ForceTermError
+        ``func`` (or ``potential``) is not a numba function; when bound, ``func``
+        returns the wrong shape or a non-finite value on the initial state.
+
+    Examples
+    --------
+    >>> import numba, numpy as np, orbits
+    >>> @numba.njit
+    ... def drag(x, v, t, m):
+    ...     return -1e-6 * v
+    >>> term = orbits.forces.UserForce(drag, velocity_dependent=True)
+    """
+
+    def __init__(self, func, velocity_dependent=False, potential=None):
+        for field, f in (("func", func), ("potential", potential)):
+            if f is not None and not hasattr(f, "py_func"):
+                raise ForceTermError(
+                    f"{field} must be compiled with @numba.njit so that it runs inside "
+                    f"the compiled loop; got the Python function {f!r} (for a plain "
+                    "Python force use orbits.integrate)", term="UserForce", field=field)
+        self.func = func
+        self.potential = potential
+        self.velocity_dependent = bool(velocity_dependent)
+        self.conservative = potential is not None
+        self.wisdom_holman = self.conservative and not self.velocity_dependent
+        self.why_not_wisdom_holman = ("it depends on velocities" if self.velocity_dependent
+                                      else "it has no potential")
+
+    def to_dict(self):
+        ref = lambda f: None if f is None else f"{f.__module__}:{f.__qualname__}"  # noqa: E731
+        return {"type": "UserForce", "func": ref(self.func),
+                "velocity_dependent": self.velocity_dependent,
+                "potential": ref(self.potential)}
+
+    @classmethod
+    def from_dict(cls, d):
+        def load(ref):
+            if ref is None:
+                return None
+            module, _, qualname = ref.partition(":")
+            try:
+                obj = importlib.import_module(module)
+                for part in qualname.split("."):
+                    obj = getattr(obj, part)
+            except (ImportError, AttributeError):
+                raise ForceTermError(
+                    f"cannot import the user function {ref!r}: define it at the top level "
+                    "of an importable module to restore or ship this simulation",
+                    term="UserForce", field="func") from None
+            return obj
+        return cls(load(d["func"]), velocity_dependent=d["velocity_dependent"],
+                   potential=load(d.get("potential")))
+
+    def __repr__(self):
+        return (f"UserForce({getattr(self.func, '__name__', self.func)}, "
+                f"velocity_dependent={self.velocity_dependent})")
+
+    def bind(self, ctx):
+        n = len(ctx.m)
+        # the body set's row k is internal row pos[k]
+        pos = np.argsort(ctx.order).astype(np.int64)
+        m_user = np.ascontiguousarray(ctx.m[pos])
+        args = (pos, np.zeros((n, 3)), np.zeros((n, 3)), m_user)
+        self._check(ctx, m_user)
+        key = f"user{id(self.func)}_{id(self.potential)}"
+        accel = specialize(_user_accel, key, cache=False, user=self.func)
+        energy = (specialize(_user_energy, key, cache=False, user_potential=self.potential)
+                  if self.potential is not None else _k.NONE.energy)
+        jac = _k.difference_jacobian(accel, key, self.velocity_dependent, cache=False)
+        return BoundTerm(_k.TermKernel(accel, energy, jac, key, cache=False), args, args)
+
+    def _check(self, ctx, m_user):
+        x = ctx.x_user
+        v = ctx.v_user
+        try:
+            a = np.asarray(self.func(x.copy(), v.copy(), 0.0, m_user))
+        except Exception as exc:  # a numba typing error names the cause
+            raise ForceTermError(f"calling func(x, v, t, m) on the initial state failed: "
+                                 f"{exc}", term=repr(self), field="func") from None
+        if a.shape != x.shape:
+            raise ForceTermError(f"func returned an array of shape {a.shape} for "
+                                 f"{len(m_user)} bodies; expected accelerations of shape "
+                                 f"{x.shape}", term=repr(self), field="func")
+        if not np.all(np.isfinite(a)):
+            raise ForceTermError("func returned non-finite accelerations on the initial "
+                                 "state", term=repr(self), field="func")
+        if self.potential is not None:
+            e = self.potential(x.copy(), m_user)
+            if not (np.ndim(e) == 0 and math.isfinite(float(e))):
+                raise ForceTermError(f"potential must return a finite float, got {e!r}",
+                                     term=repr(self), field="potential")
+
+
+def _user_accel(x, v, t, args, acc):
+    # the user's rows are the body set's order; internal row pos[k] is user row k
+    pos, xu, vu, mu = args
+    n = pos.shape[0]
+    for k in range(n):
+        for d in range(3):
+            xu[k, d] = x[pos[k], d]
+            vu[k, d] = v[pos[k], d]
+    a = user(xu, vu, t, mu)  # noqa: F821 - bound by specialize
+    for k in range(n):
+        for d in range(3):
+            acc[pos[k], d] += a[k, d]
+
+
+def _user_energy(x, v, args):
+    pos, xu, vu, mu = args
+    for k in range(pos.shape[0]):
+        for d in range(3):
+            xu[k, d] = x[pos[k], d]
+    return user_potential(xu, mu)  # noqa: F821 - bound by specialize
+
+
+_GR_KERNEL = _k.TermKernel(_k.gr_accel, _k.gr_energy, _k.gr_jacobian, "gr")
+_GR_POTENTIAL_KERNEL = _k.TermKernel(_k.gr_potential_accel, _k.gr_potential_energy,
+                                     _k.gr_potential_jacobian, "gr_potential")
+_GR_FULL_KERNEL = _k.TermKernel(_k.gr_full_accel, _k.gr_full_energy,
+                                _k.difference_jacobian(_k.gr_full_accel, "gr_full", True),
+                                "gr_full")
+_ZONAL_KERNEL = _k.TermKernel(_k.zonal_accel, _k.zonal_energy,
+                              _k.difference_jacobian(_k.zonal_accel, "zonal", False),
+                              "zonal")
