@@ -39,6 +39,8 @@ class Result:
         The unit system, with G and where it came from.
     status : str
         ``"completed"`` or the reason the run stopped.
+    forces : tuple of str
+        The force terms added to gravity, as written (``"GR(source='Sun')"``).
     """
 
     def __init__(self, **fields):
@@ -48,6 +50,7 @@ class Result:
         self.momentum = self.center_of_mass = None
         self.status = "completed"
         self.steps_rejected = 0
+        self.forces = ()
         for k, v in fields.items():
             setattr(self, k, v)
 
@@ -86,6 +89,7 @@ class Result:
             f"wall time {self.wall_time:.3g} s ({rate:.3g} steps/s)",
             f"units           {self.units['name']}, G = {self.units['G']!r} "
             f"({self.units['G_source']})",
+            f"forces          {' + '.join(['Newtonian gravity', *self.forces])}",
         ]
         e = self.max_energy_error()
         if e is not None:

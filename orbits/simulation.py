@@ -866,7 +866,8 @@ class _Recorder:
             masses=q(sim._m[self.inv].copy(), "mass"), steps=sim.steps - self.steps0,
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
             integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
-            monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0)
+            monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
+            forces=tuple(map(repr, sim.forces)))
         ref = sim._reference
         if self.rows:
             fields.update(_monitor_fields(np.array(self.rows), sim, ref))

@@ -566,3 +566,92 @@ def test_terms_round_trip_through_dicts():
         assert forces.from_dict(t.to_dict()) == t
     with pytest.raises(ForceTermError, match="unknown force term"):
         forces.from_dict({"type": "Drag"})
+
+
+# -- files, ensembles, command line -----------------------------------------------------------
+
+def _gr_sim(integrator="leapfrog"):
+    return orbits.Simulation(sun_mercury(), integrator, dt=0.5 * u.day,
+                             forces=[forces.GR("Sun"),
+                                     forces.ZonalHarmonics("Sun", 696000 * u.km, J2=2e-7)])
+
+
+@pytest.mark.parametrize("integrator", ["leapfrog", "ias15"])
+def test_restart_with_forces_is_bit_identical(tmp_path, integrator):
+    # stopped at an output and continued from the file = never stopped, bit for bit;
+    # the file records the terms and the restored simulation has them again
+    path = tmp_path / "run.h5"
+    ref = _gr_sim(integrator)
+    ref.run(until=100 * u.day, outputs=5, progress=False)
+    ref.run(until=200 * u.day, outputs=5, progress=False)
+    first = _gr_sim(integrator)
+    first.run(until=100 * u.day, outputs=5, output=path, progress=False)
+    again = orbits.Simulation.from_file(path)
+    assert again.forces == first.forces
+    again.run(until=200 * u.day, outputs=5, output=path, progress=False)
+    assert np.array_equal(again.state.x, ref.state.x)
+    assert np.array_equal(again.state.v, ref.state.v)
+    info = orbits.io.describe(path)
+    assert "GR(source='Sun')" in info and "ZonalHarmonics" in info
+
+
+def test_restart_with_gr_potential_in_wh_is_bit_identical(tmp_path):
+    # wh keeps the terms beside its workspace arrays: restored, its synchronised
+    # (corrected) output goes through the same perturbation step
+    path = tmp_path / "run.h5"
+    integ = orbits.integrators.get("wh", corrector=5)
+
+    def make():
+        return orbits.Simulation(inner_with_jupiter(), integ, dt=1 * u.day,
+                                 forces=[forces.GRPotential("Sun")])
+
+    ref = make()
+    r_ref = ref.run(until=400 * u.day, outputs=5, progress=False)
+    first = make()
+    first.run(until=200 * u.day, outputs=3, output=path, progress=False)
+    again = orbits.Simulation.from_file(path)
+    r = again.run(until=400 * u.day, outputs=3, output=path, progress=False)
+    assert np.array_equal(r.positions[-1].value, r_ref.positions[-1].value)
+
+
+def _gr_planet(a):
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    b.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au)
+    b.add("planet", mass=1 * u.Mearth, primary="Sun", a=a * u.au, e=0.3)
+    b.move_to_com()
+    return orbits.Simulation(b, "ias15", forces=[forces.GRFull()], rebound_arithmetic=False)
+
+
+def test_ensemble_rows_with_forces_serial_and_two_workers():
+    pytest.importorskip("distributed")
+    from orbits.ensemble import Ensemble
+    where = ["wall_time_s", "worker", "kernels_compiled", "kernels_loaded"]
+    params = [{"a": 1.0}, {"a": 1.5}]
+    one = Ensemble(_gr_planet, params).run(20 * u.yr, client="serial", progress=False)
+    two = Ensemble(_gr_planet, params).run(20 * u.yr, client=None, n_workers=2,
+                                           progress=False)
+    assert one.drop(columns=where).equals(two.drop(columns=where))
+
+
+def test_perturbed_ensemble_keeps_forces_and_rebound_arithmetic():
+    from orbits.ensemble import Ensemble
+    b = orbits.scenes.outer_solar_system()
+    sim = orbits.Simulation(b, "leapfrog", dt=10 * u.day, rebound_arithmetic=True,
+                            forces=[forces.GRPotential("Sun")])
+    copy = Ensemble.perturbed(sim, n=1, scale=0.0).simulation(0)
+    assert copy.rebound_arithmetic and copy.forces == sim.forces
+    sim.run(until=100 * u.yr, outputs=2, progress=False)
+    copy.run(until=100 * u.yr, outputs=2, progress=False)
+    assert np.array_equal(copy.state.x, sim.state.x)
+
+
+def test_cli_gr_option(capsys):
+    from orbits.cli import main
+    args = ["run", "outer-solar-system", "--integrator", "wh", "--dt", "10d", "--until",
+            "100yr", "--no-progress", "--gr"]
+    assert main(args + ["potential"]) == 0
+    assert "forces          Newtonian gravity + GRPotential(source='Sun')" in \
+        capsys.readouterr().out
+    assert main(args + ["sun"]) == 2
+    assert "GRPotential" in capsys.readouterr().err

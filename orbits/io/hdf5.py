@@ -206,7 +206,8 @@ class FileRecorder:
                       masses=q(sim._m[self.inv].copy(), "mass"), steps=sim.steps - self.steps0,
                       force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
                       integrator=sim.integrator.info(), units=sim.units.to_dict(),
-                      dt=sim.dt, status=status, monitors=sim.monitors, path=str(self.path))
+                      dt=sim.dt, status=status, monitors=sim.monitors, path=str(self.path),
+                      forces=tuple(map(repr, sim.forces)))
         if sim._mask:
             from ..simulation import _monitor_fields
             fields.update(_monitor_fields(row[None], sim, sim._reference))
