@@ -17,8 +17,8 @@ so that nothing downstream asks for its name:
   ``result.energy_error`` measures the integration and not the physics;
   ``conservative`` is False for a term without one;
 * its Jacobian ``da/dx``, ``da/dv``, for the implicit methods (analytic for
-  :class:`GR` and :class:`GRPotential`, central differences of the term alone
-  otherwise);
+  :class:`GR`, :class:`GRPotential` and :class:`ZonalHarmonics`; central
+  differences of the term alone for :class:`GRFull` and :class:`UserForce`);
 * ``wisdom_holman``: whether the Wisdom-Holman map can take it in its
   interaction step and stay symplectic (conservative, positions only).
 
@@ -570,6 +570,4 @@ _GR_POTENTIAL_KERNEL = _k.TermKernel(_k.gr_potential_accel, _k.gr_potential_ener
 _GR_FULL_KERNEL = _k.TermKernel(_k.gr_full_accel, _k.gr_full_energy,
                                 _k.difference_jacobian(_k.gr_full_accel, "gr_full", True),
                                 "gr_full")
-_ZONAL_KERNEL = _k.TermKernel(_k.zonal_accel, _k.zonal_energy,
-                              _k.difference_jacobian(_k.zonal_accel, "zonal", False),
-                              "zonal")
+_ZONAL_KERNEL = _k.TermKernel(_k.zonal_accel, _k.zonal_energy, _k.zonal_jacobian, "zonal")

@@ -38,6 +38,7 @@ __all__ = [
     "outer_solar_system",
     "solar_system",
     "de421",
+    "de421_states",
     "pythagorean",
     "figure_eight",
     "plummer",
@@ -591,6 +592,104 @@ def _de421_ephemeris():
     return Ephemeris(package)
 
 
+def _de421_gm(name):
+    """DE421's GM of one of the scene's bodies, in (DE421 au)^3 / day^2."""
+    if name == "Earth":
+        return _GM_DE421["GMB"] * (_EMRAT_DE421 / (1.0 + _EMRAT_DE421))
+    if name == "Moon":
+        return _GM_DE421["GMB"] * (1.0 / (1.0 + _EMRAT_DE421))
+    return _GM_DE421[_DE421_BODIES[name][1]]
+
+
+def _de421_arrays(ephemeris, tdb, tdb2):
+    """Positions (n, 11, 3) in au and velocities in au/day of the de421
+    scene's bodies at the ``n`` Julian dates ``tdb + tdb2`` (TDB)."""
+    au_per_km = (1 * u.km).to_value(u.au)
+
+    def state(series):
+        # jplephem gives (3, n) arrays in km and km/day
+        x, v = ephemeris.position_and_velocity(series, tdb, tdb2)
+        return x.T * au_per_km, v.T * au_per_km
+
+    x_emb, v_emb = state("earthmoon")
+    x_moon, v_moon = state("moon")          # geocentric
+    earth_share = 1.0 / (1.0 + _EMRAT_DE421)
+    moon_share = _EMRAT_DE421 / (1.0 + _EMRAT_DE421)
+    n = len(tdb)
+    x = np.empty((n, len(_DE421_BODIES), 3))
+    v = np.empty((n, len(_DE421_BODIES), 3))
+    for i, (name, (series, _)) in enumerate(_DE421_BODIES.items()):
+        if name == "Earth":
+            x[:, i], v[:, i] = x_emb - earth_share * x_moon, v_emb - earth_share * v_moon
+        elif name == "Moon":
+            x[:, i], v[:, i] = x_emb + moon_share * x_moon, v_emb + moon_share * v_moon
+        else:
+            x[:, i], v[:, i] = state(series)
+    return x, v
+
+
+def de421_states(epoch):
+    """The :func:`de421` scene's bodies at any epoch of DE421 (1900 to 2200).
+
+    The same eleven bodies, in the same order, units and frame as
+    :func:`de421` (barycentric ICRF, not moved to the centre of mass),
+    evaluated from the ephemeris at other times: what a run from the
+    :func:`de421` scene is compared with.
+
+    Parameters
+    ----------
+    epoch : float, array_like or astropy.time.Time
+        Julian date(s) in TDB, or a Time of any scale (converted to TDB
+        without the network; its two-part date is kept).
+
+    Returns
+    -------
+    positions, velocities : Quantity
+        In au and au/day, of shape (11, 3) for one epoch and (n, 11, 3) for
+        ``n`` epochs.
+
+    Raises
+    ------
+    ValueError
+        An epoch outside DE421's span, JD 2414992.5 to 2524624.5.
+    ImportError
+        ``jplephem`` or ``de421`` is not installed.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits import scenes
+    >>> x, v = scenes.de421_states(2451545.0)
+    >>> bool(np.all(x == scenes.de421().positions))
+    True
+    >>> x, v = scenes.de421_states([2451545.0 + 365.25, 2451545.0 + 3652.5])
+    >>> x.shape
+    (2, 11, 3)
+    """
+    from astropy.time import Time
+
+    if isinstance(epoch, Time):
+        epoch = _as_tdb(epoch)
+        tdb, tdb2 = np.atleast_1d(epoch.jd1), np.atleast_1d(epoch.jd2)
+        scalar = epoch.isscalar
+    else:
+        tdb = np.asarray(epoch, dtype=float)
+        scalar = tdb.ndim == 0
+        tdb, tdb2 = np.atleast_1d(tdb), np.zeros(tdb.size)
+    if tdb.ndim != 1:
+        raise ValueError(f"epoch must be one date or a 1-d sequence of dates, got shape "
+                         f"{np.shape(epoch)}")
+    ephemeris = _de421_ephemeris()
+    jd = tdb + tdb2
+    if not np.all((jd >= ephemeris.jalpha) & (jd <= ephemeris.jomega)):
+        raise ValueError(f"DE421 covers JD {ephemeris.jalpha} to {ephemeris.jomega} (TDB); "
+                         f"got {jd.min()} to {jd.max()}")
+    x, v = _de421_arrays(ephemeris, tdb, tdb2)
+    if scalar:
+        x, v = x[0], v[0]
+    return x << u.au, v << (u.au / u.day)
+
+
 def de421(com=False):
     """The Sun, the planets, the Moon and Pluto at J2000.0 from the JPL DE421 ephemeris.
 
@@ -659,33 +758,9 @@ def de421(com=False):
     >>> print(np.round(np.linalg.norm(r), 5))
     0.98333 AU
     """
-    ephemeris = _de421_ephemeris()
-    au_per_km = (1 * u.km).to_value(u.au)
-
-    def state(series):
-        # (3, 1) arrays in km and km/day, for the one epoch.
-        x, v = ephemeris.position_and_velocity(series, _J2000_JD_TDB)
-        return x[:, 0] * au_per_km, v[:, 0] * au_per_km
-
-    x_emb, v_emb = state("earthmoon")
-    x_moon, v_moon = state("moon")          # geocentric
-    earth_share = 1.0 / (1.0 + _EMRAT_DE421)
-    moon_share = _EMRAT_DE421 / (1.0 + _EMRAT_DE421)
-    names = list(_DE421_BODIES)
-    gm = np.empty(len(names))
-    x = np.empty((len(names), 3))
-    v = np.empty((len(names), 3))
-    for i, name in enumerate(names):
-        series, key = _DE421_BODIES[name]
-        if name == "Earth":
-            gm[i] = _GM_DE421["GMB"] * moon_share
-            x[i], v[i] = x_emb - earth_share * x_moon, v_emb - earth_share * v_moon
-        elif name == "Moon":
-            gm[i] = _GM_DE421["GMB"] * earth_share
-            x[i], v[i] = x_emb + moon_share * x_moon, v_emb + moon_share * v_moon
-        else:
-            gm[i] = _GM_DE421[key]
-            x[i], v[i] = state(series)
+    x, v = _de421_arrays(_de421_ephemeris(), np.array([_J2000_JD_TDB]), 0.0)
+    gm = np.array([_de421_gm(name) for name in _DE421_BODIES])
+    x, v = x[0], v[0]
 
     # G * (1 Msun) = GMS, carried from DE421's au to the IAU au of u.au
     # (a factor 1 - 7.5e-12) so that G m equals the header's GM in km^3/day^2.
@@ -693,7 +768,8 @@ def de421(com=False):
     units = UnitSystem(length=u.au, mass=u.Msun, time=u.day, G=G,
                        name="au-Msun-day (DE421 GM_sun)",
                        G_source="GMS of JPL DE421 (Folkner, Williams & Boggs 2008)")
-    bodies = BodySet.from_arrays(gm / _GM_DE421["GMS"], x, v, names=names, units=units)
+    bodies = BodySet.from_arrays(gm / _GM_DE421["GMS"], x, v, names=list(_DE421_BODIES),
+                                 units=units)
     if com:
         bodies.move_to_com()
     return _record(bodies, "de421", com=bool(com), epoch="2000-01-01T12:00:00.000 TDB",

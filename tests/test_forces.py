@@ -193,14 +193,17 @@ def test_gr_full_test_particles_feel_but_do_not_pull():
     np.testing.assert_allclose(a[3], ref[3], rtol=1e-12)
 
 
-@pytest.mark.parametrize("which", ["gr", "gr_potential"])
+@pytest.mark.parametrize("which", ["gr", "gr_potential", "zonal"])
 def test_analytic_jacobians_match_differences(which):
     # central differences with a step of 1e-6 on O(1) states: error ~1e-10 relative
     x, v, m = random_state(4, seed=11)
     gm = 0.4 * m
     args = (0, gm, 0.02)
+    if which == "zonal":
+        args = (0, gm, 0.05, 0.02, np.array([0.6, 0.0, 0.8]))
     accel, jac = {"gr": (kt.gr_accel, kt.gr_jacobian),
-                  "gr_potential": (kt.gr_potential_accel, kt.gr_potential_jacobian)}[which]
+                  "gr_potential": (kt.gr_potential_accel, kt.gr_potential_jacobian),
+                  "zonal": (kt.zonal_accel, kt.zonal_jacobian)}[which]
     n = 3 * len(m)
     jx = np.zeros((n, n))
     jv = np.zeros((n, n))

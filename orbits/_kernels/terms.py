@@ -40,7 +40,7 @@ from .invariants import _add
 
 __all__ = ["TermKernel", "chain", "nest", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
-           "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy",
+           "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
            "difference_jacobian"]
 
 
@@ -443,6 +443,60 @@ def zonal_energy(x, v, args):
         p4 = 0.125 * ((35.0 * u2 - 30.0) * u2 + 3.0)
         s, c = _add(s, c, m[i] * (k2 * p2 / (r * r * r) + k4 * p4 / (r ** 5)))
     return s + c
+
+
+@njit
+def zonal_jacobian(x, v, t, args, jx, jv):
+    """``da/dx`` of :func:`zonal_accel`: minus the Hessian of the potential.
+
+    Writing ``Phi = g(s, q)`` with ``s = r^2`` and ``q = r . pole``, ::
+
+        H = 2 g_s I + 4 g_ss r r^T + 2 g_sq (r pole^T + pole r^T) + g_qq pole pole^T
+
+    with the partial derivatives of ``k2 (3 q^2 s^-5/2 - s^-3/2) / 2`` and
+    ``k4 (35 q^4 s^-9/2 - 30 q^2 s^-7/2 + 3 s^-5/2) / 8``.
+    """
+    b, gm, k2, k4, pole = args[0], args[1], args[2], args[3], args[4]
+    r = np.empty(3)
+    h = np.empty((3, 3))
+    for i in range(x.shape[0]):
+        if i == b:
+            continue
+        for d in range(3):
+            r[d] = x[i, d] - x[b, d]
+        s = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        q = r[0] * pole[0] + r[1] * pole[1] + r[2] * pole[2]
+        q2 = q * q
+        s52 = s ** -2.5
+        s72 = s52 / s
+        s92 = s72 / s
+        c2 = 0.5 * k2
+        g_s = c2 * (-7.5 * q2 * s72 + 1.5 * s52)
+        g_ss = c2 * (26.25 * q2 * s92 - 3.75 * s72)
+        g_sq = c2 * (-15.0 * q * s72)
+        g_qq = c2 * (6.0 * s52)
+        if k4 != 0.0:
+            c4 = 0.125 * k4
+            s112 = s92 / s
+            s132 = s112 / s
+            g_s += c4 * (-157.5 * q2 * q2 * s112 + 105.0 * q2 * s92 - 7.5 * s72)
+            g_ss += c4 * (866.25 * q2 * q2 * s132 - 472.5 * q2 * s112 + 26.25 * s92)
+            g_sq += c4 * (-630.0 * q2 * q * s112 + 210.0 * q * s92)
+            g_qq += c4 * (420.0 * q2 * s92 - 60.0 * s72)
+        for a in range(3):
+            for c in range(3):
+                h[a, c] = (4.0 * g_ss * r[a] * r[c] + 2.0 * g_sq * (r[a] * pole[c]
+                                                                  + pole[a] * r[c])
+                           + g_qq * pole[a] * pole[c])
+            h[a, a] += 2.0 * g_s
+        w = gm[i] / gm[b]
+        for a in range(3):
+            for c in range(3):
+                jx[3 * i + a, 3 * i + c] -= h[a, c]
+                jx[3 * i + a, 3 * b + c] += h[a, c]
+                if w != 0.0:
+                    jx[3 * b + a, 3 * i + c] += w * h[a, c]
+                    jx[3 * b + a, 3 * b + c] -= w * h[a, c]
 
 
 # -- central differences of one term, for terms without an analytic Jacobian -----------

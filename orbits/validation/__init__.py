@@ -1,11 +1,13 @@
-"""The validation report: accuracy against REBOUND, work against precision,
-long-horizon drift, a stress suite and a check of a published guide.
+"""The validation report: accuracy against REBOUND, the solar system against
+the JPL DE421 ephemeris, work against precision, long-horizon drift, a stress
+suite and a check of a published guide.
 
 ``orbits validate [--quick] [--out DIR]`` (or :func:`validate`) runs it on
 this machine's cores and writes ``report.md`` with its PNG plots into ``DIR``.
 REBOUND is needed (``pip install -e ".[test]"``), and matplotlib for the
-plots.  The full report takes about ten minutes on two cores, the
-quick one a few minutes; the committed full report is in the repository's
+plots; the ephemeris section also runs REBOUNDx where it is installed.  The
+full report takes about ten minutes on two cores, the quick one a few
+minutes; the committed full report is in the repository's
 ``validation/report/``.
 
 Each section is a module with the same three members:
@@ -35,7 +37,7 @@ from ._runner import Pool, Task, run_tasks
 __all__ = ["validate", "SECTIONS", "Task", "Pool", "run_tasks", "ValidationError"]
 
 #: the report's sections, in order (module names in this package)
-SECTIONS = ("accuracy", "work_precision", "drift", "stress", "guide")
+SECTIONS = ("accuracy", "ephemeris", "work_precision", "drift", "stress", "guide")
 
 
 class ValidationError(RuntimeError):

@@ -1,0 +1,165 @@
+"""Force terms: their cost beside REBOUND + REBOUNDx, and beside our runs without them.
+
+What is measured
+----------------
+Every row times both sides in turn in one process, ``--repeats`` times, after
+a warm-up that excludes numba's compilation, and prints medians.  Ours runs
+through the public ``Simulation.run`` with ``monitors=()`` and ``outputs=2``;
+REBOUND's through ``sim.integrate`` (``sim.steps`` for WHFast) with the
+REBOUNDx effect attached, the same floats, G and c.
+
+1. ``ias15`` + :class:`~orbits.forces.GRFull` on the DE421 scene (Sun, eight
+   planets, Moon, Pluto) for 10 years, against IAS15 + ``gr_full``.
+   Goal: at most 0.3 of REBOUND's time.
+2. The overhead of :class:`~orbits.forces.GR` on ``ias15`` (Sun + 8 planets):
+   time per step with the term over time per step without.  Goal: <= 1.3.
+   REBOUND's own overhead with ``gr`` is printed beside it.
+3. The overhead of :class:`~orbits.forces.GRPotential` on ``wh`` (Sun + 8
+   planets, 1-day step): goal <= 1.2; WHFast's with ``gr_potential`` beside it.
+4. ``GR`` with 10^3 and 10^4 test particles (Sun, Jupiter and particles,
+   leapfrog): the term's added time per particle and step must stay flat
+   (O(N), not O(N^2)).
+
+Run ``python benchmarks/bench_forces.py`` (about a minute; ``--quick``: less).
+"""
+
+import argparse
+import statistics
+import time
+
+import astropy.constants as const
+import astropy.units as u
+import numpy as np
+import rebound
+import reboundx
+
+import orbits
+from orbits import forces
+
+C_AU_DAY = const.c.to_value(u.au / u.day)
+
+
+def _median_time(fn, repeats):
+    fn()  # warm-up: compilation, caches
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def ours(bodies, integrator, until_days, terms, dt=None):
+    def run():
+        sim = orbits.Simulation(bodies, integrator, dt=None if dt is None else dt * u.day,
+                                forces=terms, monitors=())
+        sim.run(until=until_days * u.day, outputs=2, progress=False)
+        run.steps = sim.steps
+    run()
+    return run
+
+
+def theirs(bodies, integrator, until_days, effect, dt=None):
+    def run():
+        sim = bodies.to_rebound()
+        sim.integrator = integrator
+        if effect:
+            rebx = reboundx.Extras(sim)
+            f = rebx.load_force(effect)
+            rebx.add_force(f)
+            f.params["c"] = C_AU_DAY
+            sim.particles[0].params["gr_source"] = 1
+        if dt is not None:
+            sim.dt = dt
+            sim.integrator.safe_mode = 0
+            sim.steps(int(round(until_days / dt)))
+        else:
+            sim.integrate(until_days)
+        run.steps = sim.steps_done
+        run.keep = sim, (rebx if effect else None)
+    return run
+
+
+def row(label, mine, peer, repeats):
+    a = _median_time(mine, repeats)
+    b = _median_time(peer, repeats)
+    return label, a, b
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--quick", action="store_true")
+    args = p.parse_args(argv)
+    rep = 3 if args.quick else args.repeats
+    years = 2 if args.quick else 10
+    ok = True
+
+    print("1. ias15 + GRFull on the DE421 scene, "
+          f"{years} years (goal: <= 0.3 of IAS15 + REBOUNDx gr_full)")
+    de = orbits.scenes.de421()
+    span = years * 365.25
+    a = _median_time(ours(de, "ias15", span, [forces.GRFull()]), rep)
+    b = _median_time(theirs(de, "ias15", span, "gr_full"), rep)
+    ratio = a / b
+    ok &= ratio <= 0.3
+    print(f"   ours {a * 1e3:9.1f} ms   REBOUND+REBOUNDx {b * 1e3:9.1f} ms   "
+          f"ratio {ratio:.3f}   {'PASS' if ratio <= 0.3 else 'MISS'}")
+
+    planets = orbits.scenes.solar_system(moon=False)
+    print("\n2. GR's overhead on ias15, Sun + 8 planets, 20 years (goal: <= 1.3)")
+    span = (4 if args.quick else 20) * 365.25
+    o0 = _median_time(ours(planets, "ias15", span, []), rep)
+    o1 = _median_time(ours(planets, "ias15", span, [forces.GR("Sun")]), rep)
+    r0 = _median_time(theirs(planets, "ias15", span, None), rep)
+    r1 = _median_time(theirs(planets, "ias15", span, "gr"), rep)
+    ok &= o1 / o0 <= 1.3
+    print(f"   ours {o0 * 1e3:8.2f} -> {o1 * 1e3:8.2f} ms  x{o1 / o0:.3f}   "
+          f"REBOUND {r0 * 1e3:8.2f} -> {r1 * 1e3:8.2f} ms  x{r1 / r0:.3f}   "
+          f"with GR ours/REBOUND {o1 / r1:.3f}   {'PASS' if o1 / o0 <= 1.3 else 'MISS'}")
+
+    print("\n3. GRPotential's overhead on wh, Sun + 8 planets, dt = 1 d, "
+          "100 years (goal: <= 1.2)")
+    span = (20 if args.quick else 100) * 365.25
+    o0 = _median_time(ours(planets, "wh", span, [], dt=1.0), rep)
+    o1 = _median_time(ours(planets, "wh", span, [forces.GRPotential("Sun")], dt=1.0), rep)
+    r0 = _median_time(theirs(planets, "whfast", span, None, dt=1.0), rep)
+    r1 = _median_time(theirs(planets, "whfast", span, "gr_potential", dt=1.0), rep)
+    ok &= o1 / o0 <= 1.2
+    print(f"   ours {o0 * 1e3:8.2f} -> {o1 * 1e3:8.2f} ms  x{o1 / o0:.3f}   "
+          f"WHFast {r0 * 1e3:8.2f} -> {r1 * 1e3:8.2f} ms  x{r1 / r0:.3f}   "
+          f"with GR ours/WHFast {o1 / r1:.3f}   {'PASS' if o1 / o0 <= 1.2 else 'MISS'}")
+
+    print("\n4. GR with test particles (Sun, Jupiter, N particles; leapfrog, 200 steps)")
+    per = []
+    for n in (1000, 10000):
+        b = orbits.BodySet()
+        b.add("Sun", mass=1 * u.Msun)
+        b.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au)
+        rng = np.random.default_rng(1)
+        a_ = rng.uniform(0.5, 4.0, n)
+        x = np.zeros((n, 3))
+        v = np.zeros((n, 3))
+        phase = rng.uniform(0, 2 * np.pi, n)
+        x[:, 0], x[:, 1] = a_ * np.cos(phase), a_ * np.sin(phase)
+        vc = np.sqrt(b.units.G / a_)
+        v[:, 0], v[:, 1] = -vc * np.sin(phase), vc * np.cos(phase)
+        full = orbits.BodySet.from_arrays(
+            np.concatenate([b.masses.value, np.zeros(n)]) * u.Msun,
+            np.vstack([b.positions.value, x]) * u.au,
+            np.vstack([b.velocities.value, v]) * u.au / u.day)
+        t0 = _median_time(ours(full, "leapfrog", 200.0, [], dt=1.0), rep)
+        t1 = _median_time(ours(full, "leapfrog", 200.0, [forces.GR("Sun")], dt=1.0), rep)
+        per.append((t1 - t0) / (200 * n))
+        print(f"   N = {n:6d}: without {t0 * 1e3:8.2f} ms, with GR {t1 * 1e3:8.2f} ms, "
+              f"GR costs {per[-1] * 1e9:6.2f} ns per particle and step")
+    flat = per[1] / per[0]
+    ok &= flat < 2.0
+    print(f"   per-particle cost at 10^4 / at 10^3: {flat:.2f} (O(N): about 1; "
+          f"O(N^2) would be 10)   {'PASS' if flat < 2.0 else 'MISS'}")
+    print("\nall goals met" if ok else "\nsome goals missed")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
