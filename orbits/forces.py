@@ -94,10 +94,11 @@ class Context(NamedTuple):
         try:
             return self.names.index(name)
         except ValueError:
+            shown = ", ".join(map(repr, self.names[:10])) + (
+                f", ... ({len(self.names)} bodies)" if len(self.names) > 10 else "")
             raise UnknownBodyError(
                 f"{term} names body {name!r} as its {field}, but the body set has no "
-                f"such body (bodies: {', '.join(map(repr, self.names))})",
-                body=name, field=field) from None
+                f"such body (bodies: {shown})", body=name, field=field) from None
 
 
 _REGISTRY = {}
@@ -237,7 +238,13 @@ def _inv_c2(term, c, ctx):
 
 class GR(_SourceTerm):
     """General relativity from one dominant body: the 1PN correction of
-    Anderson et al. (1975), as REBOUNDx's ``gr``.
+    Anderson et al. (1975), the model of REBOUNDx's ``gr`` for planets.
+
+    REBOUNDx's ``gr`` works in Jacobi coordinates and puts each body's whole
+    acceleration into its correction, so a moon's term there also carries its
+    planet's pull; here every body is a test body about the source.  The two
+    agree to 2e-9 au on the planets over 10 years and differ by 1.6e-7 au on
+    the Moon (the validation report's section *Against JPL DE421*).
 
     Every other body, test particles included, feels ::
 

@@ -13,6 +13,7 @@ import pytest
 
 import orbits
 from orbits import forces
+from test_forces import inner_with_jupiter
 
 rebound = pytest.importorskip("rebound")
 reboundx = pytest.importorskip("reboundx")
@@ -21,16 +22,6 @@ C_AU_DAY = const.c.to_value(u.au / u.day)
 YEARS = 100
 #: the issue's parity bound on final positions
 PARITY_AU = 1e-8
-
-
-def inner_with_jupiter():
-    full = orbits.scenes.solar_system()
-    keep = ["Sun", "Mercury", "Venus", "Earth", "Mars", "Jupiter"]
-    idx = [full.names.index(n) for n in keep]
-    b = orbits.BodySet.from_arrays(full.masses[idx], full.positions[idx],
-                                   full.velocities[idx], names=keep)
-    b.move_to_com()
-    return b
 
 
 def rebound_run(bodies, effect, integrator="ias15", dt=None, steps=None):

@@ -54,6 +54,17 @@ class TermKernel(NamedTuple):
     cache: bool = True  # False for a user's function, which numba cannot cache
 
 
+@njit(inline="always")
+def _pull(acc, i, src, w, ax, ay, az):
+    # body i's acceleration and the source's reaction, -w times it (w = m_i / m_src)
+    acc[i, 0] += ax
+    acc[i, 1] += ay
+    acc[i, 2] += az
+    acc[src, 0] -= w * ax
+    acc[src, 1] -= w * ay
+    acc[src, 2] -= w * az
+
+
 # -- GR from one dominant body (Anderson et al. 1975) ------------------------------------
 
 @njit
@@ -68,9 +79,6 @@ def gr_accel(x, v, t, args, acc):
     """
     src, gm, inv_c2 = args
     mu = gm[src]
-    sx = 0.0
-    sy = 0.0
-    sz = 0.0
     for i in range(x.shape[0]):
         if i == src:
             continue
@@ -87,19 +95,7 @@ def gr_accel(x, v, t, args, acc):
         f = mu * inv_c2 / (r2 * r)
         a = f * (4.0 * mu / r - u2)
         b = 4.0 * f * rv
-        ax = a * rx + b * ux
-        ay = a * ry + b * uy
-        az = a * rz + b * uz
-        acc[i, 0] += ax
-        acc[i, 1] += ay
-        acc[i, 2] += az
-        w = gm[i] / mu
-        sx += w * ax
-        sy += w * ay
-        sz += w * az
-    acc[src, 0] -= sx
-    acc[src, 1] -= sy
-    acc[src, 2] -= sz
+        _pull(acc, i, src, gm[i] / mu, a * rx + b * ux, a * ry + b * uy, a * rz + b * uz)
 
 
 @njit
@@ -189,9 +185,6 @@ def gr_potential_accel(x, v, t, args, acc):
     src, gm, inv_c2 = args[0], args[1], args[2]
     mu = gm[src]
     k = 6.0 * mu * mu * inv_c2
-    sx = 0.0
-    sy = 0.0
-    sz = 0.0
     for i in range(x.shape[0]):
         if i == src:
             continue
@@ -200,16 +193,7 @@ def gr_potential_accel(x, v, t, args, acc):
         rz = x[i, 2] - x[src, 2]
         r2 = rx * rx + ry * ry + rz * rz
         f = -k / (r2 * r2)
-        acc[i, 0] += f * rx
-        acc[i, 1] += f * ry
-        acc[i, 2] += f * rz
-        w = gm[i] / mu
-        sx += w * f * rx
-        sy += w * f * ry
-        sz += w * f * rz
-    acc[src, 0] -= sx
-    acc[src, 1] -= sy
-    acc[src, 2] -= sz
+        _pull(acc, i, src, gm[i] / mu, f * rx, f * ry, f * rz)
 
 
 @njit
@@ -388,9 +372,6 @@ def zonal_accel(x, v, t, args, acc):
     px = pole[0]
     py = pole[1]
     pz = pole[2]
-    sx = 0.0
-    sy = 0.0
-    sz = 0.0
     for i in range(x.shape[0]):
         if i == b:
             continue
@@ -408,19 +389,8 @@ def zonal_accel(x, v, t, args, acc):
             inv7 = inv5 / r2
             fr += 0.125 * k4 * inv7 * ((315.0 * u2 - 210.0) * u2 + 15.0)
             fp -= 0.125 * k4 * inv7 * (140.0 * u2 - 60.0) * u * r
-        ax = fr * rx + fp * px
-        ay = fr * ry + fp * py
-        az = fr * rz + fp * pz
-        acc[i, 0] += ax
-        acc[i, 1] += ay
-        acc[i, 2] += az
-        w = gm[i] / gm[b]
-        sx += w * ax
-        sy += w * ay
-        sz += w * az
-    acc[b, 0] -= sx
-    acc[b, 1] -= sy
-    acc[b, 2] -= sz
+        _pull(acc, i, b, gm[i] / gm[b], fr * rx + fp * px, fr * ry + fp * py,
+              fr * rz + fp * pz)
 
 
 @njit
