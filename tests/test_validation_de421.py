@@ -56,6 +56,7 @@ def test_de421_states_are_the_scene_at_j2000_and_move_after():
         scenes.de421_states(2_600_000.0)
 
 
+@pytest.mark.slow   # the section's 11 runs, with their compilation (~100 s)
 def test_relativity_takes_mercury_to_the_floor_after_a_year(rows):
     # Measured after one year: Newtonian 57.9 km from DE421, GR("Sun") 0.194 km,
     # GRFull() 0.162 km (the floor of the model terms the scene lacks).  The
@@ -72,6 +73,7 @@ def test_relativity_takes_mercury_to_the_floor_after_a_year(rows):
     assert _mercury_km(rows, "gr_potential") > newtonian
 
 
+@pytest.mark.slow   # the section's 11 runs, with their compilation (~100 s)
 def test_ours_equals_rebound_and_reboundx(rows):
     for term in ("newtonian", "gr_potential", "gr_full"):
         d, _ = ephemeris.parity(_run(rows, "orbits", term), _run(rows, "rebound", term), 0)
@@ -89,6 +91,7 @@ def test_ours_equals_rebound_and_reboundx(rows):
     assert d < PARITY_AU
 
 
+@pytest.mark.slow   # the section's 11 runs, with their compilation (~100 s)
 def test_the_section_renders(rows, tmp_path):
     text = ephemeris.section(rows, tmp_path, quick=True)
     assert text.startswith(f"## {ephemeris.TITLE}")
