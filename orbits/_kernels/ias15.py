@@ -557,7 +557,7 @@ def ias15_loop(force, stop=False):
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
-    predict_v = force.velocity_dependent or not force.jit or force.key.startswith("user")
+    predict_v = force.velocity_dependent or force.opaque
     helpers = _JITTED if force.jit else {}
     suffix = f"{force.key}{'_stop' if stop else ''}"
     return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,

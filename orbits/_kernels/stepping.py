@@ -169,6 +169,9 @@ class ForceKernel(NamedTuple):
     # terms' TermKernel; fargs is then (gravity fargs, terms' args)
     base: "ForceKernel" = None
     terms: object = None
+    # a user's function replacing gravity (orbits.integrate): nothing is known
+    # of it, so ias15 predicts velocities for it and Wisdom-Holman refuses it
+    opaque: bool = False
 
     @property
     def recorder(self):
@@ -226,7 +229,7 @@ def user_force(accel, jit):
     """A force from a user's ``accel(x, v, t)``; compiled if ``accel`` is a numba function."""
     key = f"user{id(accel)}"
     kernel = specialize(_user_force, key, jit=jit, cache=False, user_accel=accel)
-    return ForceKernel(kernel, key, jit, False)
+    return ForceKernel(kernel, key, jit, False, opaque=True)
 
 
 # -- splitting methods --------------------------------------------------------------

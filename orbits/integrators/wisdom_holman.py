@@ -238,7 +238,7 @@ class WisdomHolman(Integrator):
     def _check_system(self, ws, force, fargs):
         if force.terms is not None:
             force, fargs = force.base, fargs[0]
-        if not force.key.startswith("gravity"):
+        if force.opaque:
             raise IntegratorOptionError(
                 f"{self.name} splits Newtonian gravity into Kepler drifts and kicks and "
                 "cannot integrate another force; use a general method such as 'leapfrog' "
