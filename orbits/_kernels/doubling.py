@@ -15,7 +15,8 @@ import math
 from ._jit import specialize
 from .embedded import initial_step, next_step, step_underflow
 from .status import Status
-from .stepping import epilogues
+from .stepping import _record
+from .stopping import check_stop, no_stop
 
 __all__ = ["doubling_loop"]
 
@@ -110,9 +111,15 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
             steps += 1
             if not shortened:
                 h_prop = next_step(h, err, 4.0)
-            stop, until_record, n_mon = epilogue(  # noqa: F821 - bound by specialize
-                x, v, t, until_record, n_mon, mon, mon_t, mon_out, sargs, info)
+            until_record -= 1
+            if until_record == 0:
+                until_record = every
+                _record(x, v, t, mon, n_mon, mon_t, mon_out)
+                n_mon += 1
+            stop = stop_check(x, v, sargs)  # noqa: F821
             if stop != 0:
+                info[0] = sargs[-1][0]
+                info[1] = sargs[-1][1]
                 status = stop
                 break
         else:
@@ -130,5 +137,6 @@ def doubling_loop(force, stop=False):
     key = f"{force.key}{'_stop' if stop else ''}"
     step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel)
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
-                      epilogue=epilogues(force, stop)[1],
-                      force=force.kernel, rk4_step=step)
+                      _record=force.recorder,
+                      force=force.kernel, rk4_step=step,
+                      stop_check=check_stop if stop else no_stop)

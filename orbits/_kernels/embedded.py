@@ -20,7 +20,8 @@ import math
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import epilogues
+from .stepping import _record
+from .stopping import check_stop, no_stop
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
            "FAC_MIN", "FAC_MAX"]
@@ -161,9 +162,15 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             steps += 1
             if not shortened:
                 h_prop = next_step(h, err, q)
-            stop, until_record, n_mon = epilogue(  # noqa: F821 - bound by specialize
-                x, v, t, until_record, n_mon, mon, mon_t, mon_out, sargs, info)
+            until_record -= 1
+            if until_record == 0:
+                until_record = every
+                _record(x, v, t, mon, n_mon, mon_t, mon_out)
+                n_mon += 1
+            stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
             if stop != 0:
+                info[0] = sargs[-1][0]
+                info[1] = sargs[-1][1]
                 status = stop
                 break
         else:
@@ -180,5 +187,6 @@ def embedded_loop(force, has_e3, stop=False):
     """The adaptive embedded Runge-Kutta loop compiled for a force and an estimator."""
     key = f"{force.key}{'_e3' if has_e3 else ''}{'_stop' if stop else ''}"
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
-                      epilogue=epilogues(force, stop)[1],
-                      force=force.kernel, has_e3=bool(has_e3))
+                      _record=force.recorder,
+                      force=force.kernel, has_e3=bool(has_e3),
+                      stop_check=check_stop if stop else no_stop)

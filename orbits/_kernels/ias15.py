@@ -56,7 +56,8 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import epilogues
+from .stepping import _record  # noqa: F401 - the default recorder of the template
+from .stopping import check_stop, no_stop
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
            "PC_MAX_ITERATIONS", "MODE_GLOBAL", "MODE_PRS24", "ias15_loop", "B6_ROUNDING_GAIN",
@@ -503,9 +504,16 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         else:
             ref[1] += dt
 
-        stop, until_record, n_mon = epilogue(  # noqa: F821 - bound by specialize
-            x, v, t, until_record, n_mon, mon, mon_t, mon_out, sargs, info)
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
+            _record(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
+            n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
         if stop != 0:
+            sinfo = sargs[6]
+            info[0] = sinfo[0]
+            info[1] = sinfo[1]
             return stop, t, n_mon
         if abs(proposed) < min_dt:
             info[0] = worst
@@ -561,5 +569,5 @@ def ias15_loop(force, stop=False):
     helpers = _JITTED if force.jit else {}
     suffix = f"{force.key}{'_stop' if stop else ''}"
     return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,
-                      force=force.kernel,
-                      PREDICT_V=predict_v, epilogue=epilogues(force, stop)[1], **helpers)
+                      force=force.kernel, stop_check=check_stop if stop else no_stop,
+                      PREDICT_V=predict_v, _record=force.recorder, **helpers)

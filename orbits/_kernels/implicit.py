@@ -54,7 +54,8 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import epilogues, state_is_finite
+from .stepping import _record, state_is_finite
+from .stopping import check_stop, no_stop
 
 __all__ = ["implicit_loop", "gravity_jacobian", "user_jacobian",
            "finite_difference_jacobian", "jacobian_for", "lu_factor", "lu_solve",
@@ -385,14 +386,22 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
                 x[i, d] += dt * (v[i, d] + th * hv)
                 v[i, d] += hv
         cache[0] = 1
-        status, until_check, until_record, n_mon = epilogue(  # noqa: F821 - bound
-            x, v, t + (k + 1) * dt, k + 1 == nsteps, until_check, until_record, n_mon,
-            check_every, mon, mon_t, mon_out, sargs)
-        if status != Status.OK:
-            if status == Status.NON_FINITE:
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
+            if not state_is_finite(x, v):
                 cache[0] = 0
-                return status, k, n_mon
-            return status, k + 1, n_mon
+                return Status.NON_FINITE, k, n_mon
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
+            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
+            n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+        if stop != 0:
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
+            return stop, k + 1, n_mon
     return Status.OK, nsteps, n_mon
 
 
@@ -408,5 +417,5 @@ def implicit_loop(force, name, theta, velocity_dependent, stop=False):
         jkey = "fd_v"
     return specialize(_implicit_loop, f"{name}_{force.key}_{jkey}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache and not jkey.startswith("own"),
-                      force=force.kernel, jacobian=jac, epilogue=epilogues(force, stop)[0],
+                      force=force.kernel, jacobian=jac, _record=force.recorder, stop_check=check_stop if stop else no_stop,
                       THETA=float(theta))

@@ -43,8 +43,7 @@ from .status import Status
 from .stopping import check_stop, no_stop
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
-           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms",
-           "epilogues"]
+           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms"]
 
 #: the stopping arguments of a loop compiled without conditions
 NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
@@ -69,60 +68,6 @@ def _record(x, v, t, mon, n_mon, mon_t, mon_out):
     every, which, m, G, n_active, eps2 = mon
     mon_t[n_mon] = t
     monitor_row(x, v, m, G, n_active, eps2, which, mon_out[n_mon])
-
-
-# -- the step epilogues ---------------------------------------------------------------
-#
-# What every compiled loop does after a step, written once.  Each loop binds
-# its own copy (specialize) with the loop's recorder (_record) and stopping
-# check (stop_check), inlined.
-
-def _fixed_epilogue(x, v, t_next, last, until_check, until_record, n_mon, check_every, mon,
-                    mon_t, mon_out, sargs):
-    # After a fixed step: the finite check every check_every steps and after the
-    # last, the in-loop monitors every mon[0] steps, the stopping conditions.
-    # Returns (status, until_check, until_record, n_mon): NON_FINITE means the
-    # step went bad (not counted), another non-OK status that the run stops
-    # after this (good) step.
-    until_check -= 1
-    if until_check == 0 or last:
-        until_check = check_every
-        if not state_is_finite(x, v):
-            return Status.NON_FINITE, until_check, until_record, n_mon
-    until_record -= 1
-    if until_record == 0:
-        until_record = mon[0]
-        _record(x, v, t_next, mon, n_mon, mon_t, mon_out)
-        n_mon += 1
-    stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
-    if stop != 0 and not state_is_finite(x, v):
-        return Status.NON_FINITE, until_check, until_record, n_mon
-    return stop, until_check, until_record, n_mon
-
-
-def _adaptive_epilogue(x, v, t, until_record, n_mon, mon, mon_t, mon_out, sargs, info):
-    # After an accepted adaptive step: the in-loop monitors and the stopping
-    # conditions, whose bodies go to info.  Returns (status, until_record, n_mon).
-    until_record -= 1
-    if until_record == 0:
-        until_record = mon[0]
-        _record(x, v, t, mon, n_mon, mon_t, mon_out)
-        n_mon += 1
-    stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
-    if stop != 0:
-        info[0] = sargs[-1][0]
-        info[1] = sargs[-1][1]
-    return stop, until_record, n_mon
-
-
-def epilogues(force, stop):
-    """The fixed-step and adaptive step epilogues for a :class:`ForceKernel`'s loops
-    (``stop``: with the stopping conditions of :mod:`.stopping`)."""
-    key = f"{force.key}{'_stop' if stop else ''}"
-    bind = dict(jit=force.jit, cache=force.cache, inline=True, _record=force.recorder,
-                stop_check=check_stop if stop else no_stop)
-    return (specialize(_fixed_epilogue, key, **bind),
-            specialize(_adaptive_epilogue, key, **bind))
 
 
 # -- forces ------------------------------------------------------------------------
@@ -273,13 +218,23 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
                     v[i, 0] += h * acc[i, 0]
                     v[i, 1] += h * acc[i, 1]
                     v[i, 2] += h * acc[i, 2]
-        status, until_check, until_record, n_mon = epilogue(  # noqa: F821 - bound
-            x, v, t + (k + 1) * dt, k + 1 == nsteps, until_check, until_record, n_mon,
-            check_every, mon, mon_t, mon_out, sargs)
-        if status != Status.OK:
-            bad = status == Status.NON_FINITE
-            cache[0] = 1 if fresh and not bad else 0
-            return status, k if bad else k + 1, n_mon
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
+            if not state_is_finite(x, v):
+                cache[0] = 0
+                return Status.NON_FINITE, k, n_mon
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
+            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
+            n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+        if stop != 0:
+            cache[0] = 1 if fresh else 0
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
+            return stop, k + 1, n_mon
     cache[0] = 1 if fresh else 0
     return Status.OK, nsteps, n_mon
 
@@ -325,10 +280,11 @@ def splitting_loop(force, name, kinds, coefs, stop=False):
     """
     return specialize(_splitting_loop, f"{name}_{force.key}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache, force=force.kernel,
-                      epilogue=epilogues(force, stop)[0],
+                      _record=force.recorder,
                       implicit_kick=specialize(_implicit_kick, force.key, jit=force.jit,
                                                cache=force.cache, inline=True,
                                                force=force.kernel),
+                      stop_check=check_stop if stop else no_stop,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs))
 
@@ -371,11 +327,21 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
                     dv += b[s] * kv[s, i, d]
                 x[i, d] += dt * dx
                 v[i, d] += dt * dv
-        status, until_check, until_record, n_mon = epilogue(  # noqa: F821 - bound
-            x, v, t + (k + 1) * dt, k + 1 == nsteps, until_check, until_record, n_mon,
-            check_every, mon, mon_t, mon_out, sargs)
-        if status != Status.OK:
-            return status, k if status == Status.NON_FINITE else k + 1, n_mon
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
+        until_record -= 1
+        if until_record == 0:
+            until_record = every
+            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
+            n_mon += 1
+        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+        if stop != 0:
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, n_mon
+            return stop, k + 1, n_mon
     return Status.OK, nsteps, n_mon
 
 
@@ -384,4 +350,5 @@ def runge_kutta_loop(force, stop=False):
     (``stop``: with the stopping conditions of :mod:`.stopping`)."""
     return specialize(_runge_kutta_loop, f"{force.key}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache, force=force.kernel,
-                      epilogue=epilogues(force, stop)[0])
+                      _record=force.recorder,
+                      stop_check=check_stop if stop else no_stop)
