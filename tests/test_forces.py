@@ -345,7 +345,6 @@ def test_energy_of_gr_potential_with_wh_is_bounded_and_needs_the_term():
     # GR potential (2.6e-8 of Mercury's orbital energy, changing along its
     # eccentric orbit) would show as an error above that level
     b = inner_with_jupiter()
-    kw = dict(dt=1 * u.day, progress=False)
     newton = orbits.Simulation(b, "wh", dt=1 * u.day).run(until=20 * u.yr, outputs=400,
                                                            progress=False)
     sim = orbits.Simulation(b, "wh", dt=1 * u.day, forces=[forces.GRPotential("Sun")])
@@ -362,7 +361,6 @@ def test_energy_of_gr_potential_with_wh_is_bounded_and_needs_the_term():
     E_newton = E - pot
     left_out = np.abs(E_newton / E_newton[0] - 1).max()
     assert left_out > 5 * res.energy_error.max()
-    del kw
 
 
 def test_gr_energy_with_ias15_is_conserved():

@@ -107,7 +107,7 @@ from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, _record, state_is_finite
 
-__all__ = ["wh_loop", "synchronizer", "interaction_kick", "jump",
+__all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
            "synchronize", "apply_corrector", "COORDINATE_SYSTEMS"]
 
@@ -162,6 +162,17 @@ def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
     pair_accelerations(x, gm, n_active, 0.0, acc, 0, True)
     # to Jacobi components, with the Kepler terms i >= 2; row 0 (the centre
     # of mass) feels no internal force
+    jacobi_velocity_kick(xj, vj, acc, gm, eta, h, True)
+
+
+@njit(inline="always")
+def jacobi_velocity_kick(xj, vj, acc, gm, eta, h, kepler):
+    """Kick the Jacobi velocities ``vj[1:]`` by ``h`` times the Jacobi transform of
+    the inertial accelerations ``acc``; with ``kepler`` (a constant), rows
+    ``i >= 2`` also get ``G eta_i x'_i / r'_i^3``, the Kepler term that the
+    interaction Hamiltonian holds.  Returns the centre of mass's acceleration,
+    ``sum m a / M``, which the caller applies to row 0 or not."""
+    n = xj.shape[0]
     sx = acc[0, 0]
     sy = acc[0, 1]
     sz = acc[0, 2]
@@ -173,7 +184,7 @@ def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
         sx += w * ax
         sy += w * ay
         sz += w * az
-        if i >= 2:
+        if kepler and i >= 2:
             rx = xj[i, 0]
             ry = xj[i, 1]
             rz = xj[i, 2]
@@ -185,6 +196,7 @@ def interaction_kick(xj, vj, x, acc, gm, eta, n_active, h):
         vj[i, 0] += h * ax
         vj[i, 1] += h * ay
         vj[i, 2] += h * az
+    return sx, sy, sz
 
 
 @njit(inline="always")
@@ -356,20 +368,7 @@ def _jacobi_term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs):
         acc[i, 1] = 0.0
         acc[i, 2] = 0.0
     extra(x, x, 0.0, targs, acc)  # noqa: F821 - bound by specialize
-    sx = acc[0, 0]
-    sy = acc[0, 1]
-    sz = acc[0, 2]
-    for i in range(1, n):
-        ax = acc[i, 0] - sx
-        ay = acc[i, 1] - sy
-        az = acc[i, 2] - sz
-        w = gm[i] / eta[i]
-        sx += w * ax
-        sy += w * ay
-        sz += w * az
-        vj[i, 0] += h * ax
-        vj[i, 1] += h * ay
-        vj[i, 2] += h * az
+    sx, sy, sz = jacobi_velocity_kick(xj, vj, acc, gm, eta, h, False)
     vj[0, 0] += h * sx
     vj[0, 1] += h * sy
     vj[0, 2] += h * sz
