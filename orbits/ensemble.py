@@ -51,13 +51,20 @@ Runs are deterministic: a run gives the same numbers, bit for bit, on any
 worker as in a serial loop (``client="serial"``).
 """
 
+import ast
+import csv
 import hashlib
+import io
 import json
+import linecache
 import math
+import multiprocessing
 import os
 import pathlib
 import socket
+import sys
 import time as _time
+import warnings
 
 import astropy.units as u
 import numpy as np
@@ -65,11 +72,14 @@ import numpy as np
 from . import integrators as _integrators
 from .errors import OrbitsError, RunError
 
-__all__ = ["Ensemble", "local_cluster", "INDEX_FILE", "SWEEP_FILE", "ELEMENTS_MAX_BODIES",
-           "PROGRESS_DELAY", "WORKER_ENVIRONMENT"]
+__all__ = ["Ensemble", "local_cluster", "MissingMainGuard", "INDEX_FILE", "SWEEP_FILE",
+           "ELEMENTS_MAX_BODIES", "PROGRESS_DELAY", "WORKER_ENVIRONMENT"]
 
 #: The index of finished runs in ``out_dir``: one CSV row per run, appended as
-#: each finishes, so that an interrupted sweep knows what it has done.
+#: each finishes (one write of a whole line, then fsync), so that an interrupted
+#: sweep knows what it has done.  On reading, only complete rows count: a line
+#: cut off by a crash, or any row that does not parse whole, is dropped with a
+#: warning and its run is done again.
 INDEX_FILE = "index.csv"
 
 #: What the sweep in ``out_dir`` is (runs, ``until``, outputs, a hash of the
@@ -92,6 +102,40 @@ WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
                       # thread of its own, which shares the core with the run
                       "DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False"}
 
+
+_GUARD_ADVICE = ('each worker process of a local cluster imports the main script again and '
+                 'runs its top level: put the code that runs the sweep under '
+                 '`if __name__ == "__main__":` (as in the README\'s ensemble example), '
+                 'or run the sweep in this process with client="serial"')
+
+
+class MissingMainGuard(OrbitsError, RuntimeError):
+    """A script started a local cluster of worker processes from its top level,
+    outside ``if __name__ == "__main__":``.
+
+    Python starts the workers by importing the main script afresh in each of them
+    (the ``spawn`` start method, which Dask uses); a script that starts the sweep
+    as it is imported has each worker start another cluster, and the workers fail.
+    Put the sweep under the guard::
+
+        def build(a, e):
+            ...
+
+        if __name__ == "__main__":
+            df = orbits.Ensemble.grid(build, a=..., e=...).run(until=...)
+
+    Attributes
+    ----------
+    script : str or None
+        The main script.
+    line : int or None
+        The line of the script from which the cluster was started.
+    """
+
+    def __init__(self, message, script=None, line=None):
+        self.script = script
+        self.line = line
+        super().__init__(message)
 
 
 class Ensemble:
@@ -217,8 +261,9 @@ class Ensemble:
             ``out_dir/index.csv`` as it finishes.  Called again with the same
             ``out_dir`` the sweep skips the runs the index lists, and starts the
             others afresh (a run cut off in the middle is run again from its
-            start).  The directory must be reachable by the workers under the
-            same path.
+            start, and so is a run whose row a crash cut off: only complete
+            rows count).  The directory must be reachable by the workers under
+            the same path.
         n_workers : int, optional
             Workers of the local cluster (default: ``os.cpu_count()``).
         elements : sequence of str, optional
@@ -236,6 +281,14 @@ class Ensemble:
             exception from ``build`` other than an
             :class:`~orbits.errors.OrbitsError` stops the sweep (the rows
             finished before are kept in ``out_dir``).
+
+        Raises
+        ------
+        MissingMainGuard
+            With ``client=None``, when called from the top level of a script
+            outside ``if __name__ == "__main__":``: each worker process imports
+            the script again, so a script that starts a local cluster needs the
+            guard.
         """
         import pandas as pd
 
@@ -244,7 +297,7 @@ class Ensemble:
         done = {}
         if out_dir is not None:
             out_dir = pathlib.Path(out_dir)
-            done = _open_out_dir(out_dir, self._fingerprint(spec))
+            done = _open_out_dir(out_dir, self._fingerprint(spec), n)
         todo = [i for i in range(n) if i not in done]
         rows = dict(done)
         if todo:
@@ -313,20 +366,97 @@ def local_cluster(n_workers=None):
     """A Dask client of a new cluster on this machine: ``n_workers`` processes
     (default ``os.cpu_count()``) of one thread each, on the loopback interface,
     without dashboard, each with :data:`WORKER_ENVIRONMENT`.  Close it with
-    ``client.close(); client.cluster.close()`` (or use it in a ``with``)."""
+    ``client.close(); client.cluster.close()`` (or use it in a ``with``).
+
+    Raises :class:`MissingMainGuard` when called from the top level of a script
+    that lacks ``if __name__ == "__main__":`` (the workers cannot start)."""
     from distributed import Client, LocalCluster
 
     n = os.cpu_count() if n_workers is None else int(n_workers)
     if n < 1:
         raise ValueError(f"n_workers must be >= 1, got {n_workers}")
+    if _importing_main_in_a_child():
+        # a worker importing an unguarded script: stop here with the reason, rather
+        # than have this worker try to start a cluster of its own
+        script, line = _top_level_call(sys.modules.get("__mp_main__")) or (None, None)
+        raise MissingMainGuard(f"a new worker process, importing the main script again, "
+                               f"reached {_where(script, line)}, which starts another "
+                               f"cluster; {_GUARD_ADVICE}", script=script, line=line)
     # no dashboard; the scheduler's small HTTP endpoint (health, metrics) takes a
     # free loopback port rather than 8787, so that two sweeps at once do not clash
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           host="127.0.0.1", dashboard_address=None,
-                           scheduler_kwargs={"dashboard": False,
-                                             "dashboard_address": "127.0.0.1:0"},
-                           env=dict(WORKER_ENVIRONMENT))
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               host="127.0.0.1", dashboard_address=None,
+                               scheduler_kwargs={"dashboard": False,
+                                                 "dashboard_address": "127.0.0.1:0"},
+                               env=dict(WORKER_ENVIRONMENT))
+    except Exception as exc:
+        # Dask says only "Nanny failed to start."; name the usual cause when it is
+        # this one, and leave every other failure as it was
+        where = _unguarded_main_call()
+        if where is None:
+            raise
+        script, line = where
+        raise MissingMainGuard(f"the workers of the local cluster could not start (Dask: "
+                               f"{exc}) because {_where(script, line)} starts the cluster "
+                               f"from the top level of the script, outside "
+                               f"`if __name__ == \"__main__\":`; {_GUARD_ADVICE}",
+                               script=script, line=line) from None
     return Client(cluster)
+
+
+def _importing_main_in_a_child():
+    """Whether this is a new process of ``multiprocessing`` still importing the
+    main script (the state in which multiprocessing itself refuses to start
+    processes, "before the current process has finished its bootstrapping
+    phase")."""
+    return bool(getattr(multiprocessing.current_process(), "_inheriting", False))
+
+
+def _unguarded_main_call():
+    """``(script, line)`` when this call comes from the top level of the main
+    script, outside any ``if`` that tests ``__name__``, and the workers re-import
+    that script (every start method but ``fork``); ``None`` otherwise (a notebook,
+    ``python -c``, a call under the guard or from a function called under it)."""
+    import dask
+
+    if dask.config.get("distributed.worker.multiprocessing-method", "spawn") == "fork":
+        return None
+    main = sys.modules.get("__main__")
+    if getattr(main, "__file__", None) is None and getattr(main, "__spec__", None) is None:
+        return None   # nothing that a worker would import
+    where = _top_level_call(main)
+    if where is None:
+        return None
+    script, line = where
+    try:
+        tree = ast.parse("".join(linecache.getlines(script)))
+    except (SyntaxError, ValueError):
+        return None
+    if not tree.body:
+        return None   # the source is not at hand
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.If) and node.lineno <= line <= node.end_lineno
+                and any(isinstance(n, ast.Name) and n.id == "__name__"
+                        for n in ast.walk(node.test))):
+            return None
+    return script, line
+
+
+def _top_level_call(module):
+    """``(file, line)`` of the statement of ``module``'s top level that is running
+    now and led to this call; ``None`` when none is running."""
+    if module is None:
+        return None
+    frame = sys._getframe(1)
+    while frame is not None and not (frame.f_globals is vars(module)
+                                     and frame.f_code.co_name == "<module>"):
+        frame = frame.f_back
+    return None if frame is None else (frame.f_code.co_filename, frame.f_lineno)
+
+
+def _where(script, line):
+    return "the main script" if script is None else f"line {line} of {script}"
 
 
 # -- one run (on a worker) -------------------------------------------------------------
@@ -418,7 +548,11 @@ def _advance(sim, spec, path):
 def _outcome(exc):
     """The exception's class name in lower case with hyphens: ``CloseEncounter``
     -> ``"close-encounter"``, so that every kind of failure has its own outcome."""
-    name = type(exc).__name__
+    return _outcome_name(type(exc))
+
+
+def _outcome_name(cls):
+    name = cls.__name__
     return "".join(("-" + ch.lower()) if ch.isupper() and k else ch.lower()
                    for k, ch in enumerate(name))
 
@@ -525,7 +659,7 @@ class _Perturbation:
 
 # -- output directory ---------------------------------------------------------------------
 
-def _open_out_dir(out_dir, fingerprint):
+def _open_out_dir(out_dir, fingerprint, n_runs):
     """Create ``out_dir`` or check it holds this sweep; the rows already finished."""
     out_dir.mkdir(parents=True, exist_ok=True)
     sweep = out_dir / SWEEP_FILE
@@ -535,11 +669,11 @@ def _open_out_dir(out_dir, fingerprint):
             raise ValueError(f"{out_dir} holds another sweep (different build, parameters, "
                              f"until, outputs or elements); use a new out_dir")
     else:
-        sweep.write_text(json.dumps({"fingerprint": fingerprint}) + "\n")
+        _write_whole(sweep, json.dumps({"fingerprint": fingerprint}) + "\n")
     index = out_dir / INDEX_FILE
     if not index.exists():
         return {}
-    frame = _read_index(index)
+    frame = _read_index(index, n_runs)
     rows = {}
     for rec in frame.to_dict(orient="records"):
         rec = {k: _from_csv(k, val) for k, val in rec.items()}
@@ -547,12 +681,103 @@ def _open_out_dir(out_dir, fingerprint):
     return rows
 
 
-def _read_index(index):
+def _read_index(index, n_runs):
+    """The complete rows of ``index`` as a DataFrame.
+
+    A row counts only if it ends with its newline, parses as CSV into as many
+    fields as the header has, names a run of this sweep and a known outcome, and
+    has numbers where numbers belong.  Anything else (the half-written line a
+    crash leaves, above all) is dropped with a warning, and the file is rewritten
+    without it, so that its runs are done again and the next row starts on a
+    line of its own.
+    """
+    import pandas as pd
+
+    data = index.read_bytes()
+    # every write ends a row with "\n": whatever follows the last one is a cut-off row
+    end = data.rfind(b"\n") + 1
+    records = list(_csv_records(data[:end].decode("utf-8", errors="replace")))
+    dropped = int(end < len(data))
+    header, header_raw = records.pop(0) if records else (None, "")
+    if header is None or "run" not in header or "outcome" not in header:
+        header, dropped = None, dropped + len(records)   # without a header no row counts
+        records = []
+    good = []
+    for fields, raw in records:
+        if fields is not None and _complete_row(dict(zip(header, fields)), len(fields),
+                                                len(header), n_runs):
+            good.append(raw)
+        else:
+            dropped += 1
+    if dropped:
+        warnings.warn(f"{index}: dropped {dropped} incomplete or unreadable row(s) "
+                      f"(a write cut off); their runs will be run again", stacklevel=4)
+        if header is None:
+            index.unlink()
+        else:
+            _write_whole(index, header_raw + "".join(good))
+    if header is None:
+        return pd.DataFrame({"run": []})
+    return _parse_index(header_raw + "".join(good))
+
+
+def _parse_index(text):
     import pandas as pd
     # floats come back bit for bit: pandas 3 parses them exactly by default,
     # pandas 2 only when asked for "round_trip"
     exact = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
-    return pd.read_csv(index, keep_default_na=False, na_values=[""], **exact)
+    return pd.read_csv(io.StringIO(text), keep_default_na=False, na_values=[""], **exact)
+
+
+def _csv_records(text):
+    """``(fields, raw text)`` of each CSV record of ``text``; ``fields`` is None
+    for a record that does not parse (an unterminated quote, above all)."""
+    raw = []
+
+    def lines():
+        for line in io.StringIO(text, newline=""):
+            raw.append(line)
+            yield line
+
+    reader = csv.reader(lines(), strict=True)
+    while True:
+        try:
+            fields = next(reader)
+        except StopIteration:
+            return
+        except csv.Error:
+            fields = None
+        yield fields, "".join(raw)
+        raw.clear()
+
+
+_INTEGER_COLUMNS = ("run", "steps", "kernels_compiled", "kernels_loaded")
+_REAL_COLUMNS = ("energy_error_max", "angular_momentum_error_max", "wall_time_s")
+
+
+def _complete_row(row, n_fields, n_header, n_runs):
+    if n_fields != n_header:
+        return False
+    try:
+        if not 0 <= float(row["run"]) < n_runs:
+            return False
+        for key, val in row.items():
+            if key in _INTEGER_COLUMNS and not float(val).is_integer():
+                return False
+            if (key in _REAL_COLUMNS or key.startswith("t_stop")) and val != "":
+                float(val)
+    except ValueError:
+        return False
+    return row["outcome"] in _known_outcomes()
+
+
+def _known_outcomes():
+    names, classes = {"completed", "invalid"}, [RunError]
+    while classes:
+        cls = classes.pop()
+        names.add(_outcome_name(cls))
+        classes.extend(cls.__subclasses__())
+    return names
 
 
 _TEXT_COLUMNS = ("outcome", "message", "stop_bodies", "worker", "file")
@@ -572,19 +797,55 @@ def _finish(row, rows, out_dir):
 
     index = out_dir / INDEX_FILE
     frame = pd.DataFrame([row])
-    if index.exists():
-        # keep one header: a row with columns the file lacks rewrites the file
-        header = pd.read_csv(index, nrows=0).columns.tolist()
-        if set(frame.columns) <= set(header):
-            frame.reindex(columns=header).to_csv(index, mode="a", header=False, index=False)
-            return
-        old = _read_index(index)
-        frame = pd.concat([old, frame], ignore_index=True)
-        tmp = index.with_suffix(".tmp")
-        frame.to_csv(tmp, index=False)
-        os.replace(tmp, index)
+    header = _index_header(index)
+    if header is not None and set(frame.columns) <= set(header):
+        _append_whole(index, _to_csv(frame.reindex(columns=header), header=False))
         return
-    frame.to_csv(index, index=False)
+    if header is not None:
+        # keep one header: a row with columns the file lacks rewrites the file (its
+        # rows are all complete: _open_out_dir kept only those, and rows are
+        # appended whole)
+        frame = pd.concat([_parse_index(index.read_text(encoding="utf-8")), frame],
+                          ignore_index=True)
+    _write_whole(index, _to_csv(frame, header=True))
+
+
+def _index_header(index):
+    try:
+        with open(index, encoding="utf-8", newline="") as f:
+            first = f.readline()
+    except FileNotFoundError:
+        return None
+    return next(csv.reader([first]), None) if first.endswith("\n") else None
+
+
+def _to_csv(frame, header):
+    return frame.to_csv(index=False, header=header, lineterminator="\n")
+
+
+def _append_whole(path, text):
+    """Append ``text`` (whole lines) in one write and make it durable before the
+    next run is counted: a crash leaves the file without the line or with a
+    line that lacks its newline, which :func:`_read_index` drops."""
+    data = memoryview(text.encode("utf-8"))
+    fd = os.open(path, os.O_WRONLY | os.O_APPEND | getattr(os, "O_BINARY", 0))
+    try:
+        while data:   # one write for a regular file; the loop is for a short write
+            data = data[os.write(fd, data):]
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _write_whole(path, text):
+    """Replace ``path`` by ``text`` at once: written to a temporary file, synced,
+    then renamed over it, so that a crash leaves the old file or the new one."""
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w", encoding="utf-8", newline="") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
 
 
 _FIRST = ("outcome", "message", "stop_bodies")
