@@ -16,8 +16,8 @@ from .custom import Trajectory, integrate
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, ConvergenceFailure,
                      ElementsError, Escape, ForceTermError, IntegratorOptionError,
                      NonFiniteState,
-                     OrbitsError, StepSizeUnderflow, UnknownIntegratorError,
-                     WallTimeExceeded)
+                     OrbitsError, RunInterrupted, StepSizeUnderflow,
+                     UnknownIntegratorError, WallTimeExceeded)
 from .result import Result
 from .simulation import Simulation
 from .units import UnitSystem
@@ -33,7 +33,7 @@ __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajec
            "BodyError", "ForceTermError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow", "ConvergenceFailure",
-           "CloseEncounter", "Escape", "WallTimeExceeded", "load", "io", "Ensemble", "__version__"]
+           "CloseEncounter", "Escape", "WallTimeExceeded", "RunInterrupted", "load", "io", "Ensemble", "__version__"]
 
 
 def __getattr__(name):

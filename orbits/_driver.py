@@ -1,10 +1,14 @@
 """Advancing an integrator with the guarantee that a failure loses nothing."""
 
+import contextlib
+
 import numpy as np
 
 from ._kernels.status import Status
+from ._kernels.stepping import USER_FORCE_SIZE
+from .errors import ForceTermError
 
-__all__ = ["advance_checked", "CHECK_EVERY"]
+__all__ = ["advance_checked", "restored_on_error", "CHECK_EVERY"]
 
 #: The compiled loops test the state for NaN and inf every this many steps
 #: (a test is a dependent chain of 6N additions, as dear as the force for a few
@@ -24,8 +28,10 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     """
     saved = (x.copy(), v.copy(), _copy_workspace(ws))
     kw = {} if stop is None else {"stop": stop}
-    status, steps, n_mon = integ.advance(ws, x, v, t, dt, n, force, fargs, mon, step0,
-                                         mon_t, mon_out, velocity_dependent, CHECK_EVERY, **kw)
+    with restored_on_error(x, v, ws, saved):
+        status, steps, n_mon = integ.advance(ws, x, v, t, dt, n, force, fargs, mon, step0,
+                                             mon_t, mon_out, velocity_dependent, CHECK_EVERY,
+                                             **kw)
     if status == Status.OK:
         return Status.OK, n, n_mon, ws
     if status != Status.NON_FINITE:
@@ -44,6 +50,33 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     (status, good, n_mon), _ = rerun(n, monitors=True)    # finds the failing step
     (_, _, _), ws = rerun(good, monitors=False)             # back to the last good state
     return Status(status), good, n_mon, ws
+
+
+@contextlib.contextmanager
+def restored_on_error(x, v, ws, saved=None):
+    """Put ``x``, ``v`` and ``ws`` back as they were if the block raises.
+
+    A compiled loop works in place; an error raised inside it (a user force
+    of the wrong size) would otherwise leave the state some steps on and the
+    clock not.  A user force's size error becomes a named
+    :class:`~orbits.errors.ForceTermError`.
+    """
+    if saved is None:
+        saved = (x.copy(), v.copy(), _copy_workspace(ws))
+    try:
+        yield
+    except BaseException as exc:
+        x[...] = saved[0]
+        v[...] = saved[1]
+        for k, a in saved[2].items():
+            if isinstance(a, np.ndarray):
+                ws[k][...] = a
+        if isinstance(exc, ValueError) and str(exc) == USER_FORCE_SIZE:
+            raise ForceTermError("a user force returned an array of another shape than "
+                                 "during the check before the run; the simulation was left "
+                                 "at the start of this chunk", term="UserForce",
+                                 field="func") from None
+        raise
 
 
 def _copy_workspace(ws):

@@ -17,8 +17,8 @@ from ._driver import advance_checked
 from ._kernels import implicit as _implicit
 from ._kernels import stepping as _stepping
 from ._kernels.status import Status
-from .errors import (ConvergenceFailure, IntegratorOptionError, NonFiniteState,
-                     StepSizeUnderflow)
+from .errors import (ConvergenceFailure, ForceTermError, IntegratorOptionError,
+                     NonFiniteState, StepSizeUnderflow)
 
 __all__ = ["integrate", "Trajectory"]
 
@@ -159,6 +159,7 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
     x.ravel()[:size] = x0.ravel()
     v.ravel()[:size] = v0.ravel()
 
+    _check_accel(accel, x0, v0, t0, shape)
     force = _stepping.user_force(accel, jit=_is_jitted(accel))
     if jacobian is not None:
         _check_jacobian(jacobian, x0, v0, t0, size)
@@ -191,6 +192,8 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
             raise TypeError("accel(x, v, t) could not be compiled in the stepping loop; it "
                             "must take arrays x, v (shape of x0) and a float t and return "
                             f"an array of the shape of x0. numba said:\n{exc}") from None
+        except ValueError as exc:
+            _resize_error(exc, shape, t0 + done * dt)
         done += good
         if status != Status.OK:
             ts.append(t0 + done * dt)
@@ -230,9 +233,12 @@ def _integrate_adaptive(integ, force, fargs, mon, x, v, size, shape, scalar, t0,
     for k in range(1, outputs):
         t_out = until if k == outputs - 1 else t0 + k * (until - t0) / (outputs - 1)
         while t < t_out:
-            status, t, acc, _, _, _ = integ.advance_to(
-                ws, x, v, t, t_out, force, fargs, mon, steps, np.empty(0), np.zeros((0, 10)),
-                None, 1 << 40)
+            try:
+                status, t, acc, _, _, _ = integ.advance_to(
+                    ws, x, v, t, t_out, force, fargs, mon, steps, np.empty(0),
+                    np.zeros((0, 10)), None, 1 << 40)
+            except ValueError as exc:
+                _resize_error(exc, shape, t)
             steps += int(acc)
             if status != Status.OK:
                 ts.append(t)
@@ -251,6 +257,46 @@ def _integrate_adaptive(integ, force, fargs, mon, x, v, size, shape, scalar, t0,
         xs.append(x.ravel()[:size].copy())
         vs.append(v.ravel()[:size].copy())
     return trajectory("completed")
+
+
+def _describe(value):
+    if value is None:
+        return "None"
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        return f"a {type(value).__name__}, not numbers"
+    return "a scalar" if arr.ndim == 0 else f"an array of shape {arr.shape}"
+
+
+def _check_accel(accel, x0, v0, t0, shape):
+    """One call up front: a return of the wrong shape is a named error, not garbage."""
+    x = x0.reshape(shape).copy()
+    v = v0.reshape(shape).copy()
+    try:
+        a = accel(x, v, float(t0))
+    except numba.core.errors.TypingError as exc:
+        raise TypeError("accel(x, v, t) could not be compiled; it must take arrays x, v "
+                        f"(shape {shape}) and a float t. numba said:\n{exc}") from None
+    try:
+        arr = np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = None
+    ok = arr is not None and (arr.shape == tuple(shape)
+                              or (arr.ndim == 0 and int(np.prod(shape)) == 1))
+    if not ok:
+        raise ForceTermError(f"accel(x, v, t) returned {_describe(a)} at t0 = {t0:g}; "
+                             f"expected an array of shape {tuple(shape)}, the shape of x0",
+                             term="accel", field="return value")
+
+
+def _resize_error(exc, shape, t):
+    if str(exc) != _stepping.USER_FORCE_SIZE and not isinstance(exc, ForceTermError):
+        raise exc
+    raise ForceTermError(f"accel(x, v, t) returned a different number of values during the "
+                         f"run (after t = {t:.10g}); expected an array of shape "
+                         f"{tuple(shape)}, the shape of x0, every call",
+                         term="accel", field="return value") from None
 
 
 def _check_jacobian(jacobian, x0, v0, t0, size):

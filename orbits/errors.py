@@ -27,11 +27,17 @@ __all__ = [
     "WallTimeExceeded",
     "CloseEncounter",
     "Escape",
+    "RunInterrupted",
+    "OrbitsWarning",
 ]
 
 
 class OrbitsError(Exception):
     """Base class of every exception raised by ``orbits``."""
+
+
+class OrbitsWarning(UserWarning):
+    """Something was changed or may not be what was meant, and the run went on."""
 
 
 def _where(body, field):
@@ -180,3 +186,32 @@ class CloseEncounter(SimulationStopped):
 
 class Escape(SimulationStopped):
     """A body left the system."""
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by SIGINT (Ctrl-C) or SIGTERM, between two compiled chunks.
+
+    A subclass of :class:`KeyboardInterrupt`, so ``except KeyboardInterrupt``
+    catches it.  The simulation is left at the last completed step, with its
+    clock and state agreeing, so it can be continued with another
+    :meth:`~orbits.Simulation.run`; a run writing a file has written a restart
+    checkpoint there first, from which ``orbits resume`` finishes it.
+
+    Attributes
+    ----------
+    signal : int
+        The signal received (``signal.SIGINT`` or ``signal.SIGTERM``).
+    time : astropy.units.Quantity
+        Simulation time at which the run stopped.
+    step : int
+        Number of steps completed (since the simulation was made).
+    result : orbits.Result or None
+        Everything recorded up to there, ending with the state the run stopped at.
+    """
+
+    def __init__(self, message, signal=None, time=None, step=None, result=None):
+        self.signal = signal
+        self.time = time
+        self.step = step
+        self.result = result
+        super().__init__(message)

@@ -60,6 +60,7 @@ import astropy.constants as const
 import astropy.units as u
 import numpy as np
 
+from ._kernels import stepping as _stepping_kernels
 from ._kernels import terms as _k
 from ._kernels._jit import specialize
 from .errors import ForceTermError, UnknownBodyError
@@ -549,6 +550,9 @@ class UserForce(ForceTerm):
                                      term=repr(self), field="potential")
 
 
+_USER_FORCE_SIZE = _stepping_kernels.USER_FORCE_SIZE
+
+
 def _user_accel(x, v, t, args, acc):
     # the user's rows are the body set's order; internal row pos[k] is user row k
     pos, xu, vu, mu = args
@@ -558,6 +562,8 @@ def _user_accel(x, v, t, args, acc):
             xu[k, d] = x[pos[k], d]
             vu[k, d] = v[pos[k], d]
     a = user(xu, vu, t, mu)  # noqa: F821 - bound by specialize
+    if a.shape[0] != n or a.shape[1] != 3:
+        raise ValueError(_USER_FORCE_SIZE)  # checked at bind too; here if it varies
     for k in range(n):
         for d in range(3):
             acc[pos[k], d] += a[k, d]

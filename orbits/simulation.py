@@ -6,7 +6,12 @@ to what it returns.
 """
 
 import math
+import numbers
+import signal as _signal
+import sys
+import threading
 import time as _time
+import warnings
 from typing import NamedTuple
 
 import astropy.units as u
@@ -15,13 +20,13 @@ import numpy as np
 from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
-from ._driver import advance_checked
+from ._driver import advance_checked, restored_on_error
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import (BodyUnitsError, CloseEncounter, ConvergenceFailure, Escape,
-                     IntegratorOptionError, NonFiniteState, StepSizeUnderflow,
-                     WallTimeExceeded)
+                     IntegratorOptionError, NonFiniteState, OrbitsWarning, RunInterrupted,
+                     StepSizeUnderflow, WallTimeExceeded)
 from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
                        vector_relative_error)
 from .result import Result
@@ -38,6 +43,13 @@ PARALLEL_THRESHOLD = 72
 #: A run's compiled loop returns to Python about this often, so that progress
 #: bars move; the chunk length in steps adapts to keep to it.
 CHUNK_SECONDS = 0.25
+
+#: Outputs of a run when none are asked for.
+DEFAULT_OUTPUTS = 500
+
+#: The most steps one run may take: beyond 2**53 float64 no longer tells the
+#: times of neighbouring steps apart.
+MAX_STEPS = float(2 ** 53)
 
 #: A progress bar appears once a run has gone on this long, so short runs stay quiet.
 PROGRESS_DELAY = 3.0
@@ -253,6 +265,9 @@ class Simulation:
             self.integrator.check_terms(terms)
             self._bind_terms(bodies)
 
+        if isinstance(monitors, str):
+            raise ValueError(f"monitors must be a list of monitor names, got the string "
+                             f"{monitors!r}; write monitors=[{monitors!r}]")
         self.monitors = tuple(monitors)
         self._mask = monitor_mask(self.monitors)
         if monitor_every is not None and (int(monitor_every) != monitor_every
@@ -512,7 +527,7 @@ class Simulation:
         return row
 
     # -- running ------------------------------------------------------------------------
-    def run(self, until, outputs=500, progress=None, output=None, overwrite=False,
+    def run(self, until, outputs=None, progress=None, output=None, overwrite=False,
             checkpoint_interval=None, wall_limit=None):
         """Advance to ``until``, recording ``outputs`` evenly spread states.
 
@@ -520,9 +535,11 @@ class Simulation:
         ----------
         until : Quantity (time) or float
             End time; must be later than :attr:`time`.
-        outputs : int
+        outputs : int, optional
             Number of outputs, the current state first and the state at
-            ``until`` last (1: only the state at ``until``).  Fixed-step
+            ``until`` last (1: only the state at ``until``).  Default
+            :data:`DEFAULT_OUTPUTS` (500), or one per step for a fixed-step
+            run of fewer steps (with an :class:`~orbits.errors.OrbitsWarning`).  Fixed-step
             methods never change their step inside a run: each output is taken
             at the step boundary nearest its even spacing (``result.times``
             are the exact times), and only the very last step is shortened, if
@@ -576,16 +593,29 @@ class Simulation:
     def _plan(self, until_v, outputs, until=None):
         """Where a run to ``until_v`` takes its outputs: a :class:`RunPlan`."""
         now = self._now()
+        shown = until if until is not None else until_v
+        if not math.isfinite(until_v):
+            raise ValueError(f"until must be a finite time, got {shown}")
         if not until_v > now:
             raise ValueError(f"until = {until if until is not None else until_v} is not "
                              f"after the current time {self.time:.10g}")
+        default = outputs is None
+        if default:
+            outputs = DEFAULT_OUTPUTS
+        if (isinstance(outputs, bool) or not isinstance(outputs, numbers.Integral)) and not (
+                isinstance(outputs, numbers.Real) and float(outputs).is_integer()):
+            raise ValueError(f"outputs must be a whole number >= 1, got {outputs!r}")
         outputs = int(outputs)
         if outputs < 1:
-            raise ValueError(f"outputs must be >= 1, got {outputs}")
+            raise ValueError(f"outputs must be a whole number >= 1, got {outputs}")
         if self.integrator.adaptive:
             # outputs at exactly evenly spaced times, hit by shortening a step
             return RunPlan(until_v, outputs, 0.0, 0, False, self.steps, now)
         ratio = (until_v - now) / self._dt
+        if not ratio < MAX_STEPS:
+            raise ValueError(f"until = {shown} is {ratio:.3g} steps of dt = {self.dt:.6g} "
+                             f"away: more than the {MAX_STEPS:.3g} steps whose times float64 "
+                             f"can tell apart; use a larger dt or a nearer until")
         n_full = int(round(ratio))
         if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
             n_full = int(math.floor(ratio))
@@ -593,6 +623,12 @@ class Simulation:
         has_partial = partial > 1e-12 * max(until_v - now, self._dt)
         plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps, now)
         total = plan.total_steps
+        if default and outputs > total + 1:
+            warnings.warn(f"the run has only {total} steps: taking {total + 1} outputs (one "
+                          f"per step) instead of the default {DEFAULT_OUTPUTS}",
+                          OrbitsWarning, stacklevel=4)
+            plan = plan._replace(outputs=total + 1)
+            outputs = total + 1
         if outputs > total + 1 or not _increasing(plan.marks(), total):
             raise ValueError(f"outputs = {outputs} needs more steps than the run has "
                              f"({total}); ask for at most {total + 1} outputs or use a "
@@ -604,43 +640,54 @@ class Simulation:
         return self._t_base + (self._steps_since_base + n) * self._dt
 
     def _execute(self, plan, rec, progress, first_mark=0):
-        """Carry out ``plan`` from its output ``first_mark`` on (resuming)."""
-        if self.integrator.adaptive:
-            return self._execute_adaptive(plan, rec, progress, first_mark)
-        done = self.steps - plan.start_step
-        bar = _ProgressBar(plan.total_steps, progress)
-        bar.update(done)
+        """Carry out ``plan`` from its output ``first_mark`` on (resuming).
+
+        The one driver of every run, fixed-step and adaptive: the compiled
+        loop is entered in chunks of about :data:`CHUNK_SECONDS`, and between
+        chunks the progress bar, the wall-time limit and any SIGINT or SIGTERM
+        that arrived are looked at.
+        """
+        adaptive = self.integrator.adaptive
+        if adaptive:
+            bar = _ProgressBar(plan.outputs - 1, progress, unit="output")
+            bar.update(first_mark)
+        else:
+            bar = _ProgressBar(plan.total_steps, progress)
+            bar.update(self.steps - plan.start_step)
         wall0 = _time.perf_counter()
-        try:
-            for mark in plan.marks(first_mark):
-                done = self._advance_to(done, mark, rec, bar, wall0)
-                rec.output(self)
-            done = self._advance_to(done, plan.n_full, rec, bar, wall0)
-            if plan.has_partial and done == plan.n_full:
-                self._advance(1, rec, wall0, dt=plan.until - self._now())
-                bar.update(1)
-            rec.output(self, final=True)
-        finally:
-            bar.close()
-            rec.close()
+        self._wall0 = wall0
+        with _Signals() as self._signals:
+            try:
+                if adaptive:
+                    self._outputs_adaptive(plan, rec, bar, first_mark)
+                else:
+                    self._outputs_fixed(plan, rec, bar, first_mark)
+            finally:
+                bar.close()
+                rec.close()
         return rec.result(self, _time.perf_counter() - wall0)
 
-    def _execute_adaptive(self, plan, rec, progress, first_mark):
-        bar = _ProgressBar(plan.outputs - 1, progress)
-        bar.update(first_mark)
-        wall0 = _time.perf_counter()
-        try:
-            for k in range(first_mark + 1, plan.outputs):
-                self._advance_adaptive(plan.output_time(k), rec, wall0)
-                bar.update(1)
-                rec.output(self, final=k == plan.outputs - 1)
-            if plan.outputs == 1:
-                self._advance_adaptive(plan.until, rec, wall0)
-                rec.output(self, final=True)
-        finally:
-            bar.close()
-            rec.close()
-        return rec.result(self, _time.perf_counter() - wall0)
+    def _outputs_fixed(self, plan, rec, bar, first_mark):
+        wall0 = self._wall0
+        done = self.steps - plan.start_step
+        for mark in plan.marks(first_mark):
+            done = self._advance_to(done, mark, rec, bar, wall0)
+            rec.output(self)
+        done = self._advance_to(done, plan.n_full, rec, bar, wall0)
+        if plan.has_partial and done == plan.n_full:
+            self._advance(1, rec, wall0, dt=plan.until - self._now())
+            bar.update(1)
+        rec.output(self, final=True)
+
+    def _outputs_adaptive(self, plan, rec, bar, first_mark):
+        wall0 = self._wall0
+        for k in range(first_mark + 1, plan.outputs):
+            self._advance_adaptive(plan.output_time(k), rec, wall0)
+            bar.update(1)
+            rec.output(self, final=k == plan.outputs - 1)
+        if plan.outputs == 1:
+            self._advance_adaptive(plan.until, rec, wall0)
+            rec.output(self, final=True)
 
     def _advance_adaptive(self, t_end, rec, wall0):
         integ = self.integrator
@@ -652,9 +699,10 @@ class Simulation:
             mon_out = np.zeros((size, 10))
             mon = self._mon(every)
             t0 = _time.perf_counter()
-            status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
-                self._ws, self._x, self._v, self._t_base, t_end, self._force, self._fargs,
-                mon, self.steps, mon_t, mon_out, self._stop, n)
+            with restored_on_error(self._x, self._v, self._ws):
+                status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
+                    self._ws, self._x, self._v, self._t_base, t_end, self._force,
+                    self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)
             elapsed = _time.perf_counter() - t0
             if n_mon:
                 rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
@@ -670,7 +718,7 @@ class Simulation:
                 self._chunk *= 4
             elif elapsed > CHUNK_SECONDS:
                 self._chunk = max(16, self._chunk // 2)
-            self._check_wall(rec, wall0)
+            self._between_chunks(rec, wall0)
 
     def _advance_to(self, done, target, rec, bar, wall0):
         # the loop returns to Python about every CHUNK_SECONDS (progress bar);
@@ -687,8 +735,40 @@ class Simulation:
                     self._chunk *= 4
                 elif elapsed > CHUNK_SECONDS:
                     self._chunk = max(1, self._chunk // 2)
-            self._check_wall(rec, wall0)
+            self._between_chunks(rec, wall0)
         return done
+
+    def _between_chunks(self, rec, wall0):
+        self._check_signal(rec, wall0)
+        self._check_wall(rec, wall0)
+
+    def _check_signal(self, rec, wall0):
+        """Stop at this consistent point if SIGINT or SIGTERM arrived meanwhile."""
+        signals = getattr(self, "_signals", None)
+        if signals is None or signals.caught is None:
+            return
+        signum = signals.caught
+        signals.caught = None
+        previous = signals.saved.get(signum)
+        rec.checkpoint()
+        if callable(previous) and previous is not _signal.default_int_handler:
+            previous(signum, None)   # the caller's own handler decides; the state is whole
+            return
+        name = _signal.Signals(signum).name
+        rec.stopped(self)
+        rec.close()
+        result = rec.result(self, _time.perf_counter() - wall0, status=f"stopped by {name}")
+        if previous is _signal.default_int_handler:
+            path = getattr(rec, "path", None)
+            raise RunInterrupted(
+                f"{name} at t = {self.time:.10g} (step {self.steps}): the simulation was "
+                f"left at the last completed step, clock and state agreeing"
+                + (f", and a restart checkpoint was written to {path}" if path else "")
+                + "; the result up to here is kept on .result",
+                signal=signum, time=self.time, step=self.steps, result=result)
+        # the default action (SIGTERM ends the process): taken now that the file is whole
+        signals.restore()
+        _signal.raise_signal(signum)
 
     def _check_wall(self, rec, wall0):
         limit = getattr(self, "_wall_limit", None)
@@ -845,6 +925,13 @@ class _Recorder:
     def close(self):
         """Nothing to release for a run kept in memory."""
 
+    def checkpoint(self, finished=False):
+        """Nothing to save for a run kept in memory."""
+
+    def stopped(self, sim):
+        """A run stopped early by a signal: its result ends where it stopped."""
+        self.output(sim, final=True)
+
     def output(self, sim, final=False):
         snap = sim.snapshot()
         self.t.append(snap.t)
@@ -898,8 +985,11 @@ def _monitor_fields(rows, sim, ref):
 class _ProgressBar:
     """A tqdm bar that appears only for long runs (or always, or never)."""
 
-    def __init__(self, total, progress):
+    def __init__(self, total, progress, unit="step"):
         self.total = total
+        self.unit = unit
+        if progress is None and not _stderr_is_terminal():
+            progress = False  # a log file gets no bar
         self.progress = progress
         self.done = 0
         self.start = _time.perf_counter()
@@ -909,7 +999,7 @@ class _ProgressBar:
 
     def _open(self):
         from tqdm.auto import tqdm
-        self.bar = tqdm(total=self.total, initial=self.done, unit="step", unit_scale=True,
+        self.bar = tqdm(total=self.total, initial=self.done, unit=self.unit, unit_scale=True,
                         leave=False, desc="orbits")
 
     def update(self, n):
@@ -923,3 +1013,58 @@ class _ProgressBar:
     def close(self):
         if self.bar is not None:
             self.bar.close()
+
+
+def _stderr_is_terminal():
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
+class _Signals:
+    """SIGINT and SIGTERM held while a run is in compiled code, acted on between chunks.
+
+    Python runs a signal's handler between bytecodes only.  Ctrl-C's handler
+    raising while a compiled loop returns would leave the loop's in-place
+    state advanced and the clock not (and surfaces as ``SystemError``).  During
+    a run, in the main thread, the handler only notes the signal; the run
+    looks between chunks, at a consistent state, and stops there
+    (:meth:`Simulation._check_signal`).  Signals that were ignored stay
+    ignored, and the handlers are put back when the run ends.  A signal noted
+    after the last look is delivered when the run has finished.
+    """
+
+    SIGNALS = (_signal.SIGINT, _signal.SIGTERM)
+
+    def __init__(self):
+        self.caught = None
+        self.saved = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for signum in self.SIGNALS:
+                previous = _signal.getsignal(signum)
+                if previous in (_signal.SIG_IGN, None):
+                    continue
+                try:
+                    _signal.signal(signum, self._note)
+                except (ValueError, OSError):  # pragma: no cover - not the main interpreter
+                    continue
+                self.saved[signum] = previous
+        return self
+
+    def _note(self, signum, frame):
+        if self.caught is None:
+            self.caught = signum
+
+    def restore(self):
+        for signum, previous in self.saved.items():
+            _signal.signal(signum, previous)
+        self.saved = {}
+
+    def __exit__(self, kind, exc, tb):
+        self.restore()
+        if self.caught is not None and kind is None:
+            _signal.raise_signal(self.caught)
+        return False

@@ -83,6 +83,10 @@ def _gravity_force_exact(x, v, t, fargs, acc):
     accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc)
 
 
+#: the message of the error a user force of the wrong size raises in the loop
+USER_FORCE_SIZE = "orbits: the user force returned a different number of values than the state has"
+
+
 def _user_force(x, v, t, fargs, acc):
     # the user's arrays (any shape, ``size`` values) fill the (rows, 3) state
     # arrays in order; the padding stays zero
@@ -90,6 +94,9 @@ def _user_force(x, v, t, fargs, acc):
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
     a = np.asarray(user_accel(xu, vu, t)).ravel()  # noqa: F821 - bound by specialize
+    if a.size != size:
+        # checked before the run too (orbits.custom); here for a size that varies
+        raise ValueError(USER_FORCE_SIZE)
     flat = acc.ravel()
     for i in range(size):
         flat[i] = a[i]

@@ -36,12 +36,20 @@ of drift and kick coefficients (:class:`SplittingMethod`), an explicit
 Runge-Kutta method a Butcher table (:class:`ExplicitRungeKutta`).
 """
 
+import numbers
+import warnings
+
 import numpy as np
 
 from .._kernels import stepping
-from ..errors import IntegratorOptionError
+from ..errors import IntegratorOptionError, OrbitsWarning
 
-__all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator"]
+__all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
+           "RTOL_FLOOR"]
+
+#: The smallest relative tolerance an adaptive method is run with: 100 float64
+#: roundings (the floor scipy's ``solve_ivp`` also applies).
+RTOL_FLOOR = 100 * float(np.finfo(float).eps)
 
 
 class Integrator:
@@ -215,11 +223,26 @@ class AdaptiveIntegrator(Integrator):
     def _positive(self, *names):
         for name in names:
             value = self.config[name]
-            try:
-                ok = float(value) > 0 and float(value) < float("inf")
-            except (TypeError, ValueError):
-                ok = False
+            ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
+                  and 0 < float(value) < float("inf"))
             if not ok:
                 raise IntegratorOptionError(
                     f"integrator {self.name!r}: option {name!r} must be a positive finite "
-                    f"number, got {value!r}")
+                    f"number, got {value!r}" + (" (a string)" if isinstance(value, str)
+                                                else ""))
+            self.config[name] = float(value)
+
+    def _relative_tolerance(self, name):
+        """Raise ``name`` to :data:`RTOL_FLOOR` if asked for less, with a warning.
+
+        A relative error below a few float64 roundings cannot be delivered:
+        the error estimate of a step then reads zero only where the stages
+        round to the same numbers, and the method creeps on with steps far
+        too short to matter (23 million steps to t = 5e-5 d at rtol = 1e-30).
+        """
+        self._positive(name)
+        if self.config[name] < RTOL_FLOOR:
+            warnings.warn(f"integrator {self.name!r}: {name} = {self.config[name]:g} is below "
+                          f"what float64 arithmetic can deliver; using {RTOL_FLOOR:.3g} "
+                          f"(100 roundings)", OrbitsWarning, stacklevel=5)
+            self.config[name] = RTOL_FLOOR

@@ -39,7 +39,8 @@ class RK4Doubling(AdaptiveIntegrator):
     forces_per_step = 11
 
     def _check_options(self):
-        self._positive("rtol", "atol")
+        self._relative_tolerance("rtol")
+        self._positive("atol")
 
     def workspace(self, n, initial_step=0.0):
         z = lambda: np.zeros((n, 3))  # noqa: E731

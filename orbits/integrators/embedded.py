@@ -24,7 +24,8 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
     options = {"rtol": 1e-9, "atol": 1e-12}
 
     def _check_options(self):
-        self._positive("rtol", "atol")
+        self._relative_tolerance("rtol")
+        self._positive("atol")
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)

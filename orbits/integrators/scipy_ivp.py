@@ -5,9 +5,11 @@ These are scipy's implementations (Radau IIA of order 5, Hairer & Wanner
 user problem or a check of our own methods can use them through the same API.
 They run in Python and are slow; they are references, not workhorses.
 
-Each ``advance_to`` call starts ``solve_ivp`` afresh from the current state
-(with the last step size as its first step), so a run resumed from a file
-continues exactly as an uninterrupted one.  ``scipy`` must be installed.
+Each ``advance_to`` call starts scipy's solver afresh from the current state
+(with the last step size as its first step) and steps it to the next output,
+so a run resumed from a file continues exactly as an uninterrupted one.  A
+step that no longer moves the time (a collision ahead) ends the run with
+:class:`~orbits.errors.StepSizeUnderflow`.  ``scipy`` must be installed.
 """
 
 import numpy as np
@@ -17,6 +19,8 @@ from ..errors import IntegratorOptionError
 from .base import AdaptiveIntegrator
 
 __all__ = ["ScipyIntegrator", "Radau", "LSODA"]
+
+_EPS = float(np.finfo(float).eps)
 
 
 class ScipyIntegrator(AdaptiveIntegrator):
@@ -32,7 +36,8 @@ class ScipyIntegrator(AdaptiveIntegrator):
     stop_conditions = False
 
     def _check_options(self):
-        self._positive("rtol", "atol")
+        self._relative_tolerance("rtol")
+        self._positive("atol")
 
     def workspace(self, n, initial_step=0.0):
         return {"dt": np.array([float(initial_step)]), "info": np.full(2, -1, dtype=np.int64)}
@@ -40,7 +45,7 @@ class ScipyIntegrator(AdaptiveIntegrator):
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
                    max_steps):
         try:
-            from scipy.integrate import solve_ivp
+            from scipy import integrate
         except ImportError:  # pragma: no cover - scipy is a test dependency
             raise IntegratorOptionError(f"integrator {self.name!r} needs scipy "
                                         "(pip install scipy)") from None
@@ -59,15 +64,25 @@ class ScipyIntegrator(AdaptiveIntegrator):
         y0 = np.concatenate([x.ravel(), v.ravel()])
         first = float(ws["dt"][0])
         kw = {"first_step": min(first, t_end - t)} if first > 0 else {}
-        sol = solve_ivp(rhs, (t, t_end), y0, method=self.method, rtol=self.config["rtol"],
-                        atol=self.config["atol"], **kw)
-        if sol.status != 0 or not np.all(np.isfinite(sol.y[:, -1])):
-            return Status.STEP_UNDERFLOW, t, 0, 0, int(sol.nfev), 0
-        x[...] = sol.y[:3 * n, -1].reshape(n, 3)
-        v[...] = sol.y[3 * n:, -1].reshape(n, 3)
-        if len(sol.t) > 1:
-            ws["dt"][0] = sol.t[-1] - sol.t[-2]
-        return Status.OK, t_end, len(sol.t) - 1, 0, int(sol.nfev), 0
+        solver = getattr(integrate, self.method)(rhs, t, y0, t_end, rtol=self.config["rtol"],
+                                                 atol=self.config["atol"], **kw)
+        steps = 0
+        last_step = 0.0
+        floor = 4.0 * _EPS * max(abs(t), abs(t_end))
+        while solver.status == "running":
+            solver.step()
+            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                return Status.STEP_UNDERFLOW, t, 0, 0, int(solver.nfev), 0
+            steps += 1
+            last_step = solver.t - solver.t_old
+            if solver.status == "running" and last_step <= floor:
+                # the steps no longer move t: a collision or a singularity ahead
+                return Status.STEP_UNDERFLOW, t, 0, 0, int(solver.nfev), 0
+        x[...] = solver.y[:3 * n].reshape(n, 3)
+        v[...] = solver.y[3 * n:].reshape(n, 3)
+        if last_step > 0:
+            ws["dt"][0] = last_step
+        return Status.OK, t_end, steps, 0, int(solver.nfev), 0
 
 
 class Radau(ScipyIntegrator):
