@@ -24,15 +24,15 @@ so that nothing downstream asks for its name:
 
 Which integrators take which term:
 
-==================  ===========================================  ==================
-term                Wisdom-Holman family (``wh``, ``saba*``)      every other method
-==================  ===========================================  ==================
-:class:`GRPotential`  yes, symplectic                             yes
-:class:`ZonalHarmonics`  yes, symplectic                          yes
-:class:`UserForce`  with ``potential`` and not velocity-dependent  yes
-:class:`GR`         no (velocities)                               yes
-:class:`GRFull`     no (velocities)                               yes
-==================  ===========================================  ==================
+=======================  ==============================================  ==================
+term                     Wisdom-Holman family (``wh``, ``saba*``)        every other method
+=======================  ==============================================  ==================
+:class:`GRPotential`     yes, symplectic                                 yes
+:class:`ZonalHarmonics`  yes, symplectic                                 yes
+:class:`UserForce`       with ``potential`` and not velocity-dependent   yes
+:class:`GR`              no (velocities)                                 yes
+:class:`GRFull`          no (velocities)                                 yes
+=======================  ==============================================  ==================
 
 With a velocity-dependent term the leapfrog, Verlet and the compositions
 kick with ``v' = v + h a(x, (v + v') / 2)``, solved by fixed-point

@@ -44,7 +44,7 @@ def vector_relative_error(values, reference, scale):
     """``|L - L0| / |L0|`` for vectors of shape (n, 3).
 
     A system with zero total angular momentum (the Pythagorean problem) has
-    no relative error; there ``scale`` (sum of m |x| |v| at the start) is the
+    no relative error; there ``scale`` (sum of ``m |x| |v|`` at the start) is the
     denominator, so the figure still says how large the error is against the
     system's own angular-momentum budget.
     """

@@ -10,6 +10,8 @@ __all__ = ["plot_result", "plot_file"]
 def plot_result(result, path):
     """Orbits in the x-y plane, and the relative energy and angular-momentum
     errors against time on log axes, side by side in one PNG."""
+    if not len(result.times):
+        raise ValueError("the result holds no outputs: nothing to plot")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -51,6 +53,9 @@ def plot_result(result, path):
 
 def plot_file(path, out=None):
     """Plot an output file (see :func:`plot_result`); returns the PNG's path."""
-    from .io.hdf5 import load
+    from .io.hdf5 import OrbitsFileError, load
     out = pathlib.Path(out) if out else pathlib.Path(path).with_suffix(".png")
-    return plot_result(load(path), out)
+    result = load(path)
+    if not len(result.times):
+        raise OrbitsFileError(f"{path}: holds no outputs ({result.status}): nothing to plot")
+    return plot_result(result, out)

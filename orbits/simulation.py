@@ -551,7 +551,10 @@ class Simulation:
             Stream the outputs and monitors to this HDF5 file instead of
             keeping them in memory, with restart checkpoints (see
             :mod:`orbits.io.hdf5`).  The returned result then holds only the
-            last output; :func:`orbits.load` reads the whole file.  A file that
+            last output (its :meth:`~orbits.Result.max_energy_error`,
+            :meth:`~orbits.Result.max_angular_momentum_error` and
+            :meth:`~orbits.Result.summary` still cover the whole run);
+            :func:`orbits.load` reads the whole file.  A file that
             this simulation wrote (or was restored from) is appended to; any
             other existing file is an error unless ``overwrite=True``.
         overwrite : bool
@@ -559,7 +562,10 @@ class Simulation:
         checkpoint_interval : float, optional
             Seconds of wall time between restart checkpoints in the file
             (default :data:`orbits.io.hdf5.CHECKPOINT_SECONDS`); 0 writes one
-            at every output.  One is always written at the end.
+            at every output.  One is also written when the file is opened, at
+            the end, and on SIGINT or SIGTERM; each costs about 2 ms and
+            overwrites one of two fixed slots, so the interval does not change
+            the file's size.
         wall_limit : float, optional
             Seconds of wall-clock time after which the run stops with
             :class:`~orbits.errors.WallTimeExceeded` (checked about every
@@ -578,9 +584,13 @@ class Simulation:
             good state; the simulation is left at that state.
         """
         plan = self._plan(self._time_value(until, "until"), outputs, until)
-        if wall_limit is not None and not float(wall_limit) > 0:
+        if wall_limit is not None and not _positive_number(wall_limit):
             raise ValueError(f"wall_limit must be a positive number of seconds, "
-                             f"got {wall_limit}")
+                             f"got {wall_limit!r}")
+        if checkpoint_interval is not None and not (
+                _positive_number(checkpoint_interval) or checkpoint_interval == 0):
+            raise ValueError(f"checkpoint_interval must be a number of seconds >= 0, "
+                             f"got {checkpoint_interval!r}")
         self._wall_limit = None if wall_limit is None else float(wall_limit)
         if output is None:
             rec = _Recorder(self, initial=plan.outputs > 1)
@@ -916,6 +926,7 @@ class _Recorder:
         self.steps0 = sim.steps
         self.forces0 = sim.force_evaluations
         self.rejected0 = sim.steps_rejected
+        self.t0 = sim._now()
         self.n = n
         if initial:
             self.output(sim)
@@ -954,7 +965,7 @@ class _Recorder:
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
             integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
             monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
-            forces=tuple(map(repr, sim.forces)))
+            forces=tuple(map(repr, sim.forces)), start_time=q(self.t0, "time"))
         ref = sim._reference
         if self.rows:
             fields.update(_monitor_fields(np.array(self.rows), sim, ref))
@@ -1013,6 +1024,11 @@ class _ProgressBar:
     def close(self):
         if self.bar is not None:
             self.bar.close()
+
+
+def _positive_number(value):
+    return (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and 0 < float(value) < math.inf)
 
 
 def _stderr_is_terminal():

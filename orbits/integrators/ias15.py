@@ -16,8 +16,8 @@ ADAPTIVE_MODES = {"global": _k.MODE_GLOBAL, "prs24": _k.MODE_PRS24}
 class IAS15(AdaptiveIntegrator):
     """15th-order implicit Gauss-Radau integrator with adaptive steps (IAS15).
 
-    Options
-    -------
+    Parameters
+    ----------
     epsilon : float
         Accuracy parameter, > 0 (default 1e-9, Rein & Spiegel's value, at which
         the error per step is below double-precision rounding for smooth

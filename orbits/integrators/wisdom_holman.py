@@ -76,8 +76,8 @@ class WisdomHolman(Integrator):
     """Wisdom-Holman map in Jacobi or democratic heliocentric coordinates, with
     lazy synchronisation.
 
-    Options
-    -------
+    Parameters
+    ----------
     coordinates : {"jacobi", "democratic-heliocentric"}
         The split.  ``"jacobi"`` (default): each body orbits the interior
         mass ``G eta_i`` of the bodies before it; a two-body problem is
