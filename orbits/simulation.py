@@ -8,6 +8,7 @@ to what it returns.
 import math
 import numbers
 import signal as _signal
+import _signal as _csignal
 import sys
 import threading
 import time as _time
@@ -1051,20 +1052,22 @@ class _Signals:
     after the last look is delivered when the run has finished.
     """
 
-    SIGNALS = (_signal.SIGINT, _signal.SIGTERM)
+    SIGNALS = (int(_signal.SIGINT), int(_signal.SIGTERM))
 
     def __init__(self):
         self.caught = None
         self.saved = {}
 
     def __enter__(self):
+        # the C-level calls of the signal module: its Python wrappers' enum
+        # conversions made up most of the cost of a short run's set-up
         if threading.current_thread() is threading.main_thread():
             for signum in self.SIGNALS:
-                previous = _signal.getsignal(signum)
-                if previous in (_signal.SIG_IGN, None):
+                previous = _csignal.getsignal(signum)
+                if previous == _csignal.SIG_IGN or previous is None:
                     continue
                 try:
-                    _signal.signal(signum, self._note)
+                    _csignal.signal(signum, self._note)
                 except (ValueError, OSError):  # pragma: no cover - not the main interpreter
                     continue
                 self.saved[signum] = previous
@@ -1076,7 +1079,7 @@ class _Signals:
 
     def restore(self):
         for signum, previous in self.saved.items():
-            _signal.signal(signum, previous)
+            _csignal.signal(signum, previous)
         self.saved = {}
 
     def __exit__(self, kind, exc, tb):
