@@ -214,7 +214,7 @@ def _main(args, orbits):
         sim = orbits.Simulation.from_file(args.file)
         progress = False if args.no_progress else None
         result = None
-        if not sim._resume.finished:
+        if not sim.resume_point.finished:
             result = sim.resume(progress=progress,
                                 checkpoint_interval=args.checkpoint_interval)
             print(f"finished the interrupted run in {args.file}")

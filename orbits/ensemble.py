@@ -497,7 +497,7 @@ def run_one(build, params, index, spec, path=None):
     row["message"] = "" if exc is None else str(exc)
     row["stop_bodies"] = ",".join(getattr(exc, "bodies", ()) or ())
     units = sim.units
-    t_end = sim._now() if exc is None or exc.time is None else exc.time
+    t_end = sim.time_value if exc is None or exc.time is None else exc.time
     row[_column("t_stop", units.time)] = _value(t_end, units.time)
     row["steps"] = sim.steps
     if path is not None:   # the result of a run to a file holds only its last output

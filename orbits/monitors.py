@@ -10,7 +10,8 @@ import numpy as np
 from ._kernels import invariants as _inv
 
 __all__ = ["MONITORS", "DEFAULT_MONITORS", "monitor_mask", "relative_error",
-           "vector_relative_error", "growth_exponent", "ensemble_growth_exponent"]
+           "vector_relative_error", "growth_exponent", "ensemble_growth_exponent",
+           "monitor_fields"]
 
 #: monitor name -> bit of the kernel mask
 MONITORS = {
@@ -118,3 +119,24 @@ def ensemble_growth_exponent(t, errors, t_from, boots=400, seed=1):
     m = errors.shape[0]
     draws = [fit(errors[rng.integers(0, m, m)]) for _ in range(boots)]
     return exponent, float(np.std(draws))
+
+
+def monitor_fields(rows, monitors, reference, scales, units):
+    """A result's monitor fields from monitor ``rows`` (the compiled kernels'
+    layout: energy, L, P, centre of mass), as Quantities, with the relative
+    errors against ``reference`` (``scales``: energy and angular-momentum
+    scales used where the reference is zero)."""
+    q = units.quantity
+    out = {}
+    if "energy" in monitors:
+        out["energy"] = q(rows[:, 0], "energy")
+        out["energy_error"] = relative_error(rows[:, 0], reference[0], scale=scales[0])
+    if "angular_momentum" in monitors:
+        out["angular_momentum"] = q(rows[:, 1:4], "angular_momentum")
+        out["angular_momentum_error"] = vector_relative_error(rows[:, 1:4], reference[1:4],
+                                                              scales[1])
+    if "momentum" in monitors:
+        out["momentum"] = q(rows[:, 4:7], "momentum")
+    if "center_of_mass" in monitors:
+        out["center_of_mass"] = q(rows[:, 7:10], "length")
+    return out

@@ -13,7 +13,6 @@ import sys
 import threading
 import time as _time
 import warnings
-from typing import NamedTuple
 
 import astropy.units as u
 import numpy as np
@@ -28,12 +27,13 @@ from .bodies import BodySet
 from .errors import (BodyUnitsError, CloseEncounter, ConvergenceFailure, Escape,
                      IntegratorOptionError, NonFiniteState, OrbitsWarning, RunInterrupted,
                      StepSizeUnderflow, WallTimeExceeded)
-from .monitors import (DEFAULT_MONITORS, monitor_mask, relative_error,
-                       vector_relative_error)
+from .monitors import DEFAULT_MONITORS, monitor_fields, monitor_mask
+from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
+                      Snapshot)
 from .result import Result
 
-__all__ = ["Simulation", "SimulationConfig", "SimulationState", "Snapshot", "RunPlan",
-           "PARALLEL_THRESHOLD"]
+__all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescription",
+           "Snapshot", "RunPlan", "PARALLEL_THRESHOLD"]
 
 #: Bodies from which the threaded gravity kernel is used.  Measured with
 #: benchmarks/bench_gravity.py on the 2-core reference machine (whole leapfrog
@@ -54,101 +54,6 @@ MAX_STEPS = float(2 ** 53)
 
 #: A progress bar appears once a run has gone on this long, so short runs stay quiet.
 PROGRESS_DELAY = 3.0
-
-
-class RunPlan(NamedTuple):
-    """Where one ``run`` takes its steps and outputs; stored in output files so
-    that an interrupted run resumes with exactly the same steps."""
-
-    until: float            # end time (internal units)
-    outputs: int
-    ratio: float            # (until - start) / dt
-    n_full: int             # whole steps of dt
-    has_partial: bool       # one shortened last step to land on until
-    start_step: int         # Simulation.steps when the run began
-    start_time: float = 0.0  # time when the run began (adaptive runs' output times)
-
-    @property
-    def total_steps(self):
-        return self.n_full + int(self.has_partial)
-
-    def output_time(self, k):
-        """Time of output ``k`` of an adaptive run (exactly ``until`` for the last)."""
-        if k >= self.outputs - 1:
-            return self.until
-        return self.start_time + k * (self.until - self.start_time) / (self.outputs - 1)
-
-    def marks(self, first=0):
-        """Step counts (from the run's start) of the outputs between the first and
-        last, from the ``first``-th on; a generator, so a run of a million outputs
-        holds none of them in memory."""
-        for k in range(first + 1, self.outputs - 1):
-            yield min(int(round(k * self.ratio / (self.outputs - 1))), self.n_full)
-
-
-class SimulationConfig(NamedTuple):
-    """Everything but the bodies that makes a :class:`Simulation`: one object that
-    output files store and ensembles ship, so that a simulation is rebuilt with
-    :meth:`Simulation.from_config` rather than by re-listing its arguments.
-
-    Quantities stay Quantities; :meth:`to_dict` gives plain JSON-able values.
-    """
-
-    integrator: str
-    integrator_options: dict
-    dt: object              # Quantity (time) or None
-    forces: tuple           # ForceTerm dictionaries, the Gravity term first
-    monitors: tuple
-    monitor_every: object   # int or None
-    stop_conditions: dict   # Simulation keyword -> value
-
-    def to_dict(self):
-        """Plain values: Quantities as ``[value, unit]``."""
-        from .forces import _quantity_dict
-        return {"integrator": self.integrator,
-                "integrator_options": dict(self.integrator_options),
-                "dt": _quantity_dict(self.dt), "forces": list(self.forces),
-                "monitors": list(self.monitors), "monitor_every": self.monitor_every,
-                "stop_conditions": {k: (_quantity_dict(v) if isinstance(v, u.Quantity) else v)
-                                    for k, v in self.stop_conditions.items()}}
-
-    @classmethod
-    def from_dict(cls, d):
-        from .forces import _quantity_from
-        return cls(d["integrator"], dict(d["integrator_options"]), _quantity_from(d["dt"]),
-                   tuple(d["forces"]), tuple(d["monitors"]), d["monitor_every"],
-                   {k: _quantity_from(v) for k, v in d["stop_conditions"].items()})
-
-
-class SimulationState(NamedTuple):
-    """A simulation's dynamical state, exactly: what a restart checkpoint saves
-    and :meth:`Simulation.set_state` puts back (bit for bit).
-
-    Arrays are in the simulation's internal order (massive bodies first,
-    ``order[i]`` the body set's row of internal row ``i``) and units.
-    """
-
-    x: np.ndarray                # (N, 3), the integrator's current positions
-    v: np.ndarray                # (N, 3)
-    order: np.ndarray            # (N,) int64
-    t_base: float                # time = t_base + steps_since_base * dt
-    steps_since_base: int
-    steps: int                   # accepted steps since the simulation was made
-    force_evaluations: int
-    steps_rejected: int
-    workspace: dict              # the integrator's arrays (name -> ndarray)
-    reference: np.ndarray        # the monitors' reference row (errors are against it)
-    scales: tuple                # (energy scale, angular momentum scale)
-
-
-class Snapshot(NamedTuple):
-    """One output: time, step count, and the state in the body set's order."""
-
-    t: float
-    steps: int
-    x: np.ndarray
-    v: np.ndarray
-    monitors: np.ndarray         # one monitor row (orbits._kernels.invariants layout)
 
 
 class Simulation:
@@ -289,6 +194,11 @@ class Simulation:
         self.steps = 0              # steps since the simulation was made
         self.force_evaluations = 0
         self._chunk = 1024          # steps per compiled call; adapts in run()
+        #: the HDF5 file this simulation writes to (set by ``run(output=...)``
+        #: and :meth:`from_file`): a later ``run`` with the same ``output``
+        #: appends to it
+        self.output_path = None
+        self._resume = None
         # only the monitors asked for: the energy of a large N costs O(N^2)
         self._reference = self._monitor_row(np.zeros(10))
         self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
@@ -418,7 +328,22 @@ class Simulation:
         it; :meth:`run` with ``output=path`` appends a new run to the file.
         """
         from .io import hdf5
-        return hdf5.restore(path)
+        cp = hdf5.read_checkpoint(path)
+        sim = cls.from_config(cp.bodies, cp.config)
+        if not np.array_equal(sim._order, cp.state.order):
+            raise hdf5.OrbitsFileError(f"{path}: the stored body order does not match the "
+                                       f"masses")
+        sim.set_state(cp.state)
+        sim.output_path = cp.path
+        sim._resume = cp.point
+        return sim
+
+    @property
+    def resume_point(self):
+        """Where the run that wrote the file this simulation was restored from
+        stood at its last checkpoint (:class:`orbits.io.hdf5.ResumePoint`), until
+        :meth:`resume` finishes it; None otherwise."""
+        return self._resume
 
     def resume(self, progress=None, checkpoint_interval=None):
         """Finish the run that was interrupted, writing on into its file.
@@ -427,15 +352,15 @@ class Simulation:
         again, so the file ends as if the run had never stopped.
         """
         from .io import hdf5
-        point = getattr(self, "_resume", None)
+        point = self._resume
         if point is None:
             raise ValueError("this simulation was not restored from a file "
                              "(use Simulation.from_file)")
         if point.finished:
-            raise ValueError(f"the run in {self._output_path} finished; continue with "
-                             f"run(until=..., output={self._output_path!r})")
-        hdf5.truncate(self._output_path, point)
-        rec = hdf5.FileRecorder(self._output_path, self, point.plan,
+            raise ValueError(f"the run in {self.output_path} finished; continue with "
+                             f"run(until=..., output={self.output_path!r})")
+        hdf5.truncate(self.output_path, point)
+        rec = hdf5.FileRecorder(self.output_path, self, point.plan,
                                 checkpoint_interval=checkpoint_interval,
                                 resume_rows=point.outputs_written)
         self._resume = None
@@ -494,6 +419,21 @@ class Simulation:
                 self._ws[name][...] = arr
         self._reference = np.array(state.reference, dtype=float)
         self._E_scale, self._L_scale = (float(s) for s in state.scales)
+
+    def description(self):
+        """The :class:`SimulationDescription`: bodies, units and set-up, as an
+        output file records them beside the :attr:`state`."""
+        inv = self._inverse
+        return SimulationDescription(
+            tuple(self._names), self._m[inv].copy(), self.units, self.integrator, self._dt,
+            math.sqrt(self._eps2), self.monitors, self.monitor_every, self.parallel,
+            self.rebound_arithmetic, dict(self._stop_config), list(self._history),
+            self.config, self.forces)
+
+    @property
+    def time_value(self):
+        """The current time as a float in the simulation's unit of time."""
+        return self._now()
 
     def snapshot(self):
         """The current output (:class:`Snapshot`): the integrator synchronised, the
@@ -978,20 +918,7 @@ class _Recorder:
 
 
 def _monitor_fields(rows, sim, ref):
-    q = sim.units.quantity
-    out = {}
-    if "energy" in sim.monitors:
-        out["energy"] = q(rows[:, 0], "energy")
-        out["energy_error"] = relative_error(rows[:, 0], ref[0], scale=sim._E_scale)
-    if "angular_momentum" in sim.monitors:
-        out["angular_momentum"] = q(rows[:, 1:4], "angular_momentum")
-        out["angular_momentum_error"] = vector_relative_error(rows[:, 1:4], ref[1:4],
-                                                              sim._L_scale)
-    if "momentum" in sim.monitors:
-        out["momentum"] = q(rows[:, 4:7], "momentum")
-    if "center_of_mass" in sim.monitors:
-        out["center_of_mass"] = q(rows[:, 7:10], "length")
-    return out
+    return monitor_fields(rows, sim.monitors, ref, (sim._E_scale, sim._L_scale), sim.units)
 
 
 class _ProgressBar:

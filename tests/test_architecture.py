@@ -45,3 +45,14 @@ def test_no_dispatch_on_integrator_names_outside_registry():
         for name in ("'verlet'", '"verlet"', '"rk4"', "'rk4'"):
             if f"== {name}" in text:
                 raise AssertionError(f"{path.name} dispatches on {name}")
+
+
+def test_files_read_no_private_attribute_of_a_simulation():
+    # the HDF5 layer goes through Simulation.description(), .state, .snapshot(),
+    # .time_value and .output_path; a `sim._name` in it is a regression
+    text = (PACKAGE / "io" / "hdf5.py").read_text()
+    tree = ast.parse(text)
+    private = sorted({node.attr for node in ast.walk(tree)
+                      if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+                      and node.value.id == "sim" and node.attr.startswith("_")})
+    assert private == []

@@ -254,3 +254,31 @@ def test_memory_stays_flat_1e5_outputs(tmp_path):
 @pytest.mark.slow
 def test_memory_stays_flat_1e6_outputs(tmp_path):
     assert memory_growth_kb(tmp_path, 1_000_000) < 5_000
+
+
+def test_a_file_without_the_configuration_record_still_restores(tmp_path):
+    # files written before the configuration record hold the set-up only as
+    # separate attributes; Simulation.from_file rebuilds the same record from them
+    path = tmp_path / "old.h5"
+    kw = dict(softening=1e-4 * u.au, escape_distance=1e3 * u.au)
+    sim = outer("rk4", **kw)
+    sim.run(until=50 * u.yr, outputs=5, progress=False, output=path)
+    with h5py.File(path, "a") as f:
+        del f["parameters"].attrs["config"]
+    old = orbits.Simulation.from_file(path)
+    assert old.config == sim.config
+    old.run(until=100 * u.yr, outputs=2, progress=False)
+    sim.run(until=100 * u.yr, outputs=2, progress=False)
+    np.testing.assert_array_equal(old.bodies.positions.value, sim.bodies.positions.value)
+
+
+def test_the_file_records_the_simulation_description(tmp_path):
+    path = tmp_path / "d.h5"
+    sim = outer()
+    sim.run(until=1 * u.yr, outputs=2, progress=False, output=path)
+    desc = sim.description()
+    assert sim.output_path == str(path)
+    with h5py.File(path, "r") as f:
+        assert [n.decode() for n in f["particles/bodies/names"][()]] == list(desc.names)
+        np.testing.assert_array_equal(f["particles/bodies/mass"][()], desc.masses)
+        assert f["parameters"].attrs["dt"] == desc.dt == 10.0

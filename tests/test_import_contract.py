@@ -1,4 +1,5 @@
-"""The import-linter contract in pyproject.toml: orbits._kernels never imports astropy."""
+"""The import-linter contracts in pyproject.toml: orbits._kernels never imports astropy;
+orbits.io and orbits.records never import orbits.simulation."""
 
 import pathlib
 import shutil
@@ -13,3 +14,4 @@ def test_import_linter_contract():
     proc = subprocess.run([exe], cwd=ROOT, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "Kernels are free of astropy KEPT" in proc.stdout
+    assert "Files and ensembles go through the simulation's public records KEPT" in proc.stdout

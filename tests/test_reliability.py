@@ -81,7 +81,7 @@ def test_ctrl_c_with_a_file_writes_a_checkpoint_that_resumes_bit_identically(tmp
     with pytest.raises(RunInterrupted, match="checkpoint"):
         sim.run(until=until, outputs=outputs, progress=False, output=path)
     restored = orbits.Simulation.from_file(path)
-    assert restored.steps == sim.steps and not restored._resume.finished
+    assert restored.steps == sim.steps and not restored.resume_point.finished
     restored.resume(progress=False)
     ref_path = tmp_path / "ref.h5"
     outer(integrator).run(until=until, outputs=outputs, progress=False, output=ref_path)
@@ -128,7 +128,7 @@ def test_sigterm_stops_the_command_line_run_with_a_checkpoint(tmp_path):
     assert proc.returncode == 128 + signal.SIGTERM, err
     assert "stopped by SIGTERM" in err and "orbits resume" in err
     sim = orbits.Simulation.from_file(path)
-    assert sim.steps > 0 and not sim._resume.finished
+    assert sim.steps > 0 and not sim.resume_point.finished
     assert sim.time.to_value(u.d) == sim.steps * 10.0
 
 

@@ -116,8 +116,11 @@ import h5py
 import numpy as np
 
 from ..errors import OrbitsError
+from ..monitors import monitor_fields
+from ..records import RunPlan, SimulationState
 
-__all__ = ["FileRecorder", "load", "describe", "restore", "truncate", "ResumePoint",
+__all__ = ["FileRecorder", "load", "describe", "read_checkpoint", "Checkpoint", "truncate",
+           "ResumePoint",
            "OrbitsFileError", "FileInUse",
            "FORMAT", "FORMAT_VERSION", "CHECKPOINT_SECONDS", "BUFFER_ROWS",
            "SWMR_READ_ATTEMPTS"]
@@ -643,7 +646,12 @@ class FileRecorder:
         if not self.interval >= 0:
             raise ValueError(f"checkpoint_interval must be a number of seconds >= 0, "
                              f"got {checkpoint_interval!r}")
-        self.inv = np.argsort(sim._order)
+        # the public records of the simulation: this module reads nothing else of it
+        self.desc = sim.description()
+        state = sim.state
+        self.reference = state.reference
+        self.scales = state.scales
+        self.inv = np.argsort(state.order)
         self.buffer = []
         self.mon_buffer = []
         self.outputs_written = 0     # in this plan
@@ -655,7 +663,7 @@ class FileRecorder:
         self.end_status = 0          # a Status code when a run ends early
         self.largest = {}            # monitor -> largest relative error seen in this plan
         self.checkpoints = 0         # written by this recorder
-        mine = getattr(sim, "_output_path", None)
+        mine = sim.output_path
         mine = mine is not None and os.path.abspath(mine) == os.path.abspath(self.path)
         if self.path.exists() and not overwrite and not mine:
             raise OrbitsFileError(f"{self.path}: exists; pass overwrite=True (or --force) "
@@ -677,8 +685,8 @@ class FileRecorder:
                 self.f.swmr_mode = True
                 self.wall_before = self._stored_wall()
             else:
-                self.f = _create(self.path, sim)
-            sim._output_path = str(self.path)
+                self.f = _create(self.path, self.desc, state)
+            sim.output_path = str(self.path)
             self._series = self._series_handles()
             r = self.f["restart"]
             self._restart = {name: r[name] for name in r if isinstance(r[name], h5py.Dataset)}
@@ -702,9 +710,9 @@ class FileRecorder:
 
     def _check_same_layout(self):
         n = self.f["particles/bodies/names"].shape[0]
-        if n != len(self.sim._m):
+        if n != len(self.desc.names):
             raise OrbitsFileError(f"{self.path}: holds {n} bodies, the simulation "
-                                  f"{len(self.sim._m)}")
+                                  f"{len(self.desc.names)}")
 
     def _stored_wall(self):
         r = self.f["restart"]
@@ -734,22 +742,21 @@ class FileRecorder:
             g = obs[name]["value"]
             self._note(name, g[first:self.rows])
             t = obs["in_loop"][name]["time"][()]
-            keep = (t > plan.start_time) & (t <= sim._now())
+            keep = (t > plan.start_time) & (t <= sim.time_value)
             if keep.any():
                 self._note(name, obs["in_loop"][name]["value"][np.flatnonzero(keep)])
 
     def _note(self, name, values):
         from ..monitors import relative_error, vector_relative_error
-        sim = self.sim
-        ref = sim._reference
+        ref = self.reference
         if not len(values):
             return
         if name == "energy":
             err = relative_error(np.asarray(values, dtype=float).reshape(-1), ref[0],
-                                 scale=sim._E_scale)
+                                 scale=self.scales[0])
         else:
             err = vector_relative_error(np.asarray(values, dtype=float).reshape(-1, 3),
-                                        ref[1:4], sim._L_scale)
+                                        ref[1:4], self.scales[1])
         top = float(np.max(err))
         old = self.largest.get(name)
         self.largest[name] = top if old is None else float(np.max([old, top]))
@@ -800,8 +807,8 @@ class FileRecorder:
         q = sim.units.quantity
         t, step, x, v, row = self.last
         fields = dict(times=q(np.array([t]), "time"), positions=q(x[None], "length"),
-                      velocities=q(v[None], "velocity"), names=list(sim._names),
-                      masses=q(sim._m[self.inv].copy(), "mass"), steps=sim.steps - self.steps0,
+                      velocities=q(v[None], "velocity"), names=list(self.desc.names),
+                      masses=q(self.desc.masses.copy(), "mass"), steps=sim.steps - self.steps0,
                       force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
                       steps_rejected=sim.steps_rejected - self.rejected0,
                       integrator=sim.integrator.info(), units=sim.units.to_dict(),
@@ -809,9 +816,9 @@ class FileRecorder:
                       forces=tuple(map(repr, sim.forces)),
                       start_time=q(self.plan.start_time, "time"),
                       largest_errors=dict(self.largest))
-        if sim._mask:
-            from ..simulation import _monitor_fields
-            fields.update(_monitor_fields(row[None], sim, sim._reference))
+        if sim.monitors:
+            fields.update(monitor_fields(row[None], sim.monitors, self.reference, self.scales,
+                                         sim.units))
         return Result(**fields)
 
     # writing ---------------------------------------------------------------------------
@@ -922,12 +929,22 @@ def _element(parent, name, shape, unit):
     return g
 
 
-def _create(path, sim):
-    from .. import __version__
+def _package_version():
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("orbits")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "0+unknown"
+
+
+def _create(path, desc, state):
+    """A new file for the simulation described by ``desc`` (a
+    :class:`~orbits.records.SimulationDescription`) at ``state``."""
+    __version__ = _package_version()
     import astropy
     import numba
 
-    U = sim.units
+    U = desc.units
     tmp = path.with_name(path.name + ".creating")
     f = h5py.File(tmp, "w", libver="latest")
     f.attrs["orbits_format"] = FORMAT
@@ -938,16 +955,16 @@ def _create(path, sim):
     c = h.create_group("creator")
     c.attrs["name"] = "orbits"
     c.attrs["version"] = __version__
-    n = len(sim._m)
+    n = len(desc.names)
     unit = lambda kind: U.unit(kind).to_string()  # noqa: E731
     b = f.create_group("particles/bodies")
-    b.create_dataset("names", data=np.array(sim._names, dtype=h5py.string_dtype()))
-    b.create_dataset("mass", data=sim._m[np.argsort(sim._order)]).attrs["unit"] = unit("mass")
+    b.create_dataset("names", data=np.array(list(desc.names), dtype=h5py.string_dtype()))
+    b.create_dataset("mass", data=desc.masses).attrs["unit"] = unit("mass")
     _element(b, "position", (n, 3), (unit("length"), unit("time")))
     _element(b, "velocity", (n, 3), (unit("velocity"), unit("time")))
     obs = f.create_group("observables")
     inloop = obs.create_group("in_loop")
-    for name in sim.monitors:
+    for name in desc.monitors:
         shape = () if name == "energy" else (3,)
         u_ = (unit(_MONITOR_KIND[name]), unit("time"))
         _element(obs, name, shape, u_)
@@ -958,34 +975,34 @@ def _create(path, sim):
         "numba_version": numba.__version__, "h5py_version": h5py.__version__,
         "astropy_version": astropy.__version__,
         "written": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "integrator": sim.integrator.name,
-        "integrator_options": json.dumps(sim.integrator.config),
-        "integrator_info": json.dumps(sim.integrator.info()),
-        "dt": sim._dt, "dt_unit": unit("time"),
+        "integrator": desc.integrator.name,
+        "integrator_options": json.dumps(desc.integrator.config),
+        "integrator_info": json.dumps(desc.integrator.info()),
+        "dt": desc.dt, "dt_unit": unit("time"),
         "units": json.dumps(U.to_dict()), "G": U.G, "G_source": U.G_source,
-        "softening": float(np.sqrt(sim._eps2)), "softening_unit": unit("length"),
-        "monitors": json.dumps(list(sim.monitors)),
-        "monitor_every": sim.monitor_every or 0,
-        "parallel": bool(sim.parallel),
-        "stop_conditions": json.dumps(sim._stop_config),
-        "rebound_arithmetic": bool(sim.rebound_arithmetic),
-        "bodies_history": json.dumps(sim._history, default=str),
-        # the one record that rebuilds the simulation from its bodies (restore)
-        "config": json.dumps(sim.config.to_dict()),
-        "forces": json.dumps([t.to_dict() for t in sim.forces]),
+        "softening": float(desc.softening), "softening_unit": unit("length"),
+        "monitors": json.dumps(list(desc.monitors)),
+        "monitor_every": desc.monitor_every or 0,
+        "parallel": bool(desc.parallel),
+        "stop_conditions": json.dumps(desc.stop_conditions),
+        "rebound_arithmetic": bool(desc.rebound_arithmetic),
+        "bodies_history": json.dumps(desc.history, default=str),
+        # the one record that rebuilds the simulation from its bodies (Simulation.from_file)
+        "config": json.dumps(desc.config.to_dict()),
+        "forces": json.dumps([t.to_dict() for t in desc.forces]),
     }
     for k, v in meta.items():
         par.attrs[k] = v
-    ref = par.create_dataset("reference", data=sim._reference)
+    ref = par.create_dataset("reference", data=state.reference)
     ref.attrs["unit"] = ", ".join([unit("energy")] + [unit("angular_momentum")] * 3
                                   + [unit("momentum")] * 3 + [unit("length")] * 3)
-    par.create_dataset("scales", data=np.array([sim._E_scale, sim._L_scale])).attrs["unit"] = \
+    par.create_dataset("scales", data=np.array(state.scales)).attrs["unit"] = \
         f"{unit('energy')}, {unit('angular_momentum')}"
     par.create_dataset("start_clock", data=np.array(
-        [sim.steps, sim.force_evaluations, sim.steps_rejected], dtype=np.int64))
+        [state.steps, state.force_evaluations, state.steps_rejected], dtype=np.int64))
     r = f.create_group("restart")
     r.create_dataset("count", data=np.int64(0))
-    r.create_dataset("order", data=sim._order.astype(np.int64))
+    r.create_dataset("order", data=np.asarray(state.order, dtype=np.int64))
     for name in ("x", "v"):
         r.create_dataset(name, shape=(_SLOTS, n, 3), dtype=np.float64).attrs["unit"] = \
             unit("length" if name == "x" else "velocity")
@@ -996,7 +1013,7 @@ def _create(path, sim):
     r.create_dataset("progress", shape=(_SLOTS, 3), dtype=np.int64)
     r.create_dataset("wall", shape=(_SLOTS,), dtype=np.float64).attrs["unit"] = "s"
     ws = r.create_group("ws")
-    for name, arr in sim._ws.items():
+    for name, arr in state.workspace.items():
         if isinstance(arr, np.ndarray):
             d = ws.create_dataset(name, shape=(_SLOTS,) + arr.shape, dtype=arr.dtype)
             if arr.dtype.kind == "f":
@@ -1210,13 +1227,22 @@ def _describe_forces(par):
     return " + ".join(text)
 
 
+class Checkpoint(NamedTuple):
+    """What a file's last checkpoint rebuilds a simulation from
+    (:meth:`orbits.Simulation.from_file`)."""
+
+    bodies: object          # the BodySet at the checkpoint
+    config: dict            # SimulationConfig.to_dict() of the simulation
+    state: SimulationState  # put back with Simulation.set_state
+    point: object           # the ResumePoint: where the run that wrote the file stood
+    path: str
+
+
 @_damaged
-def restore(path):
-    """The simulation at the file's last checkpoint, with the run it was in as its
-    ``_resume`` (a :class:`ResumePoint`); :class:`OrbitsFileError` for a file
-    that is damaged or holds no complete checkpoint."""
+def read_checkpoint(path):
+    """The file's last complete checkpoint, as a :class:`Checkpoint`;
+    :class:`OrbitsFileError` for a file that is damaged or holds none."""
     from ..bodies import BodySet
-    from ..simulation import RunPlan, Simulation, SimulationState
     from ..units import UnitSystem
 
     with _open_read(path) as f:
@@ -1235,50 +1261,45 @@ def restore(path):
         v = r["v"][slot]
         bodies = BodySet.from_arrays(m, x[inv], v[inv], names=names, units=units)
         bodies.history = json.loads(par.attrs["bodies_history"])
-        if "config" in par.attrs:
-            sim = Simulation.from_config(bodies, json.loads(par.attrs["config"]))
-        else:
-            sim = _legacy_simulation(par, bodies, units)
-        if not np.array_equal(sim.state.order, order):
-            raise OrbitsFileError(f"{path}: the stored body order does not match the masses")
+        config = (json.loads(par.attrs["config"]) if "config" in par.attrs
+                  else _legacy_config(par, units))
         clock = r["clock"][slot]
-        sim.set_state(SimulationState(
+        state = SimulationState(
             x, v, order, float(r["t_base"][slot]), int(clock[1]), int(clock[0]),
             int(clock[2]), int(clock[4]), {name: r["ws"][name][slot] for name in r["ws"]},
-            par["reference"][()], tuple(par["scales"][()])))
+            par["reference"][()], tuple(par["scales"][()]))
         p = r["plan"][slot]
         plan = RunPlan(float(p[0]), int(p[1]), float(p[2]), int(p[3]), bool(p[4]), int(p[5]),
                        float(p[6]))
         written, finished, _ = (int(a) for a in r["progress"][slot])
         rows = int(clock[3])
-    sim._output_path = str(path)
-    sim._resume = ResumePoint(plan, written, bool(finished), rows, sim.time.value)
-    return sim
+        t = state.t_base + state.steps_since_base * float(par.attrs["dt"])
+    return Checkpoint(bodies, config, state, ResumePoint(plan, written, bool(finished), rows, t),
+                      str(path))
 
 
-def _legacy_simulation(par, bodies, units):
-    # files written before the configuration record
-    from .. import integrators
-    from ..simulation import Simulation
-    integ = integrators.get(par.attrs["integrator"],
-                            **json.loads(par.attrs["integrator_options"]))
+def _legacy_config(par, units):
+    # files written before the configuration record: the same record, from the
+    # attributes they have
     soft = float(par.attrs["softening"])
-
+    unit = lambda val, kind: None if val is None else [val, units.unit(kind).to_string()]  # noqa: E731
     stop = json.loads(par.attrs["stop_conditions"])
-    length = lambda val: None if val is None else val << units.length  # noqa: E731
     dt = float(par.attrs["dt"])
-    sim = Simulation(bodies, integrator=integ,
-                     dt=(dt << units.time) if dt > 0 or not integ.adaptive else None,
-                     monitors=tuple(json.loads(par.attrs["monitors"])),
-                     monitor_every=int(par.attrs["monitor_every"]) or None,
-                     softening=(soft << units.length) if soft > 0 else None,
-                     parallel=bool(par.attrs["parallel"]),
-                     encounter_distance=length(stop["encounter_distance"]),
-                     encounter_hill=stop["encounter_hill"],
-                     escape_distance=length(stop["escape_distance"]),
-                     escape_unbound=stop["escape_unbound"],
-                     rebound_arithmetic=bool(par.attrs.get("rebound_arithmetic", False)))
-    return sim
+    adaptive = json.loads(par.attrs.get("integrator_info", "{}")).get("adaptive", dt == 0)
+    return {"integrator": par.attrs["integrator"],
+            "integrator_options": json.loads(par.attrs["integrator_options"]),
+            "dt": unit(dt, "time") if dt > 0 or not adaptive else None,
+            "forces": [{"type": "Gravity",
+                        "softening": unit(soft, "length") if soft > 0 else None,
+                        "parallel": bool(par.attrs["parallel"]),
+                        "rebound_arithmetic": bool(par.attrs.get("rebound_arithmetic", False))}],
+            "monitors": json.loads(par.attrs["monitors"]),
+            "monitor_every": int(par.attrs["monitor_every"]) or None,
+            "stop_conditions": {
+                "encounter_distance": unit(stop["encounter_distance"], "length"),
+                "encounter_hill": stop["encounter_hill"],
+                "escape_distance": unit(stop["escape_distance"], "length"),
+                "escape_unbound": stop["escape_unbound"]}}
 
 
 class ResumePoint(NamedTuple):

@@ -126,8 +126,8 @@ def run_orbits(bodies, integrator, options=None, *, dt=None, until, outputs=2, t
     row["steps"] = sim.steps
     row["force_evaluations"] = sim.force_evaluations
     row["steps_rejected"] = sim.steps_rejected
-    row["t_end"] = float(sim._now())
-    row["x"] = np.array(sim._x[np.argsort(sim._order)])
+    row["t_end"] = float(sim.time_value)
+    row["x"] = np.array(sim.bodies.positions.value)
     if pieces:
         t = np.concatenate([p.times.to_value(bodies.units.time) for p in pieces])
         e = _joined(pieces, "energy_error")
