@@ -1,14 +1,17 @@
 """Advancing an integrator with the guarantee that a failure loses nothing."""
 
 import contextlib
+import signal as _signal
+import threading
 
+import _signal as _csignal
 import numpy as np
 
 from ._kernels.status import Status
 from ._kernels.stepping import USER_FORCE_SIZE
 from .errors import ForceTermError
 
-__all__ = ["advance_checked", "restored_on_error", "CHECK_EVERY"]
+__all__ = ["advance_checked", "restored_on_error", "Signals", "CHECK_EVERY"]
 
 #: The compiled loops test the state for NaN and inf every this many steps
 #: (a test is a dependent chain of 6N additions, as dear as the force for a few
@@ -81,3 +84,53 @@ def restored_on_error(x, v, ws, saved=None):
 
 def _copy_workspace(ws):
     return {k: (a.copy() if isinstance(a, np.ndarray) else a) for k, a in ws.items()}
+
+
+class Signals:
+    """SIGINT and SIGTERM held while a run is in compiled code, acted on between chunks.
+
+    Python runs a signal's handler between bytecodes only.  Ctrl-C's handler
+    raising while a compiled loop returns would leave the loop's in-place
+    state advanced and the clock not (and surfaces as ``SystemError``).  During
+    a run, in the main thread, the handler only notes the signal; the run
+    looks between chunks, at a consistent state, and stops there
+    (``Simulation._check_signal``, :func:`orbits.integrate`).  Signals that were ignored stay
+    ignored, and the handlers are put back when the run ends.  A signal noted
+    after the last look is delivered when the run has finished.
+    """
+
+    SIGNALS = (int(_signal.SIGINT), int(_signal.SIGTERM))
+
+    def __init__(self):
+        self.caught = None
+        self.saved = {}
+
+    def __enter__(self):
+        # the C-level calls of the signal module: its Python wrappers' enum
+        # conversions made up most of the cost of a short run's set-up
+        if threading.current_thread() is threading.main_thread():
+            for signum in self.SIGNALS:
+                previous = _csignal.getsignal(signum)
+                if previous == _csignal.SIG_IGN or previous is None:
+                    continue
+                try:
+                    _csignal.signal(signum, self._note)
+                except (ValueError, OSError):  # pragma: no cover - not the main interpreter
+                    continue
+                self.saved[signum] = previous
+        return self
+
+    def _note(self, signum, frame):
+        if self.caught is None:
+            self.caught = signum
+
+    def restore(self):
+        for signum, previous in self.saved.items():
+            _csignal.signal(signum, previous)
+        self.saved = {}
+
+    def __exit__(self, kind, exc, tb):
+        self.restore()
+        if self.caught is not None and kind is None:
+            _signal.raise_signal(self.caught)
+        return False

@@ -7,18 +7,19 @@ loop as Python (slower, but the same numbers).
 """
 
 import math
+import signal as _signal
 import time as _time
 
 import numba
 import numpy as np
 
 from . import integrators as _integrators
-from ._driver import advance_checked
+from ._driver import Signals, advance_checked, restored_on_error
 from ._kernels import implicit as _implicit
 from ._kernels import stepping as _stepping
 from ._kernels.status import Status
 from .errors import (ConvergenceFailure, ForceTermError, IntegratorOptionError,
-                     NonFiniteState, StepSizeUnderflow)
+                     NonFiniteState, RunInterrupted, StepSizeUnderflow)
 
 __all__ = ["integrate", "Trajectory"]
 
@@ -166,63 +167,43 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
         force = force._replace(jacobian=_implicit.user_jacobian(jacobian, _is_jitted(jacobian)),
                                key=f"{force.key}_jac{id(jacobian)}")
     fargs = (size, tuple(int(s) for s in shape))
-    mon = (0, 0, np.zeros(rows), 0.0, 0, 0.0)
     if integ.adaptive:
-        return _integrate_adaptive(integ, force, fargs, mon, x, v, size, shape, scalar,
-                                   float(t0), float(until), int(outputs),
-                                   0.0 if dt is None else float(dt))
-    ws = integ.workspace(rows)
+        ws = integ.workspace(rows, 0.0 if dt is None else float(dt))
+        t0, until = float(t0), float(until)
+        # outputs at evenly spaced times, the last exactly at until
+        marks = [until if k == outputs - 1 else t0 + k * (until - t0) / (outputs - 1)
+                 for k in range(1, int(outputs))]
+    else:
+        ws = integ.workspace(rows)
+        marks = [min(k * every, steps) for k in range(1, -(-steps // every) + 1)]
+    return _drive(integ, force, fargs, x, v, ws, shape, scalar, float(t0),
+                  None if integ.adaptive else dt, marks, velocity_dependent)
+
+
+#: what a failed status raises in :func:`integrate`
+_FAILURES = {
+    Status.NO_CONVERGENCE: (ConvergenceFailure, "no convergence",
+                            "the Newton iteration of {name!r} did not converge in step "
+                            "{next} (from t = {t:.10g}); try a smaller dt"),
+    Status.STEP_UNDERFLOW: (StepSizeUnderflow, "step-size underflow",
+                            "the step size of {name!r} collapsed at t = {t:.10g} (step "
+                            "{steps})"),
+    Status.NON_FINITE: (NonFiniteState, "non-finite state",
+                        "the state became non-finite in step {next} (from t = {t:.10g})"),
+}
+
+
+def _drive(integ, force, fargs, x, v, ws, shape, scalar, t0, dt, marks, velocity_dependent):
+    """The one driver of :func:`integrate`: outputs at ``marks`` (step counts for a
+    fixed step ``dt``, times for an adaptive method), the compiled loop entered
+    once per output, SIGINT and SIGTERM acted on between outputs."""
+    size = int(np.prod(shape))
+    rows = x.shape[0]
+    mon = (0, 0, np.zeros(rows), 0.0, 0, 0.0)
+    no_t, no_rows = np.empty(0), np.zeros((0, 10))
     ts, xs, vs = [t0], [x.ravel()[:size].copy()], [v.ravel()[:size].copy()]
     wall0 = _time.perf_counter()
-    done = 0
-
-    def trajectory(status):
-        out_shape = (len(ts),) + (() if scalar else shape)
-        return Trajectory(np.array(ts), np.array(xs).reshape(out_shape),
-                          np.array(vs).reshape(out_shape), done, integ.name,
-                          _time.perf_counter() - wall0, status)
-
-    while done < steps:
-        n = min(every, steps - done)
-        try:
-            status, good, _, ws = advance_checked(
-                integ, ws, x, v, t0 + done * dt, dt, n, force, fargs, mon, done,
-                np.empty(0), np.zeros((0, 10)), velocity_dependent)
-        except numba.core.errors.TypingError as exc:
-            raise TypeError("accel(x, v, t) could not be compiled in the stepping loop; it "
-                            "must take arrays x, v (shape of x0) and a float t and return "
-                            f"an array of the shape of x0. numba said:\n{exc}") from None
-        except ValueError as exc:
-            _resize_error(exc, shape, t0 + done * dt)
-        done += good
-        if status != Status.OK:
-            ts.append(t0 + done * dt)
-            xs.append(x.ravel()[:size].copy())
-            vs.append(v.ravel()[:size].copy())
-            t_bad = t0 + done * dt
-            if status == Status.NO_CONVERGENCE:
-                raise ConvergenceFailure(
-                    f"the Newton iteration of {integ.name!r} did not converge in step "
-                    f"{done + 1} (from t = {t_bad:.10g}); try a smaller dt; the trajectory "
-                    f"up to the last good step {done} is kept on .result",
-                    time=t_bad, step=done, result=trajectory("no convergence"))
-            raise NonFiniteState(
-                f"the state became non-finite in step {done + 1} (from t = {t_bad:.10g}); "
-                f"the trajectory up to the last good step {done} is kept on .result",
-                time=t_bad, step=done, result=trajectory("non-finite state"))
-        ts.append(t0 + done * dt)
-        xs.append(x.ravel()[:size].copy())
-        vs.append(v.ravel()[:size].copy())
-    return trajectory("completed")
-
-
-def _integrate_adaptive(integ, force, fargs, mon, x, v, size, shape, scalar, t0, until,
-                        outputs, first_step):
-    ws = integ.workspace(x.shape[0], first_step)
-    ts, xs, vs = [t0], [x.ravel()[:size].copy()], [v.ravel()[:size].copy()]
-    wall0 = _time.perf_counter()
-    t = t0
-    steps = 0
+    t, steps = t0, 0
 
     def trajectory(status):
         out_shape = (len(ts),) + (() if scalar else shape)
@@ -230,32 +211,47 @@ def _integrate_adaptive(integ, force, fargs, mon, x, v, size, shape, scalar, t0,
                           np.array(vs).reshape(out_shape), steps, integ.name,
                           _time.perf_counter() - wall0, status)
 
-    for k in range(1, outputs):
-        t_out = until if k == outputs - 1 else t0 + k * (until - t0) / (outputs - 1)
-        while t < t_out:
-            try:
-                status, t, acc, _, _, _ = integ.advance_to(
-                    ws, x, v, t, t_out, force, fargs, mon, steps, np.empty(0),
-                    np.zeros((0, 10)), None, 1 << 40)
-            except ValueError as exc:
-                _resize_error(exc, shape, t)
-            steps += int(acc)
-            if status != Status.OK:
-                ts.append(t)
-                xs.append(x.ravel()[:size].copy())
-                vs.append(v.ravel()[:size].copy())
-                if status == Status.STEP_UNDERFLOW:
-                    raise StepSizeUnderflow(
-                        f"the step size of {integ.name!r} collapsed at t = {t:.10g} (step "
-                        f"{steps}); the trajectory up to there is kept on .result",
-                        time=t, step=steps, result=trajectory("step-size underflow"))
-                raise NonFiniteState(
-                    f"the state became non-finite after t = {t:.10g} (step {steps}); the "
-                    f"trajectory up to the last good step is kept on .result",
-                    time=t, step=steps, result=trajectory("non-finite state"))
+    def keep():
         ts.append(t)
         xs.append(x.ravel()[:size].copy())
         vs.append(v.ravel()[:size].copy())
+
+    with Signals() as signals:
+        for mark in marks:
+            status = Status.OK
+            try:
+                if dt is not None:
+                    status, good, _, ws = advance_checked(
+                        integ, ws, x, v, t, dt, mark - steps, force, fargs, mon, steps,
+                        no_t, no_rows, velocity_dependent)
+                    steps += good
+                    t = t0 + steps * dt
+                else:
+                    while t < mark and status == Status.OK:
+                        with restored_on_error(x, v, ws):
+                            status, t, acc, _, _, _ = integ.advance_to(
+                                ws, x, v, t, mark, force, fargs, mon, steps, no_t, no_rows,
+                                None, 1 << 40)
+                        steps += int(acc)
+            except numba.core.errors.TypingError as exc:
+                raise TypeError("accel(x, v, t) could not be compiled in the stepping loop; "
+                                "it must take arrays x, v (shape of x0) and a float t and "
+                                "return an array of the shape of x0. numba said:\n"
+                                f"{exc}") from None
+            except ValueError as exc:
+                _resize_error(exc, shape, t)
+            keep()
+            if status != Status.OK:
+                kind, label, text = _FAILURES.get(Status(status),
+                                                  _FAILURES[Status.NON_FINITE])
+                raise kind(text.format(name=integ.name, next=steps + 1, t=t, steps=steps)
+                           + f"; the trajectory up to the last good step {steps} is kept on "
+                           f".result", time=t, step=steps, result=trajectory(label))
+            if signals.caught is not None:
+                name = _signal.Signals(signals.caught).name
+                raise RunInterrupted(f"{name} at t = {t:.10g} (step {steps}); the trajectory "
+                                     f"up to there is kept on .result", signal=signals.caught,
+                                     time=t, step=steps, result=trajectory(f"stopped by {name}"))
     return trajectory("completed")
 
 

@@ -8,9 +8,7 @@ to what it returns.
 import math
 import numbers
 import signal as _signal
-import _signal as _csignal
 import sys
-import threading
 import time as _time
 import warnings
 
@@ -20,7 +18,7 @@ import numpy as np
 from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
-from ._driver import advance_checked, restored_on_error
+from ._driver import Signals as _Signals, advance_checked, restored_on_error
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
@@ -963,54 +961,4 @@ def _stderr_is_terminal():
     try:
         return sys.stderr.isatty()
     except (AttributeError, ValueError):
-        return False
-
-
-class _Signals:
-    """SIGINT and SIGTERM held while a run is in compiled code, acted on between chunks.
-
-    Python runs a signal's handler between bytecodes only.  Ctrl-C's handler
-    raising while a compiled loop returns would leave the loop's in-place
-    state advanced and the clock not (and surfaces as ``SystemError``).  During
-    a run, in the main thread, the handler only notes the signal; the run
-    looks between chunks, at a consistent state, and stops there
-    (:meth:`Simulation._check_signal`).  Signals that were ignored stay
-    ignored, and the handlers are put back when the run ends.  A signal noted
-    after the last look is delivered when the run has finished.
-    """
-
-    SIGNALS = (int(_signal.SIGINT), int(_signal.SIGTERM))
-
-    def __init__(self):
-        self.caught = None
-        self.saved = {}
-
-    def __enter__(self):
-        # the C-level calls of the signal module: its Python wrappers' enum
-        # conversions made up most of the cost of a short run's set-up
-        if threading.current_thread() is threading.main_thread():
-            for signum in self.SIGNALS:
-                previous = _csignal.getsignal(signum)
-                if previous == _csignal.SIG_IGN or previous is None:
-                    continue
-                try:
-                    _csignal.signal(signum, self._note)
-                except (ValueError, OSError):  # pragma: no cover - not the main interpreter
-                    continue
-                self.saved[signum] = previous
-        return self
-
-    def _note(self, signum, frame):
-        if self.caught is None:
-            self.caught = signum
-
-    def restore(self):
-        for signum, previous in self.saved.items():
-            _csignal.signal(signum, previous)
-        self.saved = {}
-
-    def __exit__(self, kind, exc, tb):
-        self.restore()
-        if self.caught is not None and kind is None:
-            _signal.raise_signal(self.caught)
         return False

@@ -297,3 +297,21 @@ def test_command_line_time_options(capsys):
     # beyond float64's range
     assert main(["run", "kepler", "--dt", "10d", "--until", "1e400yr"]) == 2
     assert "finite" in capsys.readouterr().err
+
+
+def test_ctrl_c_in_integrate_stops_at_an_output_with_the_trajectory():
+    calls = [0]
+
+    def accel(x, v, t):
+        calls[0] += 1
+        if calls[0] == 25:
+            os.kill(os.getpid(), signal.SIGINT)
+        return -x
+
+    with pytest.raises(RunInterrupted) as info:
+        orbits.integrate(accel, np.ones(3), np.zeros(3), dt=0.01, steps=1000, every=10)
+    tr = info.value.result
+    # the signal came in step 24 (verlet: one force a step after the first);
+    # the run stops at the next output, step 30
+    assert tr.steps == info.value.step == 30 and tr.t[-1] == pytest.approx(0.3, rel=1e-14)
+    assert len(tr.t) == 4 and tr.status == "stopped by SIGINT"
