@@ -1,9 +1,10 @@
 """Mercury's perihelion advance from general relativity, with each GR term.
+==========================================================================
 
 Sun and Mercury alone, so that every bit of the advance is relativistic:
 the longitude of perihelion (from the Runge-Lenz vector) is fitted with a
 straight line over a century and set beside 6 pi G M / (c^2 a (1 - e^2)) per
-orbit, 42.98 arcseconds per century.
+orbit, 42.98 arcseconds per century.  ::
 
     python examples/mercury_perihelion.py
 """

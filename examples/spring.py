@@ -1,8 +1,11 @@
 """The spring oscillator of the classic integrator-choice guide, with every method.
+=================================================================================
 
 k = 100, m = 1, x0 = 1, v0 = 0, dt = 0.01, 1000 steps.  The exact energy is
 E = v^2/2 + k x^2/2 = 50 for all time; the table prints how far each method's
 energy has drifted at steps 100 and 999 and the largest drift over the run.
+The force is a numba function of the user's own, integrated by
+``orbits.integrate`` in the same compiled loops as gravity.  ::
 
     python examples/spring.py
 """

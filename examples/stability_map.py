@@ -1,11 +1,12 @@
 """Stability map: where can a second planet live next to a Jupiter?
+=================================================================
 
 The Sun, a Jupiter analogue (a = 5.2 au, e = 0.048) and a 10-Earth-mass planet
 whose semi-major axis and eccentricity run over a 40 x 40 grid.  Each run
 stops at a close encounter (the planets within 3 mutual Hill radii) or an
 escape (beyond 100 au); the map is coloured by the time that took, white where
 the planet survived the whole run.  The runs go to Dask workers, one process per
-core, and the whole sweep takes a few minutes on two cores:
+core, and the whole sweep takes a few minutes on two cores::
 
     python examples/stability_map.py                      # writes examples/stability_map.png
     python examples/stability_map.py --n 20 --until 2000  # a quicker, coarser map
@@ -15,6 +16,10 @@ The dashed line is where the planet's pericentre reaches Jupiter's aphelion;
 the dotted one is Gladman's (1993) Hill-stability limit for two circular
 orbits, a separation of 2 sqrt(3) mutual Hill radii.  Inside the band between
 them almost nothing survives; well outside it on the right almost everything.
+
+.. image:: stability_map.png
+   :alt: Time to a close encounter or escape over the grid of semi-major axis
+         and eccentricity, white where the planet survived.
 """
 
 import argparse

@@ -1,4 +1,9 @@
 """Sun, Jupiter and a massless probe for 1000 years with velocity Verlet.
+=========================================================================
+
+The README's first example as a script: a body set built from orbital
+elements and a Cartesian state, a fixed-step run with 500 outputs, the run's
+summary, and Jupiter's osculating elements at the end.  ::
 
     python examples/sun_jupiter_probe.py
 """

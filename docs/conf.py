@@ -1,0 +1,145 @@
+"""Sphinx configuration of the orbits documentation.
+
+Build (from the repository root, after ``pip install -e ".[docs]"``)::
+
+    python -m sphinx -W --keep-going -b html docs docs/_build/html
+
+The default build reaches no network.  Links into the numpy, astropy, h5py
+and Python documentation (intersphinx) need their inventories from the web:
+set ``ORBITS_DOCS_INTERSPHINX=1`` to fetch them.
+"""
+
+import os
+import pathlib
+import shutil
+import sys
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(ROOT))    # the package of this checkout, installed or not
+
+import orbits  # noqa: E402
+
+project = "orbits"
+author = "the orbits developers"
+copyright = "the orbits developers"
+release = orbits.__version__
+version = ".".join(release.split(".")[:2])
+
+extensions = [
+    "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.doctest",
+    "sphinx.ext.intersphinx",
+    "sphinx.ext.mathjax",
+    "numpydoc",
+    "sphinx_gallery.gen_gallery",
+]
+
+templates_path = ["_templates"]
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints"]
+root_doc = "index"
+default_role = "code"
+
+# -- autodoc, autosummary, numpydoc --------------------------------------------------
+# The API pages are made again at every build: a stub left from an older version of
+# the package (a name since renamed or removed) would otherwise fail the build.
+shutil.rmtree(HERE / "generated", ignore_errors=True)
+autosummary_generate = True
+autosummary_ignore_module_all = False     # a module's public names are its __all__
+autosummary_imported_members = False
+autodoc_member_order = "bysource"
+autodoc_typehints = "none"               # the numpydoc sections say the types and units
+numpydoc_show_class_members = False       # the class template lists members itself
+numpydoc_class_members_toctree = False
+numpydoc_xref_param_type = False
+
+# -- intersphinx: off by default, so that a build needs no network -------------------
+intersphinx_mapping = {}
+if os.environ.get("ORBITS_DOCS_INTERSPHINX", "") not in ("", "0"):
+    intersphinx_mapping = {
+        "python": ("https://docs.python.org/3", None),
+        "numpy": ("https://numpy.org/doc/stable/", None),
+        "astropy": ("https://docs.astropy.org/en/stable/", None),
+        "h5py": ("https://docs.h5py.org/en/stable/", None),
+    }
+    intersphinx_timeout = 30
+
+# -- sphinx-gallery --------------------------------------------------------------------
+# Examples that run within about half a minute on a 2-core machine are executed during
+# the build and their output is shown; the longer ones are shown without running:
+#   mercury_perihelion.py  four century-long runs of Sun and Mercury
+#   stability_map.py       a 40 x 40 sweep on a Dask cluster ("a few minutes on two
+#                          cores", its docstring)
+# The stability map's committed picture, examples/stability_map.png, is copied next
+# to its page (copyfile_regex) and shown by its docstring.
+sphinx_gallery_conf = {
+    "examples_dirs": str(ROOT / "examples"),
+    "gallery_dirs": "auto_examples",
+    "filename_pattern": r"/(sun_jupiter_probe|spring)\.py$",
+    "ignore_pattern": r"__init__\.py",
+    "copyfile_regex": r".*\.png$",
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "min_reported_time": 1,
+    "write_computation_times": False,
+    "show_memory": False,
+    "plot_gallery": "True",
+    "capture_repr": (),
+}
+
+# A script that is not run has no figure for its thumbnail; sphinx-gallery keeps a
+# thumbnail file that already exists, so the stability map's committed picture is
+# made into its thumbnail here, before the gallery is generated.
+def _thumbnail_from_picture(example, picture):
+    from sphinx_gallery.utils import scale_image
+
+    src = ROOT / "examples" / picture
+    thumb = HERE / "auto_examples" / "images" / "thumb" / f"sphx_glr_{example}_thumb.png"
+    if src.exists() and (not thumb.exists() or thumb.stat().st_mtime < src.stat().st_mtime):
+        thumb.parent.mkdir(parents=True, exist_ok=True)
+        scale_image(src, thumb, *sphinx_gallery_conf.get("thumbnail_size", (400, 280)))
+
+
+_thumbnail_from_picture("stability_map", "stability_map.png")
+
+# -- the table of integrators, made from the registry ---------------------------------
+def _integrator_table():
+    """``docs/_generated/integrators.inc``: every registered integrator, for the guide."""
+    rows = []
+    for info in orbits.integrators.available():
+        integ = orbits.integrators.get(info.name)
+        cls = type(integ)
+        options = ", ".join(f"``{k}={v!r}``" for k, v in integ.config.items()) or "none"
+        rows.append((f":class:`{info.name} <{cls.__module__}.{cls.__name__}>`",
+                     str(info.order), "yes" if info.symplectic else "no",
+                     "yes" if info.adaptive else "no", options, info.summary))
+    lines = [".. list-table::", "   :header-rows: 1", "   :widths: 12 6 9 8 25 40", "",
+             "   * - name", "     - order", "     - symplectic", "     - adaptive",
+             "     - options (defaults)", "     - what it is"]
+    for row in rows:
+        lines.append(f"   * - {row[0]}")
+        lines.extend(f"     - {cell}" for cell in row[1:])
+    text = "\n".join(lines) + "\n"
+    out = HERE / "_generated" / "integrators.inc"
+    out.parent.mkdir(exist_ok=True)
+    if not out.exists() or out.read_text() != text:
+        out.write_text(text)
+
+
+_integrator_table()
+
+# -- HTML -------------------------------------------------------------------------------
+html_theme = "furo"
+html_title = f"orbits {release}"
+html_static_path = []
+html_show_sourcelink = False
+
+# -- doctest builder (``-b doctest``) -------------------------------------------------
+# only the pages' own ``.. doctest::`` blocks: the docstrings' examples run under pytest
+doctest_test_doctest_blocks = ""
+doctest_global_setup = """
+import astropy.units as u
+import numpy as np
+import orbits
+"""
