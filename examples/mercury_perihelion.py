@@ -67,4 +67,8 @@ def main(years=100):
 
 
 if __name__ == "__main__":
-    main()
+    import argparse
+    p = argparse.ArgumentParser(description="Mercury's perihelion precession with each GR term")
+    p.add_argument("--years", type=float, default=100,
+                   help="length of each run in years (100; the documentation's build uses 20)")
+    main(years=p.parse_args().years)

@@ -31,7 +31,8 @@ import numpy as np
 
 import orbits
 
-HERE = pathlib.Path(__file__).resolve().parent
+# beside this script (the current folder where there is no __file__: the docs' gallery)
+HERE = pathlib.Path(globals().get("__file__", "stability_map.py")).resolve().parent
 A_J, E_J = 5.2, 0.048              # au; Jupiter's orbit
 M_PLANET = 10 * u.Mearth
 HILL_K = 3.0                       # close encounter: within this many mutual Hill radii

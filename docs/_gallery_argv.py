@@ -1,0 +1,19 @@
+"""The shorter arguments the documentation's build runs the long examples with."""
+
+import os
+import pathlib
+import tempfile
+
+__all__ = ["reset_argv", "QUICK_ARGV"]
+
+QUICK_ARGV = {
+    "mercury_perihelion.py": ["--years", "20"],
+    "stability_map.py": ["--n", "8", "--until", "3000", "--scheduler", "serial",
+                         "--png", os.path.join(tempfile.gettempdir(),
+                                               "stability_map_quick.png")],
+}
+
+
+def reset_argv(gallery_conf, script_vars):
+    """sphinx-gallery's ``reset_argv``: the arguments an example is run with."""
+    return list(QUICK_ARGV.get(pathlib.Path(script_vars["src_file"]).name, []))
