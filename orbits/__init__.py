@@ -10,13 +10,13 @@
 
 from importlib.metadata import PackageNotFoundError, version as _version
 
-from . import errors, forces, integrators, io, monitors, scenes
+from . import errors, forces, integrators, io, monitors, scenes, systemfile
 from .bodies import BodySet
 from .custom import Trajectory, integrate
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, ConvergenceFailure,
                      ElementsError, Escape, ForceTermError, IntegratorOptionError,
                      NonFiniteState,
-                     OrbitsError, RunInterrupted, StepSizeUnderflow,
+                     OrbitsError, RunInterrupted, StepSizeUnderflow, SystemFileError,
                      UnknownIntegratorError, WallTimeExceeded)
 from .result import Result
 from .simulation import Simulation
@@ -33,7 +33,8 @@ __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajec
            "BodyError", "ForceTermError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow", "ConvergenceFailure",
-           "CloseEncounter", "Escape", "WallTimeExceeded", "RunInterrupted", "load", "io", "Ensemble", "__version__"]
+           "CloseEncounter", "Escape", "WallTimeExceeded", "RunInterrupted", "SystemFileError", "systemfile",
+           "load", "io", "Ensemble", "__version__"]
 
 
 def __getattr__(name):

@@ -10,6 +10,7 @@ Every value is checked where it enters; a bad one raises a
 """
 
 import copy as _copy
+import html
 import math
 
 import astropy.units as u
@@ -23,6 +24,7 @@ from .units import UnitSystem
 __all__ = ["BodySet"]
 
 _ELEMENT_NAMES = ("a", "e", "inc", "Omega", "omega", "f", "M")
+_REPR_ROWS = 5  # rows a repr shows at each end of a long set
 
 
 class BodySet:
@@ -211,6 +213,59 @@ class BodySet:
         """An independent copy."""
         return _copy.deepcopy(self)
 
+    @classmethod
+    def read(cls, path):
+        """Read a body set from a TOML or CSV file (format: :mod:`orbits.systemfile`).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Ending in ``.toml`` or ``.csv``.
+
+        Returns
+        -------
+        BodySet
+            In the file's unit system (default au, solar masses, days).
+
+        Raises
+        ------
+        orbits.errors.SystemFileError
+            A malformed file; the message gives the file, line, body and field.
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import orbits
+        >>> path = os.path.join(tempfile.mkdtemp(), "earth-moon.toml")
+        >>> orbits.scenes.earth_moon().write(path)
+        >>> orbits.BodySet.read(path).names
+        ['Earth', 'Moon']
+        """
+        from . import systemfile
+        return systemfile.read(path).bodies
+
+    def write(self, path):
+        """Write the set to a TOML or CSV file that :meth:`read` gives back bit for bit.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Ending in ``.toml`` or ``.csv``; an existing file is replaced.
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import numpy as np
+        >>> import orbits
+        >>> bodies = orbits.scenes.figure_eight()
+        >>> path = os.path.join(tempfile.mkdtemp(), "figure-eight.csv")
+        >>> bodies.write(path)
+        >>> bool(np.array_equal(orbits.BodySet.read(path).velocities, bodies.velocities))
+        True
+        """
+        from . import systemfile
+        systemfile.write(self, path)
+
     # -- access -----------------------------------------------------------------
     def __len__(self):
         return len(self._names)
@@ -219,8 +274,57 @@ class BodySet:
         return name in self._names
 
     def __repr__(self):
-        return f"<BodySet of {len(self)} bodies: {', '.join(self._names[:8])}" + \
-            (", ...>" if len(self) > 8 else ">")
+        """The bodies with their masses and, for bound orbits, a, e and inc about the
+        bodies before each (the default primary of :meth:`elements`); a long set
+        shows its first and last rows."""
+        head, rows = self._table()
+        widths = [max(len(r[k]) for r in [head, *filter(None, rows)])
+                  for k in range(len(head))]
+        lines = [f"BodySet of {len(self)} bodies ({self.units.name}; a, e, inc about the "
+                 f"centre of mass of the bodies before each)"]
+        for row in [head, *rows]:
+            if row is None:
+                lines.append(f"  ... {len(self) - 2 * _REPR_ROWS} more ...")
+            else:
+                lines.append("  " + "  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip())
+        return "\n".join(lines)
+
+    def _repr_html_(self):
+        """The table of :meth:`__repr__`, for Jupyter."""
+        head, rows = self._table()
+
+        def cells(row, tag):
+            return "".join(f"<{tag}>{html.escape(c)}</{tag}>" for c in row)
+        body = "".join(
+            f"<tr><td colspan='{len(head)}'>&hellip; {len(self) - 2 * _REPR_ROWS} more "
+            f"&hellip;</td></tr>" if row is None else f"<tr>{cells(row, 'td')}</tr>"
+            for row in rows)
+        return (f"<div><strong>BodySet</strong> of {len(self)} bodies, units "
+                f"{html.escape(self.units.name)} (G = {self.units.G!r})"
+                f"<table><thead><tr>{cells(head, 'th')}</tr></thead><tbody>{body}</tbody>"
+                f"</table><small>a, e, inc: osculating, about the centre of mass of the "
+                f"bodies before each; blank where the orbit is not bound.</small></div>")
+
+    def _table(self):
+        """Header and rows (strings) of the reprs; None marks the rows left out."""
+        n = len(self)
+        if n > 2 * _REPR_ROWS + 1:
+            shown = [*range(_REPR_ROWS), None, *range(n - _REPR_ROWS, n)]
+        else:
+            shown = list(range(n))
+        head = ["name", *(f"{label} [{unit}]" if unit else label for label, unit in
+                          (("mass", str(self.units.mass)), ("a", str(self.units.length)))),
+                "e", "inc [deg]"]
+        rows = []
+        for i in shown:
+            if i is None:
+                rows.append(None)
+                continue
+            el = _bound_elements(self, i)
+            rows.append([self._names[i], f"{self._m[i]:.6g}",
+                         *(("", "", "") if el is None else
+                           (f"{el[0]:.6g}", f"{el[1]:.4g}", f"{math.degrees(el[2]):.4g}"))])
+        return head, rows
 
     @property
     def names(self):
@@ -293,6 +397,34 @@ class BodySet:
         q = self.units.quantity
         return {"a": q(out[0], "length"), "e": out[1] << u.dimensionless_unscaled,
                 **{k: out[j] << u.rad for j, k in enumerate(_ELEMENT_NAMES[2:], start=2)}}
+
+    def plot_orbits(self, primary=None, plane="xy", ax=None, path=None):
+        """A sketch of the set: each body on its osculating Keplerian orbit.
+
+        See :func:`orbits.plotting.plot_orbits` (needs matplotlib).
+
+        Parameters
+        ----------
+        primary : str, optional
+            The body every orbit is about; default as for :meth:`elements`.
+        plane : {"xy", "xz", "yz"}
+        ax : matplotlib.axes.Axes, optional
+        path : str or path-like, optional
+            Also write the figure there (PNG).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Examples
+        --------
+        >>> import orbits
+        >>> fig = orbits.scenes.outer_solar_system().plot_orbits(primary="Sun")
+        >>> [line.get_label() for line in fig.axes[0].lines][:2]
+        ['Jupiter', 'Saturn']
+        """
+        from .plotting import plot_orbits
+        return plot_orbits(self, primary=primary, plane=plane, ax=ax, path=path)
 
     def check(self):
         """Check the set as a whole: at least one massive body, no two at one place.
@@ -433,3 +565,19 @@ class BodySet:
 
 def _describe(value):
     return str(value)
+
+
+def _bound_elements(bodies, i):
+    """``(a, e, inc)`` of body ``i`` about the centre of mass of the bodies before it
+    (internal units, inc in rad), or None where that orbit is not a bound ellipse."""
+    m = bodies._m[:i]
+    mt = m.sum()
+    if i == 0 or not mt > 0:
+        return None
+    mu = bodies.units.G * (mt + bodies._m[i])
+    out = np.empty(7)
+    status = _kepler.state_to_elements(mu, bodies._x[i] - (m @ bodies._x[:i]) / mt,
+                                       bodies._v[i] - (m @ bodies._v[:i]) / mt, out)
+    if status != 0 or not (0 <= out[1] < 1 and out[0] > 0):
+        return None
+    return float(out[0]), float(out[1]), float(out[2])

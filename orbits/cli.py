@@ -1,4 +1,4 @@
-"""Command line: ``orbits run | resume | info | plot | validate | scenes | integrators``.
+"""Command line: ``orbits run | resume | info | plot | elements | validate | scenes | integrators``.
 
 ``main(argv=None)`` only parses arguments and calls the library; the tests
 call it with a list.
@@ -36,6 +36,70 @@ def parse_quantity(text, physical_type="time"):
     return q
 
 
+def _length(text):
+    """An argparse type: a length with a unit, or a plain number in the scene's units."""
+    return parse_quantity(text, "length")
+
+
+#: ``orbits run`` option -> (type, help); the option is passed under its own name
+INTEGRATOR_OPTIONS = {
+    "epsilon": (float, "IAS15's precision parameter, default 1e-9"),
+    "rtol": (float, "relative tolerance of the embedded methods, default 1e-9"),
+    "atol": (float, "absolute tolerance, in the scene's units, default 1e-12"),
+    "corrector": (int, "Wisdom-Holman symplectic corrector order: 0, 3, 5, 7, 11 or 17"),
+    "coordinates": (str, "Wisdom-Holman coordinates: jacobi or democratic-heliocentric"),
+}
+
+#: the integrators that take each option (tests/test_cli_run.py checks it against
+#: the registry; the help is built without importing the integrators)
+OPTION_TAKEN_BY = {
+    "epsilon": ("ias15",),
+    "rtol": ("dopri5", "dop853", "rk4-doubling", "radau", "lsoda"),
+    "atol": ("dopri5", "dop853", "rk4-doubling", "radau", "lsoda"),
+    "corrector": ("wh",),
+    "coordinates": ("wh", "saba2", "saba3", "saba4"),
+}
+
+RUN_EXAMPLES = """\
+examples:
+  orbits run outer-solar-system -i wh --dt 100d --until 1e5yr --com --out run.h5
+  orbits run outer-solar-system -i ias15 --epsilon 1e-10 --until 1000yr
+  orbits run pythagorean -i dop853 --rtol 1e-12 --until 100 --escape-distance 10
+
+your own bodies, in system.toml (numbers with units; angles in deg or rad):
+
+  [[body]]
+  name = "Sun"
+  mass = "1 Msun"
+
+  [[body]]
+  name = "Jupiter"
+  mass = "1 Mjup"
+  primary = "Sun"
+  a = "5.2 au"
+  e = 0.048
+  inc = "1.3 deg"
+
+  [[body]]
+  name = "probe"
+  mass = 0
+  position = ["1 au", "0 au", "0 au"]
+  velocity = ["0 km/s", "30 km/s", "0 km/s"]
+
+  [run]                       # optional defaults; the options above override them
+  integrator = "ias15"
+  until = "100 yr"
+
+then:
+  orbits run system.toml --com
+  orbits run system.toml -i wh --dt 10d --corrector 17 --until 1e4yr
+
+A .csv file works too: a header 'name,mass [Msun],x [au],...,vz [km/s]' (or element
+columns 'primary,a [au],e,inc [deg]'), a row per body; see orbits.systemfile.
+Exit status: 0 done, 1 stopped by a stopping condition, 2 an error.
+"""
+
+
 def _dominant(bodies):
     return bodies.names[int(np.argmax(bodies.masses.value))]
 
@@ -57,22 +121,48 @@ def _parser():
     p = argparse.ArgumentParser(prog="orbits", description="N-body orbital mechanics.")
     sub = p.add_subparsers(dest="command", required=True)
 
-    run = sub.add_parser("run", help="integrate a built-in scene and print a summary")
-    run.add_argument("scene", help="scene name (see 'orbits scenes')")
-    run.add_argument("--integrator", "-i", default="verlet",
-                     help="integrator name (see 'orbits integrators'); default verlet")
+    run = sub.add_parser("run", help="integrate a built-in scene or your own body set "
+                                     "and print a summary",
+                         description="Integrate a built-in scene or a body set from a "
+                                     "TOML or CSV file, and print a summary.",
+                         epilog=RUN_EXAMPLES,
+                         formatter_class=argparse.RawDescriptionHelpFormatter)
+    run.add_argument("scene", help="scene name (see 'orbits scenes') or a body-set file "
+                                   "ending in .toml or .csv")
+    run.add_argument("--integrator", "-i", default=None,
+                     help="integrator name (see 'orbits integrators'); default: the file's "
+                          "[run] integrator, else verlet")
     run.add_argument("--dt", type=parse_quantity, default=None,
                      help="step, with a unit (10d, 1h) or a plain number in the scene's "
                           "units; for adaptive integrators (ias15, dopri5, ...) the first "
                           "step, and optional")
-    run.add_argument("--until", type=parse_quantity, required=True,
-                     help="end time, e.g. 1000yr, or a plain number in the scene's units")
+    run.add_argument("--until", type=parse_quantity, default=None,
+                     help="end time, e.g. 1000yr, or a plain number in the scene's units; "
+                          "needed unless the file's [run] table gives it")
     run.add_argument("--outputs", type=int, default=None,
                      help="number of outputs (500, or one per step for a shorter run)")
     run.add_argument("--gr", choices=sorted(GR_TERMS),
                      help="general relativity: 'sun' (1PN correction from the most massive "
                           "body, velocity-dependent), 'potential' (its potential form, which "
                           "wh takes) or 'full' (Einstein-Infeld-Hoffmann among all bodies)")
+    opts = run.add_argument_group("integrator options", "passed only when given; an "
+                                  "integrator that does not take one is an error")
+    for option, (kind, text) in INTEGRATOR_OPTIONS.items():
+        opts.add_argument(f"--{option}", type=kind, default=None,
+                          help=f"{text}; taken by {', '.join(OPTION_TAKEN_BY[option])}")
+    stops = run.add_argument_group("stopping conditions", "checked after every step; the "
+                                   "run stops with exit status 1 and prints what it has")
+    stops.add_argument("--encounter-distance", type=_length, default=None,
+                       help="stop when two bodies come closer than this (0.01au, 1e5km)")
+    stops.add_argument("--encounter-hill", type=float, default=None,
+                       help="stop when two bodies other than the central one come within "
+                            "this many mutual Hill radii")
+    stops.add_argument("--escape-distance", type=_length, default=None,
+                       help="stop when a body is farther than this from the centre of mass "
+                            "(1000au)")
+    run.add_argument("--com", action="store_true",
+                     help="move the bodies to their centre-of-mass frame first (scenes in "
+                          "a published frame, such as outer-solar-system, drift otherwise)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
     run.add_argument("--out", help="stream outputs and checkpoints to this HDF5 file")
     run.add_argument("--force", action="store_true", help="overwrite an existing --out file")
@@ -97,6 +187,20 @@ def _parser():
                                        "as a PNG")
     plot.add_argument("file")
     plot.add_argument("-o", "--output", help="PNG path (default: next to the file)")
+    plot.add_argument("--frame", default=None, metavar="FRAME",
+                      help="barycentric, heliocentric (about the most massive body) or a "
+                           "body's name; default about the most massive body where it "
+                           "holds most of the mass, else barycentric")
+
+    elements = sub.add_parser("elements", help="the osculating orbital elements of a body "
+                                               "at every output of a file, as a table")
+    elements.add_argument("file")
+    elements.add_argument("--body", required=True, help="the body's name")
+    elements.add_argument("--primary", default=None,
+                          help="the body the orbit is about (default: the centre of mass "
+                               "of the bodies before it in the set, as REBOUND's orbit())")
+    elements.add_argument("--out", default=None,
+                          help="write the table to this CSV file instead of printing it")
 
     val = sub.add_parser("validate", help="run the validation report (accuracy against "
                                           "REBOUND, work-precision, drift, stress suite) "
@@ -137,14 +241,16 @@ def _negative_values(argv):
     return out
 
 
-_TIME_OPTIONS = ("--dt", "--until")
+# options whose value may be negative, so that it reaches the checks
+_TIME_OPTIONS = ("--dt", "--until", "--epsilon", "--rtol", "--atol", "--corrector",
+                 "--encounter-distance", "--encounter-hill", "--escape-distance")
 
 
-def _in_scene_units(value, bodies):
-    """A plain number is read in the scene's unit of time, as the help says."""
+def _in_scene_units(value, bodies, kind="time"):
+    """A plain number is read in the scene's unit of time (or ``kind``), as the help says."""
     if value is None or isinstance(value, u.Quantity):
         return value
-    return value * bodies.units.unit("time")
+    return value * bodies.units.unit(kind)
 
 
 def _terminated(signum, frame):
@@ -194,22 +300,7 @@ def _main(args, orbits):
             print(f"{info.name:18s} {info.order:5d}  {str(info.symplectic):10s} "
                   f"{str(info.adaptive):8s} {info.summary}")
     elif args.command == "run":
-        bodies = orbits.scenes.get(args.scene)
-        forces = [] if args.gr is None else [GR_TERMS[args.gr](bodies)]
-        integrator = orbits.integrators.get(args.integrator)
-        if args.dt is None and not integrator.adaptive:
-            raise ValueError(f"--dt is needed: {args.integrator!r} takes fixed steps "
-                             f"(adaptive integrators such as ias15 choose their own)")
-        sim = orbits.Simulation(bodies, integrator=integrator,
-                                dt=_in_scene_units(args.dt, bodies), forces=forces)
-        result = sim.run(until=_in_scene_units(args.until, bodies), outputs=args.outputs,
-                         progress=False if args.no_progress else None,
-                         output=args.out, overwrite=args.force,
-                         checkpoint_interval=args.checkpoint_interval)
-        print(f"scene           {args.scene}")
-        print(result.summary())
-        if args.out:
-            print(f"written         {args.out}")
+        return _run(args, orbits)
     elif args.command == "resume":
         sim = orbits.Simulation.from_file(args.file)
         progress = False if args.no_progress else None
@@ -232,9 +323,101 @@ def _main(args, orbits):
         return _validate(args)
     elif args.command == "plot":
         from orbits.plotting import plot_file
-        path = plot_file(args.file, args.output)
+        path = plot_file(args.file, args.output, frame=args.frame)
         print(f"wrote {path}")
+    elif args.command == "elements":
+        _elements(args, orbits)
     return 0
+
+
+def _elements(args, orbits):
+    import csv
+    result = orbits.load(args.file)
+    if not len(result):
+        raise orbits.io.OrbitsFileError(f"{args.file}: holds no outputs ({result.status})")
+    columns, table = result.elements_table(args.body, primary=args.primary)
+    if args.out:
+        with open(args.out, "w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(columns)
+            writer.writerows([repr(float(v)) for v in row] for row in table)
+        print(f"wrote {args.out} ({len(table)} rows: {', '.join(columns)})")
+        return
+    try:
+        print("  ".join(f"{c:>17s}" for c in columns))
+        for row in table:
+            print("  ".join(f"{v:17.10g}" for v in row))
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # the reader stopped (``| head``): no traceback; Python's documented remedy
+        import os
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+
+
+def _run(args, orbits):
+    """``orbits run``: a scene or a body-set file, the file's [run] defaults under the
+    command line's options."""
+    bodies, defaults = _bodies(args.scene, orbits)
+
+    def given(key):
+        value = getattr(args, key)
+        return defaults.get(key) if value is None else value
+
+    name = args.integrator or defaults.get("integrator", "verlet")
+    options = dict(defaults.get("options", {}))
+    options.update((k, getattr(args, k)) for k in INTEGRATOR_OPTIONS
+                   if getattr(args, k) is not None)
+    integrator = orbits.integrators.get(name, **options)
+    dt, until = given("dt"), given("until")
+    if dt is None and not integrator.adaptive:
+        raise ValueError(f"--dt is needed: {name!r} takes fixed steps "
+                         f"(adaptive integrators such as ias15 choose their own)")
+    if until is None:
+        raise ValueError("--until is needed: the end time, such as 1000yr (a body-set "
+                         "file may give it as 'until' in its [run] table)")
+    if args.com or defaults.get("com"):
+        bodies.move_to_com()
+    forces = [] if args.gr is None else [GR_TERMS[args.gr](bodies)]
+    stops = {"encounter_distance": _in_scene_units(given("encounter_distance"), bodies,
+                                                   "length"),
+             "encounter_hill": args.encounter_hill,
+             "escape_distance": _in_scene_units(given("escape_distance"), bodies, "length")}
+    sim = orbits.Simulation(bodies, integrator=integrator,
+                            dt=_in_scene_units(dt, bodies), forces=forces,
+                            **{k: v for k, v in stops.items() if v is not None})
+    print(f"scene           {args.scene}")
+    try:
+        result = sim.run(until=_in_scene_units(until, bodies), outputs=given("outputs"),
+                         progress=False if args.no_progress else None,
+                         output=args.out, overwrite=args.force,
+                         checkpoint_interval=args.checkpoint_interval)
+    except orbits.errors.SimulationStopped as exc:
+        if exc.result is not None:
+            print(exc.result.summary())
+        print(f"stopped         {exc}")
+        if args.out:
+            print(f"written         {args.out}")
+        return 1
+    print(result.summary())
+    if args.out:
+        print(f"written         {args.out}")
+    return 0
+
+
+def _bodies(scene, orbits):
+    """A built-in scene (no defaults), or a body-set file and its [run] table."""
+    if scene.lower().endswith((".toml", ".csv")):
+        import os
+        from orbits import systemfile
+        if not os.path.isfile(scene):
+            raise ValueError(f"no such file: {scene}")
+        sf = systemfile.read(scene)
+        return sf.bodies, sf.run
+    try:
+        return orbits.scenes.get(scene), {}
+    except ValueError as exc:
+        raise ValueError(f"{exc}; or give a body-set file ending in .toml or .csv") from None
 
 
 def _validate(args):

@@ -19,6 +19,7 @@ __all__ = [
     "UnknownIntegratorError",
     "IntegratorOptionError",
     "ForceTermError",
+    "SystemFileError",
     "RunError",
     "SimulationStopped",
     "NonFiniteState",
@@ -215,3 +216,29 @@ class RunInterrupted(KeyboardInterrupt):
         self.step = step
         self.result = result
         super().__init__(message)
+
+
+class SystemFileError(BodyError):
+    """A body-set file (:mod:`orbits.systemfile`, TOML or CSV) that cannot be read.
+
+    The message starts with the file and the line, then the body and the
+    field where there is one: ``system.toml, line 12: body 'Jupiter', field
+    'a': ...``.
+
+    Attributes
+    ----------
+    path : str
+        The file, as given (``"<string>"`` for text).
+    line : int or None
+        Line of the file (1-based) where the problem is.
+    body, field : str or None
+        As for :class:`BodyError`.
+    """
+
+    def __init__(self, message, path=None, line=None, body=None, field=None):
+        super().__init__(message, body=body, field=field)
+        self.path = path
+        self.line = line
+        where = ", ".join(p for p in (path, None if line is None else f"line {line}") if p)
+        if where:
+            self.args = (f"{where}: {self.args[0]}",)

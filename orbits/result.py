@@ -1,8 +1,42 @@
-"""What a run returns: outputs as Quantities, monitor series, and a summary."""
+"""What a run returns: outputs as Quantities, monitor series, and a summary.
 
+A :class:`Result` also analyses its outputs: orbital elements over time
+(:meth:`Result.elements`), the same outputs in another frame
+(:meth:`Result.relative_to`, :meth:`Result.barycentric`,
+:meth:`Result.in_frame`), tables (:meth:`Result.to_pandas`,
+:meth:`Result.to_xarray`) and plots (:meth:`Result.plot`,
+:meth:`Result.plot_elements`).  :func:`orbits.load` returns a Result, so all
+of this works on output files as well.
+"""
+
+import copy as _copy
+import math
+
+import astropy.units as u
 import numpy as np
 
-__all__ = ["Result"]
+from ._kernels import kepler as _kepler
+from .errors import BodyError, ElementsError, NoMassiveBodyError, UnknownBodyError
+from .units import UnitSystem
+
+__all__ = ["Result", "FRAMES", "DOMINANT_MASS_FRACTION"]
+
+#: Frame names that :meth:`Result.in_frame` and the plots take besides a body's name.
+FRAMES = ("barycentric", "heliocentric")
+
+#: The default frame of :meth:`Result.in_frame` is about the most massive body
+#: when that body holds more than this fraction of the total mass (a star with
+#: planets, a planet with moons); otherwise (three comparable stars, a
+#: cluster) about the barycentre, where no body is a natural centre.
+DOMINANT_MASS_FRACTION = 0.5
+
+_ELEMENT_KEYS = ("a", "e", "inc", "Omega", "omega", "f", "M")
+
+#: Monitor series that :meth:`Result.to_pandas` and :meth:`Result.to_xarray`
+#: export: (attribute, is a 3-vector).
+_MONITOR_SERIES = (("energy", False), ("energy_error", False),
+                   ("angular_momentum", True), ("angular_momentum_error", False),
+                   ("momentum", True), ("center_of_mass", True))
 
 
 class Result:
@@ -49,6 +83,11 @@ class Result:
         ``"completed"`` or the reason the run stopped.
     forces : tuple of str
         The force terms added to gravity, as written (``"GR(source='Sun')"``).
+    frame : str or None
+        The frame of ``positions`` and ``velocities``: None for the frame the
+        run was integrated in, ``"barycentric"``, or the name of the body at
+        the origin (see :meth:`relative_to`).  Monitors (energy, momentum,
+        centre of mass) are always those of the run, in its own frame.
     """
 
     def __init__(self, **fields):
@@ -61,6 +100,7 @@ class Result:
         self.forces = ()
         self.start_time = None
         self.largest_errors = None
+        self.frame = None
         for k, v in fields.items():
             setattr(self, k, v)
 
@@ -70,6 +110,31 @@ class Result:
     def __repr__(self):
         return (f"<Result: {len(self)} outputs of {len(self.names)} bodies, "
                 f"{self.integrator['name']}, {self.status}>")
+
+    def _repr_html_(self):
+        """Outputs, time span, integrator, status and largest errors, for Jupyter."""
+        import html
+        opts = ", ".join(f"{k[7:]}={v!r}" for k, v in self.integrator.items()
+                         if k.startswith("option."))
+        if len(self.times):
+            start = self.times[0] if self.start_time is None else self.start_time
+            span = f"{start:.6g} to {self.times[-1]:.6g}"
+            length = self.times[-1] - start
+            if length.unit.physical_type == "time" and abs(length) > 1 * u.yr:
+                span += f" ({length.to(u.yr):.6g})"
+        else:
+            span = "no outputs"
+        names = ", ".join(self.names[:6]) + (", ..." if len(self.names) > 6 else "")
+        errors = (("largest energy error", self.max_energy_error()),
+                  ("largest ang. momentum error", self.max_angular_momentum_error()))
+        rows = [("outputs", str(len(self))), ("bodies", f"{len(self.names)}: {names}"),
+                ("time", span),
+                ("integrator", self.integrator["name"] + (f"({opts})" if opts else "")),
+                ("steps", str(self.steps)), ("status", str(self.status)),
+                *((k, f"{v:.3e}") for k, v in errors if v is not None)]
+        cells = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{html.escape(v)}</td>"
+                        f"</tr>" for k, v in rows)
+        return f"<div><strong>Result</strong><table>{cells}</table></div>"
 
     def max_energy_error(self):
         """Largest relative energy error seen, at outputs or by the in-loop monitor."""
@@ -128,6 +193,488 @@ class Result:
                          + _final(self.angular_momentum_error))
         lines.append(f"status          {self.status}")
         return "\n".join(lines)
+
+    # -- analysis ---------------------------------------------------------------
+    def elements(self, body, primary=None):
+        """Osculating orbital elements of a body at every output.
+
+        The elements, angle conventions and default primary of
+        :meth:`orbits.BodySet.elements`, from the same compiled kernel, run on
+        all outputs at once; and the orbital period.
+
+        Parameters
+        ----------
+        body : str
+            The body's name.
+        primary : str, optional
+            The body the orbit is about.  Default: the centre of mass of the
+            bodies before ``body`` in the set (Jacobi-like, as in
+            :meth:`~orbits.BodySet.elements` and REBOUND's ``Particle.orbit()``).
+
+        Returns
+        -------
+        dict of Quantity, each of shape (n,) for n outputs
+            ``a`` (length; negative for a hyperbolic orbit), ``e``
+            (dimensionless), ``inc``, ``Omega``, ``omega``, ``f``, ``M`` (angles
+            in rad), and ``P`` (time; NaN for a hyperbolic orbit, which has no
+            period), in the run's unit system.
+
+        Raises
+        ------
+        UnknownBodyError
+            ``body`` or ``primary`` is not one of the bodies.
+        BodyError
+            ``primary`` is ``body`` itself, or no massive body comes before
+            ``body`` in the set and no primary is named.
+        ElementsError
+            At some output the state describes no orbit: the body is on its
+            primary, or the orbit is radial or parabolic to within rounding.  The
+            message gives the first such output.
+
+        Notes
+        -----
+        With ``mu = G (m_primary + m_body)`` and the relative state ``r, v``:
+        ``1/a = 2/|r| - |v|^2/mu``, the eccentricity vector is
+        ``(v x h)/mu - r/|r|`` with ``h = r x v``, and ``P = 2 pi sqrt(a^3/mu)``.
+        ``inc`` lies in [0, pi], ``Omega`` and ``omega`` in [0, 2 pi), ``f`` and
+        ``M`` in [-pi, pi]; ``M`` of a hyperbola is ``e sinh F - F``.  REBOUND
+        reduces some angles to other ranges (compare them modulo 2 pi) and gives
+        a hyperbola the negative period ``-2 pi sqrt(|a|^3/mu)``.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
+        ...                         integrator="leapfrog", dt=10 * u.day)
+        >>> result = sim.run(until=100 * u.yr, outputs=11, progress=False)
+        >>> el = result.elements("Jupiter", primary="Sun")
+        >>> el["a"].shape
+        (11,)
+        >>> print(el["a"][0].round(2), el["P"][0].to(u.yr).round(1))
+        5.2 AU 11.9 yr
+        """
+        i = self._index(body)
+        U, x, v, m = self._internal()
+        n = x.shape[0]
+        if primary is None:
+            interior = m[:i]
+            if i == 0 or not np.any(interior > 0):
+                raise BodyError("orbital elements need a primary: no massive body comes "
+                                "before this one in the set; name one with primary=",
+                                body=body, field="primary")
+            mp = interior.sum()
+            xp = (interior @ x[:, :i]) / mp
+            vp = (interior @ v[:, :i]) / mp
+        else:
+            if not isinstance(primary, str) or primary not in self.names:
+                raise UnknownBodyError(f"unknown primary {primary!r}; known bodies: "
+                                       f"{', '.join(self.names)}", body=body,
+                                       field="primary")
+            j = self.names.index(primary)
+            if j == i:
+                raise BodyError("a body has no orbit about itself; name another primary",
+                                body=body, field="primary")
+            mp, xp, vp = m[j], x[:, j], v[:, j]
+        mu = U.G * (mp + m[i])
+        if not mu > 0:
+            raise ElementsError("the primary and the body are both massless; an orbit "
+                                "needs mass", body=body, field="primary")
+        out = np.empty((n, 7))
+        status = np.zeros(n, dtype=np.int64)
+        _kepler.state_to_elements_many(np.full(n, mu), np.ascontiguousarray(x[:, i] - xp),
+                                       np.ascontiguousarray(v[:, i] - vp), out, status)
+        bad = np.flatnonzero(status)
+        if bad.size:
+            k = int(bad[0])
+            more = f" (and at {bad.size - 1} later outputs)" if bad.size > 1 else ""
+            raise ElementsError(f"at output {k} (t = {self.times[k]:.10g}){more}: "
+                                f"{_kepler.describe_status(status[k])}", body=body,
+                                field="elements")
+        a = out[:, 0]
+        period = np.full(n, np.nan)
+        bound = a > 0
+        period[bound] = 2.0 * math.pi * np.sqrt(a[bound] ** 3 / mu)
+        q = U.quantity
+        elements = {"a": q(a, "length"), "e": out[:, 1] << u.dimensionless_unscaled}
+        for k, key in enumerate(_ELEMENT_KEYS[2:], start=2):
+            elements[key] = out[:, k] << u.rad
+        elements["P"] = q(period, "time")
+        return elements
+
+    def elements_table(self, body, primary=None):
+        """:meth:`elements` at every output as a plain table for people and files.
+
+        Parameters
+        ----------
+        body : str
+            The body's name.
+        primary : str, optional
+            As for :meth:`elements`.
+
+        Returns
+        -------
+        columns : list of str
+            ``"time [d]"``, ``"a [AU]"``, ``"e"``, ``"inc [deg]"``,
+            ``"Omega [deg]"``, ``"omega [deg]"``, ``"f [deg]"``, ``"M [deg]"``,
+            ``"P [d]"``: the run's units of time and length, angles in degrees.
+        table : ndarray, shape (n, 9)
+            One row per output.
+
+        Raises
+        ------
+        UnknownBodyError, BodyError, ElementsError
+            As :meth:`elements` raises them.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
+        ...                         integrator="leapfrog", dt=10 * u.day)
+        >>> result = sim.run(until=100 * u.yr, outputs=11, progress=False)
+        >>> columns, table = result.elements_table("Saturn", primary="Sun")
+        >>> columns[:4], table.shape
+        (['time [d]', 'a [AU]', 'e', 'inc [deg]'], (11, 9))
+        """
+        el = self.elements(body, primary=primary)
+        values = [self.times.value]
+        columns = [_label("time", self.times.unit)]
+        for key in (*_ELEMENT_KEYS, "P"):
+            q = el[key].to(u.deg) if el[key].unit == u.rad else el[key]
+            values.append(q.value)
+            columns.append(_label(key, q.unit))
+        return columns, np.column_stack(values)
+
+    def relative_to(self, body):
+        """The same outputs in the frame in which ``body`` is at rest at the origin.
+
+        Parameters
+        ----------
+        body : str
+            The body's name.
+
+        Returns
+        -------
+        Result
+            A new result whose ``positions`` and ``velocities`` (Quantity, shape
+            (n, N, 3), same units) are those of this one minus ``body``'s, and
+            whose ``frame`` is ``body``.  Times, masses and monitors are shared,
+            unchanged.
+
+        Raises
+        ------
+        UnknownBodyError
+            ``body`` is not one of the bodies.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(com=True),
+        ...                         integrator="leapfrog", dt=10 * u.day)
+        >>> helio = sim.run(until=10 * u.yr, outputs=3, progress=False).relative_to("Sun")
+        >>> helio.frame, helio.positions[:, 0].max()
+        ('Sun', <Quantity 0. AU>)
+        """
+        j = self._index(body, field="frame")
+        return self._shifted(self.positions[:, j:j + 1], self.velocities[:, j:j + 1], body)
+
+    def barycentric(self):
+        """The same outputs in the frame of the centre of mass of all bodies.
+
+        Returns
+        -------
+        Result
+            A new result whose ``positions`` and ``velocities`` (Quantity, shape
+            (n, N, 3), same units) are measured from the centre of mass at each
+            output, and whose ``frame`` is ``"barycentric"``.  Times, masses and
+            monitors are shared, unchanged.
+
+        Raises
+        ------
+        NoMassiveBodyError
+            No body has mass.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
+        ...                         integrator="leapfrog", dt=10 * u.day)
+        >>> bary = sim.run(until=10 * u.yr, outputs=3, progress=False).barycentric()
+        >>> com = bary.masses.value @ bary.positions / bary.masses.value.sum()
+        >>> bool(abs(com).max() < 1e-15 * u.au)
+        True
+        """
+        m = self.masses.value
+        total = m.sum()
+        if not total > 0:
+            raise NoMassiveBodyError("the barycentre needs a body with positive mass")
+        w = m / total
+        return self._shifted((w @ self.positions)[:, None], (w @ self.velocities)[:, None],
+                             "barycentric")
+
+    def in_frame(self, frame=None):
+        """The same outputs in a frame given by name.
+
+        Parameters
+        ----------
+        frame : str, optional
+            ``"barycentric"`` (:meth:`barycentric`); ``"heliocentric"``: about
+            the most massive body (the star); or a body's name
+            (:meth:`relative_to`).  Default: about the most massive body when it
+            holds more than :data:`DOMINANT_MASS_FRACTION` of the mass,
+            otherwise barycentric.
+
+        Returns
+        -------
+        Result
+            With ``frame`` set to ``"barycentric"`` or the central body's name.
+
+        Raises
+        ------
+        UnknownBodyError
+            ``frame`` is neither a frame name nor a body's name (field ``frame``).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
+        ...                         integrator="leapfrog", dt=10 * u.day)
+        >>> result = sim.run(until=10 * u.yr, outputs=3, progress=False)
+        >>> result.in_frame().frame, result.in_frame("barycentric").frame
+        ('Sun', 'barycentric')
+        """
+        if frame is None:
+            frame = self._default_frame()
+        if frame == "barycentric":
+            return self.barycentric()
+        if frame == "heliocentric":
+            return self.relative_to(self.names[int(np.argmax(self.masses.value))])
+        if isinstance(frame, str) and frame in self.names:
+            return self.relative_to(frame)
+        raise UnknownBodyError(f"unknown frame; expected one of {', '.join(FRAMES)} or a "
+                               f"body's name ({', '.join(self.names)})", body=frame,
+                               field="frame")
+
+    # -- tables -------------------------------------------------------------------
+    def to_pandas(self):
+        """The outputs as a table, one row per output, units in the column names.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``"time [d]"``; for each body ``"<name>.x [AU]"``, ``.y``,
+            ``.z``, ``.vx [AU / d]``, ``.vy``, ``.vz`` (in the units of
+            ``positions``, ``velocities`` and ``times``); then the monitors that
+            were recorded: ``"energy [...]"``, ``"energy_error"``,
+            ``"angular_momentum.x [...]"`` ..., ``"angular_momentum_error"``,
+            ``"momentum.x [...]"`` ..., ``"center_of_mass.x [...]"`` ....
+            Dimensionless quantities have no bracket.  ``DataFrame.attrs``
+            holds ``frame``, ``names``, ``masses`` (a list of floats),
+            ``mass_unit`` and ``units`` (the unit system).
+
+        Raises
+        ------
+        ImportError
+            pandas is not installed (``pip install pandas``).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.5), integrator="leapfrog",
+        ...                         dt=1 * u.day)
+        >>> df = sim.run(until=10 * u.day, outputs=3, progress=False).to_pandas()
+        >>> list(df.columns[:4])
+        ['time [d]', 'Star.x [AU]', 'Star.y [AU]', 'Star.z [AU]']
+        """
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("Result.to_pandas needs pandas: pip install pandas") from None
+        x, v = self.positions, self.velocities
+        columns = [_label("time", self.times.unit)]
+        data = [self.times.value[:, None]]
+        n, nb = x.shape[0], x.shape[1]
+        per_body = np.concatenate([x.value, v.value], axis=2)       # (n, N, 6)
+        data.append(per_body.reshape(n, 6 * nb))
+        for name in self.names:
+            columns += [_label(f"{name}.{c}", x.unit) for c in "xyz"]
+            columns += [_label(f"{name}.{c}", v.unit) for c in ("vx", "vy", "vz")]
+        for key, values in self._monitor_series():
+            if values.ndim == 2:
+                columns += [_label(f"{key}.{c}", getattr(values, "unit", None))
+                            for c in "xyz"]
+            else:
+                columns.append(_label(key, getattr(values, "unit", None)))
+            data.append(np.asarray(getattr(values, "value", values)).reshape(n, -1))
+        df = pd.DataFrame(np.concatenate(data, axis=1), columns=columns)
+        df.attrs.update(frame=self.frame, names=list(self.names),
+                        masses=self.masses.value.tolist(),
+                        mass_unit=self.masses.unit.to_string(), units=dict(self.units))
+        return df
+
+    def to_xarray(self):
+        """The outputs as an ``xarray.Dataset``, units in the variables' attributes.
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinates ``time`` (n), ``body`` (N names) and ``axis``
+            (``"x", "y", "z"``); variables ``position`` and ``velocity``
+            (time, body, axis), ``mass`` (body) and the monitors that were
+            recorded (``energy``, ``energy_error``, ``angular_momentum``
+            (time, axis), ...).  Each has a ``units`` attribute (astropy's
+            spelling, ``""`` for dimensionless); the dataset's attributes say
+            the ``frame``, the ``integrator`` and the unit system.
+
+        Raises
+        ------
+        ImportError
+            xarray is not installed (``pip install xarray``).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.5), integrator="leapfrog",
+        ...                         dt=1 * u.day)
+        >>> result = sim.run(until=10 * u.day, outputs=3, progress=False)
+        >>> ds = result.to_xarray()                     # doctest: +SKIP
+        >>> ds["position"].attrs["units"]               # doctest: +SKIP
+        'AU'
+        """
+        try:
+            import xarray as xr
+        except ImportError:
+            raise ImportError("Result.to_xarray needs xarray: pip install xarray") from None
+
+        def var(dims, q):
+            unit = getattr(q, "unit", u.dimensionless_unscaled)
+            return xr.Variable(dims, np.asarray(getattr(q, "value", q)),
+                               attrs={"units": unit.to_string()})
+
+        data = {"position": var(("time", "body", "axis"), self.positions),
+                "velocity": var(("time", "body", "axis"), self.velocities),
+                "mass": var(("body",), self.masses)}
+        for key, values in self._monitor_series():
+            data[key] = var(("time", "axis") if values.ndim == 2 else ("time",), values)
+        coords = {"time": var(("time",), self.times), "body": list(self.names),
+                  "axis": ["x", "y", "z"]}
+        attrs = {"frame": "as integrated" if self.frame is None else self.frame,
+                 "integrator": str(self.integrator.get("name", "")),
+                 "status": str(self.status)}
+        attrs.update({f"units_{k}": str(val) for k, val in self.units.items()})
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    # -- plots --------------------------------------------------------------------
+    def plot(self, frame=None, path=None):
+        """Orbits in the x-y plane in a chosen frame, and the invariants' errors.
+
+        See :func:`orbits.plotting.plot_result`.
+
+        Parameters
+        ----------
+        frame : str, optional
+            As for :meth:`in_frame`: by default about the most massive body where
+            it holds most of the mass, else barycentric.
+        path : str or path-like, optional
+            Also write the figure there (PNG).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
+        ...                         integrator="leapfrog", dt=10 * u.day)
+        >>> fig = sim.run(until=100 * u.yr, outputs=50, progress=False).plot()
+        >>> fig.axes[0].get_title()
+        'orbits (x-y plane), about Sun'
+        """
+        from .plotting import plot_result
+        return plot_result(self, path=path, frame=frame)
+
+    def plot_elements(self, bodies=None, primary=None, path=None):
+        """Semi-major axis, eccentricity and inclination against time.
+
+        See :func:`orbits.plotting.plot_elements`.
+
+        Parameters
+        ----------
+        bodies : sequence of str, optional
+            Default: every body but ``primary`` (but the first when no primary
+            is named), at most 12.
+        primary : str, optional
+            As for :meth:`elements`.
+        path : str or path-like, optional
+            Also write the figure there (PNG).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
+        ...                         integrator="leapfrog", dt=10 * u.day)
+        >>> fig = sim.run(until=100 * u.yr, outputs=50, progress=False).plot_elements()
+        >>> [ax.get_ylabel() for ax in fig.axes]
+        ['a [AU]', 'e', 'inc [deg]']
+        """
+        from .plotting import plot_elements
+        return plot_elements(self, bodies=bodies, primary=primary, path=path)
+
+    # -- internals ----------------------------------------------------------------
+    def _index(self, name, field="body"):
+        if isinstance(name, str) and name in self.names:
+            return list(self.names).index(name)
+        raise UnknownBodyError(f"no such body; known: {', '.join(self.names)}",
+                               body=name, field=field)
+
+    def _internal(self):
+        """The unit system and plain arrays of positions, velocities and masses in it."""
+        U = UnitSystem.from_dict(self.units)
+        return (U, self.positions.to_value(U.unit("length")),
+                self.velocities.to_value(U.unit("velocity")),
+                self.masses.to_value(U.unit("mass")))
+
+    def _default_frame(self):
+        m = self.masses.value
+        k = int(np.argmax(m))
+        total = m.sum()
+        if total > 0 and m[k] > DOMINANT_MASS_FRACTION * total:
+            return self.names[k]
+        return "barycentric"
+
+    def _shifted(self, dx, dv, frame):
+        new = _copy.copy(self)
+        new.positions = self.positions - dx
+        new.velocities = self.velocities - dv
+        new.frame = frame
+        return new
+
+    def _monitor_series(self):
+        """(name, series) of the monitors recorded at every output."""
+        n = len(self.times)
+        for key, _ in _MONITOR_SERIES:
+            values = getattr(self, key, None)
+            if values is not None and len(values) == n:
+                yield key, values
+
+
+def _label(name, unit):
+    """``"name [unit]"``, or ``"name"`` for a dimensionless quantity."""
+    text = "" if unit is None else u.Unit(unit).to_string()
+    return f"{name} [{text}]" if text else name
 
 
 def _final(series):

@@ -374,8 +374,11 @@ def outer_solar_system(com=False):
         frame, in which the Sun is at rest at the origin (heliocentric
         positions and velocities) and the axes are equatorial (the planets'
         orbits are inclined about 23 deg to the xy plane).  In that frame the
-        centre of mass drifts at 6.8e-6 au/day; integrators do not mind,
-        but plots over long times do.
+        centre of mass drifts at 6.8e-6 au/day (250 au in 1e5 years);
+        integrators do not mind, but plots in that frame would.
+        :meth:`orbits.Result.plot` and ``orbits plot`` draw about the Sun by
+        default, and :meth:`orbits.Result.relative_to` or
+        :meth:`orbits.Result.barycentric` change the frame of a result.
 
     Returns
     -------

@@ -573,11 +573,16 @@ class Simulation:
         plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps, now)
         total = plan.total_steps
         if default and outputs > total + 1:
-            warnings.warn(f"the run has only {total} steps: taking {total + 1} outputs (one "
-                          f"per step) instead of the default {DEFAULT_OUTPUTS}",
-                          OrbitsWarning, stacklevel=4)
-            plan = plan._replace(outputs=total + 1)
+            # one per step; a shortened last step leaves room for one fewer, as
+            # outputs go to the nearest step boundary
             outputs = total + 1
+            while outputs > 2 and not _increasing(plan._replace(outputs=outputs).marks(),
+                                                  total):
+                outputs -= 1
+            warnings.warn(f"the run has only {total} steps: taking {outputs} outputs "
+                          f"instead of the default {DEFAULT_OUTPUTS}", OrbitsWarning,
+                          stacklevel=4)
+            plan = plan._replace(outputs=outputs)
         if outputs > total + 1 or not _increasing(plan.marks(), total):
             raise ValueError(f"outputs = {outputs} needs more steps than the run has "
                              f"({total}); ask for at most {total + 1} outputs or use a "
@@ -811,8 +816,45 @@ class Simulation:
         raise RuntimeError(f"unexpected status {status!r}")  # pragma: no cover
 
     def __repr__(self):
-        return (f"<Simulation of {len(self._m)} bodies, {self.integrator.name}, "
-                f"dt={self.dt:.6g}, t={self.time:.6g}>")
+        """One line: bodies, time, integrator and its options, step, forces, stopping
+        conditions."""
+        d = dict(self._described())
+        return (f"<Simulation of {len(self._names)} bodies at t = {d['time']}: "
+                f"{d['integrator']}, dt = {d['dt']}; forces: {d['forces']}"
+                + (f"; stops: {d['stopping']}" if "stopping" in d else "") + ">")
+
+    def _repr_html_(self):
+        """The same as a table, for Jupyter."""
+        import html
+        rows = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{html.escape(v)}</td>"
+                       f"</tr>" for k, v in self._described())
+        return f"<div><strong>Simulation</strong><table>{rows}</table></div>"
+
+    def _described(self):
+        """(label, text) rows of the reprs."""
+        integ = self.integrator
+        opts = ", ".join(f"{k}={v!r}" for k, v in integ.config.items())
+        kind = ", ".join(w for w, on in (("symplectic", integ.symplectic),
+                                         ("adaptive", integ.adaptive)) if on)
+        if integ.adaptive and self._dt == 0:
+            dt = "chosen by the integrator"
+        else:
+            dt = f"{self.dt:.6g}" + (" (first step)" if integ.adaptive else "")
+        names = ", ".join(self._names[:6]) + (", ..." if len(self._names) > 6 else "")
+        rows = [("bodies", f"{len(self._names)}: {names}"),
+                ("integrator", integ.name + (f"({opts})" if opts else "")
+                 + f" [order {integ.order}{', ' + kind if kind else ''}]"),
+                ("dt", dt),
+                ("time", f"{self.time:.6g}"),
+                ("steps", str(self.steps)),
+                ("forces", " + ".join(["Newtonian gravity", *map(repr, self.forces)])),
+                ("units", f"{self.units.name}, G = {self.units.G!r}")]
+        stops = ", ".join(f"{k} = {v:.6g}" if isinstance(v, u.Quantity) else f"{k} = {v}"
+                          for k, v in self.stop_conditions.items()
+                          if v is not None and v is not False)
+        if stops:
+            rows.append(("stopping", stops))
+        return rows
 
 
 def _split_forces(forces, softening, parallel, rebound_arithmetic):

@@ -1,0 +1,303 @@
+"""Body-set files (orbits.systemfile): exact round trips, and errors with lines."""
+
+import pathlib
+import re
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+import orbits
+from orbits import systemfile
+from orbits.errors import BodyError, SystemFileError
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def python_set():
+    bodies = orbits.BodySet()
+    bodies.add("Sun", mass=1 * u.Msun)
+    bodies.add("Jupiter", mass=9.547919e-4 * u.Msun, primary="Sun", a=5.2026 * u.au,
+               e=0.0484, inc=1.30 * u.deg, Omega=100.5 * u.deg, omega=273.9 * u.deg,
+               M=20 * u.deg)
+    bodies.add("Saturn", mass=95.16 * u.Mearth, a=9.537 * u.au, e=0.0539, inc=2.49 * u.deg,
+               f=120 * u.deg)
+    bodies.add("probe", mass=0 * u.kg, position=[1, 0, 0] * u.au,
+               velocity=[0, 30, 0] * u.km / u.s)
+    bodies.move_to_com()
+    return bodies
+
+
+def run(bodies):
+    sim = orbits.Simulation(bodies, integrator="leapfrog", dt=20 * u.day)
+    return sim.run(until=2000 * u.day, outputs=11, progress=False)
+
+
+def same_set(a, b):
+    return (a.names == b.names and a.units == b.units
+            and np.array_equal(a.masses, b.masses) and np.array_equal(a.positions, b.positions)
+            and np.array_equal(a.velocities, b.velocities))
+
+
+@pytest.mark.parametrize("ext", ["toml", "csv"])
+def test_written_set_reads_back_and_runs_bit_for_bit(tmp_path, ext):
+    bodies = python_set()
+    path = tmp_path / f"system.{ext}"
+    bodies.write(path)
+    back = orbits.BodySet.read(path)
+    assert same_set(back, bodies)
+    a, b = run(bodies), run(back)
+    assert np.array_equal(a.positions, b.positions)
+    assert np.array_equal(a.velocities, b.velocities)
+    # writing again gives the same text: nothing is lost or rounded on the way
+    back.write(tmp_path / f"again.{ext}")
+    assert (tmp_path / f"again.{ext}").read_text() == path.read_text()
+
+
+@pytest.mark.parametrize("scene", ["outer-solar-system", "figure-eight", "earth-moon"])
+def test_scenes_in_their_own_units_round_trip(scene):
+    # hlw's own G, N-body units, and km/kg/s: the unit system travels with the numbers
+    bodies = orbits.scenes.get(scene)
+    for kind in ("toml", "csv"):
+        back = systemfile.loads(systemfile.dumps(bodies, kind), kind).bodies
+        assert same_set(back, bodies), kind
+        assert back.units.G == bodies.units.G
+
+
+def test_hand_written_file_equals_the_same_set_built_in_python():
+    text = '''
+    [[body]]
+    name = "Sun"
+    mass = "1 Msun"
+
+    [[body]]
+    name = "Jupiter"
+    mass = "9.547919e-4 Msun"
+    primary = "Sun"
+    a = "5.2026 au"
+    e = 0.0484
+    inc = "1.30 deg"
+    Omega = "100.5 deg"
+    omega = "273.9 deg"
+    M = "20 deg"
+
+    [[body]]
+    name = "Saturn"
+    mass = "95.16 Mearth"
+    a = "9.537 au"
+    e = "0.0539"
+    inc = "2.49 deg"
+    f = "120 deg"
+
+    [[body]]
+    name = "probe"
+    mass = 0
+    position = ["1 au", "0 au", "0 au"]
+    velocity = ["0 km/s", "30 km/s", "0 km/s"]
+    '''
+    got = systemfile.loads(text).bodies
+    got.move_to_com()
+    assert same_set(got, python_set())
+
+
+def test_units_table_makes_plain_numbers_and_run_defaults():
+    text = '''
+    [units]
+    length = "km"
+    mass = "kg"
+    time = "s"
+
+    [[body]]
+    name = "Earth"
+    mass = 5.972e24
+    [[body]]
+    name = "sat"
+    mass = 0
+    primary = "Earth"
+    a = 7000
+    e = 0.001
+
+    [run]
+    integrator = "dop853"
+    dt = 10
+    until = "1 day"
+    outputs = 5
+    com = true
+    escape_distance = "1e6 km"
+    [run.options]
+    rtol = 1e-10
+    '''
+    sf = systemfile.loads(text)
+    assert sf.bodies.units.length == u.km
+    el = sf.bodies.elements("sat", primary="Earth")
+    assert el["a"].to_value(u.km) == pytest.approx(7000, rel=1e-12)
+    assert sf.run["dt"] == 10 * u.s and sf.run["until"] == 1 * u.day
+    assert sf.run["options"] == {"rtol": 1e-10} and sf.run["com"] is True
+    assert sf.run["escape_distance"] == 1e6 * u.km
+
+
+def test_csv_by_elements_and_state_with_comment_lines():
+    text = ("# my system\n"
+            "name,mass [Msun],x [au],y [au],z [au],vx [km/s],vy [km/s],vz [km/s],"
+            "primary,a [au],e,inc [deg]\n"
+            "# the star\n"
+            "Sun,1,0,0,0,0,0,0,,,,\n"
+            "Jupiter,9.547919e-4,,,,,,,Sun,5.2026,0.0484,1.30\n")
+    got = systemfile.loads(text, "csv").bodies
+    ref = orbits.BodySet()
+    ref.add("Sun", mass=1 * u.Msun)
+    ref.add("Jupiter", mass=9.547919e-4 * u.Msun, primary="Sun", a=5.2026 * u.au,
+            e=0.0484, inc=1.30 * u.deg)
+    assert same_set(got, ref)
+
+
+def test_readme_example_reads():
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("## Your own system", 1)[1].split("\n## ", 1)[0]
+    toml = re.search(r"```toml\n(.*?)```", section, re.S).group(1)
+    sf = systemfile.loads(toml)
+    assert sf.bodies.names == ["Sun", "Jupiter", "probe"]
+    assert sf.run["integrator"] == "ias15"
+
+
+# -- malformed files: a named error with the file and the line ------------------------
+GOOD = '''\
+[[body]]
+name = "Sun"
+mass = "1 Msun"
+
+[[body]]
+name = "Jupiter"
+mass = "9.55e-4 Msun"
+primary = "Sun"
+a = "5.2 au"
+e = 0.048
+inc = "1.3 deg"
+'''
+PROBE = '\n[[body]]\nname = "probe"\nmass = 0\n'  # lines 13-15 after GOOD
+
+TOML_CASES = {
+    # case: (text, line, body, words in the message)
+    "missing unit": (GOOD.replace('"9.55e-4 Msun"', "9.55e-4"), 7, "Jupiter",
+                     ["has no unit", "[units]"]),
+    "unit-less string": (GOOD.replace('"5.2 au"', '"5.2"'), 9, "Jupiter", ["has no unit"]),
+    "angle without unit": (GOOD.replace('"1.3 deg"', "1.3"), 11, "Jupiter",
+                           ["angle needs a unit"]),
+    "unknown field": (GOOD.replace("e = 0.048", "ecc = 0.048"), 10, "Jupiter",
+                      ["unknown field 'ecc'"]),
+    "misspelt field": (GOOD.replace("inc =", "incl ="), 11, "Jupiter", ["did you mean 'inc'"]),
+    "wrong length": (GOOD + PROBE + 'position = ["1 au", "0 au"]\n', 16, "probe",
+                     ["3 components", "got 2"]),
+    "wrong length, array over lines": (GOOD + PROBE + 'velocity = [\n  "1 km/s",\n]\n', 16,
+                                       "probe", ["3 components", "got 1"]),
+    "duplicate name": (GOOD + '\n[[body]]\nname = "Jupiter"\nmass = 0\n', 14, "Jupiter",
+                       ["already given on line 5"]),
+    "wrong physical type": (GOOD.replace('"5.2 au"', '"5.2 kg"'), 9, "Jupiter",
+                            ["expected a length"]),
+    "unreadable unit": (GOOD.replace('"5.2 au"', '"5.2 furlongz"'), 9, "Jupiter",
+                        ["cannot read"]),
+    "unknown primary": (GOOD.replace('"Sun"\na', '"Sol"\na'), 8, "Jupiter",
+                        ["unknown primary 'Sol'"]),
+    "no mass": (GOOD + PROBE.replace("mass = 0\n", ""), 13, "probe", ["needs a mass"]),
+    "state and elements": (GOOD + PROBE + 'position = ["1 au", "0 au", "0 au"]\n'
+                           'a = "1 au"\n', 16, "probe", ["not both"]),
+    "impossible orbit": (GOOD.replace("e = 0.048", "e = 1.5"), 10, "Jupiter", ["e = 1.5"]),
+    "TOML syntax": (GOOD.replace("e = 0.048", "e = 0.048 0.1"), 10, None, ["not valid TOML"]),
+    "unknown table": (GOOD + "\n[bodies]\nx = 1\n", 13, None, ["unknown table 'bodies'"]),
+    "unknown unit key": ('[units]\nlength = "au"\nlenght = "km"\n' + GOOD, 3, None,
+                         ["did you mean 'length'"]),
+    "unit of the wrong kind": ('[units]\nlength = "kg"\n' + GOOD, 2, None, ["not a length"]),
+    "run option the integrator lacks": (GOOD + '\n[run]\nintegrator = "verlet"\n'
+                                        '[run.options]\nrtol = 1e-6\n', 16, None,
+                                        ["no option 'rtol'"]),
+    "unknown run key": (GOOD + '\n[run]\nintegrater = "wh"\n', 14, None,
+                        ["did you mean 'integrator'"]),
+    "run time without unit": (GOOD + '\n[run]\nuntil = 100\n', 14, None, ["has no unit"]),
+}
+
+
+@pytest.mark.parametrize("case", list(TOML_CASES))
+def test_malformed_toml_names_the_line(case):
+    text, line, body, words = TOML_CASES[case]
+    with pytest.raises(SystemFileError) as info:
+        systemfile.loads(text, source="system.toml")
+    exc = info.value
+    assert isinstance(exc, BodyError)
+    assert exc.line == line, str(exc)
+    message = str(exc)
+    assert message.startswith(f"system.toml, line {line}: "), message
+    if body is not None:
+        assert exc.body == body and f"body {body!r}" in message
+    for word in words:
+        assert word in message
+
+
+HEADER = "name,mass [Msun],x [au],y [au],z [au],vx [km/s],vy [km/s],vz [km/s]\n"
+ROWS = "Sun,1,0,0,0,0,0,0\nprobe,0,1,0,0,0,30,0\n"
+CSV_CASES = {
+    "missing unit": ("# c\n" + HEADER.replace("mass [Msun]", "mass") + ROWS, 2, None,
+                     ["column 'mass' has no unit"]),
+    "unknown column": (HEADER.replace("vz", "vw") + ROWS, 1, None, ["unknown column 'vw'"]),
+    "angle column without unit": (HEADER.strip() + ",inc\n" + "Sun,1,0,0,0,0,0,0,\n", 1,
+                                  None, ["angle column 'inc' needs a unit"]),
+    "wrong length (columns)": (HEADER.replace(",z [au]", "") + "Sun,1,0,0,0,0,0\n", 1, None,
+                               ["3 columns"]),
+    "wrong length (cells)": (HEADER + ROWS + "moon,0,1\n", 4, None, ["expected 8 cells"]),
+    "empty component": (HEADER + "Sun,1,0,0,0,0,0,0\nprobe,0,1,,0,0,30,0\n", 3, "probe",
+                        ["y empty"]),
+    "duplicate name": (HEADER + ROWS + "# again\nSun,1,5,0,0,0,0,0\n", 5, "Sun",
+                       ["already given on line 2"]),
+    "not a number": (HEADER + "Sun,1,0,0,0,0,0,0\nprobe,zero,1,0,0,0,30,0\n", 3, "probe",
+                     ["cannot read 'zero'"]),
+    "wrong physical type": (HEADER.replace("x [au]", "x [kg]") + ROWS, 1, None,
+                            ["column 'x' is in kg, which is not a length"]),
+    "unit on a text column": (HEADER.replace("name", "name [au]") + ROWS, 1, None,
+                              ["column 'name'"]),
+}
+
+
+@pytest.mark.parametrize("case", list(CSV_CASES))
+def test_malformed_csv_names_the_line(case):
+    text, line, body, words = CSV_CASES[case]
+    with pytest.raises(SystemFileError) as info:
+        systemfile.loads(text, "csv", source="system.csv")
+    exc = info.value
+    assert exc.line == line, str(exc)
+    assert str(exc).startswith(f"system.csv, line {line}: "), str(exc)
+    if body is not None:
+        assert exc.body == body
+    for word in words:
+        assert word in str(exc)
+
+
+def test_file_errors_name_the_file(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(GOOD.replace("e = 0.048", "e = -1"))
+    with pytest.raises(SystemFileError, match=re.escape(f"{path}, line 10: body 'Jupiter', "
+                                                        f"field 'e'")):
+        orbits.BodySet.read(path)
+    with pytest.raises(SystemFileError, match="ends in .toml or .csv"):
+        orbits.BodySet.read(tmp_path / "system.json")
+    with pytest.raises(FileNotFoundError):
+        orbits.BodySet.read(tmp_path / "missing.toml")
+    with pytest.raises(SystemFileError, match="no bodies"):
+        systemfile.loads('[units]\nlength = "au"\n')
+
+
+def test_run_table_round_trips():
+    run = {"integrator": "wh", "dt": 10.5 * u.day, "until": 1e4 * u.yr, "outputs": 200,
+           "com": True, "options": {"corrector": 17, "coordinates": "jacobi"}}
+    text = systemfile.dumps(orbits.scenes.kepler(), run=run)
+    assert "[run.options]" in text
+    assert systemfile.loads(text).run == run
+    with pytest.raises(ValueError, match="no \\[run\\] table"):
+        systemfile.dumps(orbits.scenes.kepler(), "csv", run=run)
+
+
+def test_names_with_quotes_commas_and_accents_round_trip():
+    bodies = orbits.BodySet()
+    for k, name in enumerate(['Béta "B", the second', "back\\slash", "tab\there"]):
+        bodies.add(name, mass=(k + 1) * u.Msun, position=[k, 0, 0] * u.au)
+    for kind in ("toml", "csv"):
+        assert systemfile.loads(systemfile.dumps(bodies, kind), kind).bodies.names \
+            == bodies.names, kind
