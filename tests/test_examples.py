@@ -34,3 +34,30 @@ def test_mercury_perihelion_example(capsys):
     for label in ("GR (ias15)", "GRPotential (wh)", "GRFull (ias15)"):
         assert abs(rates[label] / theory - 1) < 2e-3, label
     assert "GRFull (ias15)" in capsys.readouterr().out
+
+
+def test_plotting_a_run_example(capsys):
+    # 2000 years keep it to a few seconds; the figures' layout does not depend on the length
+    mod = runpy.run_path(str(EXAMPLES / "plotting_a_run.py"))
+    result, figures = mod["main"](until=2000 * u.yr, outputs=100)
+    assert "status          completed" in capsys.readouterr().out
+    assert sorted(figures) == ["elements", "orbits", "sketch"]
+
+    orbit_axes, error_axes = figures["orbits"].axes
+    assert orbit_axes.get_title() == "orbits (x-y plane), about Sun"
+    assert (orbit_axes.get_xlabel(), orbit_axes.get_ylabel()) == ("x [AU]", "y [AU]")
+    assert len(orbit_axes.lines) == 5          # every body but the Sun, at the centre
+    assert [t.get_text() for t in orbit_axes.get_legend().get_texts()][:2] == [
+        "Sun (centre)", "Jupiter"]
+    assert error_axes.get_xlabel() == "time since start [yr]"
+    assert len(error_axes.lines) == 2          # energy and angular momentum
+
+    element_axes = figures["elements"].axes
+    assert [ax.get_ylabel() for ax in element_axes] == ["a [AU]", "e", "inc [deg]"]
+    assert [len(ax.lines) for ax in element_axes] == [5, 5, 5]
+    assert element_axes[-1].get_xlabel() == "time [yr]"
+
+    (sketch_axes,) = figures["sketch"].axes
+    assert [line.get_label() for line in sketch_axes.lines] == [
+        "Jupiter", "Saturn", "Uranus", "Neptune", "Pluto"]
+    assert sketch_axes.get_xlabel() == "x [AU]"

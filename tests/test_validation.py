@@ -112,6 +112,7 @@ def test_cheapest_ignores_failures_and_the_reference():
     assert work_precision.cheapest(rows, 1e-2)[0] == ("a", 0.1)
 
 
+@pytest.mark.slow  # ~20 s: the validate command end to end on its cheapest section
 def test_guide_section_by_command(tmp_path):
     # the whole command on its cheapest section, in this process
     assert cli.main(["validate", "--only", "guide", "--workers", "1", "--out",
