@@ -95,6 +95,20 @@ class BodySet:
         The orbit about the primary uses ``mu = G (m_primary + m_body)``, so a
         massive body on a circular orbit given this way stays circular in the
         two-body problem.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> bodies = orbits.BodySet()
+        >>> bodies.add("Sun", mass=1 * u.Msun)
+        >>> bodies.add("Earth", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, e=0.0167)
+        >>> bodies.add("probe", mass=0 * u.kg, position=[0, 2, 0] * u.au,
+        ...            velocity=[-20, 0, 0] * u.km / u.s)
+        >>> bodies.names
+        ['Sun', 'Earth', 'probe']
+        >>> round(float(bodies.elements("Earth", primary="Sun")["e"]), 4)
+        0.0167
         """
         self._check_name(name)
         m = self._scalar(mass, "mass", name, "mass")
@@ -128,13 +142,29 @@ class BodySet:
 
         Parameters
         ----------
-        masses : Quantity or array, shape (N,)
-        positions : Quantity or array, shape (N, 3)
-        velocities : Quantity or array, shape (N, 3)
+        masses : Quantity or array, shape (N,), mass
+        positions : Quantity or array, shape (N, 3), length
+        velocities : Quantity or array, shape (N, 3), velocity
+            Plain arrays are read in ``units``.
         names : sequence of str, optional
             Default ``"0"``, ``"1"``, ...
         units : UnitSystem, optional
             If given, plain numbers are read in it; otherwise Quantities are needed.
+
+        Returns
+        -------
+        BodySet
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> U = orbits.UnitSystem.nbody()
+        >>> bodies = orbits.BodySet.from_arrays([1.0, 1e-3], [[0, 0, 0], [1, 0, 0]],
+        ...                                     [[0, 0, 0], [0, 1, 0]], names=["A", "B"],
+        ...                                     units=U)
+        >>> bodies.names, bodies.positions.shape
+        (['A', 'B'], (2, 3))
         """
         bs = cls(units)
         m = bs._array(masses, "mass", "masses", (None,))
@@ -181,6 +211,19 @@ class BodySet:
         REBOUND keeps plain numbers; they are read in ``units`` (default: a
         dimensionless system with REBOUND's ``sim.G``).  Particle hashes are
         not names, so names default to ``"0"``, ``"1"``, ...
+
+        Examples
+        --------
+        >>> import rebound
+        >>> import orbits
+        >>> sim = rebound.Simulation()
+        >>> sim.add(m=1.0)
+        >>> sim.add(m=1e-3, a=1.0)
+        >>> bodies = orbits.BodySet.from_rebound(sim)
+        >>> bodies.names, bodies.units.G
+        (['0', '1'], 1.0)
+        >>> round(float(bodies.elements("1", primary="0")["a"].value), 12)
+        1.0
         """
         n = sim.N
         m = np.array([sim.particles[i].m for i in range(n)])
@@ -200,6 +243,13 @@ class BodySet:
 
         Massive bodies must come before massless ones in REBOUND's active/test
         particle split; the order of this set is kept as it is.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> sim = orbits.scenes.kepler().to_rebound()
+        >>> sim.N, round(sim.particles[1].a, 12)
+        (2, 1.0)
         """
         import rebound
         sim = rebound.Simulation()
@@ -210,7 +260,18 @@ class BodySet:
         return sim
 
     def copy(self):
-        """An independent copy."""
+        """An independent copy.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> a = orbits.scenes.kepler()
+        >>> b = a.copy()
+        >>> b.add("Moon", mass=0 * u.kg, position=[2, 0, 0] * u.au)
+        >>> len(a), len(b)
+        (2, 3)
+        """
         return _copy.deepcopy(self)
 
     @classmethod
@@ -328,26 +389,68 @@ class BodySet:
 
     @property
     def names(self):
-        """Body names, in order (list of str)."""
+        """Body names, in order (list of str).
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.scenes.kepler().names
+        ['Star', 'Planet']
+        """
         return list(self._names)
 
     @property
     def masses(self):
-        """Quantity, shape (N,), mass."""
+        """Quantity, shape (N,), mass.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.scenes.kepler().masses
+        <Quantity [1.   , 0.001] solMass>
+        """
         return self.units.quantity(self._m.copy(), "mass")
 
     @property
     def positions(self):
-        """Quantity, shape (N, 3), length."""
+        """Quantity, shape (N, 3), length.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> x = orbits.scenes.kepler().positions
+        >>> x.shape, x.unit
+        ((2, 3), Unit("AU"))
+        """
         return self.units.quantity(self._x.copy(), "length")
 
     @property
     def velocities(self):
-        """Quantity, shape (N, 3), velocity."""
+        """Quantity, shape (N, 3), velocity.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> v = orbits.scenes.kepler().velocities
+        >>> v.unit, v.shape
+        (Unit("AU / d"), (2, 3))
+        """
         return self.units.quantity(self._v.copy(), "velocity")
 
     def index(self, name):
-        """Position of ``name`` in the set."""
+        """Position of ``name`` in the set (int, from 0).
+
+        Raises
+        ------
+        UnknownBodyError
+            No body of that name; the message lists the known ones.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.scenes.kepler().index("Planet")
+        1
+        """
         try:
             return self._names.index(name)
         except ValueError:
@@ -356,16 +459,46 @@ class BodySet:
 
     @property
     def total_mass(self):
-        """Quantity, scalar, mass."""
+        """Quantity, scalar, mass.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.scenes.kepler().total_mass
+        <Quantity 1.001 solMass>
+        """
         return self.units.quantity(self._m.sum(), "mass")
 
     def center_of_mass(self):
-        """Position and velocity of the centre of mass: two Quantities, shape (3,)."""
+        """Position and velocity of the centre of mass: two Quantities, shape (3,).
+
+        Examples
+        --------
+        >>> import orbits
+        >>> x, v = orbits.scenes.kepler().center_of_mass()   # the scene is barycentric
+        >>> bool(abs(x).max().value < 1e-15), x.unit, v.unit
+        (True, Unit("AU"), Unit("AU / d"))
+        """
         x, v = self._com()
         return self.units.quantity(x, "length"), self.units.quantity(v, "velocity")
 
     def move_to_com(self):
-        """Shift positions and velocities so that the centre of mass is at rest at the origin."""
+        """Shift positions and velocities so that the centre of mass is at rest at the origin.
+
+        Raises
+        ------
+        NoMassiveBodyError
+            Every body is massless.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> bodies = orbits.scenes.kepler()
+        >>> bodies.move_to_com()
+        >>> x, v = bodies.center_of_mass()
+        >>> bool(abs(x).max().value < 1e-15 and abs(v).max().value < 1e-15)
+        True
+        """
         self._require_mass()
         x, v = self._com()
         self._x -= x
@@ -386,6 +519,13 @@ class BodySet:
         dict
             ``a`` (length), ``e``, ``inc``, ``Omega``, ``omega``, ``f``, ``M``
             (angles in rad), as Quantities.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> el = orbits.scenes.outer_solar_system().elements("Jupiter", primary="Sun")
+        >>> round(float(el["a"].value), 2), el["a"].unit, round(float(el["e"]), 3)
+        (5.2, Unit("AU"), 0.048)
         """
         i = self.index(name)
         mp, xp, vp = self._primary_state(name, primary, before=i)
@@ -432,6 +572,19 @@ class BodySet:
         Raises
         ------
         NoMassiveBodyError, CoincidentBodiesError
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> bodies = orbits.scenes.kepler()
+        >>> bodies.check()
+        >>> bodies.add("twin", mass=1 * u.Mearth, position=bodies.positions[1])
+        >>> try:
+        ...     bodies.check()
+        ... except orbits.BodyError as exc:
+        ...     print(type(exc).__name__, exc.body, exc.field)
+        CoincidentBodiesError Planet position
         """
         self._require_mass()
         if len(self) > 1:

@@ -35,6 +35,17 @@ class Trajectory:
     method : str
     wall_time : float
     status : str
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import orbits
+    >>> tr = orbits.integrate(lambda x, v, t: -x, 1.0, 0.0, dt=np.pi / 100, steps=200,
+    ...                       method="rk4", every=100)
+    >>> tr
+    <Trajectory: 3 samples, rk4, completed>
+    >>> tr.t.round(6).tolist(), tr.x.round(6).tolist(), tr.steps
+    ([0.0, 3.141593, 6.283185], [1.0, -1.0, 1.0], 200)
     """
 
     def __init__(self, t, x, v, steps, method, wall_time, status="completed"):

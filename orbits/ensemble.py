@@ -130,6 +130,14 @@ class MissingMainGuard(OrbitsError, RuntimeError):
         The main script.
     line : int or None
         The line of the script from which the cluster was started.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> from orbits.ensemble import MissingMainGuard
+    >>> exc = MissingMainGuard("starts a cluster at import", script="sweep.py", line=12)
+    >>> isinstance(exc, (orbits.OrbitsError, RuntimeError)), exc.script, exc.line
+    (True, 'sweep.py', 12)
     """
 
     def __init__(self, message, script=None, line=None):
@@ -220,6 +228,22 @@ class Ensemble:
         scale : float
             Relative size of the shifts (dimensionless).
         seed : int
+
+        Returns
+        -------
+        Ensemble
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> ens = orbits.Ensemble.perturbed(sim, n=3, scale=1e-10)
+        >>> ens.parameters
+        [{'member': 0}, {'member': 1}, {'member': 2}]
+        >>> shift = ens.simulation(1).bodies.positions - sim.bodies.positions
+        >>> shift.unit, bool(0 < abs(shift[1]).max().value < 1e-9)        # 1e-10 of 1 au
+        (Unit("AU"), True)
         """
         if int(n) != n or n < 1:
             raise ValueError(f"n must be a whole number >= 1, got {n}")
@@ -236,7 +260,28 @@ class Ensemble:
         return f"<Ensemble of {len(self)} runs of {_describe(self.build)}>"
 
     def simulation(self, run):
-        """The simulation of run number ``run``, built here (to look at or run alone)."""
+        """The simulation of run number ``run``, built here (to look at or run alone).
+
+        Parameters
+        ----------
+        run : int
+            Index into :attr:`parameters`.
+
+        Returns
+        -------
+        Simulation
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> def build(e):
+        ...     return orbits.Simulation(orbits.scenes.kepler(e=e), "leapfrog", dt=1 * u.day)
+        >>> ens = orbits.Ensemble.grid(build, e=[0.1, 0.5])
+        >>> sim = ens.simulation(1)
+        >>> round(float(sim.bodies.elements("Planet")["e"]), 6)
+        0.5
+        """
         return self.build(**self.parameters[run])
 
     # -- running --------------------------------------------------------------------
@@ -289,6 +334,18 @@ class Ensemble:
             outside ``if __name__ == "__main__":``: each worker process imports
             the script again, so a script that starts a local cluster needs the
             guard.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> ens = orbits.Ensemble.perturbed(sim, n=3, scale=1e-10)
+        >>> df = ens.run(until=1 * u.yr, client="serial", outputs=5, progress=False)
+        >>> list(df.outcome), df.t_stop_day.tolist()
+        (['completed', 'completed', 'completed'], [365.25, 365.25, 365.25])
+        >>> bool((df.energy_error_max < 1e-8).all()), round(float(df.Planet_a_au.mean()), 4)
+        (True, 1.0)
         """
         import pandas as pd
 
@@ -369,7 +426,35 @@ def local_cluster(n_workers=None):
     ``client.close(); client.cluster.close()`` (or use it in a ``with``).
 
     Raises :class:`MissingMainGuard` when called from the top level of a script
-    that lacks ``if __name__ == "__main__":`` (the workers cannot start)."""
+    that lacks ``if __name__ == "__main__":`` (the workers cannot start).
+
+    Parameters
+    ----------
+    n_workers : int, optional
+        Worker processes, >= 1.
+
+    Returns
+    -------
+    distributed.Client
+
+    Raises
+    ------
+    ValueError
+        ``n_workers`` < 1.
+    MissingMainGuard
+        Called from the top level of an unguarded script.
+
+    Examples
+    --------
+    >>> from orbits.ensemble import local_cluster
+    >>> try:
+    ...     local_cluster(n_workers=0)
+    ... except ValueError as exc:
+    ...     print(exc)
+    n_workers must be >= 1, got 0
+    >>> client = local_cluster(n_workers=2)     # doctest: +SKIP
+    >>> client.close(); client.cluster.close()  # doctest: +SKIP
+    """
     from distributed import Client, LocalCluster
 
     n = os.cpu_count() if n_workers is None else int(n_workers)

@@ -34,11 +34,34 @@ __all__ = [
 
 
 class OrbitsError(Exception):
-    """Base class of every exception raised by ``orbits``."""
+    """Base class of every exception raised by ``orbits``.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> try:
+    ...     orbits.integrators.get("rk45")
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__)
+    UnknownIntegratorError
+    """
 
 
 class OrbitsWarning(UserWarning):
-    """Something was changed or may not be what was meant, and the run went on."""
+    """Something was changed or may not be what was meant, and the run went on.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> import warnings
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = sim.run(until=3 * u.day, progress=False)   # fewer steps than outputs
+    >>> [w.category.__name__ for w in caught]
+    ['OrbitsWarning']
+    """
 
 
 def _where(body, field):
@@ -59,6 +82,16 @@ class BodyError(OrbitsError, ValueError):
         Name (or index) of the body concerned.
     field : str or None
         The field concerned: ``"mass"``, ``"position"``, ``"e"``, ...
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> try:
+    ...     orbits.scenes.kepler().add("comet", mass=-1 * u.kg)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.body, exc.field)
+    BodyError comet mass
     """
 
     def __init__(self, message, body=None, field=None):
@@ -69,38 +102,129 @@ class BodyError(OrbitsError, ValueError):
 
 
 class BodyUnitsError(BodyError, u.UnitsError):
-    """A body's value has the wrong physical type, or no unit where one is needed."""
+    """A body's value has the wrong physical type, or no unit where one is needed.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> try:
+    ...     orbits.scenes.kepler().add("moon", mass=1 * u.au)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.body, exc.field)
+    BodyUnitsError moon mass
+    """
 
 
 class ElementsError(BodyError):
-    """Orbital elements that describe no orbit (e >= 1 with a > 0, e < 0, ...)."""
+    """Orbital elements that describe no orbit (e >= 1 with a > 0, e < 0, ...).
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> try:
+    ...     orbits.scenes.kepler().add("comet", mass=0 * u.kg, a=1 * u.au, e=1.5)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.field)
+    ElementsError e
+    """
 
 
 class UnknownBodyError(BodyError, KeyError):
-    """A name that is not in the body set (an unknown ``primary=``, for example)."""
+    """A name that is not in the body set (an unknown ``primary=``, for example).
+
+    Examples
+    --------
+    >>> import orbits
+    >>> try:
+    ...     orbits.scenes.kepler().index("Moon")
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc)
+    UnknownBodyError body 'Moon': no such body; known: Star, Planet
+    >>> issubclass(orbits.errors.UnknownBodyError, KeyError)
+    True
+    """
 
     def __str__(self):  # KeyError would quote the message
         return Exception.__str__(self)
 
 
 class DuplicateBodyError(BodyError):
-    """A body name that is already used."""
+    """A body name that is already used.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> try:
+    ...     orbits.scenes.kepler().add("Star", mass=1 * u.Msun)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.body)
+    DuplicateBodyError Star
+    """
 
 
 class CoincidentBodiesError(BodyError):
-    """Two bodies at exactly the same position: their mutual force is infinite."""
+    """Two bodies at exactly the same position: their mutual force is infinite.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> bodies = orbits.scenes.kepler()
+    >>> bodies.add("twin", mass=1 * u.Mearth, position=bodies.positions[1])
+    >>> try:
+    ...     bodies.check()
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.body)
+    CoincidentBodiesError Planet
+    """
 
 
 class NoMassiveBodyError(OrbitsError, ValueError):
-    """A simulation needs at least one body with positive mass."""
+    """A simulation needs at least one body with positive mass.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> bodies = orbits.BodySet()
+    >>> bodies.add("dust", mass=0 * u.kg)
+    >>> try:
+    ...     bodies.check()
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__)
+    NoMassiveBodyError
+    """
 
 
 class UnknownIntegratorError(OrbitsError, ValueError):
-    """An integrator name that is not in the registry."""
+    """An integrator name that is not in the registry.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> try:
+    ...     orbits.integrators.get("rk45")
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, str(exc)[:50])
+    UnknownIntegratorError unknown integrator 'rk45'; valid names: euler, sym
+    """
 
 
 class IntegratorOptionError(OrbitsError, ValueError):
-    """An integrator option that is unknown, or whose value is not acceptable."""
+    """An integrator option that is unknown, or whose value is not acceptable.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> try:
+    ...     orbits.integrators.get("ias15", eps=1e-9)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, str(exc).split(';')[0])
+    IntegratorOptionError integrator 'ias15' has no option 'eps'
+    """
 
 
 class ForceTermError(OrbitsError, ValueError):
@@ -114,6 +238,16 @@ class ForceTermError(OrbitsError, ValueError):
         The term concerned, as written (``"GR('Sun')"``).
     field : str or None
         Its parameter concerned: ``"source"``, ``"radius"``, ``"func"``, ...
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> try:
+    ...     orbits.forces.ZonalHarmonics("Star", radius=-1 * u.km, J2=1e-3)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.field)
+    ForceTermError radius
     """
 
     def __init__(self, message, term=None, field=None):
@@ -134,6 +268,18 @@ class RunError(OrbitsError, RuntimeError):
         Number of steps completed (since the simulation was made) at the last good state.
     result : orbits.Result or None
         Everything recorded up to the failure, ending with the last good state.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+    ...                         escape_distance=0.5 * u.au)
+    >>> try:
+    ...     sim.run(until=10 * u.day, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.time, exc.step, len(exc.result.times))
+    Escape 1.0 d 1 2
     """
 
     def __init__(self, message, time=None, step=None, result=None):
@@ -150,6 +296,18 @@ class SimulationStopped(RunError):
     ----------
     bodies : tuple of str
         The bodies concerned (the pair for an encounter, the one for an escape).
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+    ...                         encounter_distance=2 * u.au)
+    >>> try:
+    ...     sim.run(until=10 * u.day, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.bodies)
+    CloseEncounter ('Star', 'Planet')
     """
 
     def __init__(self, message, time=None, step=None, result=None, bodies=()):
@@ -158,11 +316,39 @@ class SimulationStopped(RunError):
 
 
 class NonFiniteState(RunError):
-    """A position or velocity became NaN or infinite."""
+    """A position or velocity became NaN or infinite.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> bodies = orbits.BodySet()
+    >>> bodies.add("A", mass=1 * u.Msun)
+    >>> bodies.add("B", mass=1 * u.Msun, position=[1e-200, 0, 0] * u.au)   # r**3 underflows
+    >>> sim = orbits.Simulation(bodies, "leapfrog", dt=1 * u.day)
+    >>> try:
+    ...     sim.run(until=2 * u.day, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.step, exc.time)
+    NonFiniteState 0 0.0 d
+    """
 
 
 class StepSizeUnderflow(RunError):
-    """An adaptive integrator's step size collapsed below its minimum."""
+    """An adaptive integrator's step size collapsed below its minimum.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> ias15 = orbits.integrators.get("ias15", min_dt=1e4)   # days: above any step it takes
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), ias15)
+    >>> try:
+    ...     sim.run(until=100 * u.day, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.time < 100 * u.day)
+    StepSizeUnderflow True
+    """
 
 
 class ConvergenceFailure(RunError):
@@ -170,6 +356,17 @@ class ConvergenceFailure(RunError):
 
     The step was too large for the iteration (a close encounter, a force that
     changes too fast): a smaller step usually cures it.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "implicit-midpoint", dt=100 * u.day)
+    >>> try:
+    ...     sim.run(until=1000 * u.day, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.step, sim.time)
+    ConvergenceFailure 0 0.0 d
     """
 
 
@@ -178,15 +375,52 @@ class WallTimeExceeded(RunError):
 
     The simulation is left at the last state reached, which ``result`` ends
     with, so the run can be continued with another :meth:`~orbits.Simulation.run`.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> try:
+    ...     sim.run(until=1000 * u.day, progress=False, wall_limit=1e-9)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.time == sim.time, exc.step > 0)
+    WallTimeExceeded True True
     """
 
 
 class CloseEncounter(SimulationStopped):
-    """Two bodies came closer than the encounter distance."""
+    """Two bodies came closer than the encounter distance.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+    ...                         encounter_distance=2 * u.au)
+    >>> try:
+    ...     sim.run(until=10 * u.day, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.bodies, exc.time)
+    CloseEncounter ('Star', 'Planet') 1.0 d
+    """
 
 
 class Escape(SimulationStopped):
-    """A body left the system."""
+    """A body left the system.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+    ...                         escape_distance=0.5 * u.au)
+    >>> try:
+    ...     sim.run(until=10 * u.day, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.bodies)
+    Escape ('Planet',)
+    """
 
 
 class RunInterrupted(KeyboardInterrupt):
@@ -208,6 +442,16 @@ class RunInterrupted(KeyboardInterrupt):
         Number of steps completed (since the simulation was made).
     result : orbits.Result or None
         Everything recorded up to there, ending with the state the run stopped at.
+
+    Examples
+    --------
+    >>> import signal
+    >>> from orbits.errors import RunInterrupted
+    >>> try:   # what a run raises on Ctrl-C
+    ...     raise RunInterrupted("interrupted", signal=signal.SIGINT, step=10)
+    ... except KeyboardInterrupt as exc:
+    ...     print(exc.signal == signal.SIGINT, exc.step)
+    True 10
     """
 
     def __init__(self, message, signal=None, time=None, step=None, result=None):
@@ -233,6 +477,15 @@ class SystemFileError(BodyError):
         Line of the file (1-based) where the problem is.
     body, field : str or None
         As for :class:`BodyError`.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> try:
+    ...     orbits.systemfile.loads('[[body]]\\nname = "Sun"\\nmass = 1\\n')
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.path, exc.line, exc.field)
+    SystemFileError <string> 3 mass
     """
 
     def __init__(self, message, path=None, line=None, body=None, field=None):

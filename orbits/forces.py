@@ -70,7 +70,21 @@ __all__ = ["ForceTerm", "Gravity", "GR", "GRPotential", "GRFull", "ZonalHarmonic
 
 
 class BoundTerm(NamedTuple):
-    """A term bound to one simulation's bodies: its kernels and arguments."""
+    """A term bound to one simulation's bodies: its kernels and arguments.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import orbits
+    >>> from orbits.forces import Context
+    >>> b = orbits.scenes.kepler()
+    >>> m = b.masses.value
+    >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+    ...               b.positions.value, b.velocities.value)
+    >>> bound = orbits.forces.GRPotential("Star").bind(ctx)
+    >>> type(bound).__name__, bound.args[0]    # the source's internal index
+    ('BoundTerm', 0)
+    """
 
     kernel: _k.TermKernel
     args: tuple       # of the accelerations and the Jacobian
@@ -112,6 +126,16 @@ class ForceTerm:
     returning a :class:`BoundTerm`, and ``to_dict()``; it is registered by
     name for :func:`from_dict` (output files and ensembles rebuild terms
     from their dictionaries).
+
+    Examples
+    --------
+    >>> import orbits
+    >>> from orbits.forces import ForceTerm
+    >>> [cls.__name__ for cls in (orbits.forces.GR, orbits.forces.ZonalHarmonics)
+    ...  if issubclass(cls, ForceTerm)]
+    ['GR', 'ZonalHarmonics']
+    >>> orbits.forces.GR.velocity_dependent, orbits.forces.GRPotential.wisdom_holman
+    (True, True)
     """
 
     velocity_dependent = False
@@ -125,9 +149,45 @@ class ForceTerm:
         _REGISTRY[cls.__name__] = cls
 
     def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> bound = orbits.forces.GR("Star").bind(ctx)
+        >>> bound.args[0], round(1 / bound.args[2] ** 0.5, 1)   # source index; c in au/day
+        (0, 173.1)
+        """
         raise NotImplementedError
 
     def to_dict(self):
+        """Plain JSON-able values, Quantities as ``[value, unit]``: what output
+        files and ensembles store.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> orbits.forces.GRPotential("Sun", c=3e5 * u.km / u.s).to_dict()
+        {'type': 'GRPotential', 'source': 'Sun', 'c': [300000.0, 'km / s']}
+        """
         raise NotImplementedError
 
     def __eq__(self, other):
@@ -144,7 +204,22 @@ class ForceTerm:
 
 
 def from_dict(d):
-    """The term a :meth:`ForceTerm.to_dict` dictionary describes."""
+    """The term a :meth:`ForceTerm.to_dict` dictionary describes.
+
+    Raises
+    ------
+    ForceTermError
+        The dictionary's ``type`` names no known term.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> term = orbits.forces.from_dict({"type": "GR", "source": "Sun", "c": None})
+    >>> term
+    GR(source='Sun')
+    >>> orbits.forces.from_dict(term.to_dict()) == term
+    True
+    """
     d = dict(d)
     name = d.pop("type", None)
     if name not in _REGISTRY:
@@ -182,6 +257,15 @@ class Gravity(ForceTerm):
         Force the threaded (True) or serial (False) kernel.
     rebound_arithmetic : bool
         REBOUND's floating-point operations (see :class:`~orbits.Simulation`).
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+    ...                         forces=[orbits.forces.Gravity(softening=1e-4 * u.au)])
+    >>> sim.softening, sim.forces
+    (<Quantity 0.0001 AU>, ())
     """
 
     def __init__(self, softening=None, parallel=None, rebound_arithmetic=False):
@@ -190,11 +274,32 @@ class Gravity(ForceTerm):
         self.rebound_arithmetic = bool(rebound_arithmetic)
 
     def to_dict(self):
+        """Plain JSON-able values, Quantities as ``[value, unit]``: what output
+        files and ensembles store.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> d = orbits.forces.Gravity(softening=0.01 * u.au).to_dict()
+        >>> d["type"], d["softening"], d["parallel"], d["rebound_arithmetic"]
+        ('Gravity', [0.01, 'AU'], None, False)
+        """
         return {"type": "Gravity", "softening": _quantity_dict(self.softening),
                 "parallel": self.parallel, "rebound_arithmetic": self.rebound_arithmetic}
 
     @classmethod
     def from_dict(cls, d):
+        """The term that :meth:`to_dict` describes.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> term = orbits.forces.Gravity(softening=0.01 * u.au)
+        >>> orbits.forces.Gravity.from_dict(term.to_dict()).softening
+        <Quantity 0.01 AU>
+        """
         return cls(softening=_quantity_from(d.get("softening")), parallel=d.get("parallel"),
                    rebound_arithmetic=d.get("rebound_arithmetic", False))
 
@@ -277,6 +382,31 @@ class GR(_SourceTerm):
     why_not_wisdom_holman = "it depends on velocities"
 
     def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> orbits.forces.GR("Star").bind(ctx).args[0]
+        0
+        """
         src = self._source(ctx)
         ic2 = self._inv_c2(ctx)
         return BoundTerm(_GR_KERNEL, (src, ctx.gm, ic2), (src, ctx.gm, ic2, ctx.m))
@@ -298,11 +428,45 @@ class GRPotential(_SourceTerm):
         Name of the dominant body.
     c : Quantity (speed), optional
         Speed of light; default astropy's ``c``.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "wh", dt=5 * u.day,
+    ...                         forces=[orbits.forces.GRPotential("Star")])
+    >>> sim.forces
+    (GRPotential(source='Star'),)
     """
 
     wisdom_holman = True
 
     def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> orbits.forces.GRPotential("Star").bind(ctx).args[0]
+        0
+        """
         src = self._source(ctx)
         ic2 = self._inv_c2(ctx)
         return BoundTerm(_GR_POTENTIAL_KERNEL, (src, ctx.gm, ic2), (src, ctx.gm, ic2, ctx.m))
@@ -321,6 +485,14 @@ class GRFull(ForceTerm):
     ----------
     c : Quantity (speed), optional
         Speed of light; default astropy's ``c``.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "ias15",
+    ...                         forces=[orbits.forces.GRFull()])
+    >>> sim.forces, orbits.forces.GRFull.velocity_dependent
+    ((GRFull(),), True)
     """
 
     velocity_dependent = True
@@ -330,13 +502,57 @@ class GRFull(ForceTerm):
         self.c = c
 
     def to_dict(self):
+        """Plain JSON-able values, Quantities as ``[value, unit]``: what output
+        files and ensembles store.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.forces.GRFull().to_dict()
+        {'type': 'GRFull', 'c': None}
+        """
         return {"type": "GRFull", "c": _quantity_dict(self.c)}
 
     @classmethod
     def from_dict(cls, d):
+        """The term that :meth:`to_dict` describes.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> term = orbits.forces.GRFull()
+        >>> orbits.forces.GRFull.from_dict(term.to_dict()) == term
+        True
+        """
         return cls(c=_quantity_from(d.get("c")))
 
     def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> bound = orbits.forces.GRFull().bind(ctx)
+        >>> bound.args[1]    # massive bodies
+        2
+        """
         ic2 = _inv_c2(self, self.c, ctx)
         n = len(ctx.m)
         args = (ctx.gm, ctx.n_active, ic2, np.zeros((n, 3)), np.zeros(n))
@@ -413,16 +629,64 @@ class ZonalHarmonics(ForceTerm):
                                  term=name, field="radius")
 
     def to_dict(self):
+        """Plain JSON-able values, Quantities as ``[value, unit]``: what output
+        files and ensembles store.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> d = orbits.forces.ZonalHarmonics("Earth", 6378 * u.km, J2=1.08e-3).to_dict()
+        >>> d["type"], d["radius"], d["J2"], d["pole"]
+        ('ZonalHarmonics', [6378.0, 'km'], 0.00108, [0.0, 0.0, 1.0])
+        """
         return {"type": "ZonalHarmonics", "body": self.body,
                 "radius": _quantity_dict(self.radius), "J2": self.J2, "J4": self.J4,
                 "pole": self._pole_given}
 
     @classmethod
     def from_dict(cls, d):
+        """The term that :meth:`to_dict` describes.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> term = orbits.forces.ZonalHarmonics("Earth", 6378 * u.km, J2=1.08e-3)
+        >>> orbits.forces.ZonalHarmonics.from_dict(term.to_dict()) == term
+        True
+        """
         return cls(d["body"], _quantity_from(d["radius"]), J2=d["J2"], J4=d["J4"],
                    pole=d["pole"])
 
     def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> bound = orbits.forces.ZonalHarmonics("Star", 0.005 * u.au, J2=1e-6).bind(ctx)
+        >>> bound.args[0], f"{bound.args[2] / b.units.G:.2e}"   # index; m J2 R^2 [Msun au^2]
+        (0, '2.50e-11')
+        """
         b = ctx.index(self.body, repr(self), "body")
         if not ctx.m[b] > 0:
             raise ForceTermError(f"the oblate body {self.body!r} has no mass",
@@ -486,6 +750,21 @@ class UserForce(ForceTerm):
                                       else "it has no potential")
 
     def to_dict(self):
+        """Plain values: the functions as ``"module:qualname"`` references, which
+        :meth:`from_dict` imports again (so they must be defined at the top level
+        of an importable module).
+
+        Examples
+        --------
+        >>> import orbits
+        >>> import numba
+        >>> @numba.njit
+        ... def drag(x, v, t, m):
+        ...     return -1e-6 * v
+        >>> d = orbits.forces.UserForce(drag, velocity_dependent=True).to_dict()
+        >>> d["type"], d["func"].endswith(":drag"), d["potential"]
+        ('UserForce', True, None)
+        """
         ref = lambda f: None if f is None else f"{f.__module__}:{f.__qualname__}"  # noqa: E731
         return {"type": "UserForce", "func": ref(self.func),
                 "velocity_dependent": self.velocity_dependent,
@@ -493,6 +772,23 @@ class UserForce(ForceTerm):
 
     @classmethod
     def from_dict(cls, d):
+        """The term that :meth:`to_dict` describes.
+
+        Raises
+        ------
+        ForceTermError
+            A function cannot be imported from its reference.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> try:
+        ...     orbits.forces.UserForce.from_dict({"func": "no_such_module:f",
+        ...                                        "velocity_dependent": False})
+        ... except orbits.ForceTermError as exc:
+        ...     print(exc.field)
+        func
+        """
         def load(ref):
             if ref is None:
                 return None
@@ -515,6 +811,41 @@ class UserForce(ForceTerm):
                 f"velocity_dependent={self.velocity_dependent})")
 
     def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Raises
+        ------
+        ForceTermError
+            ``func`` returns the wrong shape or a non-finite value on the initial state.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> import numba
+        >>> @numba.njit
+        ... def drag(x, v, t, m):
+        ...     return -1e-6 * v
+        >>> bound = orbits.forces.UserForce(drag, velocity_dependent=True).bind(ctx)
+        >>> bound.args[0]    # internal row of each body of the set
+        array([0, 1])
+        """
         n = len(ctx.m)
         # the body set's row k is internal row pos[k]
         pos = np.argsort(ctx.order).astype(np.int64)

@@ -25,7 +25,31 @@ DEFAULT_MONITORS = ("energy", "angular_momentum")
 
 
 def monitor_mask(names):
-    """Bit mask for the named monitors; unknown names are an error listing the valid ones."""
+    """Bit mask for the named monitors; unknown names are an error listing the valid ones.
+
+    Parameters
+    ----------
+    names : iterable of str
+        Keys of :data:`MONITORS`.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ValueError
+        A name is not a monitor.
+
+    Examples
+    --------
+    >>> from orbits.monitors import MONITORS, monitor_mask
+    >>> mask = monitor_mask(["energy", "angular_momentum"])
+    >>> mask == MONITORS["energy"] | MONITORS["angular_momentum"]
+    True
+    >>> monitor_mask([])
+    0
+    """
     mask = 0
     for name in names:
         try:
@@ -36,7 +60,30 @@ def monitor_mask(names):
 
 
 def relative_error(values, reference, scale=None):
-    """``|values - reference| / |reference|``; ``scale`` replaces ``|reference|`` when it is 0."""
+    """``|values - reference| / |reference|``; ``scale`` replaces ``|reference|`` when it is 0.
+
+    Parameters
+    ----------
+    values : array-like, shape (n,)
+        The monitored quantity (an energy, say) as plain floats in one unit.
+    reference : float
+        Its value at the start, in the same unit.
+    scale : float, optional
+        Denominator where ``reference`` is 0 (same unit); default 1.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        Dimensionless.
+
+    Examples
+    --------
+    >>> from orbits.monitors import relative_error
+    >>> relative_error([-1.0, -1.001, -0.999], -1.0).round(6)
+    array([0.   , 0.001, 0.001])
+    >>> relative_error([0.0, 0.5], 0.0, scale=2.0)     # zero reference: against the scale
+    array([0.  , 0.25])
+    """
     denom = abs(reference) if reference != 0 else (scale or 1.0)
     return np.abs(np.asarray(values) - reference) / denom
 
@@ -48,6 +95,28 @@ def vector_relative_error(values, reference, scale):
     no relative error; there ``scale`` (sum of ``m |x| |v|`` at the start) is the
     denominator, so the figure still says how large the error is against the
     system's own angular-momentum budget.
+
+    Parameters
+    ----------
+    values : array-like, shape (n, 3)
+        The vectors (angular momenta) in one unit.
+    reference : array-like, shape (3,)
+        The vector at the start, same unit.
+    scale : float
+        Denominator where ``|reference|`` is zero (same unit).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        Dimensionless.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits.monitors import vector_relative_error
+    >>> L = np.array([[0.0, 0.0, 1.0], [0.0, 1e-6, 1.0]])
+    >>> vector_relative_error(L, L[0], scale=1.0).tolist()
+    [0.0, 1e-06]
     """
     ref = np.asarray(reference)
     norm = np.linalg.norm(ref)
@@ -60,6 +129,26 @@ def growth_exponent(t, err):
 
     Uses the running maximum of the error, so oscillations do not hide growth,
     and only the later nine tenths of the logarithmic time range.
+
+    Parameters
+    ----------
+    t : array-like, shape (n,)
+        Times since the start, in any one unit (only their ratios matter).
+    err : array-like, shape (n,)
+        Relative errors (dimensionless) at those times.
+
+    Returns
+    -------
+    float
+        NaN with fewer than three positive points.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits.monitors import growth_exponent
+    >>> t = np.logspace(0, 4, 50)
+    >>> round(growth_exponent(t, 1e-12 * t), 6), round(growth_exponent(t, 1e-12 * np.sqrt(t)), 6)
+    (1.0, 0.5)
     """
     t = np.asarray(t, dtype=float)
     err = np.maximum.accumulate(np.asarray(err, dtype=float))
@@ -104,6 +193,19 @@ def ensemble_growth_exponent(t, errors, t_from, boots=400, seed=1):
     fitted to the ensemble.  ``abs(errors.mean(axis=0))`` against the RMS tells
     a common drift (truncation, or rounding with a bias) from a random walk:
     for M independent runs it stays near ``RMS / sqrt(M)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits.monitors import ensemble_growth_exponent
+    >>> rng = np.random.default_rng(0)
+    >>> steps = rng.normal(size=(16, 10000)) * 1e-16          # 16 random walks
+    >>> walks = np.cumsum(steps, axis=1)
+    >>> t = np.arange(1, 10001, dtype=float)
+    >>> keep = np.unique(np.geomspace(1, 10000, 60).astype(int)) - 1
+    >>> exponent, spread = ensemble_growth_exponent(t[keep], walks[:, keep], t_from=10)
+    >>> bool(abs(exponent - 0.5) < 3 * spread), bool(spread < 0.1)
+    (True, True)
     """
     t = np.asarray(t, dtype=float)
     errors = np.atleast_2d(np.asarray(errors, dtype=float))
@@ -125,7 +227,44 @@ def monitor_fields(rows, monitors, reference, scales, units):
     """A result's monitor fields from monitor ``rows`` (the compiled kernels'
     layout: energy, L, P, centre of mass), as Quantities, with the relative
     errors against ``reference`` (``scales``: energy and angular-momentum
-    scales used where the reference is zero)."""
+    scales used where the reference is zero).
+
+    Parameters
+    ----------
+    rows : numpy.ndarray, shape (n, 10)
+        Monitor rows in the internal units.
+    monitors : sequence of str
+        The monitors that were recorded.
+    reference : numpy.ndarray, shape (10,)
+        The row at the start.
+    scales : tuple of float
+        Energy and angular-momentum scales (internal units).
+    units : UnitSystem
+        The units of the rows.
+
+    Returns
+    -------
+    dict
+        ``energy`` (energy), ``angular_momentum`` (angular momentum), ``momentum``
+        (momentum) and ``center_of_mass`` (length) as Quantities, and
+        ``energy_error`` and ``angular_momentum_error`` (dimensionless arrays), for
+        the monitors recorded.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import orbits
+    >>> from orbits.monitors import monitor_fields
+    >>> rows = np.zeros((2, 10))
+    >>> rows[:, 0] = [-1.0, -1.000001]                  # energy
+    >>> rows[:, 3] = [2.0, 2.0]                         # L_z
+    >>> out = monitor_fields(rows, ("energy", "angular_momentum"), rows[0], (1.0, 1.0),
+    ...                      orbits.UnitSystem())
+    >>> out["energy"].unit
+    Unit("AU2 solMass / d2")
+    >>> out["energy_error"].round(9).tolist(), out["angular_momentum_error"].tolist()
+    ([0.0, 1e-06], [0.0, 0.0])
+    """
     q = units.quantity
     out = {}
     if "energy" in monitors:

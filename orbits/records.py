@@ -17,7 +17,19 @@ __all__ = ["RunPlan", "SimulationConfig", "SimulationState", "Snapshot",
 
 class RunPlan(NamedTuple):
     """Where one ``run`` takes its steps and outputs; stored in output files so
-    that an interrupted run resumes with exactly the same steps."""
+    that an interrupted run resumes with exactly the same steps.
+
+    Times (``until``, ``start_time``, and what :meth:`output_time` returns) are
+    floats in the simulation's unit of time.
+
+    Examples
+    --------
+    >>> from orbits.records import RunPlan
+    >>> plan = RunPlan(until=10.0, outputs=3, ratio=10.5, n_full=10, has_partial=True,
+    ...                start_step=0)
+    >>> plan.total_steps, list(plan.marks()), plan.output_time(1)
+    (11, [5], 5.0)
+    """
 
     until: float            # end time (internal units)
     outputs: int
@@ -29,10 +41,27 @@ class RunPlan(NamedTuple):
 
     @property
     def total_steps(self):
+        """Steps the run takes (int): the whole steps and the shortened last one, if any.
+
+        Examples
+        --------
+        >>> from orbits.records import RunPlan
+        >>> RunPlan(10.0, 3, 10.5, 10, True, 0).total_steps   # ten whole steps and a short one
+        11
+        """
         return self.n_full + int(self.has_partial)
 
     def output_time(self, k):
-        """Time of output ``k`` of an adaptive run (exactly ``until`` for the last)."""
+        """Time of output ``k`` of an adaptive run (exactly ``until`` for the last).
+
+        Examples
+        --------
+        >>> from orbits.records import RunPlan
+        >>> plan = RunPlan(until=10.0, outputs=5, ratio=10.0, n_full=10, has_partial=False,
+        ...                start_step=0, start_time=2.0)
+        >>> [plan.output_time(k) for k in range(5)]
+        [2.0, 4.0, 6.0, 8.0, 10.0]
+        """
         if k >= self.outputs - 1:
             return self.until
         return self.start_time + k * (self.until - self.start_time) / (self.outputs - 1)
@@ -40,7 +69,16 @@ class RunPlan(NamedTuple):
     def marks(self, first=0):
         """Step counts (from the run's start) of the outputs between the first and
         last, from the ``first``-th on; a generator, so a run of a million outputs
-        holds none of them in memory."""
+        holds none of them in memory.
+
+        Examples
+        --------
+        >>> from orbits.records import RunPlan
+        >>> plan = RunPlan(until=100.0, outputs=5, ratio=100.0, n_full=100, has_partial=False,
+        ...                start_step=0)
+        >>> list(plan.marks()), list(plan.marks(first=2))
+        ([25, 50, 75], [75])
+        """
         for k in range(first + 1, self.outputs - 1):
             yield min(int(round(k * self.ratio / (self.outputs - 1))), self.n_full)
 
@@ -51,6 +89,14 @@ class SimulationConfig(NamedTuple):
     :meth:`Simulation.from_config` rather than by re-listing its arguments.
 
     Quantities stay Quantities; :meth:`to_dict` gives plain JSON-able values.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> cfg = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day).config
+    >>> cfg.integrator, cfg.dt, cfg.monitors
+    ('leapfrog', <Quantity 1. d>, ('energy', 'angular_momentum'))
     """
 
     integrator: str
@@ -62,7 +108,17 @@ class SimulationConfig(NamedTuple):
     stop_conditions: dict   # Simulation keyword -> value
 
     def to_dict(self):
-        """Plain values: Quantities as ``[value, unit]``."""
+        """Plain values: Quantities as ``[value, unit]``.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> d = sim.config.to_dict()
+        >>> d["integrator"], d["dt"]
+        ('leapfrog', [1.0, 'd'])
+        """
         from .forces import _quantity_dict
         return {"integrator": self.integrator,
                 "integrator_options": dict(self.integrator_options),
@@ -73,6 +129,26 @@ class SimulationConfig(NamedTuple):
 
     @classmethod
     def from_dict(cls, d):
+        """The :class:`SimulationConfig` that :meth:`to_dict` describes.
+
+        Parameters
+        ----------
+        d : dict
+            As :meth:`to_dict` gives it: Quantities as ``[value, unit]``.
+
+        Returns
+        -------
+        SimulationConfig
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.records import SimulationConfig
+        >>> cfg = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day).config
+        >>> SimulationConfig.from_dict(cfg.to_dict()) == cfg
+        True
+        """
         from .forces import _quantity_from
         return cls(d["integrator"], dict(d["integrator_options"]), _quantity_from(d["dt"]),
                    tuple(d["forces"]), tuple(d["monitors"]), d["monitor_every"],
@@ -85,6 +161,16 @@ class SimulationState(NamedTuple):
 
     Arrays are in the simulation's internal order (massive bodies first,
     ``order[i]`` the body set's row of internal row ``i``) and units.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> state = sim.state
+    >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+    >>> state.steps, sim.state.steps, sim.state.x.shape
+    (0, 10, (2, 3))
     """
 
     x: np.ndarray                # (N, 3), the integrator's current positions
@@ -101,7 +187,18 @@ class SimulationState(NamedTuple):
 
 
 class Snapshot(NamedTuple):
-    """One output: time, step count, and the state in the body set's order."""
+    """One output: time, step count, and the state in the body set's order.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+    >>> snap = sim.snapshot()
+    >>> snap.t, snap.steps, snap.x.shape, snap.v.shape
+    (10.0, 10, (2, 3), (2, 3))
+    """
 
     t: float
     steps: int
@@ -116,6 +213,14 @@ class SimulationDescription(NamedTuple):
 
     Numbers are plain floats in the simulation's units; ``masses`` and
     ``names`` are in the body set's order.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> d = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day).description()
+    >>> d.names, d.masses.tolist(), d.dt, d.integrator.name
+    (('Star', 'Planet'), [1.0, 0.001], 1.0, 'leapfrog')
     """
 
     names: tuple

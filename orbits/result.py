@@ -88,6 +88,17 @@ class Result:
         run was integrated in, ``"barycentric"``, or the name of the body at
         the origin (see :meth:`relative_to`).  Monitors (energy, momentum,
         centre of mass) are always those of the run, in its own frame.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> result = sim.run(until=10 * u.yr, outputs=11, progress=False)
+    >>> result
+    <Result: 11 outputs of 2 bodies, leapfrog, completed>
+    >>> result.times[-1].to(u.yr), result.positions.shape, result.positions.unit
+    (<Quantity 10. yr>, (11, 2, 3), Unit("AU"))
     """
 
     def __init__(self, **fields):
@@ -137,12 +148,43 @@ class Result:
         return f"<div><strong>Result</strong><table>{cells}</table></div>"
 
     def max_energy_error(self):
-        """Largest relative energy error seen, at outputs or by the in-loop monitor."""
+        """Largest relative energy error seen, at outputs or by the in-loop monitor.
+
+        Returns
+        -------
+        float or None
+            Dimensionless; None where the energy was not monitored.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> result = sim.run(until=10 * u.yr, outputs=11, progress=False)
+        >>> err = result.max_energy_error()
+        >>> bool(0 < err < 1e-10), bool(err == result.energy_error.max())
+        (True, True)
+        """
         return _largest(self.energy_error, self.monitor and self.monitor.get("energy_error"),
                         self._recorded("energy"))
 
     def max_angular_momentum_error(self):
-        """Largest relative angular-momentum error seen."""
+        """Largest relative angular-momentum error seen.
+
+        Returns
+        -------
+        float or None
+            Dimensionless; None where the angular momentum was not monitored.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> result = sim.run(until=10 * u.yr, outputs=11, progress=False)
+        >>> bool(result.max_angular_momentum_error() < 1e-13)
+        True
+        """
         return _largest(self.angular_momentum_error,
                         self.monitor and self.monitor.get("angular_momentum_error"),
                         self._recorded("angular_momentum"))
@@ -152,7 +194,24 @@ class Result:
         return None if value is None else np.array([value])
 
     def summary(self):
-        """A few lines for a person: what ran, how long, and how well it kept the invariants."""
+        """A few lines for a person: what ran, how long, and how well it kept the invariants.
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> result = sim.run(until=10 * u.yr, outputs=11, progress=False)
+        >>> lines = result.summary().splitlines()
+        >>> lines[0]
+        'integrator      leapfrog (order 2, symplectic)'
+        >>> [line.split()[0] for line in lines[1:]]
+        ['bodies', 'time', 'steps', 'units', 'forces', 'energy', 'ang.', 'status']
+        """
         opts = ", ".join(f"{k[7:]}={v}" for k, v in self.integrator.items()
                          if k.startswith("option."))
         wall = self.wall_time

@@ -219,7 +219,17 @@ class Simulation:
 
     @property
     def config(self):
-        """The :class:`SimulationConfig` that rebuilds this simulation from its bodies."""
+        """The :class:`SimulationConfig` that rebuilds this simulation from its bodies.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> cfg = sim.config
+        >>> cfg.integrator, cfg.dt
+        ('leapfrog', <Quantity 1. d>)
+        """
         return SimulationConfig(
             self.integrator.name, dict(self.integrator.config),
             None if (self.integrator.adaptive and self._dt == 0) else self.dt,
@@ -230,7 +240,17 @@ class Simulation:
     @classmethod
     def from_config(cls, bodies, config):
         """A simulation of ``bodies`` made as ``config`` (a :class:`SimulationConfig`
-        or its :meth:`~SimulationConfig.to_dict`) says."""
+        or its :meth:`~SimulationConfig.to_dict`) says.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> twin = orbits.Simulation.from_config(orbits.scenes.kepler(), sim.config.to_dict())
+        >>> twin.integrator.name, twin.dt
+        ('leapfrog', <Quantity 1. d>)
+        """
         from . import forces as _forces
         if isinstance(config, dict):
             config = SimulationConfig.from_dict(config)
@@ -242,12 +262,30 @@ class Simulation:
 
     @property
     def forces(self):
-        """The force terms added to Newtonian gravity (a tuple, maybe empty)."""
+        """The force terms added to Newtonian gravity (a tuple, maybe empty).
+
+        Examples
+        --------
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="ias15",
+        ...                         forces=[orbits.forces.GR("Star")])
+        >>> [type(term).__name__ for term in sim.forces]
+        ['GR']
+        """
         return self._terms
 
     @property
     def gravity(self):
-        """The gravity term with this simulation's options (:class:`orbits.forces.Gravity`)."""
+        """The gravity term with this simulation's options (:class:`orbits.forces.Gravity`).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> type(sim.gravity).__name__
+        'Gravity'
+        """
         from .forces import Gravity
         return Gravity(softening=self._softening, parallel=self.parallel,
                        rebound_arithmetic=self.rebound_arithmetic)
@@ -260,7 +298,17 @@ class Simulation:
 
     @property
     def stop_conditions(self):
-        """The stopping conditions as the keyword arguments that set them (Quantities)."""
+        """The stopping conditions as the keyword arguments that set them (Quantities).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), dt=1 * u.day,
+        ...                         escape_distance=100 * u.au)
+        >>> sim.stop_conditions["escape_distance"], sim.stop_conditions["escape_unbound"]
+        (<Quantity 100. AU>, False)
+        """
         c = self._stop_config
         q = lambda val: None if val is None else self.units.quantity(val, "length")  # noqa: E731
         return {"encounter_distance": q(c["encounter_distance"]),
@@ -270,7 +318,19 @@ class Simulation:
 
     @property
     def softening(self):
-        """The softening length (Quantity), or None."""
+        """The softening length (Quantity), or None.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> print(sim.softening)
+        None
+        >>> orbits.Simulation(orbits.scenes.kepler(), dt=1 * u.day,
+        ...                   softening=1e-3 * u.au).softening
+        <Quantity 0.001 AU>
+        """
         return self._softening
 
     def _positive_length(self, value, field):
@@ -324,6 +384,18 @@ class Simulation:
         that continuing gives bit for bit what an uninterrupted run gives.  If
         the run that wrote the file was interrupted, :meth:`resume` finishes
         it; :meth:`run` with ``output=path`` appends a new run to the file.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> import os, tempfile
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+        >>> again = orbits.Simulation.from_file(path)
+        >>> again.time, bool((again.bodies.positions == sim.bodies.positions).all())
+        (<Quantity 10. d>, True)
         """
         from .io import hdf5
         cp = hdf5.read_checkpoint(path)
@@ -339,8 +411,18 @@ class Simulation:
     @property
     def resume_point(self):
         """Where the run that wrote the file this simulation was restored from
-        stood at its last checkpoint (:class:`orbits.io.hdf5.ResumePoint`), until
-        :meth:`resume` finishes it; None otherwise."""
+        stood at its last checkpoint (:class:`orbits.io.hdf5.ResumePoint`; its
+        ``finished`` says whether that run ended), until :meth:`resume`
+        finishes it; None for a simulation not restored from a file.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> print(sim.resume_point)
+        None
+        """
         return self._resume
 
     def resume(self, progress=None, checkpoint_interval=None):
@@ -348,6 +430,29 @@ class Simulation:
 
         Output rows written after the last checkpoint are dropped and computed
         again, so the file ends as if the run had never stopped.
+
+        Returns
+        -------
+        Result
+            As :meth:`run` with ``output`` returns it: the last output, and the
+            whole run's invariants' errors.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> import os, tempfile
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+        >>> again = orbits.Simulation.from_file(path)
+        >>> again.resume_point.finished   # this run finished: nothing to resume
+        True
+        >>> try:
+        ...     again.resume(progress=False)
+        ... except ValueError as exc:
+        ...     print(str(exc).split(";")[0].endswith("finished"))
+        True
         """
         from .io import hdf5
         point = self._resume
@@ -368,17 +473,47 @@ class Simulation:
     # -- state ------------------------------------------------------------------------
     @property
     def time(self):
-        """Current simulation time (Quantity)."""
+        """Current simulation time (Quantity).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+        >>> sim.time
+        <Quantity 10. d>
+        """
         return self.units.quantity(self._now(), "time")
 
     @property
     def dt(self):
-        """Step size (Quantity)."""
+        """Step size (Quantity).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> sim.dt
+        <Quantity 1. d>
+        """
         return self.units.quantity(self._dt, "time")
 
     @property
     def bodies(self):
-        """The current state as a new :class:`BodySet`."""
+        """The current state as a new :class:`BodySet`.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+        >>> b = sim.bodies
+        >>> b.names, b.positions.unit
+        (['Star', 'Planet'], Unit("AU"))
+        """
         self.integrator.synchronize(self._ws, self._x, self._v)
         inv = np.argsort(self._order)
         bs = BodySet(self.units)
@@ -392,7 +527,17 @@ class Simulation:
 
     @property
     def state(self):
-        """The :class:`SimulationState` (copies), as a checkpoint stores it."""
+        """The :class:`SimulationState` (copies), as a checkpoint stores it.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> s = sim.state
+        >>> s.x.shape, s.steps
+        ((2, 3), 0)
+        """
         return SimulationState(
             self._x.copy(), self._v.copy(), self._order.copy(), self._t_base,
             self._steps_since_base, self.steps, self.force_evaluations, self.steps_rejected,
@@ -401,7 +546,19 @@ class Simulation:
 
     def set_state(self, state):
         """Put back a :class:`SimulationState` taken from a simulation made alike
-        (same bodies' order, integrator and forces)."""
+        (same bodies' order, integrator and forces).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> start = sim.state
+        >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+        >>> sim.set_state(start)
+        >>> sim.time
+        <Quantity 0. d>
+        """
         if not np.array_equal(self._order, state.order):
             raise ValueError("the state's body order does not match this simulation's "
                              "masses")
@@ -420,7 +577,17 @@ class Simulation:
 
     def description(self):
         """The :class:`SimulationDescription`: bodies, units and set-up, as an
-        output file records them beside the :attr:`state`."""
+        output file records them beside the :attr:`state`.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> d = sim.description()
+        >>> d.names, d.dt, d.units.name
+        (('Star', 'Planet'), 1.0, 'au-Msun-day')
+        """
         inv = self._inverse
         return SimulationDescription(
             tuple(self._names), self._m[inv].copy(), self.units, self.integrator, self._dt,
@@ -430,12 +597,32 @@ class Simulation:
 
     @property
     def time_value(self):
-        """The current time as a float in the simulation's unit of time."""
+        """The current time as a float in the simulation's unit of time.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> _ = sim.run(until=1 * u.yr, outputs=2, progress=False)
+        >>> sim.time_value, sim.time.unit
+        (365.25, Unit("d"))
+        """
         return self._now()
 
     def snapshot(self):
         """The current output (:class:`Snapshot`): the integrator synchronised, the
-        state in the body set's order, and the monitors asked for."""
+        state in the body set's order, and the monitors asked for.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> snap = sim.snapshot()
+        >>> snap.t, snap.steps, snap.x.shape
+        (0.0, 0, (2, 3))
+        """
         self.integrator.synchronize(self._ws, self._x, self._v)
         row = np.zeros(10)
         if self._mask:
@@ -521,6 +708,17 @@ class Simulation:
             A position or velocity became NaN or infinite.  The exception
             carries ``time``, ``step`` and ``result``, which ends with the last
             good state; the simulation is left at that state.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+        >>> result = sim.run(until=1 * u.yr, outputs=5, progress=False)
+        >>> result.times.round(2)
+        <Quantity [  0.  ,  91.  , 183.  , 274.  , 365.25] d>
+        >>> bool(result.max_energy_error() < 1e-5)
+        True
         """
         plan = self._plan(self._time_value(until, "until"), outputs, until)
         if wall_limit is not None and not _positive_number(wall_limit):

@@ -139,7 +139,27 @@ _NUMBER = re.compile(r"\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*")
 
 
 class SystemFile(NamedTuple):
-    """What :func:`read` gives: the bodies, the ``[run]`` defaults, and the source."""
+    """What :func:`read` gives: the bodies, the ``[run]`` defaults, and the source.
+
+    Examples
+    --------
+    >>> from orbits import systemfile
+    >>> text = '''
+    ... [[body]]
+    ... name = "Sun"
+    ... mass = "1 Msun"
+    ... [[body]]
+    ... name = "Jupiter"
+    ... mass = "1 Mjup"
+    ... a = "5.2 au"
+    ... [run]
+    ... integrator = "wh"
+    ... dt = "50 day"
+    ... '''
+    >>> sf = systemfile.loads(text)
+    >>> sf.bodies.names, sf.run["integrator"], sf.run["dt"], sf.path
+    (['Sun', 'Jupiter'], 'wh', <Quantity 50. d>, '<string>')
+    """
 
     bodies: BodySet
     #: the ``[run]`` table: ``integrator`` (str), ``dt`` and ``until``

@@ -101,12 +101,30 @@ class UnitSystem:
     # -- constructors -----------------------------------------------------------
     @classmethod
     def default(cls):
-        """au, solar masses and days, with G * Msun = astropy's GM_sun."""
+        """au, solar masses and days, with G * Msun = astropy's GM_sun.
+
+        Examples
+        --------
+        >>> from orbits import UnitSystem
+        >>> U = UnitSystem.default()
+        >>> U.name, str(U.length), str(U.mass), str(U.time)
+        ('au-Msun-day', 'AU', 'solMass', 'd')
+        >>> U == UnitSystem()
+        True
+        """
         return cls(name="au-Msun-day")
 
     @classmethod
     def nbody(cls, G=1.0):
-        """Dimensionless N-body units with ``G = 1`` (Hénon units for a cluster)."""
+        """Dimensionless N-body units with ``G = 1`` (Hénon units for a cluster).
+
+        Examples
+        --------
+        >>> from orbits import UnitSystem
+        >>> U = UnitSystem.nbody()
+        >>> U.G, U.name, U.unit("length").is_equivalent(1)
+        (1.0, 'nbody', True)
+        """
         d = u.dimensionless_unscaled
         return cls(length=d, mass=d, time=d, G=G, name="nbody",
                    G_source="N-body units" if G == 1.0 else None)
@@ -118,6 +136,14 @@ class UnitSystem:
         REBOUND derives G from its own table of unit values; for au, solar
         masses and days that is the square of Gauss's constant.  Other units
         are looked up in REBOUND itself, which must then be installed.
+
+        Examples
+        --------
+        >>> from orbits import UnitSystem
+        >>> from orbits.units import GAUSSIAN_GRAVITATIONAL_CONSTANT as k
+        >>> U = UnitSystem.rebound()
+        >>> abs(U.G / k**2 - 1) < 1e-15
+        True
         """
         length, mass, time = u.Unit(length), u.Unit(mass), u.Unit(time)
         try:
@@ -144,7 +170,15 @@ class UnitSystem:
 
     # -- conversion -------------------------------------------------------------
     def unit(self, kind):
-        """The unit of a physical kind: ``"length"``, ``"velocity"``, ``"energy"``..."""
+        """The unit of a physical kind: ``"length"``, ``"velocity"``, ``"energy"``...
+
+        Examples
+        --------
+        >>> from orbits import UnitSystem
+        >>> U = UnitSystem()
+        >>> U.unit("velocity"), U.unit("energy")
+        (Unit("AU / d"), Unit("AU2 solMass / d2"))
+        """
         try:
             return self._units[kind]
         except KeyError:
@@ -177,6 +211,22 @@ class UnitSystem:
         BodyUnitsError
             The value has the wrong physical type, or is a bare number where a
             Quantity is needed.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits import UnitSystem
+        >>> U = UnitSystem()
+        >>> float(U.to_internal(1 * u.yr, "time"))
+        365.25
+        >>> U.to_internal(2.0, "length", bare_ok=True).dtype
+        dtype('float64')
+        >>> try:
+        ...     U.to_internal(2.0, "length")
+        ... except orbits.BodyUnitsError as exc:
+        ...     print(str(exc).split(";")[0])
+        expected a Quantity with a unit of length (e.g. AU), got the bare number 2.0
         """
         target = self.unit(kind)
         if isinstance(value, u.Quantity):
@@ -200,12 +250,28 @@ class UnitSystem:
             f"unit system explicitly to use plain numbers", body=body, field=field)
 
     def quantity(self, value, kind):
-        """Attach the unit of ``kind`` to a float array, without copying."""
+        """Attach the unit of ``kind`` to a float array, without copying.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from orbits import UnitSystem
+        >>> UnitSystem().quantity(np.array([1.0, 2.0]), "velocity")
+        <Quantity [1., 2.] AU / d>
+        """
         return np.asarray(value) << self.unit(kind)
 
     # -- bookkeeping ------------------------------------------------------------
     def to_dict(self):
-        """Plain description, for results and files."""
+        """Plain description, for results and files.
+
+        Examples
+        --------
+        >>> from orbits import UnitSystem
+        >>> d = UnitSystem().to_dict()
+        >>> d["length"], d["mass"], d["time"], round(d["G"], 15)
+        ('AU', 'solMass', 'd', 0.000295912208192)
+        """
         d = self.__dict__.get("_description")
         if d is None:
             d = self.__dict__["_description"] = {
@@ -216,7 +282,15 @@ class UnitSystem:
 
     @classmethod
     def from_dict(cls, d):
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict`.
+
+        Examples
+        --------
+        >>> from orbits import UnitSystem
+        >>> U = UnitSystem.nbody()
+        >>> UnitSystem.from_dict(U.to_dict()) == U
+        True
+        """
         return cls(u.Unit(d["length"]), u.Unit(d["mass"]), u.Unit(d["time"]),
                    G=d["G"], name=d["name"], G_source=d["G_source"])
 

@@ -29,7 +29,15 @@ _REGISTRY = {}
 
 
 class IntegratorInfo(NamedTuple):
-    """What :func:`available` lists about each integrator."""
+    """What :func:`available` lists about each integrator.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> info = next(i for i in orbits.integrators.available() if i.name == "wh")
+    >>> info.name, info.order, info.symplectic, info.adaptive
+    ('wh', 2, True, False)
+    """
 
     name: str
     order: int
@@ -39,7 +47,33 @@ class IntegratorInfo(NamedTuple):
 
 
 def register(cls):
-    """Add an integrator class to the registry (usable as a decorator)."""
+    """Add an integrator class to the registry (usable as a decorator).
+
+    Parameters
+    ----------
+    cls : type
+        A subclass of :class:`~orbits.integrators.Integrator` with a ``name``.
+
+    Returns
+    -------
+    type
+        ``cls``, unchanged.
+
+    Raises
+    ------
+    TypeError
+        ``cls`` is not a named Integrator subclass.
+
+    Examples
+    --------
+    >>> from orbits import integrators
+    >>> @integrators.register
+    ... class HalfLeapfrog(type(integrators.get("leapfrog"))):
+    ...     name = "half-leapfrog-example"
+    >>> type(integrators.get("half-leapfrog-example")).__name__
+    'HalfLeapfrog'
+    >>> del integrators._REGISTRY["half-leapfrog-example"]   # keep the registry as it was
+    """
     if not (isinstance(cls, type) and issubclass(cls, Integrator) and cls.name):
         raise TypeError("only named Integrator subclasses can be registered")
     _REGISTRY[cls.name] = cls
@@ -66,6 +100,20 @@ def get(name, **options):
     ------
     UnknownIntegratorError
         The name is not registered; the message lists the valid ones.
+
+    Returns
+    -------
+    Integrator
+        An instance with its options in ``config``; an instance given as
+        ``name`` is returned as it is, or copied with ``options`` changed.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("ias15", epsilon=1e-10)
+    IAS15(epsilon=1e-10, min_dt=0.0, adaptive_mode='global')
+    >>> orbits.integrators.get("dopri5").config
+    {'rtol': 1e-09, 'atol': 1e-12}
     """
     if isinstance(name, Integrator):
         if options:
@@ -80,6 +128,17 @@ def get(name, **options):
 
 
 def available():
-    """Registered integrators with their order and properties, in registry order."""
+    """Registered integrators with their order and properties, in registry order.
+
+    Returns
+    -------
+    list of IntegratorInfo
+
+    Examples
+    --------
+    >>> import orbits
+    >>> [(i.name, i.order) for i in orbits.integrators.available() if i.symplectic][:3]
+    [('symplectic-euler', 1), ('verlet', 2), ('leapfrog', 2)]
+    """
     return [IntegratorInfo(c.name, c.order, c.symplectic, c.adaptive, c.summary)
             for c in _REGISTRY.values()]

@@ -53,7 +53,30 @@ RTOL_FLOOR = 100 * float(np.finfo(float).eps)
 
 
 class Integrator:
-    """Base class; see the module docstring for the contract."""
+    """Base class; see the module docstring for the contract.
+
+    Examples
+    --------
+    >>> import math
+    >>> import numpy as np
+    >>> from orbits import integrators
+    >>> from orbits._kernels import gravity, stepping
+    >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+    >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+    >>> force = stepping.gravity_force("small")
+    >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+    >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+    >>> integ = integrators.get("leapfrog")
+    >>> ws = integ.workspace(2)
+    >>> integ.bind(ws, force, fargs)
+    >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
+    ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+    >>> integ.synchronize(ws, x, v)
+    >>> status.name, steps, np.round(x[1], 3)        # one period: back at the start
+    ('OK', 1000, array([ 1., -0.,  0.]))
+    >>> integ.info()["order"], integ.symplectic
+    (2, True)
+    """
 
     name = None
     order = None
@@ -85,28 +108,174 @@ class Integrator:
 
     # contract, parts 3-5
     def workspace(self, n):
+        """The arrays a run keeps between calls, for ``n`` bodies (contract, part 3).
+
+        Parameters
+        ----------
+        n : int
+            Number of bodies.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            The arrays a run keeps between calls (point 3 of the contract).
+
+        Examples
+        --------
+        >>> from orbits import integrators
+        >>> ws = integrators.get("rk4").workspace(5)
+        >>> sorted(ws), ws["kx"].shape
+        (['kv', 'kx', 'vs', 'xs'], (4, 5, 3))
+        """
         raise NotImplementedError
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
+        """Advance ``x``, ``v`` by ``nsteps`` steps of ``dt`` (contract, part 4).
+
+        Parameters
+        ----------
+        ws : dict
+            The workspace (:meth:`workspace`), updated in place.
+        x, v : numpy.ndarray, shape (N, 3)
+            Positions and velocities in the internal units, advanced in place.
+        t, dt : float
+            Time at the start and step size, in the internal unit of time.
+        nsteps : int
+            Steps to take.
+        force, fargs
+            The compiled force and its arguments.
+        mon, step0, mon_t, mon_out
+            Monitor settings, the step count at the start, and the arrays the
+            monitor rows are written into.
+
+        Returns
+        -------
+        tuple
+            ``(status, steps_done, n_monitor_rows)``.
+
+        Examples
+        --------
+        >>> import math
+        >>> import numpy as np
+        >>> from orbits import integrators
+        >>> from orbits._kernels import gravity, stepping
+        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+        >>> force = stepping.gravity_force("small")
+        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> integ = integrators.get("rk4")
+        >>> ws = integ.workspace(2)
+        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        >>> status.name, steps, np.round(x[1], 6)
+        ('OK', 1000, array([1., 0., 0.]))
+        """
         raise NotImplementedError
 
     def bind(self, ws, force, fargs):
         """Called once a workspace meets its force (also after a restore); for
-        methods that keep something of the force beside their arrays."""
+        methods that keep something of the force beside their arrays.
+
+        Examples
+        --------
+        >>> import math
+        >>> import numpy as np
+        >>> from orbits import integrators
+        >>> from orbits._kernels import gravity, stepping
+        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+        >>> force = stepping.gravity_force("small")
+        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> integ = integrators.get("wh")
+        >>> ws = integ.workspace(2)
+        >>> integ.bind(ws, force, fargs)     # gravity alone: nothing kept beside the arrays
+        >>> "terms" in ws
+        False
+        """
 
     def check_terms(self, terms):
         """Refuse, with :class:`~orbits.errors.IntegratorOptionError`, a force term
-        (of :mod:`orbits.forces`) this method cannot honour; every term by default."""
+        (of :mod:`orbits.forces`) this method cannot honour; every term by default.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> gr = orbits.forces.GR("Sun")
+        >>> orbits.integrators.get("ias15").check_terms([gr])      # accepted
+        >>> try:
+        ...     orbits.integrators.get("wh").check_terms([gr])
+        ... except orbits.IntegratorOptionError as exc:
+        ...     print(type(exc).__name__)
+        IntegratorOptionError
+        """
 
     def synchronize(self, ws, x, v):
-        """Fixed-step methods here always end a step with x and v at one time."""
+        """Fixed-step methods here always end a step with x and v at one time.
+
+        Examples
+        --------
+        >>> import math
+        >>> import numpy as np
+        >>> from orbits import integrators
+        >>> from orbits._kernels import gravity, stepping
+        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+        >>> force = stepping.gravity_force("small")
+        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> integ = integrators.get("leapfrog")
+        >>> ws = integ.workspace(2)
+        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        >>> before = x.copy()
+        >>> integ.synchronize(ws, x, v)                # x and v are at one time already
+        >>> bool((x == before).all())
+        True
+        """
 
     def invalidate(self, ws):
-        """Forget anything computed from the old state."""
+        """Forget anything computed from the old state.
+
+        Examples
+        --------
+        >>> import math
+        >>> import numpy as np
+        >>> from orbits import integrators
+        >>> from orbits._kernels import gravity, stepping
+        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+        >>> force = stepping.gravity_force("small")
+        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> integ = integrators.get("verlet")
+        >>> ws = integ.workspace(2)
+        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        >>> int(ws["cache"][0])                        # the last force is cached
+        1
+        >>> integ.invalidate(ws)
+        >>> int(ws["cache"][0])
+        0
+        """
 
     def info(self):
-        """The integrator and its options, for results and files."""
+        """The integrator and its options, for results and files.
+
+        Returns
+        -------
+        dict
+            ``name``, ``order``, ``symplectic``, ``adaptive``, and each option as
+            ``option.<name>``.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.integrators.get("ias15", epsilon=1e-10).info()["option.epsilon"]
+        1e-10
+        """
         return {"name": self.name, "order": self.order, "symplectic": self.symplectic,
                 "adaptive": self.adaptive, **{f"option.{k}": v for k, v in self.config.items()}}
 
@@ -122,6 +291,15 @@ class SplittingMethod(Integrator):
     ``("kick", c)``, applied left to right, where a drift advances positions by
     ``c dt v`` and a kick velocities by ``c dt a(x)``.  Drift and kick
     coefficients must each sum to one.
+
+    Examples
+    --------
+    >>> from orbits import integrators
+    >>> leapfrog = integrators.get("leapfrog")
+    >>> leapfrog.operators
+    (('drift', 0.5), ('kick', 1.0), ('drift', 0.5))
+    >>> sum(c for kind, c in integrators.get("yoshida4").operators if kind == "kick")
+    1.0
     """
 
     operators = ()
@@ -140,11 +318,40 @@ class SplittingMethod(Integrator):
 
     def workspace(self, n):
         # vm: the implicit kick's midpoint velocities (velocity-dependent forces)
+        """``acc`` (the cached force), ``vm`` and the cache flag, for ``n`` bodies.
+
+        Examples
+        --------
+        >>> from orbits import integrators
+        >>> sorted(integrators.get("leapfrog").workspace(3))
+        ['acc', 'cache', 'vm']
+        """
         return {"acc": np.zeros((n, 3)), "vm": np.zeros((n, 3)),
                 "cache": np.zeros(1, dtype=np.int64)}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
+        """Apply the operator table ``nsteps`` times in the compiled loop (see
+        :meth:`Integrator.advance`).
+
+        Examples
+        --------
+        >>> import math
+        >>> import numpy as np
+        >>> from orbits import integrators
+        >>> from orbits._kernels import gravity, stepping
+        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+        >>> force = stepping.gravity_force("small")
+        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> integ = integrators.get("yoshida4")
+        >>> ws = integ.workspace(2)
+        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        >>> status.name, np.round(x[1], 6)
+        ('OK', array([ 1., -0.,  0.]))
+        """
         loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs,
                                        stop=stop is not None)
         return loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
@@ -153,6 +360,27 @@ class SplittingMethod(Integrator):
                     stepping.NO_STOP_ARGS if stop is None else stop)
 
     def invalidate(self, ws):
+        """Drop the cached force: the next kick evaluates it again.
+
+        Examples
+        --------
+        >>> import math
+        >>> import numpy as np
+        >>> from orbits import integrators
+        >>> from orbits._kernels import gravity, stepping
+        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+        >>> force = stepping.gravity_force("small")
+        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> integ = integrators.get("verlet")
+        >>> ws = integ.workspace(2)
+        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        >>> integ.invalidate(ws)
+        >>> ws["cache"].tolist()
+        [0]
+        """
         ws["cache"][0] = 0
 
 
@@ -160,6 +388,14 @@ class ExplicitRungeKutta(Integrator):
     """An explicit Runge-Kutta method given by its Butcher table ``A``, ``B``, ``C``.
 
     Applied to ``y = (x, v)`` with ``y' = (v, a(x, v, t))``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits import integrators
+    >>> rk4 = integrators.get("rk4")
+    >>> round(float(np.sum(rk4.B)), 12), np.allclose(np.sum(rk4.A, axis=1), rk4.C)
+    (1.0, True)
     """
 
     A = None
@@ -173,12 +409,43 @@ class ExplicitRungeKutta(Integrator):
             cls.forces_per_step = len(cls.B)
 
     def workspace(self, n):
+        """Stage buffers: ``kx``, ``kv`` of shape (stages, n, 3), and the stage
+        state ``xs``, ``vs``.
+
+        Examples
+        --------
+        >>> from orbits import integrators
+        >>> ws = integrators.get("rk2").workspace(3)
+        >>> ws["kx"].shape, ws["xs"].shape
+        ((2, 3, 3), (3, 3))
+        """
         s = len(self.B)
         return {"kx": np.zeros((s, n, 3)), "kv": np.zeros((s, n, 3)),
                 "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3))}
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
+        """Take ``nsteps`` steps of the Butcher table in the compiled loop (see
+        :meth:`Integrator.advance`).
+
+        Examples
+        --------
+        >>> import math
+        >>> import numpy as np
+        >>> from orbits import integrators
+        >>> from orbits._kernels import gravity, stepping
+        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
+        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
+        >>> force = stepping.gravity_force("small")
+        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
+        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> integ = integrators.get("rk2")
+        >>> ws = integ.workspace(2)
+        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        >>> status.name, steps
+        ('OK', 1000)
+        """
         loop = stepping.runge_kutta_loop(force, stop=stop is not None)
         return loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
                     ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every,

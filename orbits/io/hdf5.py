@@ -148,7 +148,21 @@ _LOCK_UNREADABLE_SECONDS = 5.0
 
 
 class OrbitsFileError(OrbitsError, OSError):
-    """A file that is not an orbits output, is damaged, or has another layout version."""
+    """A file that is not an orbits output, is damaged, or has another layout version.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import orbits
+    >>> path = os.path.join(tempfile.mkdtemp(), "notes.h5")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("not HDF5")
+    >>> try:
+    ...     orbits.load(path)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, str(exc).endswith("(it has no HDF5 signature)"))
+    OrbitsFileError True
+    """
 
 
 class FileInUse(OrbitsFileError):
@@ -160,6 +174,14 @@ class FileInUse(OrbitsFileError):
         The writer's process id.
     host : str or None
         The host it runs on.
+
+    Examples
+    --------
+    >>> import os
+    >>> from orbits.io.hdf5 import FileInUse, OrbitsFileError
+    >>> exc = FileInUse("run.h5: being written by process 4242", pid=4242, host="node7")
+    >>> isinstance(exc, OrbitsFileError), exc.pid, exc.host
+    (True, 4242, 'node7')
     """
 
     def __init__(self, message, pid=None, host=None):
@@ -630,6 +652,26 @@ class FileRecorder:
     output), and keeps the largest relative errors of the monitors over every
     output and in-loop row it passes on, so that :meth:`result`, which holds
     only the last output, still reports them for the whole run.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> from orbits.records import RunPlan
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
+    ...                start_step=0)
+    >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
+    >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+    >>> rec.output(sim, final=True)                   # the last output, and a checkpoint
+    >>> rec.result(sim, wall=0.0).times
+    <Quantity [10.] d>
+    >>> rec.close()
+    >>> orbits.load(path).times
+    <Quantity [ 0., 10.] d>
     """
 
     def __init__(self, path, sim, plan, overwrite=False, checkpoint_interval=None,
@@ -770,6 +812,33 @@ class FileRecorder:
 
     # Recorder interface ----------------------------------------------------------------
     def output(self, sim, final=False):
+        """Record the simulation's current state as the next output row (buffered).
+
+        Parameters
+        ----------
+        sim : Simulation
+            Its :meth:`~orbits.Simulation.snapshot` is the output.
+        final : bool
+            The run's last output: a checkpoint marked finished follows.
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.io import hdf5
+        >>> from orbits.records import RunPlan
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
+        ...                start_step=0)
+        >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
+        >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+        >>> rec.output(sim, final=True)
+        >>> rec.outputs_written, rec.checkpoints
+        (2, 2)
+        >>> rec.close()
+        """
         self.last = tuple(sim.snapshot())
         self.buffer.append(self.last)
         self.outputs_written += 1
@@ -781,7 +850,26 @@ class FileRecorder:
     def monitor_rows(self, t, rows):
         """In-loop monitor rows of the chunk the simulation has just run; called
         before its step count moves on, so the rows' steps are the multiples
-        of ``monitor_every`` after ``sim.steps`` (as the compiled loops record)."""
+        of ``monitor_every`` after ``sim.steps`` (as the compiled loops record).
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.io import hdf5
+        >>> from orbits.records import RunPlan
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
+        ...                start_step=0)
+        >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
+        >>> import numpy as np
+        >>> rec.monitor_rows(np.array([1.0]), np.zeros((1, 10)))
+        >>> len(rec.mon_buffer)
+        1
+        >>> rec.close()
+        """
         self._note_rows(rows)
         every = self.sim.monitor_every or 1
         steps = (self.sim.steps // every + 1 + np.arange(len(t), dtype=np.int64)) * every
@@ -789,11 +877,48 @@ class FileRecorder:
 
     def stopped(self, sim):
         """A run stopped between outputs (by a signal, after :meth:`checkpoint`): the
-        result ends at this state; the file gets no row off the outputs' grid."""
+        result ends at this state; the file gets no row off the outputs' grid.
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.io import hdf5
+        >>> from orbits.records import RunPlan
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
+        ...                start_step=0)
+        >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
+        >>> _ = sim.run(until=4 * u.day, outputs=2, progress=False)
+        >>> rec.stopped(sim)
+        >>> rec.result(sim, wall=0.0).times
+        <Quantity [4.] d>
+        >>> rec.close()
+        """
         self.last = tuple(sim.snapshot())
         self._note_rows(self.last[4][None])
 
     def close(self):
+        """Flush what is buffered, close the file and release the writers' lock (idempotent).
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.io import hdf5
+        >>> from orbits.records import RunPlan
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
+        ...                start_step=0)
+        >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
+        >>> rec.close()
+        >>> rec.closed, os.path.exists(path + ".lock")    # the writers' lock is released
+        (True, False)
+        """
         if not self.closed:
             self.closed = True
             try:
@@ -803,6 +928,42 @@ class FileRecorder:
                 _release(self.path)
 
     def result(self, sim, wall, status="completed"):
+        """The run's :class:`~orbits.Result`, as :meth:`orbits.Simulation.run`
+        returns it for a file.
+
+        Parameters
+        ----------
+        sim : Simulation
+        wall : float
+            Seconds of wall-clock time the run took.
+        status : str
+            How the run ended.
+
+        Returns
+        -------
+        Result
+            The last output only, with the largest relative errors of the whole
+            run in ``largest_errors``.
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.io import hdf5
+        >>> from orbits.records import RunPlan
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
+        ...                start_step=0)
+        >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
+        >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+        >>> rec.output(sim, final=True)
+        >>> r = rec.result(sim, wall=0.5)
+        >>> r.times, r.wall_time, r.path == path
+        (<Quantity [10.] d>, 0.5, True)
+        >>> rec.close()
+        """
         from ..result import Result
         q = sim.units.quantity
         t, step, x, v, row = self.last
@@ -855,6 +1016,32 @@ class FileRecorder:
         are flushed first, and the state, clock, plan and progress written are
         those of that moment, from which a resumed run finishes bit for bit as
         the uninterrupted one.
+
+        Parameters
+        ----------
+        finished : bool
+            Mark the run as finished (nothing left to resume).
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.io import hdf5
+        >>> from orbits.records import RunPlan
+        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
+        ...                start_step=0)
+        >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
+        >>> rec.checkpoints
+        1
+        >>> rec.checkpoint()
+        >>> rec.checkpoints
+        2
+        >>> rec.close()
+        >>> hdf5.read_checkpoint(path).point.finished
+        False
         """
         sim = self.sim
         self._flush_outputs()
@@ -1077,6 +1264,33 @@ def load(path):
     are the totals of the runs that wrote the file, at its last checkpoint
     (None for force evaluations and wall time in files written before they
     were kept).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    Result
+        Every output row, as Quantities in the file's units.
+
+    Raises
+    ------
+    OrbitsFileError
+        Not an orbits output, or damaged beyond reading.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> result = orbits.load(path)
+    >>> result.times, result.positions.unit, result.steps
+    (<Quantity [ 0.,  5., 10.] d>, Unit("AU"), 10)
     """
     from ..result import Result
     import astropy.units as u
@@ -1176,6 +1390,27 @@ def describe(path):
     """A few sentences saying what an output file holds.
 
     Raises :class:`OrbitsFileError` for a damaged file, as :func:`load` does.
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> text = hdf5.describe(path)
+    >>> [line.split()[0] for line in text.splitlines()[1:4]]
+    ['bodies', 'integrator', 'units']
     """
     with _open_read(path) as f:
         b = f["particles/bodies"]
@@ -1229,7 +1464,21 @@ def _describe_forces(par):
 
 class Checkpoint(NamedTuple):
     """What a file's last checkpoint rebuilds a simulation from
-    (:meth:`orbits.Simulation.from_file`)."""
+    (:meth:`orbits.Simulation.from_file`).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> cp = hdf5.read_checkpoint(path)
+    >>> cp.bodies.names, cp.config["integrator"], cp.state.steps
+    (['Star', 'Planet'], 'leapfrog', 10)
+    """
 
     bodies: object          # the BodySet at the checkpoint
     config: dict            # SimulationConfig.to_dict() of the simulation
@@ -1241,7 +1490,29 @@ class Checkpoint(NamedTuple):
 @_damaged
 def read_checkpoint(path):
     """The file's last complete checkpoint, as a :class:`Checkpoint`;
-    :class:`OrbitsFileError` for a file that is damaged or holds none."""
+    :class:`OrbitsFileError` for a file that is damaged or holds none.
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    Checkpoint
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> cp = hdf5.read_checkpoint(path)
+    >>> cp.point.finished, cp.point.time            # time in the file's unit (days)
+    (True, 10.0)
+    """
     from ..bodies import BodySet
     from ..units import UnitSystem
 
@@ -1303,7 +1574,21 @@ def _legacy_config(par, units):
 
 
 class ResumePoint(NamedTuple):
-    """Where a restored simulation stands in the run its file was written by."""
+    """Where a restored simulation stands in the run its file was written by.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> point = hdf5.read_checkpoint(path).point
+    >>> point.outputs_written, point.rows, point.finished, point.plan.until
+    (3, 3, True, 10.0)
+    """
 
     plan: object            # the RunPlan of that run
     outputs_written: int    # of that run, at the checkpoint
@@ -1319,6 +1604,32 @@ def truncate(path, point):
     clean for writing again.  The writers' lock is taken first
     (:class:`FileInUse` if a live process holds it) and kept for the
     :class:`FileRecorder` that writes on, which releases it when it closes.
+
+    Parameters
+    ----------
+    path : str or path-like
+    point : ResumePoint
+        Rows after ``point.rows``, and in-loop monitor rows after
+        ``point.time`` (in the file's unit of time), are dropped.
+
+    Raises
+    ------
+    FileInUse
+        Another live process is writing the file.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> point = hdf5.read_checkpoint(path).point
+    >>> hdf5.truncate(path, point._replace(rows=1, time=0.0))   # back to the first output
+    >>> orbits.load(path).times
+    <Quantity [0.] d>
     """
     _acquire(path)
     tmp = pathlib.Path(str(path) + ".resume")
