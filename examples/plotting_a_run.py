@@ -14,9 +14,10 @@ map and a step of 100 days, drawn three ways:
 * :meth:`orbits.BodySet.plot_orbits`: a sketch of the starting body set,
   each body on its osculating Keplerian ellipse.
 
-The plotting functions return :class:`matplotlib.figure.Figure` objects made
-without pyplot; ``plt.figure(fig)`` hands one to pyplot, so that
-``plt.show()`` (and this page) can show it.  ::
+By themselves the plotting functions return :class:`matplotlib.figure.Figure`
+objects that pyplot does not manage (nothing opens a window in a script or a
+test); given ``fig=plt.figure()`` (or ``ax=`` for the sketch) they draw into
+pyplot's figures, which ``plt.show()`` (and this page) shows.  ::
 
     python examples/plotting_a_run.py                 # run and show the figures
     python examples/plotting_a_run.py --png run       # also write run_orbits.png, ...
@@ -44,17 +45,18 @@ def main(until=1e5 * u.yr, outputs=300, png_prefix=None):
     """Run the outer solar system to ``until`` and make the three figures.
 
     Returns the run's :class:`~orbits.Result` and a dict of the figures,
-    ``"orbits"``, ``"elements"`` and ``"sketch"``; with ``png_prefix``, also
-    writes them to ``<png_prefix>_<name>.png``.
+    ``"orbits"``, ``"elements"`` and ``"sketch"``, drawn into pyplot's
+    figures (so that ``plt.show()`` and the gallery show them); with
+    ``png_prefix``, also writes them to ``<png_prefix>_<name>.png``.
     """
     bodies = orbits.scenes.outer_solar_system()
     sim = orbits.Simulation(bodies, integrator="wh", dt=100 * u.day)
     result = sim.run(until=until, outputs=outputs, progress=False)
     print(result.summary())
     figures = {
-        "orbits": result.plot(),
-        "elements": result.plot_elements(),
-        "sketch": bodies.plot_orbits(),
+        "orbits": result.plot(fig=plt.figure(figsize=(12, 5.5))),
+        "elements": result.plot_elements(fig=plt.figure(figsize=(8, 7.5))),
+        "sketch": bodies.plot_orbits(ax=plt.figure(figsize=(7, 7)).add_subplot()),
     }
     if png_prefix is not None:
         for name, fig in figures.items():
@@ -83,6 +85,4 @@ if __name__ == "__main__":
     parser.add_argument("--png", metavar="PREFIX", help="write PREFIX_<figure>.png")
     args = parser.parse_args()
     result, figures = main(args.years * u.yr, args.outputs, args.png)
-    for fig in figures.values():
-        plt.figure(fig)       # into pyplot's care: shown by plt.show() and by the gallery
     plt.show()

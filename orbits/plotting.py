@@ -88,7 +88,7 @@ def time_unit(span):
     return TIME_AXIS_UNITS[-1][1]
 
 
-def plot_result(result, path=None, frame=None):
+def plot_result(result, path=None, frame=None, fig=None):
     """A run's orbits in the x-y plane, and its invariants' errors against time.
 
     Left: each body's path in the chosen frame (at most
@@ -108,6 +108,9 @@ def plot_result(result, path=None, frame=None):
         ``"barycentric"``, ``"heliocentric"`` (about the most massive body) or
         a body's name; default about the most massive body where it holds most
         of the mass, else barycentric (see :meth:`orbits.Result.in_frame`).
+    fig : matplotlib.figure.Figure, optional
+        An empty figure to draw into, e.g. ``matplotlib.pyplot.figure()`` so
+        that pyplot shows it; default a new figure that pyplot does not manage.
 
     Returns
     -------
@@ -139,7 +142,7 @@ def plot_result(result, path=None, frame=None):
     if not len(result.times):
         raise ValueError("the result holds no outputs: nothing to plot")
     framed = result.in_frame(frame)
-    fig = _figure(figsize=(12, 5.5))
+    fig = _figure(figsize=(12, 5.5)) if fig is None else fig
     ax_orbit, ax_err = fig.subplots(1, 2)
 
     x = framed.positions
@@ -188,7 +191,7 @@ def plot_result(result, path=None, frame=None):
     return fig
 
 
-def plot_elements(result, bodies=None, primary=None, path=None):
+def plot_elements(result, bodies=None, primary=None, path=None, fig=None):
     """Osculating semi-major axis, eccentricity and inclination against time.
 
     Parameters
@@ -204,6 +207,9 @@ def plot_elements(result, bodies=None, primary=None, path=None):
         before each one (see :meth:`orbits.Result.elements`).
     path : str or path-like, optional
         Also write the figure there (PNG, 110 dpi).
+    fig : matplotlib.figure.Figure, optional
+        An empty figure to draw into, e.g. ``matplotlib.pyplot.figure()`` so
+        that pyplot shows it; default a new figure that pyplot does not manage.
 
     Returns
     -------
@@ -243,7 +249,7 @@ def plot_elements(result, bodies=None, primary=None, path=None):
     t = result.times
     tu = time_unit(t[-1] - t[0])
     time = t.to_value(tu)
-    fig = _figure(figsize=(8, 7.5))
+    fig = _figure(figsize=(8, 7.5)) if fig is None else fig
     ax_a, ax_e, ax_i = fig.subplots(3, 1, sharex=True)
     length = None
     for name, el in series.items():

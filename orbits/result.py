@@ -630,7 +630,7 @@ class Result:
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     # -- plots --------------------------------------------------------------------
-    def plot(self, frame=None, path=None):
+    def plot(self, frame=None, path=None, fig=None):
         """Orbits in the x-y plane in a chosen frame, and the invariants' errors.
 
         See :func:`orbits.plotting.plot_result`.
@@ -642,6 +642,9 @@ class Result:
             it holds most of the mass, else barycentric.
         path : str or path-like, optional
             Also write the figure there (PNG).
+        fig : matplotlib.figure.Figure, optional
+            An empty figure to draw into (``matplotlib.pyplot.figure()`` for
+            one that pyplot shows); default a new one pyplot does not manage.
 
         Returns
         -------
@@ -658,9 +661,9 @@ class Result:
         'orbits (x-y plane), about Sun'
         """
         from .plotting import plot_result
-        return plot_result(self, path=path, frame=frame)
+        return plot_result(self, path=path, frame=frame, fig=fig)
 
-    def plot_elements(self, bodies=None, primary=None, path=None):
+    def plot_elements(self, bodies=None, primary=None, path=None, fig=None):
         """Semi-major axis, eccentricity and inclination against time.
 
         See :func:`orbits.plotting.plot_elements`.
@@ -674,6 +677,9 @@ class Result:
             As for :meth:`elements`.
         path : str or path-like, optional
             Also write the figure there (PNG).
+        fig : matplotlib.figure.Figure, optional
+            An empty figure to draw into (``matplotlib.pyplot.figure()`` for
+            one that pyplot shows); default a new one pyplot does not manage.
 
         Returns
         -------
@@ -690,7 +696,7 @@ class Result:
         ['a [AU]', 'e', 'inc [deg]']
         """
         from .plotting import plot_elements
-        return plot_elements(self, bodies=bodies, primary=primary, path=path)
+        return plot_elements(self, bodies=bodies, primary=primary, path=path, fig=fig)
 
     # -- internals ----------------------------------------------------------------
     def _index(self, name, field="body"):

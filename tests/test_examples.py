@@ -38,8 +38,12 @@ def test_mercury_perihelion_example(capsys):
 
 def test_plotting_a_run_example(capsys):
     # 2000 years keep it to a few seconds; the figures' layout does not depend on the length
+    import matplotlib.pyplot as plt
+    plt.close("all")
     mod = runpy.run_path(str(EXAMPLES / "plotting_a_run.py"))
     result, figures = mod["main"](until=2000 * u.yr, outputs=100)
+    # drawn into pyplot's figures (fig=, ax=), which the gallery's scraper collects
+    assert [plt.figure(n) for n in plt.get_fignums()] == list(figures.values())
     assert "status          completed" in capsys.readouterr().out
     assert sorted(figures) == ["elements", "orbits", "sketch"]
 
@@ -61,3 +65,4 @@ def test_plotting_a_run_example(capsys):
     assert [line.get_label() for line in sketch_axes.lines] == [
         "Jupiter", "Saturn", "Uranus", "Neptune", "Pluto"]
     assert sketch_axes.get_xlabel() == "x [AU]"
+    plt.close("all")
