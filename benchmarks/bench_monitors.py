@@ -66,7 +66,7 @@ class BareLoop:
         s = self.sim
         status, done, _, s._ws = advance_checked(
             s.integrator, s._ws, s._x, s._v, self.t, s._dt, n, s._force, s._fargs, self.mon,
-            self.step0, np.empty(0), np.zeros((0, 10)))
+            self.step0, np.empty(0), np.zeros((0, 11)))
         if status != 0 or done != n:
             raise RuntimeError(f"bare loop stopped with status {status} after {done} steps")
         self.t += n * s._dt

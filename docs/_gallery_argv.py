@@ -8,6 +8,9 @@ __all__ = ["reset_argv", "QUICK_ARGV"]
 
 QUICK_ARGV = {
     "mercury_perihelion.py": ["--years", "20"],
+    "resonant_migration.py": ["--years", "4000", "--outputs", "1601"],
+    "hot_jupiter_tides.py": ["--orbits", "1500", "--outputs", "301"],
+    "poynting_robertson.py": ["--years", "600", "--outputs", "601"],
     "stability_map.py": ["--n", "8", "--until", "3000", "--scheduler", "serial",
                          "--png", os.path.join(tempfile.gettempdir(),
                                                "stability_map_quick.png")],

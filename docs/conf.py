@@ -67,10 +67,17 @@ if os.environ.get("ORBITS_DOCS_INTERSPHINX", "") not in ("", "0"):
     intersphinx_timeout = 30
 
 # -- sphinx-gallery --------------------------------------------------------------------
-# Every example runs during the build.  The two long ones take shorter arguments here
+# Every example runs during the build.  The long ones take shorter arguments here
 # (reset_argv, in _gallery_argv.py), so the build stays within a minute or two on a 2-core machine:
 #   mercury_perihelion.py  four runs of 20 years instead of 100 (2.5 s; the rates
 #                          still agree with theory to 0.01 arcsec per century)
+#   resonant_migration.py  4000 years instead of 1e4 (1.9 s): the capture into 2:1
+#                          and the libration are there, the long resonant migration not
+#   hot_jupiter_tides.py   1500 orbits instead of 3000 (0.9 s): e falls to 0.05, not 0.02
+#   poynting_robertson.py  600 years instead of 980 (0.6 s): the smallest grain reaches
+#                          0.63 au, not 0.15 au
+#                          (on a cold numba cache each of these three first compiles
+#                          ias15 with its term: 15-25 s on a shared 2-core machine)
 #   stability_map.py       an 8 x 8 grid to 3000 yr in this process (5.6 s) instead of
 #                          40 x 40 to 5e4 yr on a Dask cluster; its page shows the
 #                          committed picture of the full map, examples/stability_map.png,

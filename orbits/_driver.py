@@ -2,16 +2,20 @@
 
 import contextlib
 import signal as _signal
+import sys
 import threading
+import time as _time
 
 import _signal as _csignal
 import numpy as np
 
+from ._kernels.invariants import MONITOR_WIDTH
 from ._kernels.status import Status
 from ._kernels.stepping import USER_FORCE_SIZE
-from .errors import ForceTermError
+from .errors import ForceTermError, RunInterrupted, WallTimeExceeded
 
-__all__ = ["advance_checked", "restored_on_error", "Signals", "CHECK_EVERY"]
+__all__ = ["advance_checked", "restored_on_error", "Signals", "CHECK_EVERY", "Driven",
+           "CHUNK_SECONDS", "PROGRESS_DELAY"]
 
 #: The compiled loops test the state for NaN and inf every this many steps
 #: (a test is a dependent chain of 6N additions, as dear as the force for a few
@@ -133,4 +137,249 @@ class Signals:
         self.restore()
         if self.caught is not None and kind is None:
             _signal.raise_signal(self.caught)
+        return False
+
+
+#: A run's compiled loop returns to Python about this often, so that progress
+#: bars move; the chunk length in steps adapts to keep to it.
+CHUNK_SECONDS = 0.25
+
+#: A progress bar appears once a run has gone on this long, so short runs stay quiet.
+PROGRESS_DELAY = 3.0
+
+
+class Driven:
+    """The one run driver, shared by :class:`orbits.Simulation` and
+    :func:`orbits.integrate`.
+
+    A class that mixes it in holds one state and says how to advance it:
+    ``integrator``, ``_ws`` (its workspace), ``_x``, ``_v``, ``_force`` and
+    ``_fargs``, ``_stop`` (stopping arguments or None), ``_mon(every)`` and
+    ``monitor_every``, the clock (``_t_base``, ``_steps_since_base``, ``_dt``,
+    ``_now()``, ``time``), the counters (``steps``, ``steps_rejected``,
+    ``force_evaluations``), ``_chunk``, ``_stop_info``, ``_wall_limit`` and
+    ``_fail(status, rec, wall0)``, which raises the named error of a failed
+    status.  :meth:`execute` carries out a plan (a
+    :class:`~orbits.records.RunPlan` or anything with its ``marks``,
+    ``n_full``, ``has_partial``, ``total_steps``, ``start_step``,
+    ``outputs``, ``output_time`` and ``until``) into a recorder, which takes
+    ``output(owner, final)``, ``monitor_rows(t, rows)``, ``checkpoint()``,
+    ``stopped(owner)``, ``close()`` and ``result(owner, wall, status)``.
+    """
+
+    _wall_limit = None
+
+    def execute(self, plan, rec, progress, first_mark=0):
+        """Carry out ``plan`` from its output ``first_mark`` on (resuming).
+
+        The one driver of every run, fixed-step and adaptive: the compiled
+        loop is entered in chunks of about :data:`CHUNK_SECONDS`, and between
+        chunks the progress bar, the wall-time limit and any SIGINT or SIGTERM
+        that arrived are looked at.
+        """
+        adaptive = self.integrator.adaptive
+        if adaptive:
+            bar = _ProgressBar(plan.outputs - 1, progress, unit="output")
+            bar.update(first_mark)
+        else:
+            bar = _ProgressBar(plan.total_steps, progress)
+            bar.update(self.steps - plan.start_step)
+        wall0 = _time.perf_counter()
+        self._wall0 = wall0
+        with Signals() as self._signals:
+            try:
+                if adaptive:
+                    self._outputs_adaptive(plan, rec, bar, first_mark)
+                else:
+                    self._outputs_fixed(plan, rec, bar, first_mark)
+            finally:
+                bar.close()
+                rec.close()
+        return rec.result(self, _time.perf_counter() - wall0)
+
+    def _outputs_fixed(self, plan, rec, bar, first_mark):
+        wall0 = self._wall0
+        done = self.steps - plan.start_step
+        for mark in plan.marks(first_mark):
+            done = self._advance_to(done, mark, rec, bar, wall0)
+            rec.output(self)
+        done = self._advance_to(done, plan.n_full, rec, bar, wall0)
+        if plan.has_partial and done == plan.n_full:
+            self._advance(1, rec, wall0, dt=plan.until - self._now())
+            bar.update(1)
+        rec.output(self, final=True)
+
+    def _outputs_adaptive(self, plan, rec, bar, first_mark):
+        wall0 = self._wall0
+        for k in range(first_mark + 1, plan.outputs):
+            self._advance_adaptive(plan.output_time(k), rec, wall0)
+            bar.update(1)
+            rec.output(self, final=k == plan.outputs - 1)
+        if plan.outputs == 1:
+            self._advance_adaptive(plan.until, rec, wall0)
+            rec.output(self, final=True)
+
+    def _advance_adaptive(self, t_end, rec, wall0):
+        integ = self.integrator
+        every = self.monitor_every or 0
+        while self._t_base < t_end:
+            n = self._chunk
+            size = n // every + 1 if every else 0
+            mon_t = np.empty(size)
+            mon_out = np.zeros((size, MONITOR_WIDTH))
+            mon = self._mon(every)
+            t0 = _time.perf_counter()
+            with restored_on_error(self._x, self._v, self._ws):
+                status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
+                    self._ws, self._x, self._v, self._t_base, t_end, self._force,
+                    self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)
+            elapsed = _time.perf_counter() - t0
+            if n_mon:
+                rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
+            self._t_base = float(t_reached)
+            self.steps += int(acc)
+            self.steps_rejected += int(rej)
+            self.force_evaluations += int(fev)
+            if status != Status.OK:
+                if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
+                    self._stop_info[:] = self._ws["info"]
+                self._fail(status, rec, wall0)
+            if acc == n and elapsed < CHUNK_SECONDS / 4:
+                self._chunk *= 4
+            elif elapsed > CHUNK_SECONDS:
+                self._chunk = max(16, self._chunk // 2)
+            self._between_chunks(rec, wall0)
+
+    def _advance_to(self, done, target, rec, bar, wall0):
+        # the loop returns to Python about every CHUNK_SECONDS (progress bar);
+        # the chunk length adapts and is kept from one call to the next
+        while done < target:
+            n = min(self._chunk, target - done)
+            t0 = _time.perf_counter()
+            self._advance(n, rec, wall0)
+            elapsed = _time.perf_counter() - t0
+            done += n
+            bar.update(n)
+            if n == self._chunk:
+                if elapsed < CHUNK_SECONDS / 4:
+                    self._chunk *= 4
+                elif elapsed > CHUNK_SECONDS:
+                    self._chunk = max(1, self._chunk // 2)
+            self._between_chunks(rec, wall0)
+        return done
+
+    def _between_chunks(self, rec, wall0):
+        self._check_signal(rec, wall0)
+        self._check_wall(rec, wall0)
+
+    def _check_signal(self, rec, wall0):
+        """Stop at this consistent point if SIGINT or SIGTERM arrived meanwhile."""
+        signals = getattr(self, "_signals", None)
+        if signals is None or signals.caught is None:
+            return
+        signum = signals.caught
+        signals.caught = None
+        previous = signals.saved.get(signum)
+        rec.checkpoint()
+        if callable(previous) and previous is not _signal.default_int_handler:
+            previous(signum, None)   # the caller's own handler decides; the state is whole
+            return
+        name = _signal.Signals(signum).name
+        rec.stopped(self)
+        rec.close()
+        result = rec.result(self, _time.perf_counter() - wall0, status=f"stopped by {name}")
+        if previous is _signal.default_int_handler:
+            path = getattr(rec, "path", None)
+            raise RunInterrupted(
+                f"{name} at t = {self.time:.10g} (step {self.steps}): the simulation was "
+                f"left at the last completed step, clock and state agreeing"
+                + (f", and a restart checkpoint was written to {path}" if path else "")
+                + "; the result up to here is kept on .result",
+                signal=signum, time=self.time, step=self.steps, result=result)
+        # the default action (SIGTERM ends the process): taken now that the file is whole
+        signals.restore()
+        _signal.raise_signal(signum)
+
+    def _check_wall(self, rec, wall0):
+        limit = getattr(self, "_wall_limit", None)
+        if limit is None or _time.perf_counter() - wall0 <= limit:
+            return
+        rec.output(self, final=True)
+        rec.close()
+        result = rec.result(self, _time.perf_counter() - wall0, status="wall-time limit")
+        raise WallTimeExceeded(
+            f"the run passed its wall-time limit of {limit:g} s at t = {self.time:.10g} "
+            f"(step {self.steps}); the result up to here is kept on .result and the "
+            f"simulation was left there", time=self.time, step=self.steps, result=result)
+
+    def _advance(self, n, rec, wall0, dt=None):
+        dt = self._dt if dt is None else dt
+        every = self.monitor_every or 0
+        if every:
+            first = (self.steps // every + 1) * every  # next step index that records
+            size = max(0, (self.steps + n - first) // every + 1)
+        else:
+            size = 0
+        mon_t = np.empty(size)
+        mon_out = np.zeros((size, MONITOR_WIDTH))
+        mon = self._mon(every)
+        status, steps, n_mon, self._ws = advance_checked(
+            self.integrator, self._ws, self._x, self._v, self._now(), dt, n, self._force,
+            self._fargs, mon, self.steps, mon_t, mon_out, stop=self._stop)
+        if n_mon:
+            rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
+        if status != Status.OK:
+            self._count(steps, dt)
+            self._fail(status, rec, wall0)
+        self._count(n, dt)
+
+    def _count(self, n, dt):
+        if n == 0:
+            return
+        if dt == self._dt:
+            self._steps_since_base += n
+        else:
+            self._t_base = self._now() + dt
+            self._steps_since_base = 0
+        self.steps += n
+        self.force_evaluations += n * self.integrator.forces_per_step
+
+
+class _ProgressBar:
+    """A tqdm bar that appears only for long runs (or always, or never)."""
+
+    def __init__(self, total, progress, unit="step"):
+        self.total = total
+        self.unit = unit
+        if progress is None and not _stderr_is_terminal():
+            progress = False  # a log file gets no bar
+        self.progress = progress
+        self.done = 0
+        self.start = _time.perf_counter()
+        self.bar = None
+        if progress:
+            self._open()
+
+    def _open(self):
+        from tqdm.auto import tqdm
+        self.bar = tqdm(total=self.total, initial=self.done, unit=self.unit, unit_scale=True,
+                        leave=False, desc="orbits")
+
+    def update(self, n):
+        self.done += n
+        if self.bar is not None:
+            self.bar.update(n)
+        elif (self.progress is None
+              and _time.perf_counter() - self.start > PROGRESS_DELAY):
+            self._open()
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _stderr_is_terminal():
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):
         return False

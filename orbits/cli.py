@@ -214,8 +214,8 @@ def _parser():
     val.add_argument("--scheduler", default=None,
                      help="address of an existing Dask scheduler to run on")
     val.add_argument("--only", nargs="+", default=None, metavar="SECTION",
-                     help="run only these sections: accuracy ephemeris work_precision drift "
-                          "stress guide")
+                     help="run only these sections: accuracy ephemeris dissipative "
+                          "work_precision drift stress guide")
     val.add_argument("--no-progress", action="store_true")
 
     sub.add_parser("scenes", help="list the built-in scenes")

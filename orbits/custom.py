@@ -7,19 +7,20 @@ loop as Python (slower, but the same numbers).
 """
 
 import math
-import signal as _signal
 import time as _time
+from typing import NamedTuple
 
 import numba
 import numpy as np
 
 from . import integrators as _integrators
-from ._driver import Signals, advance_checked, restored_on_error
+from ._driver import Driven
 from ._kernels import implicit as _implicit
 from ._kernels import stepping as _stepping
 from ._kernels.status import Status
 from .errors import (ConvergenceFailure, ForceTermError, IntegratorOptionError,
-                     NonFiniteState, RunInterrupted, StepSizeUnderflow)
+                     NonFiniteState, StepSizeUnderflow)
+from .records import RunPlan
 
 __all__ = ["integrate", "Trajectory"]
 
@@ -177,18 +178,19 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
         _check_jacobian(jacobian, x0, v0, t0, size)
         force = force._replace(jacobian=_implicit.user_jacobian(jacobian, _is_jitted(jacobian)),
                                key=f"{force.key}_jac{id(jacobian)}")
+    if velocity_dependent:
+        force = force._replace(velocity_dependent=True)
     fargs = (size, tuple(int(s) for s in shape))
     if integ.adaptive:
         ws = integ.workspace(rows, 0.0 if dt is None else float(dt))
         t0, until = float(t0), float(until)
         # outputs at evenly spaced times, the last exactly at until
-        marks = [until if k == outputs - 1 else t0 + k * (until - t0) / (outputs - 1)
-                 for k in range(1, int(outputs))]
+        plan = RunPlan(until, int(outputs), 0.0, 0, False, 0, t0)
     else:
         ws = integ.workspace(rows)
-        marks = [min(k * every, steps) for k in range(1, -(-steps // every) + 1)]
+        plan = _EveryPlan(steps, every)
     return _drive(integ, force, fargs, x, v, ws, shape, scalar, float(t0),
-                  None if integ.adaptive else dt, marks, velocity_dependent)
+                  None if integ.adaptive else dt, plan)
 
 
 #: what a failed status raises in :func:`integrate`
@@ -204,66 +206,114 @@ _FAILURES = {
 }
 
 
-def _drive(integ, force, fargs, x, v, ws, shape, scalar, t0, dt, marks, velocity_dependent):
-    """The one driver of :func:`integrate`: outputs at ``marks`` (step counts for a
-    fixed step ``dt``, times for an adaptive method), the compiled loop entered
-    once per output, SIGINT and SIGTERM acted on between outputs."""
-    size = int(np.prod(shape))
-    rows = x.shape[0]
-    mon = (0, 0, np.zeros(rows), 0.0, 0, 0.0)
-    no_t, no_rows = np.empty(0), np.zeros((0, 10))
-    ts, xs, vs = [t0], [x.ravel()[:size].copy()], [v.ravel()[:size].copy()]
-    wall0 = _time.perf_counter()
-    t, steps = t0, 0
+class _EveryPlan(NamedTuple):
+    """The outputs of a fixed-step :func:`integrate`: every ``every`` steps and
+    after the last (the plan interface of :class:`orbits._driver.Driven`)."""
 
-    def trajectory(status):
-        out_shape = (len(ts),) + (() if scalar else shape)
-        return Trajectory(np.array(ts), np.array(xs).reshape(out_shape),
-                          np.array(vs).reshape(out_shape), steps, integ.name,
-                          _time.perf_counter() - wall0, status)
+    steps: int
+    every: int
+    start_step: int = 0
+    has_partial: bool = False
 
-    def keep():
-        ts.append(t)
-        xs.append(x.ravel()[:size].copy())
-        vs.append(v.ravel()[:size].copy())
+    @property
+    def n_full(self):
+        return self.steps
 
-    with Signals() as signals:
-        for mark in marks:
-            status = Status.OK
-            try:
-                if dt is not None:
-                    status, good, _, ws = advance_checked(
-                        integ, ws, x, v, t, dt, mark - steps, force, fargs, mon, steps,
-                        no_t, no_rows, velocity_dependent)
-                    steps += good
-                    t = t0 + steps * dt
-                else:
-                    while t < mark and status == Status.OK:
-                        with restored_on_error(x, v, ws):
-                            status, t, acc, _, _, _ = integ.advance_to(
-                                ws, x, v, t, mark, force, fargs, mon, steps, no_t, no_rows,
-                                None, 1 << 40)
-                        steps += int(acc)
-            except numba.core.errors.TypingError as exc:
-                raise TypeError("accel(x, v, t) could not be compiled in the stepping loop; "
-                                "it must take arrays x, v (shape of x0) and a float t and "
-                                "return an array of the shape of x0. numba said:\n"
-                                f"{exc}") from None
-            except ValueError as exc:
-                _resize_error(exc, shape, t)
-            keep()
-            if status != Status.OK:
-                kind, label, text = _FAILURES.get(Status(status),
-                                                  _FAILURES[Status.NON_FINITE])
-                raise kind(text.format(name=integ.name, next=steps + 1, t=t, steps=steps)
-                           + f"; the trajectory up to the last good step {steps} is kept on "
-                           f".result", time=t, step=steps, result=trajectory(label))
-            if signals.caught is not None:
-                name = _signal.Signals(signals.caught).name
-                raise RunInterrupted(f"{name} at t = {t:.10g} (step {steps}); the trajectory "
-                                     f"up to there is kept on .result", signal=signals.caught,
-                                     time=t, step=steps, result=trajectory(f"stopped by {name}"))
-    return trajectory("completed")
+    @property
+    def total_steps(self):
+        return self.steps
+
+    def marks(self, first=0):
+        for k in range(first + 1, -(-self.steps // self.every)):
+            yield k * self.every
+
+
+class _Samples:
+    """The recorder of :func:`integrate`: the state at every output, in the user's shape."""
+
+    end_status = 0
+
+    def __init__(self, run):
+        self.ts, self.xs, self.vs = [], [], []
+        self.output(run)
+
+    def output(self, run, final=False):
+        self.ts.append(run._now())
+        self.xs.append(run._x.ravel()[:run.size].copy())
+        self.vs.append(run._v.ravel()[:run.size].copy())
+
+    def stopped(self, run):
+        self.output(run, final=True)
+
+    def monitor_rows(self, t, rows):
+        """No monitors for a user's system."""
+
+    def checkpoint(self, finished=False):
+        """Nothing to save for a run kept in memory."""
+
+    def close(self):
+        """Nothing to release."""
+
+    def result(self, run, wall, status="completed"):
+        out_shape = (len(self.ts),) + (() if run.scalar else run.shape)
+        return Trajectory(np.array(self.ts), np.array(self.xs).reshape(out_shape),
+                          np.array(self.vs).reshape(out_shape), run.steps, run.integrator.name,
+                          wall, status)
+
+
+class _UserRun(Driven):
+    """A user's system as the run driver (:class:`orbits._driver.Driven`) sees it."""
+
+    monitor_every = 0
+    _stop = None
+
+    def __init__(self, integ, force, fargs, x, v, ws, shape, scalar, t0, dt):
+        self.integrator, self._force, self._fargs = integ, force, fargs
+        self._x, self._v, self._ws = x, v, ws
+        self.shape, self.scalar, self.size = shape, scalar, int(np.prod(shape))
+        self._t_base, self._steps_since_base = float(t0), 0
+        self._dt = 0.0 if dt is None else float(dt)
+        self.steps = self.steps_rejected = self.force_evaluations = 0
+        self._chunk = 1024
+        self._stop_info = np.full(2, -1, dtype=np.int64)
+        self._no_monitors = (0, 0, np.zeros(x.shape[0]), 0.0, 0, 0.0)
+
+    def _now(self):
+        return self._t_base + self._steps_since_base * self._dt
+
+    @property
+    def time(self):
+        return self._now()
+
+    def _mon(self, every):
+        return self._no_monitors
+
+    def _fail(self, status, rec, wall0):
+        kind, label, text = _FAILURES.get(Status(status), _FAILURES[Status.NON_FINITE])
+        rec.output(self, final=True)
+        t = self._now()
+        raise kind(text.format(name=self.integrator.name, next=self.steps + 1, t=t,
+                               steps=self.steps)
+                   + f"; the trajectory up to the last good step {self.steps} is kept on "
+                   f".result", time=t, step=self.steps,
+                   result=rec.result(self, _time.perf_counter() - wall0, label))
+
+
+def _drive(integ, force, fargs, x, v, ws, shape, scalar, t0, dt, plan):
+    """:func:`integrate` through the package's one run driver: the compiled loop
+    entered in chunks, SIGINT and SIGTERM acted on between them."""
+    run = _UserRun(integ, force, fargs, x, v, ws, shape, scalar, t0, dt)
+    if dt is not None and plan.steps == 0:
+        return _Samples(run).result(run, 0.0)
+    try:
+        return run.execute(plan, _Samples(run), progress=False)
+    except numba.core.errors.TypingError as exc:
+        raise TypeError("accel(x, v, t) could not be compiled in the stepping loop; "
+                        "it must take arrays x, v (shape of x0) and a float t and "
+                        "return an array of the shape of x0. numba said:\n"
+                        f"{exc}") from None
+    except (ValueError, ForceTermError) as exc:
+        _resize_error(exc, shape, run._now())
 
 
 def _describe(value):
@@ -298,7 +348,8 @@ def _check_accel(accel, x0, v0, t0, shape):
 
 
 def _resize_error(exc, shape, t):
-    if str(exc) != _stepping.USER_FORCE_SIZE and not isinstance(exc, ForceTermError):
+    if str(exc) != _stepping.USER_FORCE_SIZE and not (
+            isinstance(exc, ForceTermError) and exc.field == "func"):
         raise exc
     raise ForceTermError(f"accel(x, v, t) returned a different number of values during the "
                          f"run (after t = {t:.10g}); expected an array of shape "

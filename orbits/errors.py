@@ -238,6 +238,8 @@ class ForceTermError(OrbitsError, ValueError):
         The term concerned, as written (``"GR('Sun')"``).
     field : str or None
         Its parameter concerned: ``"source"``, ``"radius"``, ``"func"``, ...
+    body : str or None
+        The body concerned (the body of a tide, the body a ``beta`` is for), or None.
 
     Examples
     --------
@@ -250,10 +252,12 @@ class ForceTermError(OrbitsError, ValueError):
     ForceTermError radius
     """
 
-    def __init__(self, message, term=None, field=None):
+    def __init__(self, message, term=None, field=None, body=None):
         self.term = term
         self.field = field
-        where = ", ".join(p for p in (term, f"parameter {field!r}" if field else None) if p)
+        self.body = body
+        where = ", ".join(p for p in (term, f"body {body!r}" if body is not None else None,
+                                      f"parameter {field!r}" if field else None) if p)
         super().__init__(f"{where}: {message}" if where else message)
 
 

@@ -15,24 +15,34 @@ so that nothing downstream asks for its name:
 * its energy: the potential, or the first post-Newtonian correction to the
   conserved energy, which the energy monitor adds, so that
   ``result.energy_error`` measures the integration and not the physics;
-  ``conservative`` is False for a term without one;
+  ``conservative`` is False for a term without one, whose work ``W`` the
+  loops integrate instead (:attr:`orbits.Simulation.work`), the energy error
+  being that of ``E + W``;
 * its Jacobian ``da/dx``, ``da/dv``, for the implicit methods (analytic for
-  :class:`GR`, :class:`GRPotential` and :class:`ZonalHarmonics`; central
+  :class:`GR`, :class:`GRPotential`, :class:`ZonalHarmonics`, :class:`Migration`,
+  :class:`TidesConstantTimeLag` and :class:`RadiationPressure`; central
   differences of the term alone for :class:`GRFull` and :class:`UserForce`);
 * ``wisdom_holman``: whether the Wisdom-Holman map can take it in its
   interaction step and stay symplectic (conservative, positions only).
 
+The dissipative terms (:class:`Migration`, :class:`TidesConstantTimeLag`,
+:class:`RadiationPressure`) add nothing to the conserved energy: their energy
+kernel is zero and ``conservative`` is False.
+
 Which integrators take which term:
 
-=======================  ==============================================  ==================
-term                     Wisdom-Holman family (``wh``, ``saba*``)        every other method
-=======================  ==============================================  ==================
-:class:`GRPotential`     yes, symplectic                                 yes
-:class:`ZonalHarmonics`  yes, symplectic                                 yes
-:class:`UserForce`       with ``potential`` and not velocity-dependent   yes
-:class:`GR`              no (velocities)                                 yes
-:class:`GRFull`          no (velocities)                                 yes
-=======================  ==============================================  ==================
+=============================  ==========================================  ==================
+term                           Wisdom-Holman family (``wh``, ``saba*``)    every other method
+=============================  ==========================================  ==================
+:class:`GRPotential`           yes, symplectic                             yes
+:class:`ZonalHarmonics`        yes, symplectic                             yes
+:class:`UserForce`             with ``potential``, not velocity-dependent  yes
+:class:`GR`                    no (velocities)                             yes
+:class:`GRFull`                no (velocities)                             yes
+:class:`Migration`             no (dissipative, velocities)                yes
+:class:`TidesConstantTimeLag`  no (dissipative, velocities)                yes
+:class:`RadiationPressure`     no (dissipative, velocities)                yes
+=============================  ==========================================  ==================
 
 With a velocity-dependent term the leapfrog, Verlet and the compositions
 kick with ``v' = v + h a(x, (v + v') / 2)``, solved by fixed-point
@@ -49,7 +59,9 @@ References
 Anderson et al. 1975, ApJ 200, 221 (:class:`GR`); Nobili & Roxburgh 1986,
 IAU Symp. 114, 105 (:class:`GRPotential`); Newhall, Standish & Williams 1983,
 A&A 125, 150 (:class:`GRFull`); Murray & Dermott 1999, *Solar System
-Dynamics*, sect. 4.9 (:class:`ZonalHarmonics`).
+Dynamics*, sect. 4.9 (:class:`ZonalHarmonics`); Papaloizou & Larwood 2000, MNRAS
+315, 823 (:class:`Migration`); Hut 1981, A&A 99, 126 (:class:`TidesConstantTimeLag`);
+Burns, Lamy & Soter 1979, Icarus 40, 1 (:class:`RadiationPressure`).
 """
 
 import importlib
@@ -63,10 +75,11 @@ import numpy as np
 from ._kernels import stepping as _stepping_kernels
 from ._kernels import terms as _k
 from ._kernels._jit import specialize
-from .errors import ForceTermError, UnknownBodyError
+from .errors import BodyUnitsError, ForceTermError, UnknownBodyError
 
 __all__ = ["ForceTerm", "Gravity", "GR", "GRPotential", "GRFull", "ZonalHarmonics",
-           "UserForce", "from_dict", "BoundTerm"]
+           "Migration", "TidesConstantTimeLag", "RadiationPressure", "UserForce",
+           "from_dict", "BoundTerm"]
 
 
 class BoundTerm(NamedTuple):
@@ -333,12 +346,17 @@ class _SourceTerm(ForceTerm):
         return _inv_c2(self, self.c, ctx)
 
 
-def _inv_c2(term, c, ctx):
+def _speed_of_light(term, c, ctx):
     value = const.c if c is None else c
     cv = float(ctx.units.to_internal(value, "velocity", bare_ok=ctx.bare_ok, field="c"))
     if not (cv > 0 and math.isfinite(cv)):
         raise ForceTermError(f"the speed of light must be a positive finite speed, got {c}",
                              term=repr(term), field="c")
+    return cv
+
+
+def _inv_c2(term, c, ctx):
+    cv = _speed_of_light(term, c, ctx)
     return 1.0 / (cv * cv)
 
 
@@ -700,6 +718,623 @@ class ZonalHarmonics(ForceTerm):
         return BoundTerm(_ZONAL_KERNEL, args, args + (ctx.m,))
 
 
+# -- dissipative terms --------------------------------------------------------------------
+
+def _number(value, term, field, body=None):
+    # a plain finite float, or a named error
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        out = math.nan
+    if not math.isfinite(out):
+        raise ForceTermError(f"expected a finite number, got {value!r}", term=term,
+                             field=field, body=body)
+    return out
+
+
+def _given(value, kind, ctx, field):
+    # a Quantity (or, where allowed, a plain number) as a float in the internal units
+    return float(ctx.units.to_internal(value, kind, bare_ok=ctx.bare_ok, field=field))
+
+
+def _angular_velocity(value, ctx, term):
+    # an angular velocity 3-vector in rad per internal time unit; astropy's
+    # dimensionless_angles lets it be given as rad / s or as 1 / s alike
+    per_time = u.rad / ctx.units.unit("time")
+    if value is None:
+        return np.zeros(3)
+    if isinstance(value, u.Quantity):
+        try:
+            out = np.asarray(value.to_value(per_time, equivalencies=u.dimensionless_angles()),
+                             dtype=np.float64)
+        except u.UnitConversionError:
+            raise BodyUnitsError(f"expected an angular velocity (e.g. in {per_time}), got "
+                                 f"{value.unit.physical_type} ({value.unit})",
+                                 field="spin") from None
+    else:
+        try:  # plain numbers where the body set's own units are implied, as for lengths
+            out = ctx.units.to_internal(value, "velocity", bare_ok=ctx.bare_ok, field="spin")
+        except BodyUnitsError:
+            raise BodyUnitsError(f"expected a Quantity with a unit of angular velocity (e.g. "
+                                 f"{per_time}), got the bare value {value!r}",
+                                 field="spin") from None
+    _check_spin(out, term)
+    return np.ascontiguousarray(out, dtype=np.float64)
+
+
+def _vector_dict(value):
+    # a 3-vector as [[x, y, z], unit] for JSON, plain numbers as a list
+    if value is None or isinstance(value, u.Quantity):
+        return _quantity_dict(value)
+    return [float(c) for c in np.asarray(value, dtype=float).ravel()]
+
+
+def _check_spin(value, term):
+    value = np.asarray(value, dtype=float)
+    if value.shape != (3,) or not np.all(np.isfinite(value)):
+        raise ForceTermError(f"spin must be a finite angular-velocity 3-vector, got {value}",
+                             term=term, field="spin")
+
+
+def _massive_index(ctx, name, term, field, role):
+    i = ctx.index(name, term, field)
+    if not ctx.m[i] > 0:
+        raise ForceTermError(f"the {role} {name!r} has no mass", term=term, field=field,
+                             body=name)
+    return i
+
+
+class Migration(ForceTerm):
+    """Orbital migration and eccentricity and inclination damping of one body on
+    prescribed time scales (Papaloizou & Larwood 2000), the forces of REBOUNDx's
+    ``modify_orbits_forces``.
+
+    The body's acceleration relative to its ``primary`` is ::
+
+        a = -u / (2 tau_a) - 2 (r . u) r / (r^2 tau_e) - 2 u_z z_hat / tau_inc
+
+    with ``r``, ``u`` the body's position and velocity relative to the primary
+    and ``z_hat`` the frame's z axis (the reference plane is the xy plane).
+    Orbit-averaged, ``a`` decays as ``exp(-t / tau_a)``, and a low ``e`` as
+    ``exp(-t / tau_e)`` (at constant angular momentum, so that damping ``e``
+    also moves ``a`` a little), a low inclination as ``exp(-t / tau_inc)``.
+    The pair shares the acceleration in inverse proportion to the masses, the
+    body taking ``m_p / (m_p + m_b)`` of it and the primary the rest with the
+    opposite sign, so the relative acceleration is ``a`` and momentum is
+    conserved.  For the innermost body about the central one this is REBOUNDx's
+    default (Jacobi) choice exactly.  Give one term per body.
+
+    A positive time scale damps (inward migration), a negative one grows
+    (outward migration): REBOUNDx's ``tau_a`` is minus this one.
+    Dissipative and velocity-dependent: not for the Wisdom-Holman family.  Its
+    energy kernel is zero.
+
+    Parameters
+    ----------
+    body : str
+        Name of the migrating body.
+    tau_a, tau_e, tau_inc : Quantity (time) or None
+        E-folding times of the semi-major axis, the eccentricity and the
+        inclination; non-zero and finite; None leaves that part out (give at
+        least one).
+    primary : str, optional
+        Name of the body the orbit is relative to; default the most massive
+        other body.
+
+    Raises
+    ------
+    ForceTermError
+        A time scale that is zero or not finite, or none given; when bound, a
+        primary without mass or the body as its own primary.
+    UnknownBodyError
+        When bound, ``body`` or ``primary`` is not in the body set.
+
+    References
+    ----------
+    Papaloizou, J. C. B. & Larwood, J. D. 2000, MNRAS 315, 823.  Kostov, V. B. et
+    al. 2016, ApJ 832, 183 (the form REBOUNDx implements).
+
+    Examples
+    --------
+    >>> import astropy.units as u, orbits
+    >>> term = orbits.forces.Migration("Planet", tau_a=1e4 * u.yr, tau_e=1e3 * u.yr)
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "ias15", forces=[term])
+    >>> term.velocity_dependent, term.conservative, term.wisdom_holman
+    (True, False, False)
+    """
+
+    velocity_dependent = True
+    conservative = False
+    why_not_wisdom_holman = "it is dissipative and depends on velocities"
+
+    def __init__(self, body, tau_a=None, tau_e=None, tau_inc=None, primary=None):
+        name = f"Migration({body!r})"
+        if not isinstance(body, str):
+            raise ForceTermError(f"body must be a body's name, got {body!r}", term=name,
+                                 field="body")
+        if primary is not None and not isinstance(primary, str):
+            raise ForceTermError(f"primary must be a body's name or None, got {primary!r}",
+                                 term=name, field="primary", body=body)
+        self.body = body
+        self.primary = primary
+        self.tau_a = tau_a
+        self.tau_e = tau_e
+        self.tau_inc = tau_inc
+        if tau_a is None and tau_e is None and tau_inc is None:
+            raise ForceTermError("give at least one of tau_a, tau_e, tau_inc (a time "
+                                 "scale, Quantity)", term=name, field="tau_a", body=body)
+        for field, value in self._scales():
+            if isinstance(value, u.Quantity):
+                self._check_scale(np.asarray(value.value, dtype=float), name, field)
+
+    def _scales(self):
+        return (("tau_a", self.tau_a), ("tau_e", self.tau_e), ("tau_inc", self.tau_inc))
+
+    def _check_scale(self, value, term, field):
+        if value.shape != () or not (math.isfinite(value) and value != 0):
+            raise ForceTermError(
+                f"expected a non-zero finite time scale (positive damps, negative grows) "
+                f"or None, got {value}", term=term, field=field, body=self.body)
+
+    def to_dict(self):
+        """Plain JSON-able values, Quantities as ``[value, unit]``: what output
+        files and ensembles store.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> orbits.forces.Migration("Planet", tau_a=1e4 * u.yr).to_dict()["tau_a"]
+        [10000.0, 'yr']
+        """
+        return {"type": "Migration", "body": self.body,
+                "tau_a": _quantity_dict(self.tau_a), "tau_e": _quantity_dict(self.tau_e),
+                "tau_inc": _quantity_dict(self.tau_inc), "primary": self.primary}
+
+    @classmethod
+    def from_dict(cls, d):
+        """The term that :meth:`to_dict` describes.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> term = orbits.forces.Migration("Planet", tau_e=-300 * u.yr, primary="Star")
+        >>> orbits.forces.Migration.from_dict(term.to_dict()) == term
+        True
+        """
+        return cls(d["body"], tau_a=_quantity_from(d.get("tau_a")),
+                   tau_e=_quantity_from(d.get("tau_e")),
+                   tau_inc=_quantity_from(d.get("tau_inc")), primary=d.get("primary"))
+
+    def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> bound = orbits.forces.Migration("Planet", tau_a=1 * u.yr).bind(ctx)
+        >>> bound.args[:2], bound.args[4]     # body, primary; 1 / tau_a in 1 / day
+        ((1, 0), 0.0027378507871321013)
+        """
+        term = repr(self)
+        b = ctx.index(self.body, term, "body")
+        if self.primary is None:
+            others = [i for i in range(len(ctx.m)) if i != b]
+            if not others or not ctx.m[others].max() > 0:
+                raise ForceTermError("no other body has mass to be the primary", term=term,
+                                     field="primary", body=self.body)
+            p = others[int(np.argmax(ctx.m[others]))]
+        else:
+            p = _massive_index(ctx, self.primary, term, "primary", "primary")
+        if p == b:
+            raise ForceTermError("the body cannot be its own primary", term=term,
+                                 field="primary", body=self.body)
+        inv = []
+        for field, value in self._scales():
+            if value is None:
+                inv.append(0.0)
+                continue
+            tau = np.asarray(_given(value, "time", ctx, field))
+            self._check_scale(tau, term, field)
+            inv.append(1.0 / float(tau))
+        gb = float(ctx.gm[b])
+        gp = float(ctx.gm[p])
+        args = (b, p, gp / (gp + gb), gb / (gp + gb), inv[0], inv[1], inv[2])
+        return BoundTerm(_MIGRATION_KERNEL, args, args)
+
+
+class TidesConstantTimeLag(ForceTerm):
+    """The constant-time-lag tide raised on one body by every other massive
+    body (Hut 1981; Eggleton, Kiseleva & Hut 1998), the force of REBOUNDx's
+    ``tides_constant_time_lag`` (Baronett et al. 2022).
+
+    The body (mass ``m``, radius ``R``, Love number ``k2``, time lag ``tau``,
+    fixed spin ``Omega``) is distorted by each other massive body ``j``; the
+    bulge, lagging by ``tau``, pulls on ``j`` with ::
+
+        F_j = -3 k2 G m_j^2 R^5 / r^8 [ r + tau (2 (r . u) r / r^2 + u + r x Omega) ]
+
+    where ``r``, ``u`` are ``j``'s position and velocity relative to the body; the
+    body takes ``-F_j``, so momentum is conserved.  The first term is the
+    conservative tidal distortion (potential ``-k2 G m_j^2 R^5 / (2 r^6)``), the
+    rest the lag's dissipation; ``time_lag = 0`` leaves the conservative part
+    alone, as REBOUNDx does.  This is Hut's (1981) force with his ``k``
+    written ``k2``.  Orbit-averaged, a low eccentricity decays at Hut's
+    rate (his eq. 10), with the spin along the orbit's normal ::
+
+        de/dt = -27 k2 tau n^2 (m_j / m) (R / a)^5 e [1 - (11/18) Omega / n]
+
+    The spin is held fixed (the torque on it is not followed): zero by default,
+    as REBOUNDx's default; REBOUNDx's ``OmegaMag`` is a spin along the frame's
+    z axis, ``spin=[0, 0, OmegaMag]`` here.  REBOUNDx lets only its primary
+    raise a tide on a body other than the primary; here every massive body
+    does (the same for two bodies, or for the tide on the central body).
+    Dissipative and velocity-dependent: not for the Wisdom-Holman family.  Its
+    energy kernel is zero (the conservative part's potential included).
+
+    Parameters
+    ----------
+    body : str
+        Name of the tidally distorted body; it must have mass.
+    k2 : float
+        Its potential Love number of degree 2, twice the apsidal motion constant;
+        finite and not negative.
+    time_lag : Quantity (time)
+        The constant time lag ``tau``; finite and not negative.
+    radius : Quantity (length)
+        Its physical radius ``R``; positive and finite.
+    spin : Quantity (angular velocity), shape (3,), optional
+        Its fixed spin vector ``Omega`` (``rad / day`` or ``1 / day``); default zero.
+
+    Raises
+    ------
+    ForceTermError
+        A negative or non-finite ``k2``, ``time_lag`` or ``radius`` (or a zero
+        radius), a spin that is not a finite 3-vector; when bound, a body
+        without mass.
+    UnknownBodyError
+        When bound, ``body`` is not in the body set.
+
+    References
+    ----------
+    Hut, P. 1981, A&A 99, 126.  Eggleton, P. P., Kiseleva, L. G. & Hut, P. 1998,
+    ApJ 499, 853.  Baronett, S. A., Ferich, N., Tamayo, D. & Steffen, J. H. 2022,
+    MNRAS 510, 6001 (arXiv:2101.12277).
+
+    Examples
+    --------
+    >>> import astropy.units as u, orbits
+    >>> tide = orbits.forces.TidesConstantTimeLag("Planet", k2=0.3, time_lag=600 * u.s,
+    ...                                           radius=1 * u.Rjup)
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "ias15", forces=[tide])
+    >>> tide.velocity_dependent, tide.wisdom_holman
+    (True, False)
+    """
+
+    velocity_dependent = True
+    conservative = False
+    why_not_wisdom_holman = "it is dissipative and depends on velocities"
+
+    def __init__(self, body, k2, time_lag, radius, spin=None):
+        name = f"TidesConstantTimeLag({body!r})"
+        if not isinstance(body, str):
+            raise ForceTermError(f"body must be a body's name, got {body!r}", term=name,
+                                 field="body")
+        self.body = body
+        self.k2 = _number(k2, name, "k2", body)
+        if self.k2 < 0:
+            raise ForceTermError(f"expected a Love number k2 >= 0, got {self.k2}", term=name,
+                                 field="k2", body=body)
+        self.time_lag = time_lag
+        self.radius = radius
+        self.spin = spin
+        if isinstance(time_lag, u.Quantity):
+            self._check_lag(time_lag.value, name)
+        if isinstance(radius, u.Quantity):
+            self._check_radius(radius.value, name)
+        if isinstance(spin, u.Quantity):
+            _check_spin(spin.value, name)
+
+    def _check_lag(self, value, term):
+        value = np.asarray(value, dtype=float)
+        if value.shape != () or not (value >= 0 and math.isfinite(value)):
+            raise ForceTermError(f"expected a finite time lag >= 0, got {value}", term=term,
+                                 field="time_lag", body=self.body)
+
+    def _check_radius(self, value, term):
+        value = np.asarray(value, dtype=float)
+        if value.shape != () or not (value > 0 and math.isfinite(value)):
+            raise ForceTermError(f"expected a positive finite radius, got {value}", term=term,
+                                 field="radius", body=self.body)
+
+    def to_dict(self):
+        """Plain JSON-able values, Quantities as ``[value, unit]``: what output
+        files and ensembles store.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> d = orbits.forces.TidesConstantTimeLag("Planet", k2=0.3, time_lag=600 * u.s,
+        ...                                        radius=7e4 * u.km).to_dict()
+        >>> d["k2"], d["time_lag"], d["radius"], d["spin"]
+        (0.3, [600.0, 's'], [70000.0, 'km'], None)
+        """
+        return {"type": "TidesConstantTimeLag", "body": self.body, "k2": self.k2,
+                "time_lag": _quantity_dict(self.time_lag),
+                "radius": _quantity_dict(self.radius), "spin": _vector_dict(self.spin)}
+
+    @classmethod
+    def from_dict(cls, d):
+        """The term that :meth:`to_dict` describes.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> term = orbits.forces.TidesConstantTimeLag(
+        ...     "Planet", k2=0.3, time_lag=600 * u.s, radius=7e4 * u.km,
+        ...     spin=[0, 0, 2] * u.rad / u.day)
+        >>> orbits.forces.TidesConstantTimeLag.from_dict(term.to_dict()) == term
+        True
+        """
+        return cls(d["body"], k2=d["k2"], time_lag=_quantity_from(d["time_lag"]),
+                   radius=_quantity_from(d["radius"]), spin=_quantity_from(d.get("spin")))
+
+    def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> bound = orbits.forces.TidesConstantTimeLag("Planet", k2=0.3, time_lag=1 * u.day,
+        ...                                            radius=0.001 * u.au).bind(ctx)
+        >>> bound.args[0], f"{bound.args[2]:.1e}", bound.args[3]   # body, 3 k2 R^5, tau
+        (1, '9.0e-16', 1.0)
+        """
+        term = repr(self)
+        b = ctx.index(self.body, term, "body")
+        if not ctx.m[b] > 0:
+            raise ForceTermError("the tidally distorted body has no mass: a tide needs "
+                                 "a body with mass", term=term, field="body", body=self.body)
+        R = _given(self.radius, "length", ctx, "radius")
+        self._check_radius(R, term)
+        tau = _given(self.time_lag, "time", ctx, "time_lag")
+        self._check_lag(tau, term)
+        spin = _angular_velocity(self.spin, ctx, term)
+        args = (b, ctx.gm, 3.0 * self.k2 * R ** 5, tau, spin)
+        return BoundTerm(_TIDES_KERNEL, args, args)
+
+
+class RadiationPressure(ForceTerm):
+    """Radiation pressure and Poynting-Robertson drag from one source (Burns,
+    Lamy & Soter 1979), the force of REBOUNDx's ``radiation_forces``.
+
+    A body with ``beta`` (radiation pressure over the source's gravity) feels ::
+
+        a = beta G m_s / r^2 [ (1 - rdot / c) r_hat - u / c ]
+
+    with ``r``, ``u`` its position and velocity relative to the source and
+    ``rdot = r_hat . u``: the pressure cancels ``beta`` of the source's pull, the
+    velocity terms are the drag.  The source takes no reaction (it radiates
+    isotropically), so momentum is not conserved, as in REBOUNDx.  A circular
+    orbit spirals in as ``r^2 = r0^2 - 4 beta G m_s t / c`` (Wyatt & Whipple
+    1950), reaching the source after ``c r0^2 / (4 beta G m_s)``.
+    Dissipative and velocity-dependent: not for the Wisdom-Holman family.  Its
+    energy kernel is zero.
+
+    Parameters
+    ----------
+    source : str
+        Name of the radiating body (the Sun); it must have mass.
+    beta : float, dict or sequence of float
+        One ``beta`` for every body but the source; a dict ``{name: beta}`` (the
+        others feel nothing); or one value per body in the body set's order, 0
+        for the source.  Finite and not negative; below 1 for a body on a bound
+        orbit about the source.
+    c : Quantity (speed), optional
+        Speed of light; default astropy's ``c``.
+
+    Raises
+    ------
+    ForceTermError
+        A negative or non-finite ``beta``; when bound, ``beta >= 1`` for a body
+        bound to the source, a ``beta`` for the source itself, a sequence of the
+        wrong length, a source without mass.
+    UnknownBodyError
+        When bound, the source or a name in ``beta`` is not in the body set.
+
+    References
+    ----------
+    Burns, J. A., Lamy, P. L. & Soter, S. 1979, Icarus 40, 1.  Wyatt, S. P. &
+    Whipple, F. L. 1950, ApJ 111, 134.
+
+    Examples
+    --------
+    >>> import astropy.units as u, orbits
+    >>> b = orbits.scenes.kepler()
+    >>> b.add("dust", mass=0 * u.kg, primary="Star", a=2 * u.au)
+    >>> rad = orbits.forces.RadiationPressure("Star", beta={"dust": 0.1})
+    >>> sim = orbits.Simulation(b, "ias15", forces=[rad])
+    >>> sim.forces
+    (RadiationPressure(source='Star', beta={'dust': 0.1}),)
+    """
+
+    velocity_dependent = True
+    conservative = False
+    why_not_wisdom_holman = "it is dissipative and depends on velocities"
+
+    def __init__(self, source, beta, c=None):
+        name = f"RadiationPressure({source!r})"
+        if not isinstance(source, str):
+            raise ForceTermError(f"source must be a body's name, got {source!r}", term=name,
+                                 field="source")
+        self.source = source
+        self.c = c
+        if isinstance(beta, dict):
+            self.beta = {}
+            for key, value in beta.items():
+                if not isinstance(key, str):
+                    raise ForceTermError(f"beta's keys must be body names, got {key!r}",
+                                         term=name, field="beta")
+                self.beta[key] = self._check_beta(value, name, key)
+        elif np.ndim(beta) == 1:
+            self.beta = [self._check_beta(value, name, k) for k, value in enumerate(beta)]
+        else:
+            self.beta = self._check_beta(beta, name, None)
+
+    @staticmethod
+    def _check_beta(value, term, body):
+        out = _number(value, term, "beta", body)
+        if out < 0:
+            raise ForceTermError(f"expected beta >= 0 (radiation pushes outward), got {out}",
+                                 term=term, field="beta", body=body)
+        return out
+
+    def to_dict(self):
+        """Plain JSON-able values, Quantities as ``[value, unit]``: what output
+        files and ensembles store.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.forces.RadiationPressure("Sun", beta={"dust": 0.2}).to_dict()
+        {'type': 'RadiationPressure', 'source': 'Sun', 'beta': {'dust': 0.2}, 'c': None}
+        """
+        beta = dict(self.beta) if isinstance(self.beta, dict) else (
+            list(self.beta) if isinstance(self.beta, list) else self.beta)
+        return {"type": "RadiationPressure", "source": self.source, "beta": beta,
+                "c": _quantity_dict(self.c)}
+
+    @classmethod
+    def from_dict(cls, d):
+        """The term that :meth:`to_dict` describes.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> term = orbits.forces.RadiationPressure("Sun", beta=[0, 0.1, 0.3],
+        ...                                        c=3e5 * u.km / u.s)
+        >>> orbits.forces.RadiationPressure.from_dict(term.to_dict()) == term
+        True
+        """
+        return cls(d["source"], d["beta"], c=_quantity_from(d.get("c")))
+
+    def bind(self, ctx):
+        """Compile the term for one simulation's bodies.
+
+        Parameters
+        ----------
+        ctx : Context
+            The bodies as the simulation holds them (names, masses and ``G m`` in
+            the internal order and units).
+
+        Returns
+        -------
+        BoundTerm
+            The kernel and its arguments, in the simulation's units.
+
+        Raises
+        ------
+        ForceTermError
+            ``beta >= 1`` for a body on a bound orbit about the source (read from
+            the initial state), among the others of the class.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> from orbits.forces import Context
+        >>> b = orbits.scenes.kepler()
+        >>> m = b.masses.value
+        >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
+        ...               b.positions.value, b.velocities.value)
+        >>> bound = orbits.forces.RadiationPressure("Star", beta=0.1).bind(ctx)
+        >>> bound.args[0], bound.args[2]     # the source; beta of each body
+        (0, array([0. , 0.1]))
+        """
+        term = repr(self)
+        s = _massive_index(ctx, self.source, term, "source", "source")
+        n = len(ctx.m)
+        beta = np.zeros(n)
+        if isinstance(self.beta, dict):
+            for name, value in self.beta.items():
+                i = ctx.index(name, term, "beta")
+                if i == s:
+                    raise ForceTermError("the source feels no radiation of its own; leave "
+                                         "it out of beta", term=term, field="beta", body=name)
+                beta[i] = value
+        elif isinstance(self.beta, list):
+            if len(self.beta) != n:
+                raise ForceTermError(f"expected {n} values of beta, one per body in the body "
+                                     f"set's order, got {len(self.beta)}", term=term,
+                                     field="beta")
+            beta[:] = np.asarray(self.beta)[ctx.order]
+            if beta[s] != 0:
+                raise ForceTermError(f"the source feels no radiation of its own; expected "
+                                     f"beta = 0 for it, got {beta[s]}", term=term,
+                                     field="beta", body=self.source)
+        else:
+            beta[:] = self.beta
+            beta[s] = 0.0
+        self._check_bound(ctx, s, beta, term)
+        ic = 1.0 / _speed_of_light(self, self.c, ctx)
+        args = (s, float(ctx.gm[s]), beta, ic)
+        return BoundTerm(_RADIATION_KERNEL, args, args)
+
+    def _check_bound(self, ctx, s, beta, term):
+        # beta >= 1 cancels the source's pull or more: a bound body would be flung out
+        us = ctx.order[s]
+        for i in np.flatnonzero(beta >= 1.0):
+            k = ctx.order[i]
+            r = float(np.linalg.norm(ctx.x_user[k] - ctx.x_user[us]))
+            v2 = float(np.sum((ctx.v_user[k] - ctx.v_user[us]) ** 2))
+            if 0.5 * v2 - (ctx.gm[s] + ctx.gm[i]) / r < 0:
+                raise ForceTermError(
+                    f"beta = {beta[i]} >= 1 for a body on a bound orbit about "
+                    f"{self.source!r}: radiation would cancel the source's gravity or more; "
+                    f"expected beta < 1 for a bound body", term=term, field="beta",
+                    body=ctx.names[i])
+
+
 class UserForce(ForceTerm):
     """A force of your own, added to gravity and compiled into the same loop.
 
@@ -717,7 +1352,9 @@ class UserForce(ForceTerm):
         negative gradient divided by the masses is ``a``: the energy monitor
         adds it, and with ``velocity_dependent=False`` the Wisdom-Holman
         family can take the term.  Without it the term counts as
-        non-conservative and the energy monitor does not see it.
+        non-conservative: its work is integrated into
+        :attr:`orbits.Simulation.work` and the energy monitor reports
+        ``|E + W - E0| / |E0|``.
 
     Raises
     ------
@@ -915,3 +1552,9 @@ _GR_FULL_KERNEL = _k.TermKernel(_k.gr_full_accel, _k.gr_full_energy,
                                 _k.difference_jacobian(_k.gr_full_accel, "gr_full", True),
                                 "gr_full")
 _ZONAL_KERNEL = _k.TermKernel(_k.zonal_accel, _k.zonal_energy, _k.zonal_jacobian, "zonal")
+_MIGRATION_KERNEL = _k.TermKernel(_k.migration_accel, _k.dissipative_energy,
+                                  _k.migration_jacobian, "migration")
+_TIDES_KERNEL = _k.TermKernel(_k.tides_accel, _k.dissipative_energy, _k.tides_jacobian,
+                              "tides_ctl")
+_RADIATION_KERNEL = _k.TermKernel(_k.radiation_accel, _k.dissipative_energy,
+                                  _k.radiation_jacobian, "radiation")

@@ -223,24 +223,32 @@ def ensemble_growth_exponent(t, errors, t_from, boots=400, seed=1):
     return exponent, float(np.std(draws))
 
 
-def monitor_fields(rows, monitors, reference, scales, units):
+def monitor_fields(rows, monitors, reference, scales, units, work=False):
     """A result's monitor fields from monitor ``rows`` (the compiled kernels'
-    layout: energy, L, P, centre of mass), as Quantities, with the relative
-    errors against ``reference`` (``scales``: energy and angular-momentum
-    scales used where the reference is zero).
+    layout, :data:`orbits._kernels.invariants.MONITOR_COLUMNS`: energy, L, P,
+    centre of mass, work), as Quantities, with the relative errors against
+    ``reference`` (``scales``: energy and angular-momentum scales used where
+    the reference is zero).
+
+    The energy error is that of ``E + W``, the energy plus the work ``W`` that
+    non-conservative force terms have taken out (zero without them), so that
+    it measures the integration and not the dissipation.
 
     Parameters
     ----------
-    rows : numpy.ndarray, shape (n, 10)
-        Monitor rows in the internal units.
+    rows : numpy.ndarray, shape (n, 11)
+        Monitor rows in the internal units (rows of 10 columns, without the
+        work, count it as zero).
     monitors : sequence of str
         The monitors that were recorded.
-    reference : numpy.ndarray, shape (10,)
+    reference : numpy.ndarray, shape (11,)
         The row at the start.
     scales : tuple of float
         Energy and angular-momentum scales (internal units).
     units : UnitSystem
         The units of the rows.
+    work : bool
+        Also return the work series (for a simulation with non-conservative terms).
 
     Returns
     -------
@@ -248,14 +256,15 @@ def monitor_fields(rows, monitors, reference, scales, units):
         ``energy`` (energy), ``angular_momentum`` (angular momentum), ``momentum``
         (momentum) and ``center_of_mass`` (length) as Quantities, and
         ``energy_error`` and ``angular_momentum_error`` (dimensionless arrays), for
-        the monitors recorded.
+        the monitors recorded; ``work`` (energy) with ``work`` and the energy
+        monitor.
 
     Examples
     --------
     >>> import numpy as np
     >>> import orbits
     >>> from orbits.monitors import monitor_fields
-    >>> rows = np.zeros((2, 10))
+    >>> rows = np.zeros((2, 11))
     >>> rows[:, 0] = [-1.0, -1.000001]                  # energy
     >>> rows[:, 3] = [2.0, 2.0]                         # L_z
     >>> out = monitor_fields(rows, ("energy", "angular_momentum"), rows[0], (1.0, 1.0),
@@ -264,12 +273,22 @@ def monitor_fields(rows, monitors, reference, scales, units):
     Unit("AU2 solMass / d2")
     >>> out["energy_error"].round(9).tolist(), out["angular_momentum_error"].tolist()
     ([0.0, 1e-06], [0.0, 0.0])
+    >>> rows[:, 10] = [0.0, 0.000001]                   # work: the energy drag took out
+    >>> out = monitor_fields(rows, ("energy",), rows[0], (1.0, 1.0), orbits.UnitSystem(),
+    ...                      work=True)
+    >>> out["work"].value.tolist(), out["energy_error"].round(9).tolist()
+    ([0.0, 1e-06], [0.0, 0.0])
     """
     q = units.quantity
     out = {}
     if "energy" in monitors:
+        w = _work_column(rows)
         out["energy"] = q(rows[:, 0], "energy")
-        out["energy_error"] = relative_error(rows[:, 0], reference[0], scale=scales[0])
+        out["energy_error"] = relative_error(rows[:, 0] + w,
+                                             reference[0] + float(_work_column(reference)),
+                                             scale=scales[0])
+        if work:
+            out["work"] = q(np.broadcast_to(w, rows[:, 0].shape).copy(), "energy")
     if "angular_momentum" in monitors:
         out["angular_momentum"] = q(rows[:, 1:4], "angular_momentum")
         out["angular_momentum_error"] = vector_relative_error(rows[:, 1:4], reference[1:4],
@@ -279,3 +298,12 @@ def monitor_fields(rows, monitors, reference, scales, units):
     if "center_of_mass" in monitors:
         out["center_of_mass"] = q(rows[:, 7:10], "length")
     return out
+
+
+def _work_column(rows):
+    """The work column of monitor rows (or of one row); 0.0 where the rows have
+    none (written before it was kept)."""
+    rows = np.asarray(rows)
+    if rows.shape[-1] > _inv.WORK_COLUMN:
+        return rows[..., _inv.WORK_COLUMN]
+    return 0.0 if rows.ndim == 1 else np.zeros(rows.shape[0])

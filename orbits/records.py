@@ -181,7 +181,10 @@ class SimulationState(NamedTuple):
     steps: int                   # accepted steps since the simulation was made
     force_evaluations: int
     steps_rejected: int
-    workspace: dict              # the integrator's arrays (name -> ndarray)
+    # the integrator's arrays (name -> ndarray); with non-conservative force
+    # terms also "work": W, the energy they took out, and its rounding
+    # compensation (see Simulation.work), carried with the state it belongs to
+    workspace: dict
     reference: np.ndarray        # the monitors' reference row (errors are against it)
     scales: tuple                # (energy scale, angular momentum scale)
 
@@ -204,7 +207,8 @@ class Snapshot(NamedTuple):
     steps: int
     x: np.ndarray
     v: np.ndarray
-    monitors: np.ndarray         # one monitor row (orbits._kernels.invariants layout)
+    monitors: np.ndarray         # one monitor row (orbits._kernels.invariants layout,
+                                 # the work of non-conservative terms in its last column)
 
 
 class SimulationDescription(NamedTuple):

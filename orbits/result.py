@@ -34,7 +34,7 @@ _ELEMENT_KEYS = ("a", "e", "inc", "Omega", "omega", "f", "M")
 
 #: Monitor series that :meth:`Result.to_pandas` and :meth:`Result.to_xarray`
 #: export: (attribute, is a 3-vector).
-_MONITOR_SERIES = (("energy", False), ("energy_error", False),
+_MONITOR_SERIES = (("energy", False), ("work", False), ("energy_error", False),
                    ("angular_momentum", True), ("angular_momentum_error", False),
                    ("momentum", True), ("center_of_mass", True))
 
@@ -52,8 +52,16 @@ class Result:
     masses : Quantity, shape (N,)
     energy : Quantity, shape (n,) or None
         Total energy at the outputs (None if the energy monitor is off).
+    work : Quantity, shape (n,) or None
+        With non-conservative force terms (drag, tides, migration, radiation
+        pressure, a :class:`~orbits.forces.UserForce` without a potential) and
+        the energy monitor: ``W``, the energy those terms have taken out of the
+        bodies since the simulation was made (see
+        :attr:`orbits.Simulation.work`); None otherwise.
     energy_error : ndarray, shape (n,) or None
-        ``|E - E0| / |E0|`` against the energy when the simulation was made.
+        ``|E + W - E0| / |E0|`` against the energy when the simulation was
+        made: the integration's error, the work ``W`` of non-conservative terms
+        (zero without them) accounted for.
     angular_momentum : Quantity, shape (n, 3) or None
     angular_momentum_error : ndarray, shape (n,) or None
         ``|L - L0| / |L0|`` (see :func:`orbits.monitors.vector_relative_error`).
@@ -103,7 +111,7 @@ class Result:
 
     def __init__(self, **fields):
         self.monitor = None
-        self.energy = self.energy_error = None
+        self.energy = self.energy_error = self.work = None
         self.angular_momentum = self.angular_momentum_error = None
         self.momentum = self.center_of_mass = None
         self.status = "completed"

@@ -7,8 +7,6 @@ to what it returns.
 
 import math
 import numbers
-import signal as _signal
-import sys
 import time as _time
 import warnings
 
@@ -18,13 +16,12 @@ import numpy as np
 from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
-from ._driver import Signals as _Signals, advance_checked, restored_on_error
+from ._driver import CHUNK_SECONDS, PROGRESS_DELAY, Driven  # noqa: F401 - documented here
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import (BodyUnitsError, CloseEncounter, ConvergenceFailure, Escape,
-                     IntegratorOptionError, NonFiniteState, OrbitsWarning, RunInterrupted,
-                     StepSizeUnderflow, WallTimeExceeded)
+                     IntegratorOptionError, NonFiniteState, OrbitsWarning, StepSizeUnderflow)
 from .monitors import DEFAULT_MONITORS, monitor_fields, monitor_mask
 from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
                       Snapshot)
@@ -39,10 +36,6 @@ __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescr
 #: at N = 96.  Below it thread start-up (~4 us a step) outweighs the split work.
 PARALLEL_THRESHOLD = 72
 
-#: A run's compiled loop returns to Python about this often, so that progress
-#: bars move; the chunk length in steps adapts to keep to it.
-CHUNK_SECONDS = 0.25
-
 #: Outputs of a run when none are asked for.
 DEFAULT_OUTPUTS = 500
 
@@ -50,11 +43,8 @@ DEFAULT_OUTPUTS = 500
 #: times of neighbouring steps apart.
 MAX_STEPS = float(2 ** 53)
 
-#: A progress bar appears once a run has gone on this long, so short runs stay quiet.
-PROGRESS_DELAY = 3.0
 
-
-class Simulation:
+class Simulation(Driven):
     """A body set evolving under Newtonian gravity and added force terms with a
     chosen integrator.
 
@@ -186,6 +176,10 @@ class Simulation:
         self._ws = (self.integrator.workspace(n, self._dt) if adaptive
                     else self.integrator.workspace(n))
         self.integrator.bind(self._ws, self._force, self._fargs)
+        if self._force.work is not None:
+            # W lives in the workspace, so that it is saved, restored and
+            # checkpointed with the state it belongs to
+            self._ws["work"] = self._fargs[2][3]
         self.steps_rejected = 0
         self._t_base = 0.0          # time = t_base + steps_since_base * dt
         self._steps_since_base = 0
@@ -198,13 +192,19 @@ class Simulation:
         self.output_path = None
         self._resume = None
         # only the monitors asked for: the energy of a large N costs O(N^2)
-        self._reference = self._monitor_row(np.zeros(10))
+        self._reference = self._monitor_row(np.zeros(_inv.MONITOR_WIDTH))
         self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
 
     def _bind_terms(self, bodies):
-        """Compile gravity and the added terms into one force (see :mod:`orbits.forces`)."""
+        """Compile gravity and the added terms into one force (see :mod:`orbits.forces`).
+
+        The non-conservative terms (``conservative = False``) are chained once
+        more on their own: the loops integrate their work from that chain
+        (:func:`orbits._kernels.stepping.with_terms`), so that the energy
+        monitor can report ``E + W``.
+        """
         from . import forces as _forces
         from ._kernels import terms as _kterms
         ctx = _forces.Context([self._names[k] for k in self._order], self._m, self._gm,
@@ -212,9 +212,15 @@ class Simulation:
                               np.ascontiguousarray(bodies._x), np.ascontiguousarray(bodies._v))
         bound = [term.bind(ctx) for term in self._terms]
         chain = _kterms.chain([b.kernel for b in bound])
+        dissipative = [b for term, b in zip(self._terms, bound) if not term.conservative]
+        work = _kterms.chain([b.kernel for b in dissipative]) if dissipative else None
         self._force = _stepping.with_terms(self._force, chain,
-                                           any(t.velocity_dependent for t in self._terms))
+                                           any(t.velocity_dependent for t in self._terms),
+                                           work=work)
         self._fargs = (self._fargs, _kterms.nest([b.args for b in bound]))
+        if work is not None:
+            self._fargs += (_stepping.work_args(_kterms.nest([b.args for b in dissipative]),
+                                                self._m),)
         self._eargs = _kterms.nest([b.energy_args for b in bound])
 
     @property
@@ -468,7 +474,7 @@ class Simulation:
                                 resume_rows=point.outputs_written)
         self._resume = None
         first_mark = max(0, point.outputs_written - 1)
-        return self._execute(point.plan, rec, progress, first_mark=first_mark)
+        return self.execute(point.plan, rec, progress, first_mark=first_mark)
 
     # -- state ------------------------------------------------------------------------
     @property
@@ -572,7 +578,10 @@ class Simulation:
         for name, arr in state.workspace.items():
             if name in self._ws:
                 self._ws[name][...] = arr
-        self._reference = np.array(state.reference, dtype=float)
+        # a reference row written before the work column was kept: its work is 0
+        ref = np.asarray(state.reference, dtype=float)
+        self._reference = np.zeros(max(_inv.MONITOR_WIDTH, len(ref)))
+        self._reference[:len(ref)] = ref
         self._E_scale, self._L_scale = (float(s) for s in state.scales)
 
     def description(self):
@@ -624,7 +633,7 @@ class Simulation:
         (0.0, 0, (2, 3))
         """
         self.integrator.synchronize(self._ws, self._x, self._v)
-        row = np.zeros(10)
+        row = np.zeros(_inv.MONITOR_WIDTH)
         if self._mask:
             self._monitor_row(row)
         inv = self._inverse
@@ -650,7 +659,38 @@ class Simulation:
                          self._mask, row)
         if self._eargs is not None and self._mask & _inv.ENERGY:
             row[0] += self._force.terms.energy(self._x, self._v, self._eargs)
+            row[_inv.WORK_COLUMN] = _stepping.work_total(self._ws)
         return row
+
+    @property
+    def _has_work(self):
+        # non-conservative terms, whose work the loops integrate
+        return self._force.work is not None
+
+    @property
+    def work(self):
+        """W, the energy the non-conservative force terms have taken out of the
+        bodies since the simulation was made (Quantity, energy; zero without
+        such terms).
+
+        ``W = -int sum_i m_i a_i . v_i dt`` over the accelerations of the terms
+        with ``conservative = False`` alone (drag, tides, migration, radiation
+        pressure, a :class:`~orbits.forces.UserForce` without a potential),
+        integrated inside the compiled loop by the integrator's own quadrature,
+        so that ``E + W`` stays the initial energy up to the integration error:
+        the energy monitor reports ``|E + W - E0| / |E0|``.  A restart from a
+        file carries it on bit for bit.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog",
+        ...                         dt=1 * u.day)
+        >>> sim.work                               # no non-conservative terms
+        <Quantity 0. AU2 solMass / d2>
+        """
+        return self.units.quantity(_stepping.work_total(self._ws), "energy")
 
     # -- running ------------------------------------------------------------------------
     def run(self, until, outputs=None, progress=None, output=None, overwrite=False,
@@ -735,7 +775,7 @@ class Simulation:
             from .io import hdf5
             rec = hdf5.FileRecorder(output, self, plan, overwrite=overwrite,
                                     checkpoint_interval=checkpoint_interval)
-        return self._execute(plan, rec, progress)
+        return self.execute(plan, rec, progress)
 
     def _plan(self, until_v, outputs, until=None):
         """Where a run to ``until_v`` takes its outputs: a :class:`RunPlan`."""
@@ -790,181 +830,6 @@ class Simulation:
     def _time_after(self, n):
         # the time after n more steps of dt, computed as every step count is
         return self._t_base + (self._steps_since_base + n) * self._dt
-
-    def _execute(self, plan, rec, progress, first_mark=0):
-        """Carry out ``plan`` from its output ``first_mark`` on (resuming).
-
-        The one driver of every run, fixed-step and adaptive: the compiled
-        loop is entered in chunks of about :data:`CHUNK_SECONDS`, and between
-        chunks the progress bar, the wall-time limit and any SIGINT or SIGTERM
-        that arrived are looked at.
-        """
-        adaptive = self.integrator.adaptive
-        if adaptive:
-            bar = _ProgressBar(plan.outputs - 1, progress, unit="output")
-            bar.update(first_mark)
-        else:
-            bar = _ProgressBar(plan.total_steps, progress)
-            bar.update(self.steps - plan.start_step)
-        wall0 = _time.perf_counter()
-        self._wall0 = wall0
-        with _Signals() as self._signals:
-            try:
-                if adaptive:
-                    self._outputs_adaptive(plan, rec, bar, first_mark)
-                else:
-                    self._outputs_fixed(plan, rec, bar, first_mark)
-            finally:
-                bar.close()
-                rec.close()
-        return rec.result(self, _time.perf_counter() - wall0)
-
-    def _outputs_fixed(self, plan, rec, bar, first_mark):
-        wall0 = self._wall0
-        done = self.steps - plan.start_step
-        for mark in plan.marks(first_mark):
-            done = self._advance_to(done, mark, rec, bar, wall0)
-            rec.output(self)
-        done = self._advance_to(done, plan.n_full, rec, bar, wall0)
-        if plan.has_partial and done == plan.n_full:
-            self._advance(1, rec, wall0, dt=plan.until - self._now())
-            bar.update(1)
-        rec.output(self, final=True)
-
-    def _outputs_adaptive(self, plan, rec, bar, first_mark):
-        wall0 = self._wall0
-        for k in range(first_mark + 1, plan.outputs):
-            self._advance_adaptive(plan.output_time(k), rec, wall0)
-            bar.update(1)
-            rec.output(self, final=k == plan.outputs - 1)
-        if plan.outputs == 1:
-            self._advance_adaptive(plan.until, rec, wall0)
-            rec.output(self, final=True)
-
-    def _advance_adaptive(self, t_end, rec, wall0):
-        integ = self.integrator
-        every = self.monitor_every or 0
-        while self._t_base < t_end:
-            n = self._chunk
-            size = n // every + 1 if every else 0
-            mon_t = np.empty(size)
-            mon_out = np.zeros((size, 10))
-            mon = self._mon(every)
-            t0 = _time.perf_counter()
-            with restored_on_error(self._x, self._v, self._ws):
-                status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
-                    self._ws, self._x, self._v, self._t_base, t_end, self._force,
-                    self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)
-            elapsed = _time.perf_counter() - t0
-            if n_mon:
-                rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
-            self._t_base = float(t_reached)
-            self.steps += int(acc)
-            self.steps_rejected += int(rej)
-            self.force_evaluations += int(fev)
-            if status != Status.OK:
-                if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
-                    self._stop_info[:] = self._ws["info"]
-                self._fail(status, rec, wall0)
-            if acc == n and elapsed < CHUNK_SECONDS / 4:
-                self._chunk *= 4
-            elif elapsed > CHUNK_SECONDS:
-                self._chunk = max(16, self._chunk // 2)
-            self._between_chunks(rec, wall0)
-
-    def _advance_to(self, done, target, rec, bar, wall0):
-        # the loop returns to Python about every CHUNK_SECONDS (progress bar);
-        # the chunk length adapts and is kept from one call to the next
-        while done < target:
-            n = min(self._chunk, target - done)
-            t0 = _time.perf_counter()
-            self._advance(n, rec, wall0)
-            elapsed = _time.perf_counter() - t0
-            done += n
-            bar.update(n)
-            if n == self._chunk:
-                if elapsed < CHUNK_SECONDS / 4:
-                    self._chunk *= 4
-                elif elapsed > CHUNK_SECONDS:
-                    self._chunk = max(1, self._chunk // 2)
-            self._between_chunks(rec, wall0)
-        return done
-
-    def _between_chunks(self, rec, wall0):
-        self._check_signal(rec, wall0)
-        self._check_wall(rec, wall0)
-
-    def _check_signal(self, rec, wall0):
-        """Stop at this consistent point if SIGINT or SIGTERM arrived meanwhile."""
-        signals = getattr(self, "_signals", None)
-        if signals is None or signals.caught is None:
-            return
-        signum = signals.caught
-        signals.caught = None
-        previous = signals.saved.get(signum)
-        rec.checkpoint()
-        if callable(previous) and previous is not _signal.default_int_handler:
-            previous(signum, None)   # the caller's own handler decides; the state is whole
-            return
-        name = _signal.Signals(signum).name
-        rec.stopped(self)
-        rec.close()
-        result = rec.result(self, _time.perf_counter() - wall0, status=f"stopped by {name}")
-        if previous is _signal.default_int_handler:
-            path = getattr(rec, "path", None)
-            raise RunInterrupted(
-                f"{name} at t = {self.time:.10g} (step {self.steps}): the simulation was "
-                f"left at the last completed step, clock and state agreeing"
-                + (f", and a restart checkpoint was written to {path}" if path else "")
-                + "; the result up to here is kept on .result",
-                signal=signum, time=self.time, step=self.steps, result=result)
-        # the default action (SIGTERM ends the process): taken now that the file is whole
-        signals.restore()
-        _signal.raise_signal(signum)
-
-    def _check_wall(self, rec, wall0):
-        limit = getattr(self, "_wall_limit", None)
-        if limit is None or _time.perf_counter() - wall0 <= limit:
-            return
-        rec.output(self, final=True)
-        rec.close()
-        result = rec.result(self, _time.perf_counter() - wall0, status="wall-time limit")
-        raise WallTimeExceeded(
-            f"the run passed its wall-time limit of {limit:g} s at t = {self.time:.10g} "
-            f"(step {self.steps}); the result up to here is kept on .result and the "
-            f"simulation was left there", time=self.time, step=self.steps, result=result)
-
-    def _advance(self, n, rec, wall0, dt=None):
-        dt = self._dt if dt is None else dt
-        every = self.monitor_every or 0
-        if every:
-            first = (self.steps // every + 1) * every  # next step index that records
-            size = max(0, (self.steps + n - first) // every + 1)
-        else:
-            size = 0
-        mon_t = np.empty(size)
-        mon_out = np.zeros((size, 10))
-        mon = self._mon(every)
-        status, steps, n_mon, self._ws = advance_checked(
-            self.integrator, self._ws, self._x, self._v, self._now(), dt, n, self._force,
-            self._fargs, mon, self.steps, mon_t, mon_out, stop=self._stop)
-        if n_mon:
-            rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
-        if status != Status.OK:
-            self._count(steps, dt)
-            self._fail(status, rec, wall0)
-        self._count(n, dt)
-
-    def _count(self, n, dt):
-        if n == 0:
-            return
-        if dt == self._dt:
-            self._steps_since_base += n
-        else:
-            self._t_base = self._now() + dt
-            self._steps_since_base = 0
-        self.steps += n
-        self.force_evaluations += n * self.integrator.forces_per_step
 
     def _fail(self, status, rec, wall0):
         reason = {Status.NON_FINITE: "non-finite state",
@@ -1156,49 +1021,10 @@ class _Recorder:
 
 
 def _monitor_fields(rows, sim, ref):
-    return monitor_fields(rows, sim.monitors, ref, (sim._E_scale, sim._L_scale), sim.units)
-
-
-class _ProgressBar:
-    """A tqdm bar that appears only for long runs (or always, or never)."""
-
-    def __init__(self, total, progress, unit="step"):
-        self.total = total
-        self.unit = unit
-        if progress is None and not _stderr_is_terminal():
-            progress = False  # a log file gets no bar
-        self.progress = progress
-        self.done = 0
-        self.start = _time.perf_counter()
-        self.bar = None
-        if progress:
-            self._open()
-
-    def _open(self):
-        from tqdm.auto import tqdm
-        self.bar = tqdm(total=self.total, initial=self.done, unit=self.unit, unit_scale=True,
-                        leave=False, desc="orbits")
-
-    def update(self, n):
-        self.done += n
-        if self.bar is not None:
-            self.bar.update(n)
-        elif (self.progress is None
-              and _time.perf_counter() - self.start > PROGRESS_DELAY):
-            self._open()
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
+    return monitor_fields(rows, sim.monitors, ref, (sim._E_scale, sim._L_scale), sim.units,
+                          work=sim._has_work)
 
 
 def _positive_number(value):
     return (isinstance(value, numbers.Real) and not isinstance(value, bool)
             and 0 < float(value) < math.inf)
-
-
-def _stderr_is_terminal():
-    try:
-        return sys.stderr.isatty()
-    except (AttributeError, ValueError):
-        return False

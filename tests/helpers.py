@@ -39,6 +39,6 @@ def adaptive_fixed_steps_error(name, n, e=0.2):
     for k in range(n):
         status, t, acc, rej, fev, _ = integ.advance_to(
             ws, x, v, t, (k + 1) * 2 * math.pi / n, force, fargs, mon, k, np.empty(0),
-            np.zeros((0, 10)), None, 10)
+            np.zeros((0, 11)), None, 10)
         assert status == 0 and acc == 1 and rej == 0
     return np.abs(x - x0).max() + np.abs(v - v0).max()

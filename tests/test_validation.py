@@ -141,6 +141,6 @@ def test_quick_report(tmp_path):
         assert f"| {name} |" in text or f"`{name}`" in text, name
     for image in re.findall(r"\]\(([^)]+\.png)\)", text):
         assert (tmp_path / image).stat().st_size > 10_000, image
-    for title in ("Accuracy against REBOUND", "Work against precision", "Long-horizon drift",
-                  "Stress suite", "The integrator-choice guide, checked"):
+    for title in ("Accuracy against REBOUND", "Dissipative forces", "Work against precision",
+                  "Long-horizon drift", "Stress suite", "The integrator-choice guide, checked"):
         assert f"## {title}" in text

@@ -8,6 +8,10 @@ the result of the two half steps is kept (no local extrapolation, so the
 method stays fourth order).  Step sizes follow the same controller as the
 embedded pairs (:mod:`.embedded`), with the error exponent 1/5.  Eleven force
 evaluations a step (the first stage is shared).
+
+The work of non-conservative force terms (:mod:`.stepping`) is integrated by
+the two half steps that are kept, each with RK4's weights, and committed only
+when the step is accepted.
 """
 
 import math
@@ -15,17 +19,18 @@ import math
 from ._jit import specialize
 from .embedded import initial_step, next_step, step_underflow
 from .status import Status
-from .stepping import _record
-from .stopping import check_stop, no_stop
+from .stepping import GO, step_epilogue, work_kernels
 
 __all__ = ["doubling_loop"]
 
 
 
-def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs):
+def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
     # classic RK4 from (x, v) with its first stage (k0x, k0v) given; result in
-    # (xo, vo).  kx, kv hold stages 1..3.
+    # (xo, vo).  kx, kv hold stages 1..3.  Returns RK4's mean of the work rate
+    # P over the stages (p0 at the first), with track and HAS_WORK, else 0.
     n = x.shape[0]
+    pw = p0 / 6.0
     for st in range(3):
         a = 0.5 * h if st < 2 else h
         for i in range(n):
@@ -40,12 +45,16 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs):
                 vs[i, d] = v[i, d] + a * gv
                 kx[st, i, d] = vs[i, d]
         force(xs, vs, t + (0.5 * h if st < 2 else h), fargs, kv[st])  # noqa: F821
+        if HAS_WORK and track:  # noqa: F821 - bound by specialize
+            pw += (2.0 if st < 2 else 1.0) / 6.0 * work_rate(  # noqa: F821
+                xs, vs, t + (0.5 * h if st < 2 else h), fargs)
     for i in range(n):
         for d in range(3):
             xo[i, d] = x[i, d] + h / 6.0 * (k0x[i, d] + 2.0 * kx[0, i, d]
                                             + 2.0 * kx[1, i, d] + kx[2, i, d])
             vo[i, d] = v[i, d] + h / 6.0 * (k0v[i, d] + 2.0 * kv[0, i, d]
                                             + 2.0 * kv[1, i, d] + kv[2, i, d])
+    return pw if HAS_WORK and track else 0.0  # noqa: F821
 
 
 def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
@@ -72,20 +81,27 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
     if h_prop <= 0.0:
         h_prop = initial_step(x, v, k0x, k0v, rtol, atol, t_end - t)
     status = Status.OK
+    p0 = 0.0
+    if HAS_WORK:  # noqa: F821 - bound by specialize
+        p0 = work_rate(x, v, t, fargs)  # noqa: F821
     while steps < max_steps and t < t_end:
         h = h_prop
         shortened = False
         if t + 1.01 * h >= t_end:
             h = t_end - t
             shortened = True
-        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs)  # noqa: F821
-        rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh, fargs)  # noqa: F821
+        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, False)  # noqa: F821
+        pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,  # noqa: F821
+                      fargs, p0, True)
         for i in range(n):
             for d in range(3):
                 kmx[i, d] = vh[i, d]
         force(xh, vh, t + 0.5 * h, fargs, kmv)  # noqa: F821
-        rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs, x2, v2,  # noqa: F821
-                 fargs)
+        pm = 0.0
+        if HAS_WORK:  # noqa: F821
+            pm = work_rate(xh, vh, t + 0.5 * h, fargs)  # noqa: F821
+        pb = rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs,  # noqa: F821
+                      x2, v2, fargs, pm, True)
         fev += 10
         err = 0.0
         for i in range(n):
@@ -111,13 +127,15 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
             steps += 1
             if not shortened:
                 h_prop = next_step(h, err, 4.0)
-            until_record -= 1
-            if until_record == 0:
-                until_record = every
-                _record(x, v, t, mon, n_mon, mon_t, mon_out)
-                n_mon += 1
-            stop = stop_check(x, v, sargs)  # noqa: F821
-            if stop != 0:
+            if HAS_WORK:  # noqa: F821
+                work_add(fargs, -0.5 * h * (pa + pb))  # noqa: F821
+                p0 = work_rate(x, v, t, fargs)  # noqa: F821
+            n_before = n_mon
+            stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
+                x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
+                sargs)
+            work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+            if stop != GO:
                 info[0] = sargs[-1][0]
                 info[1] = sargs[-1][1]
                 status = stop
@@ -135,8 +153,9 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
 def doubling_loop(force, stop=False):
     """The RK4 step-doubling loop compiled for a force."""
     key = f"{force.key}{'_stop' if stop else ''}"
-    step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel)
+    work = work_kernels(force)
+    step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel,
+                      HAS_WORK=work["HAS_WORK"], work_rate=work["work_rate"])
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
-                      _record=force.recorder,
-                      force=force.kernel, rk4_step=step,
-                      stop_check=check_stop if stop else no_stop)
+                      nrt=force.runtime, force=force.kernel, rk4_step=step,
+                      step_end=step_epilogue(force, stop), **work)

@@ -14,14 +14,17 @@ and the next step is ``h * min(FAC_MAX, max(FAC_MIN, SAFETY * err^(-1/(q+1))))``
 with ``q`` the order of the error estimator.  A step shortened to land on an
 output time does not change the proposed step size, so outputs do not disturb
 the step sequence.
+
+The work of non-conservative force terms (:mod:`.stepping`) is integrated
+with the weights ``b`` of the propagated solution, ``W += -h sum_j b_j
+P(stage j)``, and committed only when the step is accepted.
 """
 
 import math
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import _record
-from .stopping import check_stop, no_stop
+from .stepping import GO, step_epilogue, work_kernels
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
            "FAC_MIN", "FAC_MAX"]
@@ -93,6 +96,9 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     if h_prop <= 0.0:
         h_prop = initial_step(x, v, kx[0], kv[0], rtol, atol, t_end - t)
     status = Status.OK
+    p0 = 0.0
+    if HAS_WORK:  # noqa: F821 - bound by specialize
+        p0 = work_rate(x, v, t, fargs)  # noqa: F821
     while steps < max_steps and t < t_end:
         h = h_prop
         shortened = False
@@ -100,6 +106,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             # land on t_end, also when only a sliver would be left (HNW's DOPRI5)
             h = t_end - t
             shortened = True
+        pw = b[0] * p0
         for st in range(1, s):
             for i in range(n):
                 for d in range(3):
@@ -114,6 +121,8 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
                     vs[i, d] = vi
                     kx[st, i, d] = vi
             force(xs, vs, t + c[st] * h, fargs, kv[st])  # noqa: F821
+            if HAS_WORK and b[st] != 0.0:  # noqa: F821
+                pw += b[st] * work_rate(xs, vs, t + c[st] * h, fargs)  # noqa: F821
         fev += s - 1
         for i in range(n):
             for d in range(3):
@@ -162,13 +171,15 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             steps += 1
             if not shortened:
                 h_prop = next_step(h, err, q)
-            until_record -= 1
-            if until_record == 0:
-                until_record = every
-                _record(x, v, t, mon, n_mon, mon_t, mon_out)
-                n_mon += 1
-            stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
-            if stop != 0:
+            if HAS_WORK:  # noqa: F821
+                work_add(fargs, -h * pw)  # noqa: F821
+                p0 = work_rate(x, v, t, fargs)  # noqa: F821
+            n_before = n_mon
+            stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
+                x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
+                sargs)
+            work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+            if stop != GO:
                 info[0] = sargs[-1][0]
                 info[1] = sargs[-1][1]
                 status = stop
@@ -187,6 +198,5 @@ def embedded_loop(force, has_e3, stop=False):
     """The adaptive embedded Runge-Kutta loop compiled for a force and an estimator."""
     key = f"{force.key}{'_e3' if has_e3 else ''}{'_stop' if stop else ''}"
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
-                      _record=force.recorder,
-                      force=force.kernel, has_e3=bool(has_e3),
-                      stop_check=check_stop if stop else no_stop)
+                      nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),
+                      step_end=step_epilogue(force, stop), **work_kernels(force))

@@ -37,6 +37,12 @@ afresh from its ``g`` (``b = C g``), not carried over from the prediction,
 so that the rounding errors of successive steps are independent and the
 energy error is a random walk (Brouwer's law; see ``_ias15_loop``).
 
+The work of non-conservative force terms (:mod:`.stepping`) over a step is
+``-dt`` times the Gauss-Radau quadrature of the work rate ``P`` on the step's
+eight nodes, ``h = 0`` and the seven spacings, with the states of the last
+predictor-corrector iteration: the left Radau rule of eight nodes, exact for
+polynomials of degree 14 (:data:`RADAU_WEIGHTS`).
+
 References
 ----------
 .. [1] Everhart, E. 1985, "An efficient integrator that uses Gauss-Radau
@@ -56,12 +62,11 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import _record  # noqa: F401 - the default recorder of the template
-from .stopping import check_stop, no_stop
+from .stepping import GO, step_epilogue, work_kernels
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
            "PC_MAX_ITERATIONS", "MODE_GLOBAL", "MODE_PRS24", "ias15_loop", "B6_ROUNDING_GAIN",
-           "radau_spacings"]
+           "radau_spacings", "RADAU_WEIGHTS", "radau_weights"]
 
 #: Gauss-Radau spacings h_1 .. h_7 on [0, 1] (h_0 = 0 is the start of the
 #: step): the roots of the degree-7 Radau polynomial, as printed by Everhart
@@ -153,11 +158,48 @@ def _tables(h):
 
 C_TABLE, D_TABLE, R_TABLE = _tables(SPACINGS)
 
+
+def radau_weights(h):
+    """The weights of the quadrature on [0, 1] with nodes 0 and ``h`` (the
+    spacings): ``w_k`` is the integral of the Lagrange polynomial of node
+    ``k``, computed in exact rational arithmetic from the float nodes, so that
+    the rule integrates ``t^j`` exactly for ``j`` below the number of nodes; at
+    the Gauss-Radau spacings it is the left Radau rule, exact up to
+    ``j = 2 * 8 - 2 = 14``.
+
+    Examples
+    --------
+    >>> from orbits._kernels.ias15 import SPACINGS, radau_weights
+    >>> w = radau_weights(SPACINGS)
+    >>> len(w), round(float(w.sum()), 15), round(float(w[0]), 15)   # w_0 = 1 / n^2
+    (8, 1.0, 0.015625)
+    """
+    hs = [Fraction(0)] + [Fraction(float(x)) for x in h]
+    weights = []
+    for k, hk in enumerate(hs):
+        poly = [Fraction(1)]               # coefficients of h^0, h^1, ...
+        for j, hj in enumerate(hs):
+            if j == k:
+                continue
+            new = [Fraction(0)] * (len(poly) + 1)
+            for m, c in enumerate(poly):
+                new[m + 1] += c / (hk - hj)
+                new[m] -= c * hj / (hk - hj)
+            poly = new
+        weights.append(float(sum(c / (m + 1) for m, c in enumerate(poly))))
+    return np.array(weights)
+
+
+#: weights of the Gauss-Radau quadrature on the step's nodes 0, h_1 .. h_7
+#: (:func:`radau_weights`), for the work of non-conservative terms
+RADAU_WEIGHTS = radau_weights(SPACINGS)
+
 # constants read by the compiled loop (numba freezes global arrays)
 _H = SPACINGS
 _C = C_TABLE
 _D = D_TABLE
 _R = R_TABLE
+_WR = RADAU_WEIGHTS
 # binomial(k + 1, m + 1) for the extrapolation of b to the next step
 _BINOM = np.array([[float(math.comb(k + 1, m + 1)) for k in range(7)] for m in range(7)])
 # 1 / ((k + 2) (k + 3)) and 1 / (k + 2): the predictor's integration weights
@@ -304,11 +346,18 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
             e[...] = 0.0
         _g_from_b(b, g)
 
+        # the work rate at the start of the step, the Radau rule's node h = 0
+        p0 = 0.0
+        if HAS_WORK:  # noqa: F821 - bound by specialize
+            p0 = work_rate(x, v, t, fargs)  # noqa: F821
+
         # predictor-corrector
         err_last = 2.0
+        pw = 0.0
         for it in range(PC_MAX_ITERATIONS):
             maxdb6 = 0.0
             maxa = 0.0
+            pw = _WR[0] * p0          # the work's quadrature, of this iteration's states
             for sub in range(1, 8):
                 h = _H[sub - 1]
                 hdt = h * dt
@@ -326,6 +375,8 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                                         b[4, i, d] * _V4 + h * (b[5, i, d] * _V5 + h * (
                                             b[6, i, d] * _V6)))))))))
                 force(xs, vs, t + (ct + hdt), fargs, acc)  # noqa: F821
+                if HAS_WORK:  # noqa: F821
+                    pw += _WR[sub] * work_rate(xs, vs, t + (ct + hdt), fargs)  # noqa: F821
                 for i in range(n):
                     for d in range(3):
                         r = (acc[i, d] - a0[i, d]) * _R[sub, 0]
@@ -471,6 +522,8 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 csv[i, d] = y - (vn - v[i, d])
                 v[i, d] = vn
         flags[0] = 0
+        if HAS_WORK:  # noqa: F821
+            work_add(fargs, -dt * pw)  # noqa: F821
         if trimmed:
             t = t_end
             ct = 0.0
@@ -504,13 +557,11 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         else:
             ref[1] += dt
 
-        until_record -= 1
-        if until_record == 0:
-            until_record = every
-            _record(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
-            n_mon += 1
-        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
-        if stop != 0:
+        n_before = n_mon
+        stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
+            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out, sargs)
+        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+        if stop != GO:
             sinfo = sargs[6]
             info[0] = sinfo[0]
             info[1] = sinfo[1]
@@ -557,7 +608,8 @@ def ias15_loop(force, stop=False):
 
     ``stop`` compiles in the stopping conditions of :mod:`.stopping`.
     Velocities are predicted at the substeps only for forces that read them
-    (gravity does not).
+    (gravity does not), and for forces whose non-conservative terms' work it
+    integrates.
 
     The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
     dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs,
@@ -565,9 +617,11 @@ def ias15_loop(force, stop=False):
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
-    predict_v = force.velocity_dependent or force.opaque
+    # the work rate P = sum m a . v needs the velocities at the nodes
+    predict_v = force.velocity_dependent or force.opaque or force.work is not None
     helpers = _JITTED if force.jit else {}
     suffix = f"{force.key}{'_stop' if stop else ''}"
     return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,
-                      force=force.kernel, stop_check=check_stop if stop else no_stop,
-                      PREDICT_V=predict_v, _record=force.recorder, **helpers)
+                      nrt=force.runtime, force=force.kernel,
+                      step_end=step_epilogue(force, stop), PREDICT_V=predict_v,
+                      **work_kernels(force), **helpers)

@@ -46,6 +46,11 @@ Jacobians have the signature ``jacobian(x, v, t, fargs, jx, jv)`` and write
 arrays ``jx`` and ``jv``: :func:`gravity_jacobian` for pairwise gravity, a
 user's function through :func:`user_jacobian`, and central differences of the
 force otherwise (:func:`finite_difference_jacobian`).
+
+The work of non-conservative force terms (:mod:`.stepping`) is the method
+applied to ``W' = -P``: ``W += -h P(x*, v*, t0 + theta h)`` at the last stage
+point, which for the midpoint rule is the non-conservative part of the
+kinetic-energy change ``h sum m a* . (v0 + v1) / 2`` of the step.
 """
 
 import math
@@ -54,8 +59,7 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import _record, state_is_finite
-from .stopping import check_stop, no_stop
+from .stepping import GO, state_is_finite, step_epilogue, work_kernels
 
 __all__ = ["implicit_loop", "gravity_jacobian", "user_jacobian",
            "finite_difference_jacobian", "jacobian_for", "lu_factor", "lu_solve",
@@ -379,6 +383,8 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
         if not converged:
             cache[0] = 0
             return Status.NO_CONVERGENCE, k, n_mon
+        if HAS_WORK:  # noqa: F821 - bound by specialize
+            work_add(fargs, -dt * work_rate(xs, vs, ts, fargs))  # noqa: F821
         # the step, with the accelerations at the last stage point
         for i in range(n):
             for d in range(3):
@@ -386,22 +392,15 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
                 x[i, d] += dt * (v[i, d] + th * hv)
                 v[i, d] += hv
         cache[0] = 1
-        until_check -= 1
-        if until_check == 0 or k + 1 == nsteps:
-            until_check = check_every
-            if not state_is_finite(x, v):
+        n_before = n_mon
+        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+            x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
+            every, mon, n_mon, mon_t, mon_out, sargs)
+        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+        if status != GO:
+            if status == Status.NON_FINITE:
                 cache[0] = 0
-                return Status.NON_FINITE, k, n_mon
-        until_record -= 1
-        if until_record == 0:
-            until_record = every
-            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
-            n_mon += 1
-        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
-        if stop != 0:
-            if not state_is_finite(x, v):
-                return Status.NON_FINITE, k, n_mon
-            return stop, k + 1, n_mon
+            return status, done, n_mon
     return Status.OK, nsteps, n_mon
 
 
@@ -417,5 +416,5 @@ def implicit_loop(force, name, theta, velocity_dependent, stop=False):
         jkey = "fd_v"
     return specialize(_implicit_loop, f"{name}_{force.key}_{jkey}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache and not jkey.startswith("own"),
-                      force=force.kernel, jacobian=jac, _record=force.recorder, stop_check=check_stop if stop else no_stop,
-                      THETA=float(theta))
+                      force=force.kernel, jacobian=jac, step_end=step_epilogue(force, stop),
+                      THETA=float(theta), **work_kernels(force))

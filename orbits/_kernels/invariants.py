@@ -11,16 +11,24 @@ import math
 from ._jit import njit
 
 __all__ = ["energy", "angular_momentum", "momentum", "center_of_mass",
-           "monitor_row", "MONITOR_COLUMNS", "ENERGY", "ANGULAR_MOMENTUM",
-           "MOMENTUM", "CENTER_OF_MASS"]
+           "monitor_row", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
+           "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS"]
 
 # Bits of the ``which`` mask of monitor_row, and the columns they fill.
 ENERGY = 1
 ANGULAR_MOMENTUM = 2
 MOMENTUM = 4
 CENTER_OF_MASS = 8
-#: column layout of a monitor row
-MONITOR_COLUMNS = ("energy", "Lx", "Ly", "Lz", "px", "py", "pz", "comx", "comy", "comz")
+#: column layout of a monitor row; "work" is W, the energy the non-conservative
+#: force terms have taken out since the simulation was made (written by the
+#: loops that integrate it, not by :func:`monitor_row`: it is not a function of
+#: the state), so that E + W is the conserved quantity
+MONITOR_COLUMNS = ("energy", "Lx", "Ly", "Lz", "px", "py", "pz", "comx", "comy", "comz",
+                   "work")
+#: columns of a monitor row
+MONITOR_WIDTH = len(MONITOR_COLUMNS)
+#: the column of the work
+WORK_COLUMN = MONITOR_COLUMNS.index("work")
 
 
 @njit
@@ -102,7 +110,8 @@ def center_of_mass(x, m, out):
 
 @njit
 def monitor_row(x, v, m, G, n_active, eps2, which, row):
-    """Fill one monitor row (layout :data:`MONITOR_COLUMNS`) for the bits in ``which``."""
+    """Fill one monitor row (layout :data:`MONITOR_COLUMNS`) for the bits in ``which``;
+    the work column is left as it is."""
     if which & ENERGY:
         row[0] = energy(x, v, m, G, n_active, eps2)
     if which & ANGULAR_MOMENTUM:

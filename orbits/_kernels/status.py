@@ -7,7 +7,7 @@ matching exception of :mod:`orbits.errors`.
 
 from enum import IntEnum
 
-__all__ = ["Status"]
+__all__ = ["Status", "with_status"]
 
 
 class Status(IntEnum):
@@ -17,3 +17,16 @@ class Status(IntEnum):
     CLOSE_ENCOUNTER = 3
     ESCAPE = 4
     NO_CONVERGENCE = 5  # an implicit method's Newton iteration did not converge
+
+
+def with_status(status, *rest):
+    """A loop's return with its status as a :class:`Status` (compiled loops
+    return plain integers).
+
+    Examples
+    --------
+    >>> from orbits._kernels.status import with_status
+    >>> with_status(1, 10, 0)
+    (<Status.NON_FINITE: 1>, 10, 0)
+    """
+    return (Status(status),) + rest

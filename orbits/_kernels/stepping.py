@@ -28,6 +28,20 @@ the step that triggered it.  Loops compiled without conditions call
 Monitors (energy, angular momentum, ...) are recorded every ``every`` steps,
 counted from the start of the simulation (``step0``), into ``mon_t`` and
 ``mon_out``; ``every = 0`` switches them off and costs one branch a step.
+
+The work of non-conservative force terms.  A force built by :func:`with_terms`
+with non-conservative terms (``work``) carries a third item in ``fargs``, the
+work arguments ``(their args, m, scratch, box)``: the loops integrate
+``W = -int P dt``, ``P = sum_i m_i a_i . v_i`` over those terms' accelerations
+alone, each with its own quadrature (the splitting kicks with the kick's
+midpoint velocity, Runge-Kutta methods with their weights ``b``, IAS15 with
+the Radau rule of its nodes), and add it to ``box[0]`` (``box[1]`` keeps what
+rounding lost, Neumaier's compensation), so that ``E + W`` is conserved up to
+the integration error; a monitor row records ``W`` in its work column.  The
+box is the workspace's ``"work"`` array (:func:`work_bound`), so that the
+state and its work are saved, restored and checkpointed together.  Loops
+compiled for other forces bind ``HAS_WORK = False`` and no-op kernels, and
+compile to what they were without it.
 """
 
 import math
@@ -38,12 +52,14 @@ import numpy as np
 from ._jit import njit, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
                       accelerate_pairwise_rebound, accelerate_pairwise_small)
-from .invariants import ENERGY, monitor_row
+from .invariants import ENERGY, WORK_COLUMN, monitor_row
 from .status import Status
 from .stopping import check_stop, no_stop
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
-           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms"]
+           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms",
+           "step_epilogue", "epilogue", "GO", "work_kernels", "work_args", "work_bound",
+           "work_total"]
 
 #: the stopping arguments of a loop compiled without conditions
 NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
@@ -68,6 +84,54 @@ def _record(x, v, t, mon, n_mon, mon_t, mon_out):
     every, which, m, G, n_active, eps2 = mon
     mon_t[n_mon] = t
     monitor_row(x, v, m, G, n_active, eps2, which, mon_out[n_mon])
+
+
+#: the status of a step epilogue (:func:`step_epilogue`) that lets a loop carry on
+GO = -1
+
+
+def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record, every,
+              mon, n_mon, mon_t, mon_out, sargs):
+    # The epilogue of every loop's step, at time t after step k (of nsteps):
+    # the finite check (fixed-step loops, check=True: every check_every
+    # steps and after the last; adaptive loops test their error estimate
+    # instead), the monitors when due, and the stopping conditions.  Returns
+    # (status, steps_done, until_check, until_record, n_mon): status GO to
+    # carry on, else what the loop returns with steps_done.  A plain call, not
+    # inlined at numba's level: arrays handed to an inlined function are
+    # reference-counted on every call (see orbits._kernels._jit), which costs
+    # more than the call LLVM then inlines anyway.
+    if check:
+        until_check -= 1
+        if until_check == 0 or k + 1 == nsteps:
+            until_check = check_every
+            if not state_is_finite(x, v):
+                return Status.NON_FINITE, k, until_check, until_record, n_mon
+    until_record -= 1
+    if until_record == 0:
+        until_record = every
+        _record(x, v, t, mon, n_mon, mon_t, mon_out)
+        n_mon += 1
+    stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+    if stop != 0:
+        if check and not state_is_finite(x, v):
+            return Status.NON_FINITE, k, until_check, until_record, n_mon
+        return stop, k + 1, until_check, until_record, n_mon
+    return GO, k + 1, until_check, until_record, n_mon
+
+
+def step_epilogue(force, stop=False):
+    """The step epilogue of the loops compiled for a :class:`ForceKernel`
+    (``stop``: with the stopping conditions of :mod:`.stopping`)."""
+    return epilogue(force.recorder, f"{force.key}{'_stop' if stop else ''}", jit=force.jit,
+                    cache=force.cache, runtime=force.runtime, stop=stop)
+
+
+def epilogue(record, key, jit=True, cache=True, runtime=False, stop=False):
+    """The step epilogue with monitor recorder ``record``, compiled under ``key``
+    (``runtime``: for loops that need numba's runtime)."""
+    return specialize(_step_end, key, jit=jit, inline=True, nrt=runtime, cache=cache,
+                      _record=record, stop_check=check_stop if stop else no_stop)
 
 
 # -- forces ------------------------------------------------------------------------
@@ -124,6 +188,23 @@ class ForceKernel(NamedTuple):
     # a user's function replacing gravity (orbits.integrate): nothing is known
     # of it, so ias15 predicts velocities for it and Wisdom-Holman refuses it
     opaque: bool = False
+    # it needs numba's runtime although it is the package's own (the threaded
+    # gravity kernel, whose thread pool does)
+    allocates: bool = False
+    # for gravity with non-conservative terms (with_terms): their TermKernel,
+    # whose work the loops integrate; fargs then has the work arguments third
+    work: object = None
+
+    @property
+    def runtime(self):
+        """Whether loops calling it need numba's runtime (reference counts).
+
+        A user's function (which cannot be cached) may allocate, and the
+        threaded gravity kernel needs it; the package's other force and term
+        kernels allocate nothing, so their loops are compiled without the
+        runtime, whose reference counts on the arrays of every inlined call
+        would cost more than a small step (see :mod:`orbits._kernels._jit`)."""
+        return self.allocates or not self.cache
 
     @property
     def recorder(self):
@@ -146,7 +227,7 @@ def gravity_force(kind):
         kernel = specialize(_gravity_force_exact, key, inline=True)
         return ForceKernel(kernel, key, True, True)
     kernel = specialize(_gravity_force, key, inline=True, pair_kernel=_PAIR_KERNELS[kind])
-    return ForceKernel(kernel, key, True, True)
+    return ForceKernel(kernel, key, True, True, allocates=kind == "parallel")
 
 
 def _forced(x, v, t, fargs, acc):
@@ -164,17 +245,131 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
         row[0] += extra_energy(x, v, eargs)  # noqa: F821 - bound by specialize
 
 
-def with_terms(base, terms, velocity_dependent):
+def with_terms(base, terms, velocity_dependent, work=None):
     """Gravity ``base`` (a :class:`ForceKernel`) plus the terms of a
     :class:`~orbits._kernels.terms.TermKernel`: ``fargs = (base fargs, terms' args)``,
-    and monitors ``mon`` with the terms' energy arguments as a seventh item."""
+    and monitors ``mon`` with the terms' energy arguments as a seventh item.
+
+    ``work``, the :class:`~orbits._kernels.terms.TermKernel` of the
+    non-conservative terms among them (a chain of their own), makes the loops
+    integrate their work (see the module notes); ``fargs`` is then
+    ``(base fargs, terms' args, work args)`` with the work arguments of
+    :func:`work_args`.
+    """
     key = f"{base.key}+{terms.key}"
     cache = base.cache and terms.cache
     kernel = specialize(_forced, key, cache=cache, inline=True, base=base.kernel,
                         extra=terms.accel)
     record = specialize(_record_terms, key, cache=cache, extra_energy=terms.energy)
+    if work is not None:
+        key += f"+work_{work.key}"
+        cache = cache and work.cache
     return ForceKernel(kernel, key, True, cache, velocity_dependent=bool(velocity_dependent),
-                       record=record, base=base, terms=terms)
+                       record=record, base=base, terms=terms, allocates=base.allocates,
+                       work=work)
+
+
+# -- the work of the non-conservative terms -----------------------------------------
+
+def _work_rate(x, v, t, fargs):
+    # P = sum_i m_i a_i . v_i, a the non-conservative terms' accelerations alone
+    wargs = fargs[2]
+    nargs, m, scratch = wargs[0], wargs[1], wargs[2]
+    n = x.shape[0]
+    for i in range(n):
+        scratch[i, 0] = 0.0
+        scratch[i, 1] = 0.0
+        scratch[i, 2] = 0.0
+    nc_accel(x, v, t, nargs, scratch)  # noqa: F821 - bound by specialize
+    s = 0.0
+    for i in range(n):
+        s += m[i] * (scratch[i, 0] * v[i, 0] + scratch[i, 1] * v[i, 1]
+                     + scratch[i, 2] * v[i, 2])
+    return s
+
+
+@njit(inline="always")
+def _work_add(fargs, dw):
+    # W += dw with Neumaier's compensation in box[1]: a long run adds millions
+    # of increments, whose rounding would otherwise grow with their number
+    box = fargs[2][3]
+    s = box[0]
+    t = s + dw
+    if abs(s) >= abs(dw):
+        box[1] += (s - t) + dw
+    else:
+        box[1] += (dw - t) + s
+    box[0] = t
+
+
+@njit(inline="always")
+def _work_note(fargs, mon_out, n_before, n_mon):
+    # a monitor row recorded by this step's epilogue gets the work done so far
+    # (rows of the width before the work column have no room for it)
+    if n_mon > n_before and mon_out.shape[1] > WORK_COLUMN:
+        box = fargs[2][3]
+        mon_out[n_mon - 1, WORK_COLUMN] = box[0] + box[1]
+
+
+@njit(inline="always")
+def _no_work_rate(x, v, t, fargs):
+    return 0.0
+
+
+@njit(inline="always")
+def _no_work_add(fargs, dw):
+    pass
+
+
+@njit(inline="always")
+def _no_work_note(fargs, mon_out, n_before, n_mon):
+    pass
+
+
+def work_kernels(force):
+    """The bindings of a loop compiled for ``force`` that integrate the work of
+    its non-conservative terms (see the module notes): ``HAS_WORK`` and the
+    kernels ``work_rate(x, v, t, fargs) -> P``, ``work_add(fargs, dW)`` and
+    ``work_note(fargs, mon_out, n_before, n_mon)`` (records W in a monitor row
+    just written).  For a force without such terms they are no-ops, which
+    compile to nothing."""
+    if force.work is None:
+        return dict(HAS_WORK=False, work_rate=_no_work_rate, work_add=_no_work_add,
+                    work_note=_no_work_note)
+    rate = specialize(_work_rate, force.work.key, cache=force.work.cache, inline=True,
+                      nc_accel=force.work.accel)
+    return dict(HAS_WORK=True, work_rate=rate, work_add=_work_add, work_note=_work_note)
+
+
+def work_args(args, m):
+    """The work arguments of :func:`with_terms`: the non-conservative terms'
+    ``args`` (nested as :func:`~orbits._kernels.terms.chain` takes them), the
+    masses ``m`` (shape (N,), internal order), a scratch (N, 3) array and a
+    box ``(W, compensation)``, which :func:`work_bound` replaces by the
+    workspace's."""
+    return (args, m, np.zeros((len(m), 3)), np.zeros(2))
+
+
+def work_bound(force, fargs, ws):
+    """``fargs`` with the work box of the workspace ``ws`` (its ``"work"`` array,
+    made if missing), for a force with non-conservative terms; ``fargs``
+    itself otherwise.  Each integrator's ``advance`` calls it, so that a
+    workspace copied and run again (:func:`orbits._driver.advance_checked`)
+    integrates its own work."""
+    if force.work is None:
+        return fargs
+    box = ws.get("work")
+    if box is None:
+        box = ws["work"] = np.zeros(2)
+    wargs = fargs[2]
+    return (fargs[0], fargs[1], (wargs[0], wargs[1], wargs[2], box))
+
+
+def work_total(ws):
+    """W in the workspace ``ws``: the energy the non-conservative terms have taken
+    out of the bodies since the workspace was made (0.0 without such terms)."""
+    box = ws.get("work")
+    return 0.0 if box is None else float(box[0] + box[1])
 
 
 def user_force(accel, jit):
@@ -196,7 +391,9 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
     # share one force evaluation.  `fresh` (kept in cache[0] between calls)
     # says whether acc belongs to the current positions.  A velocity-dependent
     # force is kicked with the implicit midpoint velocity (implicit_kick), so
-    # the kick stays symmetric; vm is its scratch.
+    # the kick stays symmetric; vm is its scratch.  A kick v' = v + h a changes
+    # the kinetic energy by exactly h sum m a . (v + v') / 2: the
+    # non-conservative terms' part of it is their work (HAS_WORK).
     n = x.shape[0]
     every = mon[0]
     n_mon = 0
@@ -217,6 +414,9 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
             elif velocity_dependent:
                 implicit_kick(x, v, tx, h, fargs, acc, vm)
                 fresh = False
+                if HAS_WORK:  # noqa: F821 - bound by specialize
+                    # vm is the kick's midpoint velocity (v + v') / 2
+                    work_add(fargs, -h * work_rate(x, vm, tx, fargs))  # noqa: F821
             else:
                 if not fresh:
                     force(x, v, tx, fargs, acc)  # noqa: F821 - bound by specialize
@@ -225,23 +425,19 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
                     v[i, 0] += h * acc[i, 0]
                     v[i, 1] += h * acc[i, 1]
                     v[i, 2] += h * acc[i, 2]
-        until_check -= 1
-        if until_check == 0 or k + 1 == nsteps:
-            until_check = check_every
-            if not state_is_finite(x, v):
-                cache[0] = 0
-                return Status.NON_FINITE, k, n_mon
-        until_record -= 1
-        if until_record == 0:
-            until_record = every
-            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
-            n_mon += 1
-        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
-        if stop != 0:
-            cache[0] = 1 if fresh else 0
-            if not state_is_finite(x, v):
-                return Status.NON_FINITE, k, n_mon
-            return stop, k + 1, n_mon
+                if HAS_WORK:  # noqa: F821
+                    for i in range(n):
+                        for d in range(3):
+                            vm[i, d] = v[i, d] - 0.5 * h * acc[i, d]
+                    work_add(fargs, -h * work_rate(x, vm, tx, fargs))  # noqa: F821
+        n_before = n_mon
+        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+            x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
+            every, mon, n_mon, mon_t, mon_out, sargs)
+        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+        if status != GO:
+            cache[0] = 1 if fresh and status != Status.NON_FINITE else 0
+            return status, done, n_mon
     cache[0] = 1 if fresh else 0
     return Status.OK, nsteps, n_mon
 
@@ -286,14 +482,13 @@ def splitting_loop(force, name, kinds, coefs, stop=False):
     ``stop`` compiles in the stopping conditions of :mod:`.stopping`.
     """
     return specialize(_splitting_loop, f"{name}_{force.key}{'_stop' if stop else ''}",
-                      jit=force.jit, cache=force.cache, force=force.kernel,
-                      _record=force.recorder,
+                      jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
+                      step_end=step_epilogue(force, stop),
                       implicit_kick=specialize(_implicit_kick, force.key, jit=force.jit,
                                                cache=force.cache, inline=True,
                                                force=force.kernel),
-                      stop_check=check_stop if stop else no_stop,
                       KINDS=tuple(int(k) for k in kinds),
-                      COEFS=tuple(float(c) for c in coefs))
+                      COEFS=tuple(float(c) for c in coefs), **work_kernels(force))
 
 
 # -- explicit Runge-Kutta ---------------------------------------------------------------
@@ -302,7 +497,8 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
                       mon_t, mon_out, check_every, sargs):
     # y = (x, v), y' = (v, a(x, v, t)); stage s has state
     # y + dt sum_j A[s, j] k_j and derivative k_s.  kx[s] = stage velocity,
-    # kv[s] = stage acceleration.
+    # kv[s] = stage acceleration.  The work is the same method applied to
+    # W' = -P(x, v, t): W += -dt sum_s b_s P(stage s).
     n = x.shape[0]
     n_stages = b.shape[0]
     every = mon[0]
@@ -311,6 +507,7 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
     until_record = every - step0 % every if every > 0 else -1
     for k in range(nsteps):
         tk = t + k * dt
+        pw = 0.0
         for s in range(n_stages):
             for i in range(n):
                 for d in range(3):
@@ -325,6 +522,8 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
                     vs[i, d] = vi
                     kx[s, i, d] = vi
             force(xs, vs, tk + c[s] * dt, fargs, kv[s])  # noqa: F821 - bound by specialize
+            if HAS_WORK and b[s] != 0.0:  # noqa: F821
+                pw += b[s] * work_rate(xs, vs, tk + c[s] * dt, fargs)  # noqa: F821
         for i in range(n):
             for d in range(3):
                 dx = 0.0
@@ -334,21 +533,15 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
                     dv += b[s] * kv[s, i, d]
                 x[i, d] += dt * dx
                 v[i, d] += dt * dv
-        until_check -= 1
-        if until_check == 0 or k + 1 == nsteps:
-            until_check = check_every
-            if not state_is_finite(x, v):
-                return Status.NON_FINITE, k, n_mon
-        until_record -= 1
-        if until_record == 0:
-            until_record = every
-            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
-            n_mon += 1
-        stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
-        if stop != 0:
-            if not state_is_finite(x, v):
-                return Status.NON_FINITE, k, n_mon
-            return stop, k + 1, n_mon
+        if HAS_WORK:  # noqa: F821
+            work_add(fargs, -dt * pw)  # noqa: F821
+        n_before = n_mon
+        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+            x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
+            every, mon, n_mon, mon_t, mon_out, sargs)
+        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+        if status != GO:
+            return status, done, n_mon
     return Status.OK, nsteps, n_mon
 
 
@@ -356,6 +549,5 @@ def runge_kutta_loop(force, stop=False):
     """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`
     (``stop``: with the stopping conditions of :mod:`.stopping`)."""
     return specialize(_runge_kutta_loop, f"{force.key}{'_stop' if stop else ''}",
-                      jit=force.jit, cache=force.cache, force=force.kernel,
-                      _record=force.recorder,
-                      stop_check=check_stop if stop else no_stop)
+                      jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
+                      step_end=step_epilogue(force, stop), **work_kernels(force))

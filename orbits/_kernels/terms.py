@@ -26,7 +26,11 @@ Standish, E. M. & Williams, J. G. 1983, A&A 125, 150 (the Einstein-Infeld-
 Hoffmann equations of the JPL ephemerides).  Damour, T. & Deruelle, N. 1985
 and Will, C. M. 2014, Living Rev. Relativ. 17, 4 (the conserved 1PN energy).
 Murray, C. D. & Dermott, S. F. 1999, *Solar System Dynamics*, sect. 4.9 (the
-zonal harmonics).
+zonal harmonics).  Papaloizou, J. C. B. & Larwood, J. D. 2000, MNRAS 315, 823
+(migration and damping forces).  Hut, P. 1981, A&A 99, 126 and Eggleton, P. P.,
+Kiseleva, L. G. & Hut, P. 1998, ApJ 499, 853 (the constant-time-lag tide).
+Burns, J. A., Lamy, P. L. & Soter, S. 1979, Icarus 40, 1 (radiation pressure and
+Poynting-Robertson drag).
 """
 
 import math
@@ -41,6 +45,8 @@ from .invariants import _add
 __all__ = ["TermKernel", "chain", "nest", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
+           "migration_accel", "migration_jacobian", "tides_accel", "tides_jacobian",
+           "radiation_accel", "radiation_jacobian", "dissipative_energy",
            "difference_jacobian"]
 
 
@@ -79,23 +85,44 @@ def gr_accel(x, v, t, args, acc):
     """
     src, gm, inv_c2 = args
     mu = gm[src]
+    k = mu * inv_c2
+    inv_mu = 1.0 / mu
+    # one division a body, and the source's reaction summed in registers (a
+    # store to acc[src] every body would chain the iterations through memory)
+    x0, x1, x2 = x[src, 0], x[src, 1], x[src, 2]
+    v0, v1, v2 = v[src, 0], v[src, 1], v[src, 2]
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
     for i in range(x.shape[0]):
         if i == src:
             continue
-        rx = x[i, 0] - x[src, 0]
-        ry = x[i, 1] - x[src, 1]
-        rz = x[i, 2] - x[src, 2]
-        ux = v[i, 0] - v[src, 0]
-        uy = v[i, 1] - v[src, 1]
-        uz = v[i, 2] - v[src, 2]
+        rx = x[i, 0] - x0
+        ry = x[i, 1] - x1
+        rz = x[i, 2] - x2
+        ux = v[i, 0] - v0
+        uy = v[i, 1] - v1
+        uz = v[i, 2] - v2
         r2 = rx * rx + ry * ry + rz * rz
-        r = math.sqrt(r2)
+        inv_r = 1.0 / math.sqrt(r2)
         u2 = ux * ux + uy * uy + uz * uz
         rv = rx * ux + ry * uy + rz * uz
-        f = mu * inv_c2 / (r2 * r)
-        a = f * (4.0 * mu / r - u2)
+        f = k * inv_r * inv_r * inv_r
+        a = f * (4.0 * mu * inv_r - u2)
         b = 4.0 * f * rv
-        _pull(acc, i, src, gm[i] / mu, a * rx + b * ux, a * ry + b * uy, a * rz + b * uz)
+        ax = a * rx + b * ux
+        ay = a * ry + b * uy
+        az = a * rz + b * uz
+        acc[i, 0] += ax
+        acc[i, 1] += ay
+        acc[i, 2] += az
+        w = gm[i] * inv_mu
+        sx += w * ax
+        sy += w * ay
+        sz += w * az
+    acc[src, 0] -= sx
+    acc[src, 1] -= sy
+    acc[src, 2] -= sz
 
 
 @njit
@@ -467,6 +494,255 @@ def zonal_jacobian(x, v, t, args, jx, jv):
                 if w != 0.0:
                     jx[3 * b + a, 3 * i + c] += w * h[a, c]
                     jx[3 * b + a, 3 * b + c] -= w * h[a, c]
+
+
+# -- dissipative terms: no energy of their own ------------------------------------------
+
+@njit
+def dissipative_energy(x, v, args):
+    """0.0: a dissipative term adds nothing to the conserved energy (the work it
+    does is accounted for elsewhere)."""
+    return 0.0
+
+
+# -- migration and damping on prescribed time scales (Papaloizou & Larwood 2000) --------
+
+@njit(inline="always")  # called every substep: a call costs ~15 % of it
+def migration_accel(x, v, t, args, acc):
+    """Migration and eccentricity / inclination damping of body ``b`` about ``p``::
+
+        a_rel = -u / (2 tau_a) - 2 (r . u) r / (r^2 tau_e) - 2 u_z z / tau_inc
+
+    with ``r``, ``u`` the position and velocity of ``b`` relative to ``p`` and
+    ``z`` the frame's z axis; ``b`` takes ``wb a_rel`` and ``p`` takes
+    ``-wp a_rel`` with ``wb = m_p / (m_p + m_b)``, ``wp = m_b / (m_p + m_b)``, so
+    the relative acceleration is ``a_rel`` and momentum is conserved.
+    ``args = (b, p, wb, wp, 1 / tau_a, 1 / tau_e, 1 / tau_inc)``, an inverse
+    time scale 0 for a time scale left out.
+    """
+    b, p, wb, wp, ia, ie, ii = args
+    rx = x[b, 0] - x[p, 0]
+    ry = x[b, 1] - x[p, 1]
+    rz = x[b, 2] - x[p, 2]
+    ux = v[b, 0] - v[p, 0]
+    uy = v[b, 1] - v[p, 1]
+    uz = v[b, 2] - v[p, 2]
+    fu = -0.5 * ia
+    fr = -2.0 * ie * (rx * ux + ry * uy + rz * uz) / (rx * rx + ry * ry + rz * rz)
+    ax = fu * ux + fr * rx
+    ay = fu * uy + fr * ry
+    az = fu * uz + fr * rz - 2.0 * ii * uz
+    acc[b, 0] += wb * ax
+    acc[b, 1] += wb * ay
+    acc[b, 2] += wb * az
+    acc[p, 0] -= wp * ax
+    acc[p, 1] -= wp * ay
+    acc[p, 2] -= wp * az
+
+
+@njit(inline="always")
+def _add_pair_block(jx, jv, i, j, wi, wj, dx, dv):
+    # a_rel(r, u) with r = x_i - x_j, u = v_i - v_j: i takes wi a_rel, j takes -wj a_rel
+    for a in range(3):
+        for c in range(3):
+            jx[3 * i + a, 3 * i + c] += wi * dx[a, c]
+            jx[3 * i + a, 3 * j + c] -= wi * dx[a, c]
+            jv[3 * i + a, 3 * i + c] += wi * dv[a, c]
+            jv[3 * i + a, 3 * j + c] -= wi * dv[a, c]
+            if wj != 0.0:
+                jx[3 * j + a, 3 * i + c] -= wj * dx[a, c]
+                jx[3 * j + a, 3 * j + c] += wj * dx[a, c]
+                jv[3 * j + a, 3 * i + c] -= wj * dv[a, c]
+                jv[3 * j + a, 3 * j + c] += wj * dv[a, c]
+
+
+@njit
+def migration_jacobian(x, v, t, args, jx, jv):
+    """``da/dx`` and ``da/dv`` of :func:`migration_accel`::
+
+        d a_rel / d r = -(2 / tau_e) [ (r u^T + (r . u) I) / r^2 - 2 (r . u) r r^T / r^4 ]
+        d a_rel / d u = -I / (2 tau_a) - 2 r r^T / (r^2 tau_e) - 2 z z^T / tau_inc
+    """
+    b, p, wb, wp, ia, ie, ii = args
+    r = np.empty(3)
+    u = np.empty(3)
+    dx = np.zeros((3, 3))
+    dv = np.zeros((3, 3))
+    for d in range(3):
+        r[d] = x[b, d] - x[p, d]
+        u[d] = v[b, d] - v[p, d]
+    r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+    ru = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
+    for a in range(3):
+        for c in range(3):
+            dx[a, c] = -2.0 * ie * (r[a] * u[c] / r2 - 2.0 * ru * r[a] * r[c] / (r2 * r2))
+            dv[a, c] = -2.0 * ie * r[a] * r[c] / r2
+        dx[a, a] -= 2.0 * ie * ru / r2
+        dv[a, a] -= 0.5 * ia
+    dv[2, 2] -= 2.0 * ii
+    _add_pair_block(jx, jv, b, p, wb, wp, dx, dv)
+
+
+# -- the constant-time-lag tide (Hut 1981; Eggleton, Kiseleva & Hut 1998) ---------------
+
+@njit(inline="always")  # called every substep: a call costs ~15 % of it
+def tides_accel(x, v, t, args, acc):
+    """The tide raised on body ``b`` (radius ``R``, Love number ``k2``, time lag
+    ``tau``, spin ``Omega``) by every other massive body ``j``, as the force on
+    ``j``::
+
+        F_j = -3 k2 G m_j^2 R^5 / r^8 [ r + tau (2 (r . u) r / r^2 + u + r x Omega) ]
+
+    with ``r``, ``u`` the position and velocity of ``j`` relative to ``b``; ``b``
+    takes ``-F_j``.  ``args = (b, gm, 3 k2 R^5, tau, Omega)``.
+    """
+    b, gm, k, tau, om = args
+    for j in range(x.shape[0]):
+        if j == b or gm[j] == 0.0:
+            continue
+        rx = x[j, 0] - x[b, 0]
+        ry = x[j, 1] - x[b, 1]
+        rz = x[j, 2] - x[b, 2]
+        ux = v[j, 0] - v[b, 0]
+        uy = v[j, 1] - v[b, 1]
+        uz = v[j, 2] - v[b, 2]
+        r2 = rx * rx + ry * ry + rz * rz
+        r8 = r2 * r2 * r2 * r2
+        q = 2.0 * tau * (rx * ux + ry * uy + rz * uz) / r2
+        gx = rx * (1.0 + q) + tau * (ux + ry * om[2] - rz * om[1])
+        gy = ry * (1.0 + q) + tau * (uy + rz * om[0] - rx * om[2])
+        gz = rz * (1.0 + q) + tau * (uz + rx * om[1] - ry * om[0])
+        f = -k * gm[j] / r8
+        w = gm[j] / gm[b]
+        acc[j, 0] += f * gx
+        acc[j, 1] += f * gy
+        acc[j, 2] += f * gz
+        acc[b, 0] -= w * f * gx
+        acc[b, 1] -= w * f * gy
+        acc[b, 2] -= w * f * gz
+
+
+@njit
+def tides_jacobian(x, v, t, args, jx, jv):
+    """``da/dx`` and ``da/dv`` of :func:`tides_accel`.  With ``s = r^2``,
+    ``w = r . u``, ``q = 2 tau w / s``, ``g' = (1 + q) r + tau (u + r x Omega)``
+    and ``g = s^-4 g'`` (so that ``F_j = -3 k2 G m_j^2 R^5 g``)::
+
+        dg/dr = s^-4 [ (1 + q) I + 2 tau r (u^T / s - 2 w r^T / s^2) - tau [Omega]x ]
+                - 8 s^-5 g' r^T
+        dg/du = tau s^-4 (I + 2 r r^T / s)
+
+    where ``[Omega]x v = Omega x v``.
+    """
+    b, gm, k, tau, om = args
+    r = np.empty(3)
+    u = np.empty(3)
+    gp = np.empty(3)
+    dx = np.empty((3, 3))
+    dv = np.empty((3, 3))
+    for j in range(x.shape[0]):
+        if j == b or gm[j] == 0.0:
+            continue
+        for d in range(3):
+            r[d] = x[j, d] - x[b, d]
+            u[d] = v[j, d] - v[b, d]
+        s = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        w = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
+        q = 2.0 * tau * w / s
+        gp[0] = r[0] * (1.0 + q) + tau * (u[0] + r[1] * om[2] - r[2] * om[1])
+        gp[1] = r[1] * (1.0 + q) + tau * (u[1] + r[2] * om[0] - r[0] * om[2])
+        gp[2] = r[2] * (1.0 + q) + tau * (u[2] + r[0] * om[1] - r[1] * om[0])
+        s4 = 1.0 / (s * s * s * s)
+        f = -k * gm[j]
+        for a in range(3):
+            for c in range(3):
+                # d/dr_c of s^-4 g'_a: -8 s^-5 g'_a r_c + s^-4 dg'_a/dr_c, where
+                # dg'_a/dr_c = (1 + q) delta_ac + 2 tau r_a (u_c / s - 2 w r_c / s^2)
+                #              - tau [Omega]x_ac
+                d = 2.0 * tau * r[a] * (u[c] / s - 2.0 * w * r[c] / (s * s))
+                if a == c:
+                    d += 1.0 + q
+                dx[a, c] = f * (s4 * d - 8.0 * s4 / s * gp[a] * r[c])
+                dv[a, c] = f * tau * s4 * 2.0 * r[a] * r[c] / s
+            dv[a, a] += f * tau * s4
+        # r x Omega = -Omega x r: its derivative is -[Omega]x
+        dx[0, 1] += f * s4 * tau * om[2]
+        dx[0, 2] -= f * s4 * tau * om[1]
+        dx[1, 0] -= f * s4 * tau * om[2]
+        dx[1, 2] += f * s4 * tau * om[0]
+        dx[2, 0] += f * s4 * tau * om[1]
+        dx[2, 1] -= f * s4 * tau * om[0]
+        _add_pair_block(jx, jv, j, b, 1.0, gm[j] / gm[b], dx, dv)
+
+
+# -- radiation pressure and Poynting-Robertson drag (Burns, Lamy & Soter 1979) ----------
+
+@njit(inline="always")  # called every substep: a call costs ~15 % of it
+def radiation_accel(x, v, t, args, acc):
+    """Radiation from the source ``s`` on each body ``i`` with ``beta_i != 0``::
+
+        a_i = beta_i G m_s / r^2 [ (1 - rdot / c) r_hat - u / c ]
+
+    with ``r``, ``u`` relative to the source and ``rdot = r_hat . u``.  The source
+    takes no reaction (it radiates isotropically).
+    ``args = (s, G m_s, beta, 1 / c)``, ``beta`` of shape (N,).
+    """
+    s, mu, beta, ic = args
+    for i in range(x.shape[0]):
+        if beta[i] == 0.0:
+            continue
+        rx = x[i, 0] - x[s, 0]
+        ry = x[i, 1] - x[s, 1]
+        rz = x[i, 2] - x[s, 2]
+        ux = v[i, 0] - v[s, 0]
+        uy = v[i, 1] - v[s, 1]
+        uz = v[i, 2] - v[s, 2]
+        r2 = rx * rx + ry * ry + rz * rz
+        r = math.sqrt(r2)
+        k = beta[i] * mu / r2
+        fr = k * (1.0 - (rx * ux + ry * uy + rz * uz) * ic / r) / r
+        fu = -k * ic
+        acc[i, 0] += fr * rx + fu * ux
+        acc[i, 1] += fr * ry + fu * uy
+        acc[i, 2] += fr * rz + fu * uz
+
+
+@njit
+def radiation_jacobian(x, v, t, args, jx, jv):
+    """``da/dx`` and ``da/dv`` of :func:`radiation_accel`, writing
+    ``a = k [r / r^3 - (r . u) r / (c r^4) - u / (c r^2)]`` with ``k = beta G m_s``::
+
+        da/dr = k [ I / r^3 - 3 r r^T / r^5
+                    - ((r . u) I + r u^T) / (c r^4) + 4 (r . u) r r^T / (c r^6)
+                    + 2 u r^T / (c r^4) ]
+        da/du = -k [ r r^T / (c r^4) + I / (c r^2) ]
+    """
+    s, mu, beta, ic = args
+    r = np.empty(3)
+    u = np.empty(3)
+    dx = np.empty((3, 3))
+    dv = np.empty((3, 3))
+    for i in range(x.shape[0]):
+        if beta[i] == 0.0:
+            continue
+        for d in range(3):
+            r[d] = x[i, d] - x[s, d]
+            u[d] = v[i, d] - v[s, d]
+        r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        rr = math.sqrt(r2)
+        w = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
+        k = beta[i] * mu
+        i3 = 1.0 / (r2 * rr)
+        i4 = 1.0 / (r2 * r2)
+        for a in range(3):
+            for c in range(3):
+                dx[a, c] = k * (-3.0 * r[a] * r[c] * i3 / r2 - ic * r[a] * u[c] * i4
+                                + 4.0 * ic * w * r[a] * r[c] * i4 / r2
+                                + 2.0 * ic * u[a] * r[c] * i4)
+                dv[a, c] = -k * ic * r[a] * r[c] * i4
+            dx[a, a] += k * (i3 - ic * w * i4)
+            dv[a, a] -= k * ic / r2
+        _add_pair_block(jx, jv, i, s, 1.0, 0.0, dx, dv)
 
 
 # -- central differences of one term, for terms without an analytic Jacobian -----------

@@ -105,7 +105,7 @@ from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi
 from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
-from .stepping import DRIFT, _record, state_is_finite
+from .stepping import DRIFT, GO, _record, epilogue
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
@@ -338,21 +338,25 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                     kepler_drift_all(xj, vj, eta, h, xs, vs)
             else:
                 perturbation(xj, vj, xs, acc, gm, eta, n_active, h, targs)  # noqa: F821
-        until_check -= 1
-        if until_check == 0 or k + 1 == nsteps:
-            until_check = check_every
-            if not state_is_finite(xj, vj):
-                owed_box[0] = owed
-                return Status.NON_FINITE, k, n_mon
-        until_record -= 1
-        if until_record == 0:
-            until_record = every
-            synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0],
-                        targs)
-            _record(x, v, t + (k + 1) * dt, mon, n_mon, mon_t, mon_out)
-            n_mon += 1
+        # the shared epilogue checks the internal state; its recorder
+        # synchronises first, so the monitors see the inertial state at the time
+        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+            xj, vj, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
+            every, (mon, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)),
+            n_mon, mon_t, mon_out, ())
+        if status != GO:
+            owed_box[0] = owed
+            return status, done, n_mon
     owed_box[0] = owed
     return Status.OK, nsteps, n_mon
+
+
+def _wh_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
+    # the recorder the Wisdom-Holman loop hands the shared step epilogue:
+    # mon is (the monitors' arguments, the synchronisation's)
+    mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs) = mon
+    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs)  # noqa: F821
+    _record(x, v, t, mon_args, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
 
 
 def _jacobi_term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs):
@@ -486,12 +490,14 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     the perturbation step, and ``record`` records the monitors."""
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms)
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
-    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=False,
-                      cache=terms is None or terms.cache,
+    cache = terms is None or terms.cache
+    recorder = specialize(_wh_record, key, cache=cache, nrt=False, synchronize=sync,
+                          _record=record)
+    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=False, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
                       perturbation=perturbation, apply_corrector=corrector,
-                      synchronize=sync, _record=record)
+                      step_end=epilogue(recorder, f"wh_{key}", cache=cache))
 
 
 #: the Jacobi versions, compiled on first use

@@ -19,7 +19,10 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
    mon_t, mon_out, velocity_dependent, check_every, stop)``, which advances ``x`` and ``v`` (shape (N, 3), in place)
    by ``nsteps`` steps of ``dt`` from time ``t`` with the compiled loop for
    ``force`` and returns ``(status, steps_done, n_monitor_rows)`` as
-   described in :mod:`orbits._kernels.stepping`;
+   described in :mod:`orbits._kernels.stepping`; for a force with
+   non-conservative terms it integrates their work into ``ws["work"]``
+   (``fargs`` bound to it by :func:`~orbits._kernels.stepping.work_bound`),
+   or refuses such terms in ``check_terms``;
 5. implements ``synchronize(ws, x, v)`` (bring x and v to the same time
    where the method keeps them apart; a no-op for methods that never do) and
    ``invalidate(ws)`` (forget cached forces after the state was changed from
@@ -41,6 +44,7 @@ import warnings
 
 import numpy as np
 
+from .._kernels.status import with_status
 from .._kernels import stepping
 from ..errors import IntegratorOptionError, OrbitsWarning
 
@@ -70,7 +74,7 @@ class Integrator:
     >>> ws = integ.workspace(2)
     >>> integ.bind(ws, force, fargs)
     >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-    ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+    ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
     >>> integ.synchronize(ws, x, v)
     >>> status.name, steps, np.round(x[1], 3)        # one period: back at the start
     ('OK', 1000, array([ 1., -0.,  0.]))
@@ -168,7 +172,7 @@ class Integrator:
         >>> integ = integrators.get("rk4")
         >>> ws = integ.workspace(2)
         >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
         >>> status.name, steps, np.round(x[1], 6)
         ('OK', 1000, array([1., 0., 0.]))
         """
@@ -229,7 +233,7 @@ class Integrator:
         >>> integ = integrators.get("leapfrog")
         >>> ws = integ.workspace(2)
         >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
         >>> before = x.copy()
         >>> integ.synchronize(ws, x, v)                # x and v are at one time already
         >>> bool((x == before).all())
@@ -253,7 +257,7 @@ class Integrator:
         >>> integ = integrators.get("verlet")
         >>> ws = integ.workspace(2)
         >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
         >>> int(ws["cache"][0])                        # the last force is cached
         1
         >>> integ.invalidate(ws)
@@ -348,16 +352,17 @@ class SplittingMethod(Integrator):
         >>> integ = integrators.get("yoshida4")
         >>> ws = integ.workspace(2)
         >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
         >>> status.name, np.round(x[1], 6)
         ('OK', array([ 1., -0.,  0.]))
         """
         loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs,
                                        stop=stop is not None)
-        return loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
+        fargs = stepping.work_bound(force, fargs, ws)
+        return with_status(*loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
                     velocity_dependent or force.velocity_dependent,
                     mon, step0, mon_t, mon_out, check_every,
-                    stepping.NO_STOP_ARGS if stop is None else stop)
+                    stepping.NO_STOP_ARGS if stop is None else stop))
 
     def invalidate(self, ws):
         """Drop the cached force: the next kick evaluates it again.
@@ -376,7 +381,7 @@ class SplittingMethod(Integrator):
         >>> integ = integrators.get("verlet")
         >>> ws = integ.workspace(2)
         >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
         >>> integ.invalidate(ws)
         >>> ws["cache"].tolist()
         [0]
@@ -442,14 +447,15 @@ class ExplicitRungeKutta(Integrator):
         >>> integ = integrators.get("rk2")
         >>> ws = integ.workspace(2)
         >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
         >>> status.name, steps
         ('OK', 1000)
         """
         loop = stepping.runge_kutta_loop(force, stop=stop is not None)
-        return loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
+        fargs = stepping.work_bound(force, fargs, ws)
+        return with_status(*loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
                     ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every,
-                    stepping.NO_STOP_ARGS if stop is None else stop)
+                    stepping.NO_STOP_ARGS if stop is None else stop))
 
 
 class AdaptiveIntegrator(Integrator):

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from .._kernels.status import with_status
 from .._kernels import doubling as _doubling
 from .._kernels import stepping as _stepping
 from .base import AdaptiveIntegrator
@@ -56,9 +57,10 @@ class RK4Doubling(AdaptiveIntegrator):
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
                    max_steps):
         loop = _doubling.doubling_loop(force, stop=stop is not None)
+        fargs = _stepping.work_bound(force, fargs, ws)
         w = ws
-        return loop(x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
+        return with_status(*loop(x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
                     w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
                     w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
                     _stepping.NO_STOP_ARGS if stop is None else stop, int(max_steps),
-                    float(self.config["rtol"]), float(self.config["atol"]))
+                    float(self.config["rtol"]), float(self.config["atol"])))

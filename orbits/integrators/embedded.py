@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from .._kernels.status import with_status
 from .._kernels import embedded as _embedded
 from .._kernels import stepping as _stepping
 from . import dop853_coefficients as _dop853
@@ -46,11 +47,12 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
                    max_steps):
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
         loop = _embedded.embedded_loop(force, self.E3 is not None, stop=stop is not None)
-        return loop(x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
+        fargs = _stepping.work_bound(force, fargs, ws)
+        return with_status(*loop(x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
                     float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],
                     ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
                     mon_t, mon_out, _stepping.NO_STOP_ARGS if stop is None else stop,
-                    int(max_steps), float(self.config["rtol"]), float(self.config["atol"]))
+                    int(max_steps), float(self.config["rtol"]), float(self.config["atol"])))
 
 
 class Dopri5(EmbeddedRungeKutta):

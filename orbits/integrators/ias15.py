@@ -2,8 +2,9 @@
 
 import numpy as np
 
+from .._kernels.status import Status
 from .._kernels import ias15 as _k
-from .._kernels.stepping import NO_STOP_ARGS
+from .._kernels.stepping import NO_STOP_ARGS, work_bound
 from ..errors import IntegratorOptionError
 from .base import AdaptiveIntegrator
 
@@ -84,7 +85,7 @@ class IAS15(AdaptiveIntegrator):
     >>> status, t, *_ = integ.advance_to(
     ...     ws, x, v, 0.0, 2 * np.pi, gravity_force("small"),
     ...     gravity_args(1.0, gm, 1, 0.0), (0, 0, gm, 1.0, 1, 0.0), 0,
-    ...     np.empty(0), np.zeros((0, 10)), None, 10**6)
+    ...     np.empty(0), np.zeros((0, 11)), None, 10**6)
     >>> int(status), t == 2 * np.pi, bool(np.allclose(x[1], [1.0, 0.0, 0.0], atol=1e-12))
     (0, True, True)
     """
@@ -136,6 +137,7 @@ class IAS15(AdaptiveIntegrator):
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out,
                    stop, max_steps):
         loop = _k.ias15_loop(force, stop=stop is not None)
+        fargs = work_bound(force, fargs, ws)
         status, t_reached, n_mon = loop(
             x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
             ws["er"], ws["csx"], ws["csv"], ws["xs"], ws["vs"], ws["acc"], ws["P"],
@@ -144,7 +146,7 @@ class IAS15(AdaptiveIntegrator):
             int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
             ADAPTIVE_MODES[self.config["adaptive_mode"]])
         c = ws["counts"]
-        return status, t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
+        return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
 
     def invalidate(self, ws):
         """The state was changed from outside: recompute the force, forget the

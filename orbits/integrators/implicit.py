@@ -14,6 +14,7 @@ O(N^3) work: they are meant for a few bodies, or for a user's force through
 
 import numpy as np
 
+from .._kernels.status import Status
 from .._kernels import implicit, stepping
 from .base import Integrator
 
@@ -50,12 +51,13 @@ class ImplicitOneLeg(Integrator):
         velocity_dependent = bool(velocity_dependent or force.velocity_dependent)
         loop = implicit.implicit_loop(force, self.name, self.theta, velocity_dependent,
                                       stop=stop is not None)
+        fargs = stepping.work_bound(force, fargs, ws)
         status, done, n_mon = loop(
             x, v, t, dt, nsteps, ws["w"], ws["dw"], ws["xs"], ws["vs"], ws["acc"],
             ws["cache"], ws["jx"], ws["jv"], ws["lu"], ws["piv"], ws["newton_iterations"],
             fargs, bool(velocity_dependent), mon, step0, mon_t, mon_out, check_every,
             stepping.NO_STOP_ARGS if stop is None else stop)
-        return status, done, n_mon
+        return Status(status), done, n_mon
 
     def invalidate(self, ws):
         ws["cache"][0] = 0

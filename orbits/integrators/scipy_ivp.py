@@ -10,10 +10,16 @@ Each ``advance_to`` call starts scipy's solver afresh from the current state
 so a run resumed from a file continues exactly as an uninterrupted one.  A
 step that no longer moves the time (a collision ahead) ends the run with
 :class:`~orbits.errors.StepSizeUnderflow`.  ``scipy`` must be installed.
+
+With non-conservative force terms the ODE's state gets one more component,
+the work ``W`` with ``W' = -P`` (see :mod:`orbits._kernels.stepping`), which
+scipy's solver integrates (and controls the error of) with the rest, so that
+``E + W`` is conserved to the solver's tolerance.
 """
 
 import numpy as np
 
+from .._kernels import stepping as _stepping
 from .._kernels.status import Status
 from ..errors import IntegratorOptionError
 from .base import AdaptiveIntegrator
@@ -54,14 +60,21 @@ class ScipyIntegrator(AdaptiveIntegrator):
                                         "monitors; drop monitor_every")
         n = x.shape[0]
         acc = np.zeros((n, 3))      # a user state pads its last row: those entries stay 0
+        work = force.work is not None
+        if work:
+            fargs = _stepping.work_bound(force, fargs, ws)
+            rate = _stepping.work_kernels(force)["work_rate"]
 
         def rhs(time, y):
             xs = np.ascontiguousarray(y[:3 * n].reshape(n, 3))
-            vs = np.ascontiguousarray(y[3 * n:].reshape(n, 3))
+            vs = np.ascontiguousarray(y[3 * n:6 * n].reshape(n, 3))
             force.kernel(xs, vs, time, fargs, acc)
-            return np.concatenate([y[3 * n:], acc.ravel()])
+            parts = [y[3 * n:6 * n], acc.ravel()]
+            if work:
+                parts.append([-rate(xs, vs, time, fargs)])
+            return np.concatenate(parts)
 
-        y0 = np.concatenate([x.ravel(), v.ravel()])
+        y0 = np.concatenate([x.ravel(), v.ravel()] + ([[0.0]] if work else []))
         first = float(ws["dt"][0])
         kw = {"first_step": min(first, t_end - t)} if first > 0 else {}
         solver = getattr(integrate, self.method)(rhs, t, y0, t_end, rtol=self.config["rtol"],
@@ -79,10 +92,20 @@ class ScipyIntegrator(AdaptiveIntegrator):
                 # the steps no longer move t: a collision or a singularity ahead
                 return Status.STEP_UNDERFLOW, t, 0, 0, int(solver.nfev), 0
         x[...] = solver.y[:3 * n].reshape(n, 3)
-        v[...] = solver.y[3 * n:].reshape(n, 3)
+        v[...] = solver.y[3 * n:6 * n].reshape(n, 3)
+        if work:
+            _add_work(ws["work"], float(solver.y[-1]))
         if last_step > 0:
             ws["dt"][0] = last_step
         return Status.OK, t_end, steps, 0, int(solver.nfev), 0
+
+
+def _add_work(box, dw):
+    # W += dw, compensated as the compiled loops do it (stepping._work_add)
+    s = float(box[0])
+    t = s + dw
+    box[1] += ((s - t) + dw) if abs(s) >= abs(dw) else ((dw - t) + s)
+    box[0] = t
 
 
 class Radau(ScipyIntegrator):

@@ -16,6 +16,7 @@ import warnings
 
 import numpy as np
 
+from .._kernels.status import with_status
 from .._kernels import coordinates as _coordinates
 from .._kernels import wisdom_holman as _wh
 from .._kernels.stepping import DRIFT, KICK
@@ -281,9 +282,9 @@ class WisdomHolman(Integrator):
         gm, n_active = gravity[0], gravity[1]
         loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"],
                            terms, force.recorder)
-        return loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
+        return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
                     ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
-                    ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs)
+                    ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and

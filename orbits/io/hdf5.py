@@ -20,6 +20,10 @@ adds two groups of its own::
         angular_momentum     value (T, 3)
         momentum             value (T, 3)
         center_of_mass       value (T, 3)
+        work                 value (T,): W, the energy non-conservative force terms
+                             took out since the simulation was made (with the
+                             energy monitor and such terms only; the energy error
+                             is that of E + W)
         in_loop/<same>       the series recorded inside the compiled loop every
                              monitor_every steps, when that was asked for
     /parameters              attrs: the run's metadata (orbits and library versions,
@@ -27,7 +31,9 @@ adds two groups of its own::
                              source, softening, monitors, stopping conditions, when
                              written, how the body set was made, as JSON where
                              structured)
-        reference            (10,) the monitors' values when the simulation was made
+        reference            (11,) the monitors' values when the simulation was made
+                             (the layout of orbits._kernels.invariants.MONITOR_COLUMNS;
+                             files without the work read as (10,))
         scales               (2,) energy and angular-momentum scales for relative errors
     /restart                 the last two checkpoints, in alternating slots
         count                () int64: complete checkpoints written; the valid slot
@@ -44,7 +50,9 @@ adds two groups of its own::
                              2 step-size underflow, 3 close encounter, 4 escape)
         wall                 (2,) float, seconds: wall-clock time the runs writing
                              the file had taken at the checkpoint
-        ws/<name>            (2, ...) the integrator's workspace arrays
+        ws/<name>            (2, ...) the integrator's workspace arrays (with
+                             non-conservative terms, ws/work: W and its rounding
+                             compensation)
     /parameters/start_clock  (3,) int64: steps, force evaluations and rejected steps
                              of the simulation when the file was made (the
                              totals since are ``clock`` less these)
@@ -116,7 +124,7 @@ import h5py
 import numpy as np
 
 from ..errors import OrbitsError
-from ..monitors import monitor_fields
+from ..monitors import _work_column, monitor_fields
 from ..records import RunPlan, SimulationState
 
 __all__ = ["FileRecorder", "load", "describe", "read_checkpoint", "Checkpoint", "truncate",
@@ -134,9 +142,12 @@ BUFFER_ROWS = 256
 _SLOTS = 2
 _MONITOR_NAMES = ("energy", "angular_momentum", "momentum", "center_of_mass")
 _MONITOR_COLUMNS = {"energy": slice(0, 1), "angular_momentum": slice(1, 4),
-                    "momentum": slice(4, 7), "center_of_mass": slice(7, 10)}
+                    "momentum": slice(4, 7), "center_of_mass": slice(7, 10),
+                    "work": slice(10, 11)}
 _MONITOR_KIND = {"energy": "energy", "angular_momentum": "angular_momentum",
-                 "momentum": "momentum", "center_of_mass": "length"}
+                 "momentum": "momentum", "center_of_mass": "length", "work": "energy"}
+#: the series of one value per row (the others are 3-vectors)
+_SCALAR_SERIES = ("energy", "work")
 #: tries of a metadata read whose checksum fails, in SWMR mode.  HDF5 sleeps
 #: 1, 2, 4, ... ns between tries, so 24 tries give up after 2**24 ns = 17 ms
 #: (measured: 41 ms for 25 tries, 1.1 s for 30); a live writer rewrites a
@@ -691,6 +702,8 @@ class FileRecorder:
         # the public records of the simulation: this module reads nothing else of it
         self.desc = sim.description()
         state = sim.state
+        # the work of non-conservative terms is kept beside the energy
+        self.work = _keeps_work(self.desc)
         self.reference = state.reference
         self.scales = state.scales
         self.inv = np.argsort(state.order)
@@ -724,6 +737,8 @@ class FileRecorder:
                         f"writing it was killed, finish that run first with resume() "
                         f"(orbits resume)") from None
                 self._check_same_layout()
+                # a file written before the work was kept goes on without it
+                self.work = self.work and "work" in self.f["observables"]
                 self.f.swmr_mode = True
                 self.wall_before = self._stored_wall()
             else:
@@ -768,9 +783,13 @@ class FileRecorder:
         p = self.f["particles/bodies"]
         obs = self.f["observables"]
         series = [(_datasets(p["position"]), 2, None), (_datasets(p["velocity"]), 3, None)]
-        series += [(_datasets(obs[name]), 4, name) for name in self.sim.monitors]
-        inloop = {name: _datasets(obs["in_loop"][name]) for name in self.sim.monitors}
+        names = self._series_names()
+        series += [(_datasets(obs[name]), 4, name) for name in names]
+        inloop = {name: _datasets(obs["in_loop"][name]) for name in names}
         return series, inloop
+
+    def _series_names(self):
+        return tuple(self.sim.monitors) + (("work",) if self.work else ())
 
     def _largest_so_far(self):
         # a resumed run's largest errors include those of its outputs and
@@ -782,11 +801,18 @@ class FileRecorder:
             if name not in sim.monitors:
                 continue
             g = obs[name]["value"]
-            self._note(name, g[first:self.rows])
+            values = g[first:self.rows]
+            if name == "energy" and self.work:
+                values = values + obs["work"]["value"][first:self.rows]
+            self._note(name, values)
             t = obs["in_loop"][name]["time"][()]
             keep = (t > plan.start_time) & (t <= sim.time_value)
             if keep.any():
-                self._note(name, obs["in_loop"][name]["value"][np.flatnonzero(keep)])
+                rows = np.flatnonzero(keep)
+                values = obs["in_loop"][name]["value"][rows]
+                if name == "energy" and self.work:
+                    values = values + obs["in_loop"]["work"]["value"][rows]
+                self._note(name, values)
 
     def _note(self, name, values):
         from ..monitors import relative_error, vector_relative_error
@@ -794,8 +820,9 @@ class FileRecorder:
         if not len(values):
             return
         if name == "energy":
-            err = relative_error(np.asarray(values, dtype=float).reshape(-1), ref[0],
-                                 scale=self.scales[0])
+            # values are E + W, against E0 + W0
+            err = relative_error(np.asarray(values, dtype=float).reshape(-1),
+                                 ref[0] + float(_work_column(ref)), scale=self.scales[0])
         else:
             err = vector_relative_error(np.asarray(values, dtype=float).reshape(-1, 3),
                                         ref[1:4], self.scales[1])
@@ -806,7 +833,7 @@ class FileRecorder:
     def _note_rows(self, rows):
         names = self.sim.monitors
         if "energy" in names:
-            self._note("energy", rows[:, 0])
+            self._note("energy", rows[:, 0] + _work_column(rows))
         if "angular_momentum" in names:
             self._note("angular_momentum", rows[:, 1:4])
 
@@ -865,7 +892,7 @@ class FileRecorder:
         ...                start_step=0)
         >>> rec = hdf5.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
         >>> import numpy as np
-        >>> rec.monitor_rows(np.array([1.0]), np.zeros((1, 10)))
+        >>> rec.monitor_rows(np.array([1.0]), np.zeros((1, 11)))
         >>> len(rec.mon_buffer)
         1
         >>> rec.close()
@@ -979,7 +1006,7 @@ class FileRecorder:
                       largest_errors=dict(self.largest))
         if sim.monitors:
             fields.update(monitor_fields(row[None], sim.monitors, self.reference, self.scales,
-                                         sim.units))
+                                         sim.units, work=self.work))
         return Result(**fields)
 
     # writing ---------------------------------------------------------------------------
@@ -995,7 +1022,7 @@ class FileRecorder:
                 values = np.array([b[col] for b in self.buffer])
                 if name is not None:
                     values = values[:, _MONITOR_COLUMNS[name]]
-                    if name == "energy":
+                    if name in _SCALAR_SERIES:
                         values = values[:, 0]
                 _append(dsets, n0, steps, t, values)
             self.rows = n0 + k
@@ -1004,8 +1031,10 @@ class FileRecorder:
             t, steps, rows = (np.concatenate(part) for part in zip(*self.mon_buffer))
             for name, dsets in inloop.items():
                 vals = rows[:, _MONITOR_COLUMNS[name]]
+                if name == "work" and rows.shape[1] <= _MONITOR_COLUMNS["work"].start:
+                    vals = np.zeros((len(rows), 1))   # rows without the work column
                 _append(dsets, dsets[1].shape[0], steps, t,
-                        vals[:, 0] if name == "energy" else vals)
+                        vals[:, 0] if name in _SCALAR_SERIES else vals)
             self.mon_buffer = []
         self.f.flush()
 
@@ -1073,6 +1102,12 @@ class FileRecorder:
 
 def _datasets(group):
     return group["step"], group["time"], group["value"]
+
+
+def _keeps_work(desc):
+    """Whether a file of the simulation ``desc`` describes keeps the work series:
+    with the energy monitor and a non-conservative force term."""
+    return "energy" in desc.monitors and any(not t.conservative for t in desc.forces)
 
 
 def _append(dsets, n0, steps, t, values):
@@ -1151,8 +1186,8 @@ def _create(path, desc, state):
     _element(b, "velocity", (n, 3), (unit("velocity"), unit("time")))
     obs = f.create_group("observables")
     inloop = obs.create_group("in_loop")
-    for name in desc.monitors:
-        shape = () if name == "energy" else (3,)
+    for name in tuple(desc.monitors) + (("work",) if _keeps_work(desc) else ()):
+        shape = () if name in _SCALAR_SERIES else (3,)
         u_ = (unit(_MONITOR_KIND[name]), unit("time"))
         _element(obs, name, shape, u_)
         _element(inloop, name, shape, u_)
@@ -1182,7 +1217,8 @@ def _create(path, desc, state):
         par.attrs[k] = v
     ref = par.create_dataset("reference", data=state.reference)
     ref.attrs["unit"] = ", ".join([unit("energy")] + [unit("angular_momentum")] * 3
-                                  + [unit("momentum")] * 3 + [unit("length")] * 3)
+                                  + [unit("momentum")] * 3 + [unit("length")] * 3
+                                  + [unit("energy")] * (len(state.reference) - 10))
     par.create_dataset("scales", data=np.array(state.scales)).attrs["unit"] = \
         f"{unit('energy')}, {unit('angular_momentum')}"
     par.create_dataset("start_clock", data=np.array(
@@ -1233,11 +1269,14 @@ def _damaged(func):
 def _rows(f, monitors, in_loop=False):
     """Rows that every series of the outputs (or the in-loop monitors) holds: a
     reader of a live file may see one series extended before the next."""
+    obs = f["observables/in_loop"] if in_loop else f["observables"]
+    # the work series, where the file keeps it, goes with the energy's
+    names = list(monitors) + (["work"] if "energy" in monitors and "work" in obs else [])
     if in_loop:
-        groups = [f["observables/in_loop"][name] for name in monitors]
+        groups = [obs[name] for name in names]
     else:
         groups = [f["particles/bodies/position"], f["particles/bodies/velocity"]]
-        groups += [f["observables"][name] for name in monitors]
+        groups += [obs[name] for name in names]
     return min((g[k].shape[0] for g in groups for k in ("step", "time", "value")), default=0)
 
 
@@ -1324,9 +1363,16 @@ def load(path):
         obs = f["observables"]
         for name in monitors:
             fields[name] = q(obs[name]["value"])
+        # the work of non-conservative terms, where the file keeps it
+        work = "energy" in monitors and "work" in obs
+        w0 = float(_work_column(ref))
+        if work:
+            fields["work"] = q(obs["work"]["value"])
         if "energy" in monitors:
-            fields["energy_error"] = relative_error(obs["energy/value"][:n], ref[0],
-                                                    scale=e_scale)
+            e = obs["energy/value"][:n]
+            if work:
+                e = e + obs["work/value"][:n]
+            fields["energy_error"] = relative_error(e, ref[0] + w0, scale=e_scale)
         if "angular_momentum" in monitors:
             fields["angular_momentum_error"] = vector_relative_error(
                 obs["angular_momentum/value"][:n], ref[1:4], l_scale)
@@ -1335,8 +1381,11 @@ def load(path):
         if monitors and m:
             mon = {"times": q(inloop[monitors[0]]["time"], m)}
             if "energy" in monitors:
-                mon["energy_error"] = relative_error(inloop["energy/value"][:m], ref[0],
-                                                     scale=e_scale)
+                e = inloop["energy/value"][:m]
+                if work:
+                    mon["work"] = q(inloop["work"]["value"], m)
+                    e = e + inloop["work/value"][:m]
+                mon["energy_error"] = relative_error(e, ref[0] + w0, scale=e_scale)
             if "angular_momentum" in monitors:
                 mon["angular_momentum_error"] = vector_relative_error(
                     inloop["angular_momentum/value"][:m], ref[1:4], l_scale)

@@ -1,13 +1,14 @@
 """The validation report: accuracy against REBOUND, the solar system against
-the JPL DE421 ephemeris, work against precision, long-horizon drift, a stress
+the JPL DE421 ephemeris, the dissipative force terms against REBOUNDx and
+their analytic rates, work against precision, long-horizon drift, a stress
 suite and a check of a published guide.
 
 ``orbits validate [--quick] [--out DIR]`` (or :func:`validate`) runs it on
 this machine's cores and writes ``report.md`` with its PNG plots into ``DIR``.
 REBOUND is needed (``pip install -e ".[test]"``), and matplotlib for the
-plots; the ephemeris section also runs REBOUNDx where it is installed.  The
-full report takes about ten minutes on two cores, the quick one a few
-minutes; the committed full report is in the repository's
+plots; the ephemeris and dissipative-forces sections also run REBOUNDx where
+it is installed.  The full report takes about ten minutes on two cores, the
+quick one a few minutes; the committed full report is in the repository's
 ``validation/report/``.
 
 Each section is a module with the same three members:
@@ -37,7 +38,8 @@ from ._runner import Pool, Task, run_tasks
 __all__ = ["validate", "SECTIONS", "Task", "Pool", "run_tasks", "ValidationError"]
 
 #: the report's sections, in order (module names in this package)
-SECTIONS = ("accuracy", "ephemeris", "work_precision", "drift", "stress", "guide")
+SECTIONS = ("accuracy", "ephemeris", "dissipative", "work_precision", "drift", "stress",
+            "guide")
 
 
 class ValidationError(RuntimeError):

@@ -48,7 +48,7 @@ class Run:
     def to(self, t_end, max_steps=10**9, every=0, rows=0):
         mon = (every, 1, self.m, self.G, self.na, 0.0)
         mon_t = np.empty(rows)
-        mon_out = np.zeros((rows, 10))
+        mon_out = np.zeros((rows, 11))
         out = self.integ.advance_to(self.ws, self.x, self.v, self.t, t_end, self.force,
                                     self.fargs, mon, self.steps, mon_t, mon_out, None,
                                     max_steps)
@@ -330,7 +330,7 @@ def test_non_finite_force_restores_the_last_good_state():
     ws = integ.workspace(1, 0.01)
     status, t, acc, rej, fev, _ = integ.advance_to(
         ws, x, v, 0.0, 5.0, force, (3, (1, 3)), (0, 0, np.ones(1), 1.0, 1, 0.0), 0,
-        np.empty(0), np.zeros((0, 10)), None, 10**6)
+        np.empty(0), np.zeros((0, 11)), None, 10**6)
     assert status == Status.NON_FINITE
     assert 0 < t <= 1.0
     # a harmonic oscillator: the last good state is exact

@@ -108,7 +108,7 @@ def _advance(name, x, v, dt, n, fargs):
     ws = integ.workspace(x.shape[0])
     mon = (0, 0, np.zeros(x.shape[0]), 1.0, 2, 0.0)
     status, done, _ = integ.advance(ws, x, v, 0.0, dt, n, stepping.gravity_force("small"),
-                                    fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+                                    fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
     assert status == 0 and done == n
     return ws
 

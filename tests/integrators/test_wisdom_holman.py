@@ -73,7 +73,7 @@ def _assert_returns_to_start(integ_config):
     x, v = sim._x, sim._v
     x0, v0 = x.copy(), v.copy()
     mon = (0, 0, sim._m, 1.0, sim._n_active, 0.0)
-    args = (sim._force, sim._fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+    args = (sim._force, sim._fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
     for h in (50.0, -50.0):
         status, _, _ = integ.advance(ws, x, v, 0.0, h, 300, *args)
         assert status == 0
@@ -109,7 +109,7 @@ def test_invalidate_restarts_from_the_inertial_state():
     sim = orbits.Simulation(b, integrator="wh", dt=30 * u.day, monitors=())
     integ = sim.integrator
     mon = (0, 0, sim._m, 1.0, sim._n_active, 0.0)
-    args = (sim._force, sim._fargs, mon, 0, np.empty(0), np.zeros((0, 10)))
+    args = (sim._force, sim._fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
     x, v = sim._x.copy(), sim._v.copy()
     ws = integ.workspace(len(x))
     integ.advance(ws, x, v, 0.0, 30.0, 100, *args)
