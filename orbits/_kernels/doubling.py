@@ -130,11 +130,9 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
             if HAS_WORK:  # noqa: F821
                 work_add(fargs, -0.5 * h * (pa + pb))  # noqa: F821
                 p0 = work_rate(x, v, t, fargs)  # noqa: F821
-            n_before = n_mon
             stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-                sargs)
-            work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+                sargs, fargs)
             if stop != GO:
                 info[0] = sargs[-1][0]
                 info[1] = sargs[-1][1]

@@ -174,11 +174,9 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             if HAS_WORK:  # noqa: F821
                 work_add(fargs, -h * pw)  # noqa: F821
                 p0 = work_rate(x, v, t, fargs)  # noqa: F821
-            n_before = n_mon
             stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-                sargs)
-            work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+                sargs, fargs)
             if stop != GO:
                 info[0] = sargs[-1][0]
                 info[1] = sargs[-1][1]

@@ -557,10 +557,9 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         else:
             ref[1] += dt
 
-        n_before = n_mon
         stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
-            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out, sargs)
-        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out, sargs,
+            fargs)
         if stop != GO:
             sinfo = sargs[6]
             info[0] = sinfo[0]

@@ -392,11 +392,9 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
                 x[i, d] += dt * (v[i, d] + th * hv)
                 v[i, d] += hv
         cache[0] = 1
-        n_before = n_mon
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, mon, n_mon, mon_t, mon_out, sargs)
-        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+            every, mon, n_mon, mon_t, mon_out, sargs, fargs)
         if status != GO:
             if status == Status.NON_FINITE:
                 cache[0] = 0

@@ -91,7 +91,7 @@ GO = -1
 
 
 def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record, every,
-              mon, n_mon, mon_t, mon_out, sargs):
+              mon, n_mon, mon_t, mon_out, sargs, fargs):
     # The epilogue of every loop's step, at time t after step k (of nsteps):
     # the finite check (fixed-step loops, check=True: every check_every
     # steps and after the last; adaptive loops test their error estimate
@@ -111,6 +111,7 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
     if until_record == 0:
         until_record = every
         _record(x, v, t, mon, n_mon, mon_t, mon_out)
+        work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
         n_mon += 1
     stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
     if stop != 0:
@@ -124,14 +125,18 @@ def step_epilogue(force, stop=False):
     """The step epilogue of the loops compiled for a :class:`ForceKernel`
     (``stop``: with the stopping conditions of :mod:`.stopping`)."""
     return epilogue(force.recorder, f"{force.key}{'_stop' if stop else ''}", jit=force.jit,
-                    cache=force.cache, runtime=force.runtime, stop=stop)
+                    cache=force.cache, runtime=force.runtime, stop=stop,
+                    work_note=work_kernels(force)["work_note"])
 
 
-def epilogue(record, key, jit=True, cache=True, runtime=False, stop=False):
+def epilogue(record, key, jit=True, cache=True, runtime=False, stop=False, work_note=None):
     """The step epilogue with monitor recorder ``record``, compiled under ``key``
-    (``runtime``: for loops that need numba's runtime)."""
+    (``runtime``: for loops that need numba's runtime; ``work_note``: what
+    writes the work of non-conservative terms into a monitor row, see
+    :func:`work_kernels`; none by default)."""
     return specialize(_step_end, key, jit=jit, inline=True, nrt=runtime, cache=cache,
-                      _record=record, stop_check=check_stop if stop else no_stop)
+                      _record=record, stop_check=check_stop if stop else no_stop,
+                      work_note=_no_work_note if work_note is None else work_note)
 
 
 # -- forces ------------------------------------------------------------------------
@@ -303,12 +308,10 @@ def _work_add(fargs, dw):
 
 
 @njit(inline="always")
-def _work_note(fargs, mon_out, n_before, n_mon):
-    # a monitor row recorded by this step's epilogue gets the work done so far
-    # (rows of the width before the work column have no room for it)
-    if n_mon > n_before and mon_out.shape[1] > WORK_COLUMN:
-        box = fargs[2][3]
-        mon_out[n_mon - 1, WORK_COLUMN] = box[0] + box[1]
+def _work_note(fargs, mon_out, row):
+    # the monitor row just recorded gets the work done so far
+    box = fargs[2][3]
+    mon_out[row, WORK_COLUMN] = box[0] + box[1]
 
 
 @njit(inline="always")
@@ -322,7 +325,7 @@ def _no_work_add(fargs, dw):
 
 
 @njit(inline="always")
-def _no_work_note(fargs, mon_out, n_before, n_mon):
+def _no_work_note(fargs, mon_out, row):
     pass
 
 
@@ -330,9 +333,9 @@ def work_kernels(force):
     """The bindings of a loop compiled for ``force`` that integrate the work of
     its non-conservative terms (see the module notes): ``HAS_WORK`` and the
     kernels ``work_rate(x, v, t, fargs) -> P``, ``work_add(fargs, dW)`` and
-    ``work_note(fargs, mon_out, n_before, n_mon)`` (records W in a monitor row
-    just written).  For a force without such terms they are no-ops, which
-    compile to nothing."""
+    ``work_note(fargs, mon_out, row)`` (records W in the monitor row just
+    written, called by the step epilogue).  For a force without such terms
+    they are no-ops, which compile to nothing."""
     if force.work is None:
         return dict(HAS_WORK=False, work_rate=_no_work_rate, work_add=_no_work_add,
                     work_note=_no_work_note)
@@ -430,11 +433,9 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
                         for d in range(3):
                             vm[i, d] = v[i, d] - 0.5 * h * acc[i, d]
                     work_add(fargs, -h * work_rate(x, vm, tx, fargs))  # noqa: F821
-        n_before = n_mon
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, mon, n_mon, mon_t, mon_out, sargs)
-        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+            every, mon, n_mon, mon_t, mon_out, sargs, fargs)
         if status != GO:
             cache[0] = 1 if fresh and status != Status.NON_FINITE else 0
             return status, done, n_mon
@@ -535,11 +536,9 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
                 v[i, d] += dt * dv
         if HAS_WORK:  # noqa: F821
             work_add(fargs, -dt * pw)  # noqa: F821
-        n_before = n_mon
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, mon, n_mon, mon_t, mon_out, sargs)
-        work_note(fargs, mon_out, n_before, n_mon)  # noqa: F821
+            every, mon, n_mon, mon_t, mon_out, sargs, fargs)
         if status != GO:
             return status, done, n_mon
     return Status.OK, nsteps, n_mon

@@ -343,7 +343,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             xj, vj, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
             every, (mon, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)),
-            n_mon, mon_t, mon_out, ())
+            n_mon, mon_t, mon_out, (), ())
         if status != GO:
             owed_box[0] = owed
             return status, done, n_mon
@@ -460,19 +460,22 @@ def _kernels(coordinates, terms=None):
     cache = terms is None or terms.cache
     # without numba's runtime: these allocate nothing, and the reference
     # counts of the inlined kernels' array arguments would cost more than a
-    # two-body step's kick (see orbits._kernels._jit)
+    # two-body step's kick (see orbits._kernels._jit).  A user's term (not
+    # cacheable) may return a new array every call, which only the runtime
+    # frees: with it, it runs with the runtime.
+    nrt = not cache
     if terms is None:
-        perturbation = specialize(_plain_perturbation, key, inline=True, nrt=False,
+        perturbation = specialize(_plain_perturbation, key, inline=True, nrt=nrt,
                                   step=step)
     else:
-        kick = specialize(term_kick, key, cache=cache, inline=True, nrt=False,
+        kick = specialize(term_kick, key, cache=cache, inline=True, nrt=nrt,
                           extra=terms.accel)
         perturbation = specialize(_perturbation_with_terms, key, cache=cache, inline=True,
-                                  nrt=False, term_kick=kick,
+                                  nrt=nrt, term_kick=kick,
                                   HELIOCENTRIC=coordinates != "jacobi")
-    corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=False,
+    corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
                            perturbation=perturbation)
-    sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=False,
+    sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt,
                       from_internal=from_internal, apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
 
@@ -491,9 +494,10 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms)
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
-    recorder = specialize(_wh_record, key, cache=cache, nrt=False, synchronize=sync,
+    nrt = not cache
+    recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, synchronize=sync,
                           _record=record)
-    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=False, cache=cache,
+    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
                       perturbation=perturbation, apply_corrector=corrector,

@@ -59,7 +59,8 @@ class RK4Doubling(AdaptiveIntegrator):
         loop = _doubling.doubling_loop(force, stop=stop is not None)
         fargs = _stepping.work_bound(force, fargs, ws)
         w = ws
-        return with_status(*loop(x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
+        return with_status(*loop(x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"],
+                    w["kx"], w["kv"],
                     w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
                     w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
                     _stepping.NO_STOP_ARGS if stop is None else stop, int(max_steps),
