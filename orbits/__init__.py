@@ -10,7 +10,7 @@
 
 from importlib.metadata import PackageNotFoundError, version as _version
 
-from . import errors, forces, integrators, io, monitors, scenes, systemfile
+from . import analysis, errors, forces, integrators, io, monitors, scenes, systemfile
 from .bodies import BodySet
 from .custom import Trajectory, integrate
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, ConvergenceFailure,
@@ -29,7 +29,7 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0+unknown"
 
 __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajectory",
-           "scenes", "integrators", "monitors", "errors", "forces", "OrbitsError",
+           "scenes", "integrators", "monitors", "analysis", "errors", "forces", "OrbitsError",
            "BodyError", "ForceTermError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow", "ConvergenceFailure",
