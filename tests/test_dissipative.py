@@ -587,6 +587,7 @@ def test_terms_round_trip_through_dicts(term):
     assert back.velocity_dependent is True
 
 
+@pytest.mark.slow  # 27 s of compiling on a fresh clone; the restart test below covers it
 def test_simulation_runs_and_terms_rebuilt_from_dicts_run_bit_identically():
     # what a restart or an ensemble rebuilds from the dictionaries binds to the same
     # floats: the two runs agree bit for bit.  Migration with its default primary
@@ -620,7 +621,9 @@ def _dissipative_sim(integrator="ias15", dt=None):
     return orbits.Simulation(_dusty(), integrator, dt=dt, forces=terms)
 
 
-@pytest.mark.parametrize("integrator, dt", [("ias15", None), ("leapfrog", 0.5 * u.day)])
+@pytest.mark.parametrize("integrator, dt", [
+    ("ias15", None),
+    pytest.param("leapfrog", 0.5 * u.day, marks=pytest.mark.slow)])  # 22 s compiling
 def test_restart_with_dissipative_terms_is_bit_identical(tmp_path, integrator, dt):
     # a run stopped half-way and continued from its file: the same floats as one
     # run straight through, the terms rebuilt from the file and the work W
@@ -648,6 +651,7 @@ def _migrating(a):
         forces.RadiationPressure("Star", beta=0.0)])
 
 
+@pytest.mark.slow  # 27 s: the workers compile their loops; test_forces checks the mechanism
 def test_ensemble_rows_with_dissipative_terms_serial_and_two_workers():
     # the workers rebuild the terms from the configuration: identical rows
     pytest.importorskip("distributed")
