@@ -15,8 +15,8 @@ import orbits
 from orbits import forces
 from test_forces import inner_with_jupiter
 
-rebound = pytest.importorskip("rebound")
-reboundx = pytest.importorskip("reboundx")
+import rebound  # noqa: E402 - test dependencies: missing is an error, not a skip
+import reboundx  # noqa: E402
 
 C_AU_DAY = const.c.to_value(u.au / u.day)
 YEARS = 100
