@@ -169,6 +169,20 @@ class Driven:
 
     _wall_limit = None
 
+    @property
+    def _X(self):
+        # the arrays the compiled loops advance: the state, and after it the
+        # tangent rows of a run with variations (orbits.Simulation)
+        return self._x
+
+    @property
+    def _V(self):
+        return self._v
+
+    def _renormalise(self):
+        # scale back the chaos indicators' tangent vector (a run with them only)
+        raise NotImplementedError
+
     def execute(self, plan, rec, progress, first_mark=0):
         """Carry out ``plan`` from its output ``first_mark`` on (resuming).
 
@@ -229,9 +243,9 @@ class Driven:
             mon_out = np.zeros((size, MONITOR_WIDTH))
             mon = self._mon(every)
             t0 = _time.perf_counter()
-            with restored_on_error(self._x, self._v, self._ws):
+            with restored_on_error(self._X, self._V, self._ws):
                 status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
-                    self._ws, self._x, self._v, self._t_base, t_end, self._force,
+                    self._ws, self._X, self._V, self._t_base, t_end, self._force,
                     self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)
             elapsed = _time.perf_counter() - t0
             if n_mon:
@@ -240,6 +254,10 @@ class Driven:
             self.steps += int(acc)
             self.steps_rejected += int(rej)
             self.force_evaluations += int(fev)
+            if status == Status.RENORMALISE:
+                self._renormalise()
+                self._between_chunks(rec, wall0)
+                continue
             if status != Status.OK:
                 if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
                     self._stop_info[:] = self._ws["info"]
@@ -315,23 +333,34 @@ class Driven:
     def _advance(self, n, rec, wall0, dt=None):
         dt = self._dt if dt is None else dt
         every = self.monitor_every or 0
-        if every:
-            first = (self.steps // every + 1) * every  # next step index that records
-            size = max(0, (self.steps + n - first) // every + 1)
-        else:
-            size = 0
-        mon_t = np.empty(size)
-        mon_out = np.zeros((size, MONITOR_WIDTH))
         mon = self._mon(every)
-        status, steps, n_mon, self._ws = advance_checked(
-            self.integrator, self._ws, self._x, self._v, self._now(), dt, n, self._force,
-            self._fargs, mon, self.steps, mon_t, mon_out, stop=self._stop)
-        if n_mon:
-            rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
+        left = n
+        while True:
+            if every:
+                first = (self.steps // every + 1) * every  # next step index that records
+                size = max(0, (self.steps + left - first) // every + 1)
+            else:
+                size = 0
+            mon_t = np.empty(size)
+            mon_out = np.zeros((size, MONITOR_WIDTH))
+            status, steps, n_mon, self._ws = advance_checked(
+                self.integrator, self._ws, self._X, self._V, self._now(), dt, left,
+                self._force, self._fargs, mon, self.steps, mon_t, mon_out, stop=self._stop)
+            if n_mon:
+                rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
+            if status != Status.RENORMALISE:
+                break
+            # the chaos indicators' tangent vector grew large: scaled back, the
+            # rest of the chunk goes on
+            self._count(steps, dt)
+            self._renormalise()
+            left -= steps
+            if left == 0:
+                return
         if status != Status.OK:
             self._count(steps, dt)
             self._fail(status, rec, wall0)
-        self._count(n, dt)
+        self._count(left, dt)
 
     def _count(self, n, dt):
         if n == 0:

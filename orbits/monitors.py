@@ -9,7 +9,7 @@ import numpy as np
 
 from ._kernels import invariants as _inv
 
-__all__ = ["MONITORS", "DEFAULT_MONITORS", "monitor_mask", "relative_error",
+__all__ = ["MONITORS", "CHAOS_MONITORS", "DEFAULT_MONITORS", "monitor_mask", "relative_error",
            "vector_relative_error", "growth_exponent", "ensemble_growth_exponent",
            "monitor_fields"]
 
@@ -19,7 +19,13 @@ MONITORS = {
     "angular_momentum": _inv.ANGULAR_MOMENTUM,
     "momentum": _inv.MOMENTUM,
     "center_of_mass": _inv.CENTER_OF_MASS,
+    "megno": _inv.MEGNO,
+    "lyapunov": _inv.LYAPUNOV,
+    "fli": _inv.FLI,
 }
+
+#: the monitors that need a tangent vector (orbits._kernels.variational)
+CHAOS_MONITORS = ("megno", "lyapunov", "fli")
 
 DEFAULT_MONITORS = ("energy", "angular_momentum")
 
@@ -297,6 +303,14 @@ def monitor_fields(rows, monitors, reference, scales, units, work=False):
         out["momentum"] = q(rows[:, 4:7], "momentum")
     if "center_of_mass" in monitors:
         out["center_of_mass"] = q(rows[:, 7:10], "length")
+    col = _inv.MONITOR_COLUMNS.index("megno")
+    if rows.shape[1] > col:
+        if "megno" in monitors:
+            out["megno"] = rows[:, col].copy()
+        if "lyapunov" in monitors:
+            out["lyapunov"] = rows[:, col + 1] / q(1.0, "time")
+        if "fli" in monitors:
+            out["fli"] = rows[:, col + 2].copy()
     return out
 
 

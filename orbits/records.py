@@ -106,6 +106,8 @@ class SimulationConfig(NamedTuple):
     monitors: tuple
     monitor_every: object   # int or None
     stop_conditions: dict   # Simulation keyword -> value
+    variations: object = None  # None, "state", "all" or an int
+    seed: object = None        # the seed of the random tangent vectors (int) or None
 
     def to_dict(self):
         """Plain values: Quantities as ``[value, unit]``.
@@ -125,7 +127,8 @@ class SimulationConfig(NamedTuple):
                 "dt": _quantity_dict(self.dt), "forces": list(self.forces),
                 "monitors": list(self.monitors), "monitor_every": self.monitor_every,
                 "stop_conditions": {k: (_quantity_dict(v) if isinstance(v, u.Quantity) else v)
-                                    for k, v in self.stop_conditions.items()}}
+                                    for k, v in self.stop_conditions.items()},
+                "variations": self.variations, "seed": self.seed}
 
     @classmethod
     def from_dict(cls, d):
@@ -152,7 +155,8 @@ class SimulationConfig(NamedTuple):
         from .forces import _quantity_from
         return cls(d["integrator"], dict(d["integrator_options"]), _quantity_from(d["dt"]),
                    tuple(d["forces"]), tuple(d["monitors"]), d["monitor_every"],
-                   {k: _quantity_from(v) for k, v in d["stop_conditions"].items()})
+                   {k: _quantity_from(v) for k, v in d["stop_conditions"].items()},
+                   d.get("variations"), d.get("seed"))
 
 
 class SimulationState(NamedTuple):

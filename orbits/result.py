@@ -36,7 +36,8 @@ _ELEMENT_KEYS = ("a", "e", "inc", "Omega", "omega", "f", "M")
 #: export: (attribute, is a 3-vector).
 _MONITOR_SERIES = (("energy", False), ("work", False), ("energy_error", False),
                    ("angular_momentum", True), ("angular_momentum_error", False),
-                   ("momentum", True), ("center_of_mass", True))
+                   ("momentum", True), ("center_of_mass", True), ("megno", False),
+                   ("lyapunov", False), ("fli", False))
 
 
 class Result:
@@ -67,6 +68,22 @@ class Result:
         ``|L - L0| / |L0|`` (see :func:`orbits.monitors.vector_relative_error`).
     momentum, center_of_mass : Quantity, shape (n, 3) or None
         When those monitors are on.
+    megno, fli : ndarray, shape (n,) or None
+        With those monitors: the running mean of MEGNO (Cincotta & Simo
+        2000; tends to 2 on a regular orbit and grows as ``lambda t / 2`` on a
+        chaotic one) and the fast Lyapunov indicator ``max ln |delta|`` at
+        the outputs (see :class:`orbits.Simulation`'s ``monitors``).
+    lyapunov : Quantity (1 / time), shape (n,) or None
+        With that monitor: the largest Lyapunov exponent's estimate
+        ``ln(|delta(t)| / |delta(0)|) / t`` at the outputs.
+    jacobian : ndarray, shape (6N, 6N) or (6N, 7N), or None
+        With ``variations="state"`` or ``"all"``: the derivatives of the final
+        state with respect to the initial one (see
+        :attr:`orbits.Simulation.jacobian`).
+    tangent_vectors : ndarray, shape (k, N, 6) or None
+        With variations or chaos monitors: the final tangent vectors (see
+        :attr:`orbits.Simulation.tangent_vectors`); ``seed`` is the seed of
+        the random ones.
     monitor : dict or None
         Series recorded inside the compiled loop every ``monitor_every``
         steps: ``times`` and the same error arrays as above.
@@ -114,6 +131,8 @@ class Result:
         self.energy = self.energy_error = self.work = None
         self.angular_momentum = self.angular_momentum_error = None
         self.momentum = self.center_of_mass = None
+        self.megno = self.lyapunov = self.fli = None
+        self.jacobian = self.tangent_vectors = self.seed = None
         self.status = "completed"
         self.steps_rejected = 0
         self.forces = ()

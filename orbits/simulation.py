@@ -62,8 +62,14 @@ class Simulation(Driven):
         unit system explicitly.
     monitors : sequence of str
         Any of ``"energy"``, ``"angular_momentum"``, ``"momentum"``,
-        ``"center_of_mass"``.  Default: energy and angular momentum.  An empty
-        sequence switches them off and costs nothing.
+        ``"center_of_mass"``, and the chaos indicators ``"megno"`` (the running
+        mean of MEGNO, Cincotta & Simo 2000: 2 on a regular orbit, growing as
+        ``lambda t / 2`` on a chaotic one), ``"lyapunov"`` (the largest
+        Lyapunov exponent's estimate ``ln(|delta(t)| / |delta(0)|) / t``, in
+        1 / time) and ``"fli"`` (the fast Lyapunov indicator,
+        ``max ln |delta|``), from a tangent vector integrated alongside (see
+        ``variations`` and ``seed``).  Default: energy and angular momentum.
+        An empty sequence switches them off and costs nothing.
     monitor_every : int, optional
         Also record the monitors inside the compiled loop every this many
         steps (in ``result.monitor``).  Default: only at outputs.
@@ -86,6 +92,20 @@ class Simulation(Driven):
         With ``escape_distance``: count a body beyond it only if it is also
         unbound (positive energy about the centre of mass).
 
+    variations : {None, "state", "all"} or int, optional
+        Integrate the first-order variational equations alongside
+        (:mod:`orbits._kernels.variational`): ``"state"`` the derivatives of
+        the state with respect to every initial position and velocity,
+        ``"all"`` also with respect to every mass, an int that many random
+        tangent vectors (unit norm over positions and velocities, from
+        ``seed``).  Each force term contributes through its Jacobian.  The
+        derivatives of the current state are :attr:`jacobian` and
+        :attr:`tangent_vectors`, and the result of a run and its file carry
+        them.  The chaos monitors (``"megno"``, ``"lyapunov"``, ``"fli"``) add
+        a random tangent vector of their own.
+    seed : int, optional
+        Seed of the random tangent vectors (the chaos monitors' and an int
+        ``variations``); the same seed gives the same vectors and results.
     rebound_arithmetic : bool
         Compute gravity with REBOUND's floating-point operations (its serial
         ``gravity = "basic"``), so that ``leapfrog`` reproduces REBOUND's
@@ -111,7 +131,7 @@ class Simulation(Driven):
     def __init__(self, bodies, integrator="verlet", dt=None, *, forces=(),
                  monitors=DEFAULT_MONITORS, monitor_every=None, softening=None, parallel=None,
                  encounter_distance=None, encounter_hill=None, escape_distance=None,
-                 escape_unbound=False, rebound_arithmetic=False):
+                 escape_unbound=False, rebound_arithmetic=False, variations=None, seed=None):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
@@ -173,13 +193,19 @@ class Simulation(Driven):
         self._stop_info = np.zeros(2, dtype=np.int64)
         self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
                                      escape_unbound)
-        self._ws = (self.integrator.workspace(n, self._dt) if adaptive
-                    else self.integrator.workspace(n))
+        # the force without variations, and its arguments
+        self._base_force, self._base_fargs = self._force, self._fargs
+        self._bind_variations(variations, seed)
+        rows = len(self._rows_x)
+        self._ws = (self.integrator.workspace(rows, self._dt) if adaptive
+                    else self.integrator.workspace(rows))
         self.integrator.bind(self._ws, self._force, self._fargs)
-        if self._force.work is not None:
+        if self._base_force.work is not None:
             # W lives in the workspace, so that it is saved, restored and
             # checkpointed with the state it belongs to
-            self._ws["work"] = self._fargs[2][3]
+            self._ws["work"] = self._base_fargs[2][3]
+        if self._chaos_box is not None:
+            self._ws["chaos"] = self._chaos_box
         self.steps_rejected = 0
         self._t_base = 0.0          # time = t_base + steps_since_base * dt
         self._steps_since_base = 0
@@ -196,6 +222,148 @@ class Simulation(Driven):
         self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
+
+    def _bind_variations(self, variations, seed):
+        """Tangent rows after the bodies' and the force of the augmented system
+        (:mod:`orbits._kernels.variational`), for ``variations`` and the chaos
+        monitors."""
+        from ._kernels import variational as _var
+        from .monitors import CHAOS_MONITORS
+        n = len(self._m)
+        chaos = any(name in CHAOS_MONITORS for name in self.monitors)
+        if variations is None:
+            n_state, n_mass, n_random = 0, 0, 0
+        elif isinstance(variations, str) and variations in ("state", "all"):
+            n_state, n_mass, n_random = 6 * n, (n if variations == "all" else 0), 0
+        elif (isinstance(variations, numbers.Integral) and not isinstance(variations, bool)
+              and variations >= 1):
+            n_state, n_mass, n_random = 0, 0, int(variations)
+        else:
+            raise IntegratorOptionError(
+                f"variations must be None, 'state', 'all' or a whole number of random "
+                f"tangent vectors >= 1, got {variations!r}")
+        if seed is not None and not isinstance(seed, numbers.Integral):
+            raise IntegratorOptionError(f"seed must be an integer, got {seed!r}")
+        if seed is None and (chaos or n_random):
+            # drawn once and kept in the config, so that a rebuilt simulation
+            # (a file, an ensemble's member) starts from the same vectors
+            seed = int(np.random.SeedSequence().entropy % 2 ** 63)
+        self._variations = variations
+        self._seed = None if seed is None else int(seed)
+        self._n_chaos = int(chaos)
+        k = self._n_chaos + n_random + n_state + n_mass
+        self._n_tangent = k
+        self._tangent_layout = (self._n_chaos, n_random, n_state, n_mass)
+        self._rows_x = np.zeros((n * (1 + k), 3))
+        self._rows_v = np.zeros((n * (1 + k), 3))
+        self._rows_x[:n] = self._x
+        self._rows_v[:n] = self._v
+        self._x = self._rows_x[:n]
+        self._v = self._rows_v[:n]
+        self._chaos_box = None
+        if k == 0:
+            return
+        if n_mass and self._terms:
+            raise IntegratorOptionError(
+                "variations='all' (derivatives with respect to the masses) take gravity's "
+                "dependence on the masses only, and the force terms "
+                f"{', '.join(map(repr, self._terms))} depend on them too; use "
+                "variations='state', or drop the terms")
+        dx, dv, dm = self._initial_tangents(n, seed)
+        self._rows_x[n:] = dx.reshape(-1, 3)
+        self._rows_v[n:] = dv.reshape(-1, 3)
+        self._chaos_box = _var.chaos_box(0.0)
+        self._force = _var.with_variations(self._base_force, masses=bool(n_mass), chaos=chaos)
+        self._fargs = _var.variation_args(self._base_fargs, n, dm, self._chaos_box,
+                                          self.units.G, self._eps2)
+
+    def _initial_tangents(self, n, seed):
+        # (k, n, 3) position and velocity parts and (k, n) mass parts, in the
+        # internal (massive first) order: the chaos vector, the random ones,
+        # then a unit vector per initial coordinate of each body in the body
+        # set's order (x, y, z, vx, vy, vz), then per mass
+        n_chaos, n_random, n_state, n_mass = self._tangent_layout
+        k = self._n_tangent
+        dx = np.zeros((k, n, 3))
+        dv = np.zeros((k, n, 3))
+        dm = np.zeros((k, n))
+        rng = np.random.default_rng(seed)
+        for j in range(n_chaos + n_random):
+            w = rng.standard_normal((2, n, 3))
+            w /= np.sqrt(np.sum(w * w))
+            dx[j], dv[j] = w
+        j = n_chaos + n_random
+        inv = self._inverse
+        for b in range(n if n_state else 0):
+            for c in range(6):
+                (dx if c < 3 else dv)[j + 6 * b + c, inv[b], c % 3] = 1.0
+        j += n_state
+        for b in range(n_mass):
+            dm[j + b, inv[b]] = 1.0
+        return dx, dv, dm
+
+    @property
+    def _X(self):
+        return self._rows_x
+
+    @property
+    def _V(self):
+        return self._rows_v
+
+    def _renormalise(self):
+        from ._kernels import variational as _var
+        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
+        _var.renormalise(self._rows_x, self._rows_v, len(self._m), self._ws["chaos"])
+        self.integrator.invalidate(self._ws)
+
+    def _tangent_rows(self):
+        """The tangent vectors now, shape (k, N, 6) in the body set's order, and
+        the mass parts (k, N)."""
+        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
+        n = len(self._m)
+        k = self._n_tangent
+        t = np.concatenate([self._rows_x[n:].reshape(k, n, 3),
+                            self._rows_v[n:].reshape(k, n, 3)], axis=2)
+        return t[:, self._inverse]
+
+    @property
+    def tangent_vectors(self):
+        """The tangent vectors now (None without variations): an array of shape
+        (k, N, 6), each the derivative of the state (positions, then
+        velocities, bodies in the body set's order, in the internal units)
+        along its initial direction.  The chaos monitors' vector comes first
+        (renormalised, so only its direction is meaningful), then the random
+        ones, then those of ``variations="state"`` or ``"all"``."""
+        if not self._n_tangent:
+            return None
+        return self._tangent_rows()
+
+    @property
+    def jacobian(self):
+        """The derivatives of the current state with respect to the initial one
+        (with ``variations="state"`` or ``"all"``; None otherwise): an array
+        of shape (6N, 6N), or (6N, 7N) with the masses, whose entry ``[6 i +
+        c, 6 j + d]`` is the derivative of body i's coordinate c (x, y, z, vx,
+        vy, vz) with respect to body j's initial coordinate d, bodies in the
+        body set's order, and column ``6N + j`` that with respect to body j's
+        mass; in the simulation's internal units (:attr:`units`).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+        ...                         variations="state")
+        >>> _ = sim.run(until=1 * u.yr, outputs=2, progress=False)
+        >>> sim.jacobian.shape
+        (12, 12)
+        """
+        n_chaos, n_random, n_state, n_mass = self._tangent_layout
+        if not n_state:
+            return None
+        t = self._tangent_rows()[n_chaos + n_random:]
+        n = len(self._m)
+        return t.reshape(n_state + n_mass, 6 * n).T.copy()
 
     def _bind_terms(self, bodies):
         """Compile gravity and the added terms into one force (see :mod:`orbits.forces`).
@@ -241,7 +409,8 @@ class Simulation(Driven):
             None if (self.integrator.adaptive and self._dt == 0) else self.dt,
             tuple([self.gravity.to_dict()] + [t.to_dict() for t in self._terms]),
             tuple(self.monitors), self.monitor_every,
-            {k: v for k, v in self.stop_conditions.items() if v is not None and v is not False})
+            {k: v for k, v in self.stop_conditions.items() if v is not None and v is not False},
+            self._variations, self._seed)
 
     @classmethod
     def from_config(cls, bodies, config):
@@ -264,7 +433,8 @@ class Simulation(Driven):
         terms = [t if isinstance(t, _forces.ForceTerm) else _forces.from_dict(t)
                  for t in config.forces]
         return cls(bodies, integ, dt=config.dt, forces=terms, monitors=config.monitors,
-                   monitor_every=config.monitor_every, **config.stop_conditions)
+                   monitor_every=config.monitor_every, variations=config.variations,
+                   seed=config.seed, **config.stop_conditions)
 
     @property
     def forces(self):
@@ -520,7 +690,7 @@ class Simulation(Driven):
         >>> b.names, b.positions.unit
         (['Star', 'Planet'], Unit("AU"))
         """
-        self.integrator.synchronize(self._ws, self._x, self._v)
+        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
         inv = np.argsort(self._order)
         bs = BodySet(self.units)
         bs._bare_ok = self._bare_ok
@@ -547,8 +717,15 @@ class Simulation(Driven):
         return SimulationState(
             self._x.copy(), self._v.copy(), self._order.copy(), self._t_base,
             self._steps_since_base, self.steps, self.force_evaluations, self.steps_rejected,
-            {k: a.copy() for k, a in self._ws.items() if isinstance(a, np.ndarray)},
-            self._reference.copy(), (self._E_scale, self._L_scale))
+            self._saved_workspace(), self._reference.copy(), (self._E_scale, self._L_scale))
+
+    def _saved_workspace(self):
+        # the workspace's arrays, and the tangent rows of a run with variations
+        ws = {k: a.copy() for k, a in self._ws.items() if isinstance(a, np.ndarray)}
+        if self._n_tangent:
+            n = len(self._m)
+            ws["tangent"] = np.stack([self._rows_x[n:], self._rows_v[n:]])
+        return ws
 
     def set_state(self, state):
         """Put back a :class:`SimulationState` taken from a simulation made alike
@@ -578,6 +755,14 @@ class Simulation(Driven):
         for name, arr in state.workspace.items():
             if name in self._ws:
                 self._ws[name][...] = arr
+        if self._n_tangent:
+            tangent = state.workspace.get("tangent")
+            if tangent is None or tangent.shape != (2,) + self._rows_x[len(self._m):].shape:
+                raise ValueError("the state has no tangent vectors of this simulation's "
+                                 "variations")
+            n = len(self._m)
+            self._rows_x[n:] = tangent[0]
+            self._rows_v[n:] = tangent[1]
         # a reference row written before the work column was kept: its work is 0
         ref = np.asarray(state.reference, dtype=float)
         self._reference = np.zeros(max(_inv.MONITOR_WIDTH, len(ref)))
@@ -632,7 +817,7 @@ class Simulation(Driven):
         >>> snap.t, snap.steps, snap.x.shape
         (0.0, 0, (2, 3))
         """
-        self.integrator.synchronize(self._ws, self._x, self._v)
+        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
         row = np.zeros(_inv.MONITOR_WIDTH)
         if self._mask:
             self._monitor_row(row)
@@ -658,14 +843,18 @@ class Simulation(Driven):
         _inv.monitor_row(self._x, self._v, self._m, self.units.G, self._n_active, self._eps2,
                          self._mask, row)
         if self._eargs is not None and self._mask & _inv.ENERGY:
-            row[0] += self._force.terms.energy(self._x, self._v, self._eargs)
+            row[0] += self._base_force.terms.energy(self._x, self._v, self._eargs)
             row[_inv.WORK_COLUMN] = _stepping.work_total(self._ws)
+        if self._chaos_box is not None:
+            from ._kernels.variational import chaos_values
+            col = _inv.MONITOR_COLUMNS.index("megno")
+            row[col:col + 3] = chaos_values(self._ws["chaos"])
         return row
 
     @property
     def _has_work(self):
         # non-conservative terms, whose work the loops integrate
-        return self._force.work is not None
+        return self._base_force.work is not None
 
     @property
     def work(self):
@@ -1010,6 +1199,10 @@ class _Recorder:
             integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
             monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
             forces=tuple(map(repr, sim.forces)), start_time=q(self.t0, "time"))
+        if sim._n_tangent:
+            fields["jacobian"] = sim.jacobian
+            fields["tangent_vectors"] = sim.tangent_vectors
+            fields["seed"] = sim._seed
         ref = sim._reference
         if self.rows:
             fields.update(_monitor_fields(np.array(self.rows), sim, ref))

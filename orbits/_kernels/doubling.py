@@ -20,6 +20,7 @@ from ._jit import specialize
 from .embedded import initial_step, next_step, step_underflow
 from .status import Status
 from .stepping import GO, step_epilogue, work_kernels
+from .variational import measured_rows
 
 __all__ = ["doubling_loop"]
 
@@ -69,7 +70,9 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
     fev = 0
     info[0] = -1
     info[1] = -1
-    ncomp = 6 * n
+    # the error measures the bodies' rows (not the tangent rows of variations)
+    ne = rows(x, fargs)  # noqa: F821 - bound by specialize
+    ncomp = 6 * ne
     if fsal[0] == 0:
         force(x, v, t, fargs, k0v)  # noqa: F821
         fev += 1
@@ -79,7 +82,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         fsal[0] = 1
     h_prop = dtbox[0]
     if h_prop <= 0.0:
-        h_prop = initial_step(x, v, k0x, k0v, rtol, atol, t_end - t)
+        h_prop = initial_step(x[:ne], v[:ne], k0x[:ne], k0v[:ne], rtol, atol, t_end - t)
     status = Status.OK
     p0 = 0.0
     if HAS_WORK:  # noqa: F821 - bound by specialize
@@ -104,7 +107,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                       x2, v2, fargs, pm, True)
         fev += 10
         err = 0.0
-        for i in range(n):
+        for i in range(ne):
             for d in range(3):
                 sx = atol + rtol * max(abs(x[i, d]), abs(x2[i, d]))
                 sv = atol + rtol * max(abs(v[i, d]), abs(v2[i, d]))
@@ -156,4 +159,5 @@ def doubling_loop(force, stop=False):
                       HAS_WORK=work["HAS_WORK"], work_rate=work["work_rate"])
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, rk4_step=step,
-                      step_end=step_epilogue(force, stop), **work)
+                      step_end=step_epilogue(force, stop), rows=measured_rows(force),
+                      **work)

@@ -25,6 +25,7 @@ import math
 from ._jit import njit, specialize
 from .status import Status
 from .stepping import GO, step_epilogue, work_kernels
+from .variational import measured_rows
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
            "FAC_MIN", "FAC_MAX"]
@@ -84,7 +85,9 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     fev = 0
     info[0] = -1
     info[1] = -1
-    ncomp = 6 * n
+    # the error measures the bodies' rows (not the tangent rows of variations)
+    ne = rows(x, fargs)  # noqa: F821 - bound by specialize
+    ncomp = 6 * ne
     if fsal[0] == 0:
         force(x, v, t, fargs, kv[0])  # noqa: F821 - bound by specialize
         fev += 1
@@ -94,7 +97,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
         fsal[0] = 1
     h_prop = dtbox[0]
     if h_prop <= 0.0:
-        h_prop = initial_step(x, v, kx[0], kv[0], rtol, atol, t_end - t)
+        h_prop = initial_step(x[:ne], v[:ne], kx[0, :ne], kv[0, :ne], rtol, atol, t_end - t)
     status = Status.OK
     p0 = 0.0
     if HAS_WORK:  # noqa: F821 - bound by specialize
@@ -138,7 +141,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
         fev += 1
         err5 = 0.0
         err3 = 0.0
-        for i in range(n):
+        for i in range(ne):
             for d in range(3):
                 ex = 0.0
                 ev = 0.0
@@ -197,4 +200,5 @@ def embedded_loop(force, has_e3, stop=False):
     key = f"{force.key}{'_e3' if has_e3 else ''}{'_stop' if stop else ''}"
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),
-                      step_end=step_epilogue(force, stop), **work_kernels(force))
+                      step_end=step_epilogue(force, stop), rows=measured_rows(force),
+                      **work_kernels(force))

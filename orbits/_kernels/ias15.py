@@ -63,6 +63,7 @@ import numpy as np
 from ._jit import njit, specialize
 from .status import Status
 from .stepping import GO, step_epilogue, work_kernels
+from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
            "PC_MAX_ITERATIONS", "MODE_GLOBAL", "MODE_PRS24", "ias15_loop", "B6_ROUNDING_GAIN",
@@ -296,6 +297,8 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     # used only when the loop is called again at the time it returned.
     # counts: (accepted, rejected, force evaluations) of this call.
     n = x.shape[0]
+    # the step control measures the bodies' rows (not the tangent rows of variations)
+    ne = rows(x, fargs)  # noqa: F821 - bound by specialize
     every = mon[0]
     cap = mon_t.shape[0]
     n_mon = 0
@@ -328,7 +331,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 return Status.NON_FINITE, t, n_mon
         proposed = dtp[0]
         if proposed == 0.0 or not math.isfinite(proposed):
-            proposed = _first_step(x, a0, t_end - t)
+            proposed = _first_step(x[:ne], a0[:ne], t_end - t)
         proposed = abs(proposed) * direction
         remaining = (t_end - t) - ct
         trimmed = abs(proposed) >= abs(remaining)
@@ -386,7 +389,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                         g[sub - 1, i, d] = r
                         for m in range(sub):
                             b[m, i, d] += _C[m, sub - 1] * dg
-                        if sub == 7:
+                        if sub == 7 and i < ne:
                             db = abs(dg)
                             if db > maxdb6 or not db == db:
                                 maxdb6 = db
@@ -417,7 +420,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         worst = -1
         maxb6 = 0.0
         maxa = 0.0
-        for i in range(n):
+        for i in range(ne):
             for d in range(3):
                 bb = abs(b[6, i, d])
                 if bb > maxb6 or not bb == bb:
@@ -435,7 +438,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
             # would not make it smaller (it stays at the rounding level whatever
             # the step, and the step would shrink towards zero in a close
             # encounter); keep the step instead
-            if abs(dt_new) < abs(dt) and maxb6 <= _b6_rounding(x, xs, a0, acc, n):
+            if abs(dt_new) < abs(dt) and maxb6 <= _b6_rounding(x, xs, a0, acc, ne):
                 dt_new = dt
         elif maxb6 == maxb6:
             dt_new = dt / SAFETY
@@ -444,7 +447,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         if mode == MODE_PRS24 and dt_new == dt_new:
             tau2 = math.inf
             worst_prs = -1
-            for i in range(n):
+            for i in range(ne):
                 y2 = 0.0
                 y3 = 0.0
                 y4 = 0.0
@@ -623,4 +626,4 @@ def ias15_loop(force, stop=False):
     return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force, stop), PREDICT_V=predict_v,
-                      **work_kernels(force), **helpers)
+                      rows=measured_rows(force), **work_kernels(force), **helpers)

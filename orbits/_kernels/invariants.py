@@ -19,12 +19,18 @@ ENERGY = 1
 ANGULAR_MOMENTUM = 2
 MOMENTUM = 4
 CENTER_OF_MASS = 8
+#: the chaos indicators (not computed by monitor_row; see MONITOR_COLUMNS)
+MEGNO = 16
+LYAPUNOV = 32
+FLI = 64
 #: column layout of a monitor row; "work" is W, the energy the non-conservative
 #: force terms have taken out since the simulation was made (written by the
 #: loops that integrate it, not by :func:`monitor_row`: it is not a function of
-#: the state), so that E + W is the conserved quantity
+#: the state), so that E + W is the conserved quantity; "megno", "lyapunov"
+#: and "fli" are the chaos indicators of a run with them (written by the
+#: loops too, from the tangent vector: orbits._kernels.variational)
 MONITOR_COLUMNS = ("energy", "Lx", "Ly", "Lz", "px", "py", "pz", "comx", "comy", "comz",
-                   "work")
+                   "work", "megno", "lyapunov", "fli")
 #: columns of a monitor row
 MONITOR_WIDTH = len(MONITOR_COLUMNS)
 #: the column of the work

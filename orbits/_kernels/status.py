@@ -17,6 +17,9 @@ class Status(IntEnum):
     CLOSE_ENCOUNTER = 3
     ESCAPE = 4
     NO_CONVERGENCE = 5  # an implicit method's Newton iteration did not converge
+    # the chaos indicators' tangent vector wants scaling back (not a failure:
+    # the driver renormalises it and carries on; orbits._kernels.variational)
+    RENORMALISE = 6
 
 
 def with_status(status, *rest):

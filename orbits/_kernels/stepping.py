@@ -107,6 +107,7 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
             until_check = check_every
             if not state_is_finite(x, v):
                 return Status.NON_FINITE, k, until_check, until_record, n_mon
+    renormalise = tangent_step(x, v, t, fargs)  # noqa: F821 - bound by specialize
     until_record -= 1
     if until_record == 0:
         until_record = every
@@ -118,25 +119,35 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
         if check and not state_is_finite(x, v):
             return Status.NON_FINITE, k, until_check, until_record, n_mon
         return stop, k + 1, until_check, until_record, n_mon
+    if renormalise:
+        # the chaos indicators' tangent vector has grown large: the driver
+        # scales it back between calls (orbits._kernels.variational)
+        return Status.RENORMALISE, k + 1, until_check, until_record, n_mon
     return GO, k + 1, until_check, until_record, n_mon
 
 
 def step_epilogue(force, stop=False):
     """The step epilogue of the loops compiled for a :class:`ForceKernel`
     (``stop``: with the stopping conditions of :mod:`.stopping`)."""
+    from .variational import tangent_kernels
     return epilogue(force.recorder, f"{force.key}{'_stop' if stop else ''}", jit=force.jit,
                     cache=force.cache, runtime=force.runtime, stop=stop,
-                    work_note=work_kernels(force)["work_note"])
+                    work_note=work_kernels(force)["work_note"],
+                    tangent_step=tangent_kernels(force)["tangent_step"])
 
 
-def epilogue(record, key, jit=True, cache=True, runtime=False, stop=False, work_note=None):
+def epilogue(record, key, jit=True, cache=True, runtime=False, stop=False, work_note=None,
+             tangent_step=None):
     """The step epilogue with monitor recorder ``record``, compiled under ``key``
     (``runtime``: for loops that need numba's runtime; ``work_note``: what
     writes the work of non-conservative terms into a monitor row, see
-    :func:`work_kernels`; none by default)."""
+    :func:`work_kernels`; none by default; ``tangent_step``: the chaos
+    indicators' update after a step, see :mod:`.variational`; none by
+    default)."""
     return specialize(_step_end, key, jit=jit, inline=True, nrt=runtime, cache=cache,
                       _record=record, stop_check=check_stop if stop else no_stop,
-                      work_note=_no_work_note if work_note is None else work_note)
+                      work_note=_no_work_note if work_note is None else work_note,
+                      tangent_step=_no_tangent_step if tangent_step is None else tangent_step)
 
 
 # -- forces ------------------------------------------------------------------------
@@ -199,6 +210,13 @@ class ForceKernel(NamedTuple):
     # for gravity with non-conservative terms (with_terms): their TermKernel,
     # whose work the loops integrate; fargs then has the work arguments third
     work: object = None
+    # for a force with variations (orbits._kernels.variational.with_variations):
+    # the force whose variational equations it integrates alongside (fargs
+    # are then (its fargs, the variations' args), and the state has tangent
+    # rows after the bodies'), and whether tangent vector 0 carries the chaos
+    # indicators
+    inner: "ForceKernel" = None
+    chaos: bool = False
 
     @property
     def runtime(self):
@@ -329,13 +347,22 @@ def _no_work_note(fargs, mon_out, row):
     pass
 
 
+@njit(inline="always")
+def _no_tangent_step(x, v, t, fargs):
+    return False
+
+
 def work_kernels(force):
     """The bindings of a loop compiled for ``force`` that integrate the work of
     its non-conservative terms (see the module notes): ``HAS_WORK`` and the
     kernels ``work_rate(x, v, t, fargs) -> P``, ``work_add(fargs, dW)`` and
     ``work_note(fargs, mon_out, row)`` (records W in the monitor row just
     written, called by the step epilogue).  For a force without such terms
-    they are no-ops, which compile to nothing."""
+    they are no-ops, which compile to nothing.  A force with variations
+    (``force.inner``) gets its inner force's, on the bodies' rows."""
+    if force.inner is not None:
+        from .variational import variational_work_kernels
+        return variational_work_kernels(force, work_kernels(force.inner))
     if force.work is None:
         return dict(HAS_WORK=False, work_rate=_no_work_rate, work_add=_no_work_add,
                     work_note=_no_work_note)
@@ -358,7 +385,13 @@ def work_bound(force, fargs, ws):
     made if missing), for a force with non-conservative terms; ``fargs``
     itself otherwise.  Each integrator's ``advance`` calls it, so that a
     workspace copied and run again (:func:`orbits._driver.advance_checked`)
-    integrates its own work."""
+    integrates its own work.  A force with variations also gets the
+    workspace's chaos accumulators (its ``"chaos"`` array)."""
+    if force.inner is not None:
+        inner = work_bound(force.inner, fargs[0], ws)
+        vargs = fargs[1]
+        box = ws.get("chaos", vargs[4])
+        return (inner, vargs[:4] + (box,) + vargs[5:])
     if force.work is None:
         return fargs
     box = ws.get("work")

@@ -44,7 +44,8 @@ def no_stop(x, v, sargs):
 def check_stop(x, v, sargs):
     """The conditions in ``sargs`` (see the module docstring); 0 to carry on."""
     mask, d2, hill_k, esc2, gm, central, info = sargs
-    n = x.shape[0]
+    # the bodies' rows (a run with variations has tangent rows after them)
+    n = min(x.shape[0], gm.shape[0])
     if mask & (ENCOUNTER_DISTANCE | ENCOUNTER_HILL):
         third_gmc = 1.0 / (3.0 * gm[central])
         for i in range(1, n):
