@@ -231,6 +231,12 @@ class Simulation(Driven):
         from .monitors import CHAOS_MONITORS
         n = len(self._m)
         chaos = any(name in CHAOS_MONITORS for name in self.monitors)
+        if chaos and not self.integrator.chaos_indicators:
+            raise IntegratorOptionError(
+                f"{self.integrator.name!r} steps outside the package's compiled loops and "
+                f"cannot follow the chaos monitors "
+                f"{', '.join(n for n in self.monitors if n in CHAOS_MONITORS)}; use 'ias15', "
+                "'dop853', 'leapfrog' or 'wh'")
         if variations is None:
             n_state, n_mass, n_random = 0, 0, 0
         elif isinstance(variations, str) and variations in ("state", "all"):

@@ -14,6 +14,7 @@ goal the tests hold to is 1e-6 relative per column (the column's norm).
 import copy
 
 import astropy.units as u
+import numba
 import numpy as np
 import pytest
 
@@ -129,7 +130,16 @@ TERMS = [
                  id="Tides", marks=pytest.mark.slow),
     pytest.param(lambda: [forces.RadiationPressure("Sun", beta={"Probe": 0.3})],
                  id="RadiationPressure", marks=pytest.mark.slow),
+    pytest.param(lambda: [forces.UserForce(_drag, velocity_dependent=True)], id="UserForce",
+                 marks=pytest.mark.slow),
 ]
+
+
+@numba.njit
+def _drag(x, v, t, m):
+    # a user's term without a Jacobian (central differences stand in): a weak
+    # drag on every body
+    return -1e-4 * v
 
 
 @pytest.mark.parametrize("make", TERMS)
@@ -178,6 +188,8 @@ def test_bad_variations_are_named_errors():
     with pytest.raises(IntegratorOptionError, match="seed"):
         orbits.Simulation(_system(), "leapfrog", dt=1 * u.day, monitors=["megno"],
                           seed="one")
+    with pytest.raises(IntegratorOptionError, match="chaos monitors megno"):
+        orbits.Simulation(_system(), "radau", monitors=["megno"])
     with pytest.raises(ValueError, match="unknown monitor"):
         orbits.Simulation(_system(), "leapfrog", dt=1 * u.day, monitors=["megnos"])
 

@@ -96,6 +96,9 @@ class Integrator:
     forces_per_step = 1
     #: whether ``advance`` checks the stopping conditions (``stop=``) inside its loop
     stop_conditions = False
+    #: whether its loop updates the chaos indicators after every step (the
+    #: shared step epilogue, :mod:`orbits._kernels.variational`)
+    chaos_indicators = True
 
     def __init__(self, **options):
         unknown = sorted(set(options) - set(self.options))
