@@ -31,6 +31,13 @@ parameters
 ``energy_error_max``, ``angular_momentum_error_max``
     Largest relative errors at the outputs (and in the in-loop monitor series,
     if the simulation records one); NaN when the monitor is off.
+``megno``, ``lyapunov_per_<time unit>``, ``fli``
+    With those chaos monitors (:class:`~orbits.Simulation`'s ``monitors``):
+    their values at the end of the run (at the stop, for a run that stopped
+    early), so that a stability map is one sweep.  The Lyapunov exponent's
+    estimate is in 1 / the run's unit of time (``lyapunov_per_day``).  A row
+    reproduces bit for bit when ``build`` gives its simulations a ``seed``;
+    without one each run draws its own (kept in its file with ``out_dir``).
 ``<body>_a_<length unit>``, ``<body>_e``, ``<body>_inc_rad``
     Osculating elements at the end, of every body but the most massive one,
     about the most massive one; NaN where no orbit is defined.
@@ -592,6 +599,7 @@ def run_one(build, params, index, spec, path=None):
     lerr = result.max_angular_momentum_error() if result is not None else None
     row["energy_error_max"] = math.nan if e is None else e
     row["angular_momentum_error_max"] = math.nan if lerr is None else lerr
+    row.update(_chaos_indicators(sim, result))
     row.update(_final_elements(sim, spec.elements))
     row["wall_time_s"] = wall
     row.update(_worker_fields(loaded0, log))
@@ -640,6 +648,31 @@ def _outcome_name(cls):
     name = cls.__name__
     return "".join(("-" + ch.lower()) if ch.isupper() and k else ch.lower()
                    for k, ch in enumerate(name))
+
+
+def _chaos_indicators(sim, result):
+    """The chaos monitors' last values in ``result`` (NaN where it has none), as
+    ``{"megno": ..., "lyapunov_per_<time unit>": ..., "fli": ...}`` for the
+    monitors ``sim`` follows."""
+    from .monitors import CHAOS_MONITORS
+    out = {}
+    for name in CHAOS_MONITORS:
+        if name not in sim.monitors:
+            continue
+        series = None if result is None else getattr(result, name, None)
+        if name == "lyapunov":
+            time = sim.units.time
+            value = (math.nan if series is None or not len(series)
+                     else float(series[-1].to_value(time ** -1)))
+            out[_lyapunov_column(time)] = value
+        else:
+            out[name] = math.nan if series is None or not len(series) else float(series[-1])
+    return out
+
+
+def _lyapunov_column(time):
+    """``lyapunov_per_<time unit>``: the column of the Lyapunov estimate, in 1 / ``time``."""
+    return _column("lyapunov_per", time)
 
 
 def _final_elements(sim, names):
@@ -837,7 +870,8 @@ def _csv_records(text):
 
 
 _INTEGER_COLUMNS = ("run", "steps", "kernels_compiled", "kernels_loaded")
-_REAL_COLUMNS = ("energy_error_max", "angular_momentum_error_max", "wall_time_s")
+_REAL_COLUMNS = ("energy_error_max", "angular_momentum_error_max", "wall_time_s", "megno",
+                 "fli")
 
 
 def _complete_row(row, n_fields, n_header, n_runs):
@@ -849,7 +883,8 @@ def _complete_row(row, n_fields, n_header, n_runs):
         for key, val in row.items():
             if key in _INTEGER_COLUMNS and not float(val).is_integer():
                 return False
-            if (key in _REAL_COLUMNS or key.startswith("t_stop")) and val != "":
+            if (key in _REAL_COLUMNS or key.startswith(("t_stop", "lyapunov_per"))) \
+                    and val != "":
                 float(val)
     except ValueError:
         return False
@@ -939,8 +974,9 @@ _LAST = ("wall_time_s", "worker", "kernels_compiled", "kernels_loaded", "file")
 
 
 def _column_order(columns, parameters):
-    """run, parameters, outcome, stop time, errors, elements (sorted), where it ran:
-    the same order whether the rows were computed now or read from the index."""
+    """run, parameters, outcome, stop time, errors, chaos indicators, elements
+    (sorted), where it ran: the same order whether the rows were computed now or
+    read from the index."""
     columns = list(columns)
     params = []
     for p in parameters:
@@ -949,7 +985,8 @@ def _column_order(columns, parameters):
             if name not in params:
                 params.append(name)
     t_stop = sorted(c for c in columns if c.startswith("t_stop"))
-    fixed = ["run", *params, *_FIRST, *t_stop, *_MIDDLE]
+    chaos = ["megno", *sorted(c for c in columns if c.startswith("lyapunov_per")), "fli"]
+    fixed = ["run", *params, *_FIRST, *t_stop, *_MIDDLE, *chaos]
     elements = sorted(c for c in columns if c not in fixed and c not in _LAST)
     return [c for c in (*fixed, *elements, *_LAST) if c in columns]
 

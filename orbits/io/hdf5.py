@@ -24,6 +24,9 @@ adds two groups of its own::
                              took out since the simulation was made (with the
                              energy monitor and such terms only; the energy error
                              is that of E + W)
+        megno, fli           value (T,), dimensionless (unit "1"): the chaos monitors'
+                             running mean of MEGNO and fast Lyapunov indicator
+        lyapunov             value (T,), unit 1 / time: the Lyapunov exponent's estimate
         in_loop/<same>       the series recorded inside the compiled loop every
                              monitor_every steps, when that was asked for
     /parameters              attrs: the run's metadata (orbits and library versions,
@@ -31,9 +34,10 @@ adds two groups of its own::
                              source, softening, monitors, stopping conditions, when
                              written, how the body set was made, as JSON where
                              structured)
-        reference            (11,) the monitors' values when the simulation was made
+        reference            (14,) the monitors' values when the simulation was made
                              (the layout of orbits._kernels.invariants.MONITOR_COLUMNS;
-                             files without the work read as (10,))
+                             older files have (10,), without the work, or (11,),
+                             without the chaos indicators)
         scales               (2,) energy and angular-momentum scales for relative errors
     /restart                 the last two checkpoints, in alternating slots
         count                () int64: complete checkpoints written; the valid slot
@@ -52,7 +56,16 @@ adds two groups of its own::
                              the file had taken at the checkpoint
         ws/<name>            (2, ...) the integrator's workspace arrays (with
                              non-conservative terms, ws/work: W and its rounding
-                             compensation)
+                             compensation; with variations or chaos monitors,
+                             ws/tangent (2, 2, k N, 3): the k tangent vectors'
+                             position and velocity rows, internal order, and
+                             ws/chaos: the chaos monitors' accumulators)
+        tangent_vectors      (2, k, N, 6) with variations or chaos monitors: the
+                             tangent vectors at the checkpoint as
+                             Simulation.tangent_vectors gives them (synchronised,
+                             body-set order, internal units); attr layout = the
+                             numbers of vectors (chaos, random, state, mass), from
+                             which load() rebuilds the Jacobian
     /parameters/start_clock  (3,) int64: steps, force evaluations and rejected steps
                              of the simulation when the file was made (the
                              totals since are ``clock`` less these)
@@ -123,13 +136,14 @@ from typing import NamedTuple
 import h5py
 import numpy as np
 
+from .._kernels import invariants as _inv
 from ..errors import OrbitsError
-from ..monitors import _work_column, monitor_fields
+from ..monitors import CHAOS_MONITORS, _work_column, monitor_fields
 from ..records import RunPlan, SimulationState
 
 __all__ = ["FileRecorder", "load", "describe", "read_checkpoint", "Checkpoint", "truncate",
            "ResumePoint",
-           "OrbitsFileError", "FileInUse",
+           "OrbitsFileError", "FileInUse", "TangentShapeError",
            "FORMAT", "FORMAT_VERSION", "CHECKPOINT_SECONDS", "BUFFER_ROWS",
            "SWMR_READ_ATTEMPTS"]
 
@@ -141,13 +155,19 @@ CHECKPOINT_SECONDS = 60.0
 BUFFER_ROWS = 256
 _SLOTS = 2
 _MONITOR_NAMES = ("energy", "angular_momentum", "momentum", "center_of_mass")
+#: the chaos indicators, one value per row each (orbits.monitors.CHAOS_MONITORS)
+_CHAOS = ("megno", "lyapunov", "fli")
 _MONITOR_COLUMNS = {"energy": slice(0, 1), "angular_momentum": slice(1, 4),
                     "momentum": slice(4, 7), "center_of_mass": slice(7, 10),
-                    "work": slice(10, 11)}
+                    "work": slice(10, 11),
+                    **{name: slice(_inv.MONITOR_COLUMNS.index(name),
+                                   _inv.MONITOR_COLUMNS.index(name) + 1) for name in _CHAOS}}
+#: the unit of each series: a kind of orbits.units.UnitSystem, or "1 / time"
 _MONITOR_KIND = {"energy": "energy", "angular_momentum": "angular_momentum",
-                 "momentum": "momentum", "center_of_mass": "length", "work": "energy"}
+                 "momentum": "momentum", "center_of_mass": "length", "work": "energy",
+                 "megno": "dimensionless", "lyapunov": "1 / time", "fli": "dimensionless"}
 #: the series of one value per row (the others are 3-vectors)
-_SCALAR_SERIES = ("energy", "work")
+_SCALAR_SERIES = ("energy", "work") + _CHAOS
 #: tries of a metadata read whose checksum fails, in SWMR mode.  HDF5 sleeps
 #: 1, 2, 4, ... ns between tries, so 24 tries give up after 2**24 ns = 17 ms
 #: (measured: 41 ms for 25 tries, 1.1 s for 30); a live writer rewrites a
@@ -198,6 +218,32 @@ class FileInUse(OrbitsFileError):
     def __init__(self, message, pid=None, host=None):
         self.pid = pid
         self.host = host
+        super().__init__(message)
+
+
+class TangentShapeError(OrbitsFileError):
+    """A file whose stored tangent vectors do not have the shape that its
+    simulation's ``variations`` and chaos monitors call for (a damaged file,
+    or one edited by hand), so that neither the derivatives nor a restart can
+    be read from it.
+
+    Attributes
+    ----------
+    expected, found : tuple of int
+        The shapes.
+
+    Examples
+    --------
+    >>> from orbits.io.hdf5 import OrbitsFileError, TangentShapeError
+    >>> exc = TangentShapeError("run.h5: tangent vectors of shape (2, 3, 6)", expected=(19, 3, 6),
+    ...                         found=(2, 3, 6))
+    >>> isinstance(exc, OrbitsFileError), exc.expected, exc.found
+    (True, (19, 3, 6), (2, 3, 6))
+    """
+
+    def __init__(self, message, expected=None, found=None):
+        self.expected = expected
+        self.found = found
         super().__init__(message)
 
 
@@ -770,6 +816,25 @@ class FileRecorder:
         if n != len(self.desc.names):
             raise OrbitsFileError(f"{self.path}: holds {n} bodies, the simulation "
                                   f"{len(self.desc.names)}")
+        # the tangent vectors' shapes: the rows the checkpoints restore, and the
+        # derivatives (which files written before they were kept lack)
+        r = self.f["restart"]
+        layout = _tangent_layout(self.desc.monitors, self.desc.config.variations, n)
+        tangent = self.sim.state.workspace.get("tangent")
+        rows = r["ws/tangent"].shape[1:] if "tangent" in r["ws"] else None
+        if rows != (None if tangent is None else tangent.shape):
+            self._tangent_mismatch("tangent rows", rows,
+                                   None if tangent is None else tangent.shape)
+        if "tangent_vectors" in r and r["tangent_vectors"].shape[1:] != (sum(layout), n, 6):
+            self._tangent_mismatch("tangent vectors", r["tangent_vectors"].shape[1:],
+                                   (sum(layout), n, 6))
+
+    def _tangent_mismatch(self, what, have, want):
+        raise TangentShapeError(
+            f"{self.path}: holds {what} of shape {have}, but the simulation appending to it "
+            f"has {want} (variations={self.desc.config.variations!r}, monitors "
+            f"{', '.join(self.desc.monitors) or 'none'}); write to a new file",
+            expected=want, found=have)
 
     def _stored_wall(self):
         r = self.f["restart"]
@@ -1007,6 +1072,10 @@ class FileRecorder:
         if sim.monitors:
             fields.update(monitor_fields(row[None], sim.monitors, self.reference, self.scales,
                                          sim.units, work=self.work))
+        tangents = sim.tangent_vectors
+        if tangents is not None:
+            fields.update(jacobian=sim.jacobian, tangent_vectors=tangents,
+                          seed=self.desc.config.seed)
         return Result(**fields)
 
     # writing ---------------------------------------------------------------------------
@@ -1092,6 +1161,8 @@ class FileRecorder:
                 _write_rows(r[name], slot, np.asarray(value)[None], extend=False)
         for name, arr in state.workspace.items():
             _write_rows(self._ws[name], slot, arr[None], extend=False)
+        if "tangent_vectors" in r:
+            _write_rows(r["tangent_vectors"], slot, sim.tangent_vectors[None], extend=False)
         self.f.flush()
         r["count"][()] = count + 1
         r["count"].flush()
@@ -1159,6 +1230,49 @@ def _package_version():
         return "0+unknown"
 
 
+def _series_unit(U, name):
+    """The unit (a string) of the monitor series ``name`` in the unit system ``U``."""
+    kind = _MONITOR_KIND[name]
+    if kind == "1 / time":
+        return (U.unit("time") ** -1).to_string()
+    if kind == "dimensionless":
+        return "1"
+    return U.unit(kind).to_string()
+
+
+def _tangent_layout(monitors, variations, n):
+    """``(chaos, random, state, mass)``: how many tangent vectors of each kind a
+    simulation of ``n`` bodies with these ``monitors`` and ``variations``
+    integrates, in the order :attr:`orbits.Simulation.tangent_vectors` lists
+    them (one for the chaos monitors; an int ``variations`` random ones; 6 n
+    for ``"state"``; 6 n and n for ``"all"``).  Read off the configuration,
+    as the simulation lays them out, so that a file is checked against what
+    its own record says."""
+    chaos = int(any(name in CHAOS_MONITORS for name in monitors))
+    if isinstance(variations, str):
+        state = 6 * n if variations in ("state", "all") else 0
+        return chaos, 0, state, (n if variations == "all" else 0)
+    random = int(variations) if variations is not None and not isinstance(variations, bool) \
+        else 0
+    return chaos, random, 0, 0
+
+
+def _config_layout(config, n):
+    # the tangent layout of a configuration dictionary (SimulationConfig.to_dict())
+    return _tangent_layout(config.get("monitors", ()), config.get("variations"), n)
+
+
+def _jacobian(tangents, layout):
+    """The Jacobian (6 N, 6 N) or (6 N, 7 N) that tangent vectors (k, N, 6)
+    laid out as ``layout`` hold, as :attr:`orbits.Simulation.jacobian`; None
+    without ``variations="state"`` or ``"all"``."""
+    chaos, random, state, mass = layout
+    if not state:
+        return None
+    n = tangents.shape[1]
+    return tangents[chaos + random:].reshape(state + mass, 6 * n).T.copy()
+
+
 def _create(path, desc, state):
     """A new file for the simulation described by ``desc`` (a
     :class:`~orbits.records.SimulationDescription`) at ``state``."""
@@ -1188,7 +1302,7 @@ def _create(path, desc, state):
     inloop = obs.create_group("in_loop")
     for name in tuple(desc.monitors) + (("work",) if _keeps_work(desc) else ()):
         shape = () if name in _SCALAR_SERIES else (3,)
-        u_ = (unit(_MONITOR_KIND[name]), unit("time"))
+        u_ = (_series_unit(U, name), unit("time"))
         _element(obs, name, shape, u_)
         _element(inloop, name, shape, u_)
     par = f.create_group("parameters")
@@ -1216,9 +1330,10 @@ def _create(path, desc, state):
     for k, v in meta.items():
         par.attrs[k] = v
     ref = par.create_dataset("reference", data=state.reference)
-    ref.attrs["unit"] = ", ".join([unit("energy")] + [unit("angular_momentum")] * 3
-                                  + [unit("momentum")] * 3 + [unit("length")] * 3
-                                  + [unit("energy")] * (len(state.reference) - 10))
+    ref_units = ([unit("energy")] + [unit("angular_momentum")] * 3 + [unit("momentum")] * 3
+                 + [unit("length")] * 3 + [unit("energy")]
+                 + [_series_unit(U, name) for name in _CHAOS])
+    ref.attrs["unit"] = ", ".join(ref_units[:len(state.reference)])
     par.create_dataset("scales", data=np.array(state.scales)).attrs["unit"] = \
         f"{unit('energy')}, {unit('angular_momentum')}"
     par.create_dataset("start_clock", data=np.array(
@@ -1235,6 +1350,15 @@ def _create(path, desc, state):
         f"{unit('time')}, 1, 1, 1, 1, 1, {unit('time')}"
     r.create_dataset("progress", shape=(_SLOTS, 3), dtype=np.int64)
     r.create_dataset("wall", shape=(_SLOTS,), dtype=np.float64).attrs["unit"] = "s"
+    layout = _tangent_layout(desc.monitors, desc.config.variations, n)
+    if sum(layout):
+        # the derivatives at the checkpoint, as Simulation.tangent_vectors gives
+        # them (the integrator synchronised, body-set order), so that a reader
+        # needs neither the integrator nor the internal order
+        d = r.create_dataset("tangent_vectors", shape=(_SLOTS, sum(layout), n, 6),
+                             dtype=np.float64)
+        d.attrs["unit"] = "internal"
+        d.attrs["layout"] = np.array(layout, dtype=np.int64)
     ws = r.create_group("ws")
     for name, arr in state.workspace.items():
         if isinstance(arr, np.ndarray):
@@ -1302,7 +1426,10 @@ def load(path):
     ``steps``, ``force_evaluations``, ``steps_rejected`` and ``wall_time``
     are the totals of the runs that wrote the file, at its last checkpoint
     (None for force evaluations and wall time in files written before they
-    were kept).
+    were kept).  With variations or chaos monitors, ``jacobian`` and
+    ``tangent_vectors`` are those at the last checkpoint too, which for a
+    finished run is its last output, and ``seed`` the seed of the random
+    tangent vectors.
 
     Parameters
     ----------
@@ -1362,7 +1489,7 @@ def load(path):
         e_scale, l_scale = par["scales"][()]
         obs = f["observables"]
         for name in monitors:
-            fields[name] = q(obs[name]["value"])
+            fields[name] = _series(obs[name], name, n)
         # the work of non-conservative terms, where the file keeps it
         work = "energy" in monitors and "work" in obs
         w0 = float(_work_column(ref))
@@ -1389,8 +1516,59 @@ def load(path):
             if "angular_momentum" in monitors:
                 mon["angular_momentum_error"] = vector_relative_error(
                     inloop["angular_momentum/value"][:m], ref[1:4], l_scale)
+            for name in _CHAOS:
+                if name in monitors:
+                    mon[name] = _series(inloop[name], name, m)
             fields["monitor"] = mon
+        fields.update(_derivatives(f, path))
     return Result(**fields)
+
+
+def _series(group, name, rows):
+    """The first ``rows`` values of a monitor series, as a result holds them:
+    Quantities, but MEGNO and the FLI as plain arrays (dimensionless)."""
+    import astropy.units as u
+    values = group["value"][:rows]
+    if _MONITOR_KIND[name] == "dimensionless":
+        return values
+    return values << u.Unit(group["value"].attrs["unit"])
+
+
+def _config(f):
+    """The configuration record (SimulationConfig.to_dict()) a file keeps; {} for
+    files written before it."""
+    par = f["parameters"]
+    return json.loads(par.attrs["config"]) if "config" in par.attrs else {}
+
+
+def _derivatives(f, path):
+    """``jacobian``, ``tangent_vectors`` and ``seed`` of a file with variations or
+    chaos monitors, at its last checkpoint (the last output of a finished run),
+    as a Result holds them; {} for a file without (or written before the
+    derivatives were kept, or before its first checkpoint)."""
+    config = _config(f)
+    n = f["particles/bodies/names"].shape[0]
+    layout = _config_layout(config, n)
+    if not sum(layout):
+        return {}
+    out = {"seed": config.get("seed")}
+    r = f["restart"]
+    count = int(r["count"][()])
+    if "tangent_vectors" not in r or not count:
+        return out
+    d = r["tangent_vectors"]
+    want = (_SLOTS, sum(layout), n, 6)
+    stored = tuple(int(k) for k in d.attrs.get("layout", layout))
+    if d.shape != want or stored != tuple(layout):
+        raise TangentShapeError(
+            f"{path}: holds tangent vectors of shape {d.shape[1:]} (laid out as {stored}: "
+            f"chaos, random, state, mass), but its configuration (variations="
+            f"{config.get('variations')!r}, monitors {', '.join(config['monitors']) or 'none'}"
+            f") calls for {want[1:]} (laid out as {tuple(layout)})",
+            expected=want[1:], found=d.shape[1:])
+    tangents = d[(count - 1) % _SLOTS]
+    out.update(tangent_vectors=tangents, jacobian=_jacobian(tangents, layout))
+    return out
 
 
 def _status(f, path=None):
@@ -1483,6 +1661,14 @@ def describe(path):
             f"monitors        {', '.join(monitors) or 'none'}",
             f"forces          {_describe_forces(par)}",
         ]
+        config = _config(f)
+        layout = _config_layout(config, len(names))
+        if sum(layout):
+            kinds = [f"{k} {what}" for k, what in zip(
+                layout, ("for the chaos monitors", "random", "of the state", "of the masses"))
+                if k]
+            lines.append(f"variations      {config.get('variations')}; {sum(layout)} tangent "
+                         f"vectors ({', '.join(kinds)}), seed {config.get('seed')}")
         count = int(f["restart/count"][()])
         if count:
             slot = (count - 1) % _SLOTS
@@ -1583,6 +1769,7 @@ def read_checkpoint(path):
         bodies.history = json.loads(par.attrs["bodies_history"])
         config = (json.loads(par.attrs["config"]) if "config" in par.attrs
                   else _legacy_config(par, units))
+        _check_tangent_rows(r["ws"], config, len(names), path)
         clock = r["clock"][slot]
         state = SimulationState(
             x, v, order, float(r["t_base"][slot]), int(clock[1]), int(clock[0]),
@@ -1596,6 +1783,24 @@ def read_checkpoint(path):
         t = state.t_base + state.steps_since_base * float(par.attrs["dt"])
     return Checkpoint(bodies, config, state, ResumePoint(plan, written, bool(finished), rows, t),
                       str(path))
+
+
+def _check_tangent_rows(ws, config, n, path):
+    """Raise :class:`TangentShapeError` where the checkpoints' tangent rows
+    (``ws/tangent``: positions and velocities of every tangent vector, after
+    the bodies' rows) do not have the shape the configuration calls for."""
+    k = sum(_config_layout(config, n))
+    want = (2, n * k, 3) if k else None
+    found = ws["tangent"].shape[1:] if "tangent" in ws else None
+    if found != want:
+        what = ("no tangent rows" if found is None else
+                f"tangent rows of shape {found}" + (f" ({found[1] / n:g} vectors of {n} bodies)"
+                                                     if len(found) == 3 else ""))
+        raise TangentShapeError(
+            f"{path}: its checkpoints hold {what}, but its configuration (variations="
+            f"{config.get('variations')!r}, monitors {', '.join(config['monitors']) or 'none'}"
+            f") calls for " + (f"{k} tangent vectors, rows of shape {want}" if k else "none")
+            + "; the file cannot restore the simulation", expected=want, found=found)
 
 
 def _legacy_config(par, units):
