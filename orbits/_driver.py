@@ -190,6 +190,16 @@ class Driven:
         loop is entered in chunks of about :data:`CHUNK_SECONDS`, and between
         chunks the progress bar, the wall-time limit and any SIGINT or SIGTERM
         that arrived are looked at.
+
+        Fixed-step runs whose outputs fall every ``k`` steps (outputs that
+        divide the run's steps evenly), for a recorder that gives a
+        ``row_buffer(k)`` to write the next k into and takes
+        ``output_rows(owner, times, rows)``, record them inside the compiled
+        loop, with the monitors, into rows of :data:`MONITOR_WIDTH` + ``6 N``
+        columns (:func:`orbits._kernels.stepping.record_state`): one call
+        into the loop for many outputs rather than one each.  Their times
+        are computed as :meth:`_now` would at their steps, and the state and
+        monitors are those the output would have taken outside the loop.
         """
         adaptive = self.integrator.adaptive
         if adaptive:
@@ -211,17 +221,45 @@ class Driven:
                 rec.close()
         return rec.result(self, _time.perf_counter() - wall0)
 
+    #: (k, origin): outputs are being recorded in the loop every k steps
+    #: counted from step ``origin`` (see :meth:`execute`)
+    _in_loop = None
+
     def _outputs_fixed(self, plan, rec, bar, first_mark):
         wall0 = self._wall0
         done = self.steps - plan.start_step
-        for mark in plan.marks(first_mark):
-            done = self._advance_to(done, mark, rec, bar, wall0)
-            rec.output(self)
+        k = self._output_interval(plan, rec)
+        if k:
+            last = (plan.outputs - 2) * k      # the last output before the final one
+            if done < last:
+                self._in_loop = (k, plan.start_step)
+                try:
+                    done = self._advance_to(done, last, rec, bar, wall0)
+                finally:
+                    self._in_loop = None
+        else:
+            for mark in plan.marks(first_mark):
+                done = self._advance_to(done, mark, rec, bar, wall0)
+                rec.output(self)
         done = self._advance_to(done, plan.n_full, rec, bar, wall0)
         if plan.has_partial and done == plan.n_full:
             self._advance(1, rec, wall0, dt=plan.until - self._now())
             bar.update(1)
         rec.output(self, final=True)
+
+    def _output_interval(self, plan, rec):
+        # k when the plan's outputs between the first and the last fall every
+        # k steps and can be recorded in the loop (see execute), else 0
+        if (getattr(rec, "row_buffer", None) is None or self.monitor_every
+                or plan.outputs < 3):
+            return 0
+        k = int(round(plan.ratio / (plan.outputs - 1)))
+        # the marks are round(i ratio / (outputs - 1)): all i k when ratio is
+        # within a quarter step of (outputs - 1) k
+        if k < 1 or abs(plan.ratio - k * (plan.outputs - 1)) >= 0.25 \
+                or (plan.outputs - 2) * k > plan.n_full:
+            return 0
+        return k
 
     def _outputs_adaptive(self, plan, rec, bar, first_mark):
         wall0 = self._wall0
@@ -332,21 +370,32 @@ class Driven:
 
     def _advance(self, n, rec, wall0, dt=None):
         dt = self._dt if dt is None else dt
-        every = self.monitor_every or 0
+        if self._in_loop:
+            every, origin = self._in_loop
+            width = MONITOR_WIDTH + 6 * len(self._x)
+        else:
+            every, origin, width = self.monitor_every or 0, 0, MONITOR_WIDTH
         mon = self._mon(every)
         left = n
         while True:
+            s0 = self.steps - origin
             if every:
-                first = (self.steps // every + 1) * every  # next step index that records
-                size = max(0, (self.steps + left - first) // every + 1)
+                first = (s0 // every + 1) * every  # next step index that records
+                size = max(0, (s0 + left - first) // every + 1)
             else:
                 size = 0
             mon_t = np.empty(size)
-            mon_out = np.zeros((size, MONITOR_WIDTH))
+            # outputs are written straight where the recorder keeps them
+            mon_out = (rec.row_buffer(size) if self._in_loop and size
+                       else np.zeros((size, width)))
             status, steps, n_mon, self._ws = advance_checked(
                 self.integrator, self._ws, self._X, self._V, self._now(), dt, left,
-                self._force, self._fargs, mon, self.steps, mon_t, mon_out, stop=self._stop)
-            if n_mon:
+                self._force, self._fargs, mon, s0, mon_t, mon_out, stop=self._stop)
+            if n_mon and self._in_loop:
+                # the outputs' times as _now() gives them at their steps
+                at = self._steps_since_base + (first - s0) + every * np.arange(n_mon)
+                rec.output_rows(self, self._t_base + at * self._dt, mon_out[:n_mon])
+            elif n_mon:
                 rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
             if status != Status.RENORMALISE:
                 break

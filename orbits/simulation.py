@@ -965,7 +965,7 @@ class Simulation(Driven):
                              f"got {checkpoint_interval!r}")
         self._wall_limit = None if wall_limit is None else float(wall_limit)
         if output is None:
-            rec = _Recorder(self, initial=plan.outputs > 1)
+            rec = _Recorder(self, initial=plan.outputs > 1, capacity=plan.outputs)
         else:
             from .io import hdf5
             rec = hdf5.FileRecorder(output, self, plan, overwrite=overwrite,
@@ -1009,14 +1009,13 @@ class Simulation(Driven):
             # one per step; a shortened last step leaves room for one fewer, as
             # outputs go to the nearest step boundary
             outputs = total + 1
-            while outputs > 2 and not _increasing(plan._replace(outputs=outputs).marks(),
-                                                  total):
+            while outputs > 2 and not _marks_ok(plan._replace(outputs=outputs), total):
                 outputs -= 1
             warnings.warn(f"the run has only {total} steps: taking {outputs} outputs "
                           f"instead of the default {DEFAULT_OUTPUTS}", OrbitsWarning,
                           stacklevel=4)
             plan = plan._replace(outputs=outputs)
-        if outputs > total + 1 or not _increasing(plan.marks(), total):
+        if outputs > total + 1 or not _marks_ok(plan, total):
             raise ValueError(f"outputs = {outputs} needs more steps than the run has "
                              f"({total}); ask for at most {total + 1} outputs or use a "
                              f"smaller dt")
@@ -1141,6 +1140,20 @@ def _split_forces(forces, softening, parallel, rebound_arithmetic):
     return tuple(t for t in forces if not isinstance(t, Gravity)), gravity
 
 
+def _marks_ok(plan, total):
+    # the plan's marks are strictly increasing and below total, without
+    # walking a million of them where arithmetic tells: marks are round(i s)
+    # with s = ratio / (outputs - 1); within a quarter step of a whole k they
+    # are i k exactly, and at s >= 2 consecutive ones are at least one apart
+    o = plan.outputs
+    if o > 2:
+        s = plan.ratio / (o - 1)
+        k = int(round(s))
+        if (k >= 1 and abs(plan.ratio - k * (o - 1)) < 0.25) or s >= 2:
+            return min(int(round((o - 2) * s)), plan.n_full) < total
+    return _increasing(plan.marks(), total)
+
+
 def _increasing(marks, total):
     last = 0
     for mark in marks:
@@ -1153,13 +1166,17 @@ def _increasing(marks, total):
 class _Recorder:
     """Collects outputs and monitor rows during one run."""
 
-    def __init__(self, sim, initial=True):
+    def __init__(self, sim, initial=True, capacity=1):
         n = len(sim._m)
         self.inv = np.argsort(sim._order)
-        self.t = []
-        self.x = []
-        self.v = []
-        self.rows = []
+        self.order = sim._order
+        # the outputs: their times, and rows of the monitors, then the
+        # positions and velocities in the simulation's internal order (the
+        # layout of the rows recorded inside the loop, which writes into
+        # this array directly; it grows if a run takes more outputs)
+        self.t = np.empty(capacity)
+        self.rows = np.zeros((capacity, _inv.MONITOR_WIDTH + 6 * n))
+        self.count = 0
         self.mon_t = []
         self.mon_rows = []
         self.steps0 = sim.steps
@@ -1182,13 +1199,37 @@ class _Recorder:
         """A run stopped early by a signal: its result ends where it stopped."""
         self.output(sim, final=True)
 
+    def _room(self, k):
+        # space for k more outputs
+        if self.count + k > len(self.t):
+            size = max(2 * len(self.t), self.count + k)
+            self.t = np.resize(self.t, size)
+            rows = np.zeros((size, self.rows.shape[1]))
+            rows[:self.count] = self.rows[:self.count]
+            self.rows = rows
+
     def output(self, sim, final=False):
         snap = sim.snapshot()
-        self.t.append(snap.t)
-        self.x.append(snap.x)
-        self.v.append(snap.v)
-        if sim._mask:
-            self.rows.append(snap.monitors)
+        self._room(1)
+        i = self.count
+        w, n = _inv.MONITOR_WIDTH, self.n
+        self.t[i] = snap.t
+        self.rows[i, :w] = snap.monitors
+        self.rows[i, w:w + 3 * n] = snap.x[self.order].ravel()
+        self.rows[i, w + 3 * n:] = snap.v[self.order].ravel()
+        self.count += 1
+
+    def row_buffer(self, k):
+        """Where the compiled loop writes the next ``k`` outputs (see
+        :meth:`orbits._driver.Driven.execute`)."""
+        self._room(k)
+        return self.rows[self.count:self.count + k]
+
+    def output_rows(self, sim, t, rows):
+        """The loop wrote ``rows`` (from :meth:`row_buffer`) at times ``t``."""
+        k = len(t)
+        self.t[self.count:self.count + k] = t
+        self.count += k
 
     def monitor_rows(self, t, rows):
         self.mon_t.append(t.copy())
@@ -1198,8 +1239,7 @@ class _Recorder:
         U = sim.units
         q = U.quantity
         fields = dict(
-            times=q(np.array(self.t), "time"), positions=q(np.array(self.x), "length"),
-            velocities=q(np.array(self.v), "velocity"), names=list(sim._names),
+            times=q(self.t[:self.count], "time"), names=list(sim._names),
             masses=q(sim._m[self.inv].copy(), "mass"), steps=sim.steps - self.steps0,
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
             integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
@@ -1209,9 +1249,16 @@ class _Recorder:
             fields["jacobian"] = sim.jacobian
             fields["tangent_vectors"] = sim.tangent_vectors
             fields["seed"] = sim._seed
+        w, n = _inv.MONITOR_WIDTH, self.n
+        rows = self.rows[:self.count]
+        x = rows[:, w:w + 3 * n].reshape(-1, n, 3)
+        v = rows[:, w + 3 * n:w + 6 * n].reshape(-1, n, 3)
+        if not np.array_equal(self.inv, np.arange(n)):
+            x, v = x[:, self.inv], v[:, self.inv]
+        fields.update(positions=q(x, "length"), velocities=q(v, "velocity"))
         ref = sim._reference
-        if self.rows:
-            fields.update(_monitor_fields(np.array(self.rows), sim, ref))
+        if sim._mask:
+            fields.update(_monitor_fields(rows[:, :w], sim, ref))
         if self.mon_t:
             mon = _monitor_fields(np.concatenate(self.mon_rows), sim, ref)
             mon["times"] = q(np.concatenate(self.mon_t), "time")

@@ -28,6 +28,10 @@ the step that triggered it.  Loops compiled without conditions call
 Monitors (energy, angular momentum, ...) are recorded every ``every`` steps,
 counted from the start of the simulation (``step0``), into ``mon_t`` and
 ``mon_out``; ``every = 0`` switches them off and costs one branch a step.
+Outputs use the same mechanism: rows ``6 N`` wider than the monitors' also
+take the bodies' state (:func:`record_state`), so that a run's evenly
+spaced outputs are recorded inside the loop, ``step0`` then counting from
+the run's start (:meth:`orbits._driver.Driven.execute`).
 
 The work of non-conservative force terms.  A force built by :func:`with_terms`
 with non-conservative terms (``work``) carries a third item in ``fargs``, the
@@ -52,7 +56,7 @@ import numpy as np
 from ._jit import njit, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
                       accelerate_pairwise_rebound, accelerate_pairwise_small)
-from .invariants import ENERGY, WORK_COLUMN, monitor_row
+from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, monitor_row
 from .status import Status
 from .stopping import check_stop, no_stop
 
@@ -79,11 +83,26 @@ def state_is_finite(x, v):
     return math.isfinite(s)
 
 
+@njit(inline="always")
+def record_state(x, v, m, row):
+    """Outputs recorded in the loop: a row wider than :data:`MONITOR_WIDTH` by
+    ``6 N`` (N = ``len(m)``, the bodies) also takes their positions and
+    velocities after the monitors."""
+    w = MONITOR_WIDTH
+    n = m.shape[0]
+    if row.shape[0] >= w + 6 * n:
+        for i in range(n):
+            for d in range(3):
+                row[w + 3 * i + d] = x[i, d]
+                row[w + 3 * (n + i) + d] = v[i, d]
+
+
 @njit
 def _record(x, v, t, mon, n_mon, mon_t, mon_out):
     every, which, m, G, n_active, eps2 = mon
     mon_t[n_mon] = t
     monitor_row(x, v, m, G, n_active, eps2, which, mon_out[n_mon])
+    record_state(x, v, m, mon_out[n_mon])
 
 
 #: the status of a step epilogue (:func:`step_epilogue`) that lets a loop carry on
@@ -266,6 +285,7 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
     monitor_row(x, v, m, G, n_active, eps2, which, row)
     if which & ENERGY:
         row[0] += extra_energy(x, v, eargs)  # noqa: F821 - bound by specialize
+    record_state(x, v, m, row)
 
 
 def with_terms(base, terms, velocity_dependent, work=None):

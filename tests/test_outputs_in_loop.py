@@ -1,0 +1,93 @@
+"""Outputs recorded inside the compiled loop (orbits._driver.Driven.execute).
+
+A fixed-step run whose outputs fall every k steps records them inside the
+loop; one whose outputs do not, or one written to a file, takes each output
+between two calls of the loop.  Both must give the same outputs, to the bit:
+the same state at the same steps, times computed as the clock computes them,
+and monitors from the same compiled functions.
+"""
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+import orbits
+from orbits import forces
+
+
+def _same(a, b):
+    assert np.array_equal(a.times.value, b.times.value)
+    assert np.array_equal(a.positions.value, b.positions.value)
+    assert np.array_equal(a.velocities.value, b.velocities.value)
+    for name in ("energy", "energy_error", "angular_momentum", "work", "megno", "fli"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert (x is None) == (y is None), name
+        if x is not None:
+            assert np.array_equal(np.asarray(getattr(x, "value", x)),
+                                  np.asarray(getattr(y, "value", y))), name
+
+
+@pytest.mark.parametrize("integrator, dt", [("leapfrog", 10 * u.day), ("wh", 30 * u.day),
+                                            ("rk4", 10 * u.day)])
+def test_outputs_in_the_loop_equal_those_taken_between_calls(integrator, dt):
+    scene = orbits.scenes.outer_solar_system()
+    k = 7
+    until = 700 * k * dt    # 700 outputs every 7 steps, and the first
+    make = lambda: orbits.Simulation(scene, integrator, dt=dt,  # noqa: E731
+                                     monitors=["energy", "angular_momentum", "momentum"])
+    inloop = make().run(until=until, outputs=701, progress=False)
+    # the same outputs one call of the loop each: monitor_every switches the
+    # recording in the loop off for outputs
+    sim = make()
+    sim.monitor_every = 10 ** 9
+    between = sim.run(until=until, outputs=701, progress=False)
+    assert len(inloop) == 701
+    _same(inloop, between)
+
+
+def test_with_terms_work_and_chaos_monitors():
+    b = orbits.BodySet()
+    b.add("Star", 1 * u.Msun)
+    b.add("Planet", 1 * u.Mjup, primary="Star", a=1 * u.au, e=0.1)
+    b.add("Outer", 1 * u.Mjup, primary="Star", a=2.5 * u.au, e=0.05, f=2 * u.rad)
+
+    def make():
+        return orbits.Simulation(b, "leapfrog", dt=2 * u.day, seed=1,
+                                 monitors=["energy", "megno", "fli"],
+                                 forces=[forces.Migration("Planet", tau_a=1e4 * u.yr)])
+    inloop = make().run(until=1000 * u.day, outputs=101, progress=False)
+    sim = make()
+    sim.monitor_every = 10 ** 9
+    between = sim.run(until=1000 * u.day, outputs=101, progress=False)
+    _same(inloop, between)
+    assert inloop.work[-1].value != 0.0 and inloop.megno[-1] > 0
+
+
+def test_uneven_outputs_and_a_shortened_last_step_keep_the_old_path():
+    # 10.5 steps a output: marks at rounded steps, between calls; the result
+    # is unchanged by the in-loop path's existence (times on step boundaries)
+    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    r = sim.run(until=105.5 * u.day, outputs=11, progress=False)
+    steps = r.times.to_value(u.day)
+    assert steps[-1] == 105.5 and np.all(np.diff(steps) > 0)
+
+
+def test_a_failure_keeps_the_outputs_before_it():
+    # two bodies of negligible mass flying at each other meet exactly at the
+    # origin in the middle of the third step, where the force is 0/0 (as in
+    # test_simulation): the outputs recorded in the loop before the failing
+    # step are kept, and the run's last output is the last good state
+    from orbits.errors import NonFiniteState
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("a", mass=1e-300, position=[5, 0, 0], velocity=[-2, 0, 0])
+    b.add("b", mass=1e-300, position=[-5, 0, 0], velocity=[2, 0, 0])
+    sim = orbits.Simulation(b, "leapfrog", dt=1.0)
+    with pytest.raises(NonFiniteState) as info:
+        sim.run(until=20.0, outputs=21, progress=False)
+    r = info.value.result
+    # the outputs at steps 0, 1, 2, then the final one at the last good step
+    # (as between calls: the failure's output repeats an output at that step)
+    assert np.array_equal(r.times.value, [0.0, 1.0, 2.0, 2.0])
+    assert r.times.value[-1] == sim.time.value
+    assert np.all(np.isfinite(r.positions.value))
+    assert np.array_equal(r.positions.value[:, 0, 0], 5 - 2 * r.times.value)
