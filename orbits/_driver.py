@@ -194,7 +194,7 @@ class Driven:
         Fixed-step runs whose outputs fall every ``k`` steps (outputs that
         divide the run's steps evenly), for a recorder that gives a
         ``row_buffer(k)`` to write the next k into and takes
-        ``output_rows(owner, times, rows)``, record them inside the compiled
+        ``output_rows(owner, steps, times, rows)``, record them inside the compiled
         loop, with the monitors, into rows of :data:`MONITOR_WIDTH` + ``6 N``
         columns (:func:`orbits._kernels.stepping.record_state`): one call
         into the loop for many outputs rather than one each.  Their times
@@ -250,7 +250,8 @@ class Driven:
     def _output_interval(self, plan, rec):
         # k when the plan's outputs between the first and the last fall every
         # k steps and can be recorded in the loop (see execute), else 0
-        if (getattr(rec, "row_buffer", None) is None or self.monitor_every
+        if (getattr(rec, "row_buffer", None) is None
+                or not getattr(rec, "records_in_loop", True) or self.monitor_every
                 or plan.outputs < 3):
             return 0
         k = int(round(plan.ratio / (plan.outputs - 1)))
@@ -309,8 +310,12 @@ class Driven:
     def _advance_to(self, done, target, rec, bar, wall0):
         # the loop returns to Python about every CHUNK_SECONDS (progress bar);
         # the chunk length adapts and is kept from one call to the next
+        cap = getattr(rec, "max_rows", None) if self._in_loop else None
         while done < target:
             n = min(self._chunk, target - done)
+            if cap:
+                # a recorder that streams (a file) holds at most cap outputs
+                n = min(n, cap * self._in_loop[0])
             t0 = _time.perf_counter()
             self._advance(n, rec, wall0)
             elapsed = _time.perf_counter() - t0
@@ -325,6 +330,9 @@ class Driven:
         return done
 
     def _between_chunks(self, rec, wall0):
+        note = getattr(rec, "between_chunks", None)
+        if note is not None:
+            note()
         self._check_signal(rec, wall0)
         self._check_wall(rec, wall0)
 
@@ -392,9 +400,11 @@ class Driven:
                 self.integrator, self._ws, self._X, self._V, self._now(), dt, left,
                 self._force, self._fargs, mon, s0, mon_t, mon_out, stop=self._stop)
             if n_mon and self._in_loop:
-                # the outputs' times as _now() gives them at their steps
-                at = self._steps_since_base + (first - s0) + every * np.arange(n_mon)
-                rec.output_rows(self, self._t_base + at * self._dt, mon_out[:n_mon])
+                # the outputs' steps, and their times as _now() gives them there
+                ahead = (first - s0) + every * np.arange(n_mon)
+                rec.output_rows(self, self.steps + ahead,
+                                self._t_base + (self._steps_since_base + ahead) * self._dt,
+                                mon_out[:n_mon])
             elif n_mon:
                 rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
             if status != Status.RENORMALISE:

@@ -1225,7 +1225,7 @@ class _Recorder:
         self._room(k)
         return self.rows[self.count:self.count + k]
 
-    def output_rows(self, sim, t, rows):
+    def output_rows(self, sim, steps, t, rows):
         """The loop wrote ``rows`` (from :meth:`row_buffer`) at times ``t``."""
         k = len(t)
         self.t[self.count:self.count + k] = t

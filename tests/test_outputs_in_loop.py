@@ -91,3 +91,60 @@ def test_a_failure_keeps_the_outputs_before_it():
     assert r.times.value[-1] == sim.time.value
     assert np.all(np.isfinite(r.positions.value))
     assert np.array_equal(r.positions.value[:, 0, 0], 5 - 2 * r.times.value)
+
+
+def test_streamed_to_a_file_in_pieces(tmp_path, monkeypatch):
+    # a file takes the outputs recorded in the loop in pieces of at most
+    # max_rows (memory stays flat); made small here so that the run takes
+    # many pieces, with checkpoints between them: the file holds what memory does
+    from orbits.io import hdf5
+    monkeypatch.setattr(hdf5.FileRecorder, "max_rows", 7)
+    scene = orbits.scenes.outer_solar_system()
+
+    def make():
+        return orbits.Simulation(scene, "wh", dt=30 * u.day, monitors=["energy", "megno"],
+                                 seed=2)
+    mem = make().run(until=300 * 30 * u.day, outputs=101, progress=False)
+    path = tmp_path / "run.h5"
+    make().run(until=300 * 30 * u.day, outputs=101, output=path, progress=False,
+               checkpoint_interval=0)
+    back = orbits.load(path)
+    _same(mem, back)
+
+
+class _Crash(Exception):
+    pass
+
+
+def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch):
+    # outputs streamed in pieces of 5 with a checkpoint between pieces; the
+    # process dies after writing the rows of the fourth piece, before its
+    # checkpoint: resumed from the file, the run writes the same file, bit for bit
+    from orbits.io import hdf5
+    monkeypatch.setattr(hdf5.FileRecorder, "max_rows", 5)
+    scene = orbits.scenes.outer_solar_system()
+
+    def run(path):
+        sim = orbits.Simulation(scene, "leapfrog", dt=10 * u.day)
+        sim.run(until=400 * 10 * u.day, outputs=41, output=path, progress=False,
+                checkpoint_interval=1e-9)
+    whole, cut = tmp_path / "whole.h5", tmp_path / "cut.h5"
+    run(whole)
+    real = hdf5.FileRecorder.output_rows
+    calls = []
+
+    def crashing(self, *args):
+        real(self, *args)
+        calls.append(1)
+        if len(calls) == 4:
+            raise _Crash()
+    monkeypatch.setattr(hdf5.FileRecorder, "output_rows", crashing)
+    with pytest.raises(_Crash):
+        run(cut)
+    monkeypatch.setattr(hdf5.FileRecorder, "output_rows", real)
+    orbits.Simulation.from_file(cut).resume(progress=False)
+    a, b = orbits.load(whole), orbits.load(cut)
+    assert np.array_equal(a.times.value, b.times.value)
+    assert np.array_equal(a.positions.value, b.positions.value)
+    assert np.array_equal(a.energy_error, b.energy_error)
+    assert b.status == "completed" and len(b) == 41

@@ -754,6 +754,8 @@ class FileRecorder:
         self.scales = state.scales
         self.inv = np.argsort(state.order)
         self.buffer = []
+        self._rowbuf = None          # outputs recorded in the loop (row_buffer)
+        self._checkpoint_due = False
         self.mon_buffer = []
         self.outputs_written = 0     # in this plan
         self.last = None
@@ -938,6 +940,61 @@ class FileRecorder:
             self._flush_outputs()
         if final or _time.perf_counter() - self.last_checkpoint >= self.interval:
             self.checkpoint(finished=final)
+
+    #: outputs a call of the compiled loop records at most, so that a run of
+    #: any number of outputs holds no more than this many in memory
+    max_rows = 16 * BUFFER_ROWS
+
+    @property
+    def records_in_loop(self):
+        """Whether outputs may be recorded inside the compiled loop: not with
+        ``checkpoint_interval=0``, which asks for a checkpoint at every output."""
+        return self.interval > 0
+
+    def row_buffer(self, k):
+        """Where the compiled loop writes the next ``k`` outputs (at most
+        :attr:`max_rows`): rows of the monitors, then the bodies' positions
+        and velocities in the simulation's internal order (see
+        :meth:`orbits._driver.Driven.execute`)."""
+        from .._kernels.invariants import MONITOR_WIDTH
+        width = MONITOR_WIDTH + 6 * len(self.desc.names)
+        if self._rowbuf is None or len(self._rowbuf) < k:
+            self._rowbuf = np.zeros((k, width))
+        return self._rowbuf[:k]
+
+    def output_rows(self, sim, steps, t, rows):
+        """The loop wrote ``rows`` (from :meth:`row_buffer`) at ``steps`` and
+        times ``t``: written to the file as they are, after the buffered
+        outputs before them."""
+        from .._kernels.invariants import MONITOR_WIDTH
+        self._flush_outputs()
+        series, _ = self._series
+        w, n, k = MONITOR_WIDTH, len(self.desc.names), len(t)
+        x = rows[:, w:w + 3 * n].reshape(k, n, 3)[:, self.inv]
+        v = rows[:, w + 3 * n:w + 6 * n].reshape(k, n, 3)[:, self.inv]
+        mon = rows[:, :w]
+        self._note_rows(mon)
+        steps = np.asarray(steps, dtype=np.int64)
+        for dsets, col, name in series:
+            if name is None:
+                values = x if col == 2 else v
+            else:
+                values = mon[:, _MONITOR_COLUMNS[name]]
+                if name in _SCALAR_SERIES:
+                    values = values[:, 0]
+            _append(dsets, self.rows, steps, t, values)
+        self.rows += k
+        self.outputs_written += k
+        self.last = (float(t[-1]), int(steps[-1]), x[-1], v[-1], mon[-1].copy())
+        self._checkpoint_due = True
+
+    def between_chunks(self):
+        """The simulation's clock and state agree again: write the checkpoint
+        that outputs recorded in the loop made due, if its interval passed."""
+        if self._checkpoint_due and \
+                _time.perf_counter() - self.last_checkpoint >= self.interval:
+            self._checkpoint_due = False
+            self.checkpoint()
 
     def monitor_rows(self, t, rows):
         """In-loop monitor rows of the chunk the simulation has just run; called
