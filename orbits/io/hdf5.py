@@ -967,11 +967,14 @@ class FileRecorder:
         times ``t``: written to the file as they are, after the buffered
         outputs before them."""
         from .._kernels.invariants import MONITOR_WIDTH
-        self._flush_outputs()
+        if self.buffer or self.mon_buffer:
+            self._flush_outputs(sync=False)
         series, _ = self._series
         w, n, k = MONITOR_WIDTH, len(self.desc.names), len(t)
-        x = rows[:, w:w + 3 * n].reshape(k, n, 3)[:, self.inv]
-        v = rows[:, w + 3 * n:w + 6 * n].reshape(k, n, 3)[:, self.inv]
+        x = rows[:, w:w + 3 * n].reshape(k, n, 3)
+        v = rows[:, w + 3 * n:w + 6 * n].reshape(k, n, 3)
+        if not np.array_equal(self.inv, np.arange(n)):
+            x, v = x[:, self.inv], v[:, self.inv]
         mon = rows[:, :w]
         self._note_rows(mon)
         steps = np.asarray(steps, dtype=np.int64)
@@ -1136,7 +1139,9 @@ class FileRecorder:
         return Result(**fields)
 
     # writing ---------------------------------------------------------------------------
-    def _flush_outputs(self):
+    def _flush_outputs(self, sync=True):
+        # the buffered outputs and in-loop rows into their datasets; sync:
+        # and the file flushed to disk
         series, inloop = self._series
         if self.buffer:
             k = len(self.buffer)
@@ -1162,7 +1167,8 @@ class FileRecorder:
                 _append(dsets, dsets[1].shape[0], steps, t,
                         vals[:, 0] if name in _SCALAR_SERIES else vals)
             self.mon_buffer = []
-        self.f.flush()
+        if sync:
+            self.f.flush()
 
     def checkpoint(self, finished=False):
         """Write the restart state into the free slot, then advance ``count``.

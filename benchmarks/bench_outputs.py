@@ -1,0 +1,144 @@
+"""What an output costs: a run with many outputs against the same run with two.
+
+What is measured
+----------------
+The outer solar system (``orbits.scenes.outer_solar_system()``) with
+``leapfrog`` (10-day step) and ``wh`` (30-day step), ``--outputs`` outputs
+(default 10^5) one every ``k`` steps (k = 1 and 10), default monitors
+(energy and angular momentum at each output):
+
+* ``memory``: ``Simulation.run(outputs=...)`` kept in memory;
+* ``hdf5``: the same streamed to an HDF5 file (``output=``);
+* ``REBOUND loop``: REBOUND (same floats, ``leapfrog`` or WHFast with
+  ``safe_mode = 0``) advanced to each output time by ``sim.integrate`` in a
+  Python loop that copies the positions and velocities out
+  (``sim.serialize_particle_data``) and computes the energy, the way a
+  REBOUND user records outputs.
+
+The cost of an output is the run's time minus the same run with two
+outputs, divided by the number of outputs; each figure is the median of
+``--repeats`` runs timed in turn, after a warm-up that excludes compilation.
+Memory: the peak resident size of a process that streams 10^6 outputs to a
+file, against one that takes 10^4 (``--memory``), so that the difference is
+what the outputs keep in memory.
+
+Goals, printed with PASS/MISS: an output recorded in memory costs at most
+0.5 us beyond its steps, streamed to HDF5 at most 2 us, and 10^6 streamed
+outputs leave the peak memory within 50 MB of 10^4 (flat).
+
+Run ``python benchmarks/bench_outputs.py`` (about a minute) or ``--quick``.
+"""
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+
+import astropy.units as u
+import numpy as np
+
+import orbits
+
+SCENES = [("leapfrog", 10.0), ("wh", 30.0)]
+
+
+def _ours(integrator, dt, n_out, k, path=None):
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator, dt=dt * u.day)
+    until = n_out * k * dt * u.day
+    t0 = time.perf_counter()
+    sim.run(until=until, outputs=n_out + 1, progress=False, output=path, overwrite=True)
+    return time.perf_counter() - t0
+
+
+def _rebound(integrator, dt, n_out, k):
+    import rebound
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator, dt=dt * u.day)
+    rsim = sim.bodies.to_rebound() if hasattr(sim.bodies, "to_rebound") else None
+    if rsim is None:
+        raise RuntimeError("BodySet.to_rebound is missing")
+    rsim.integrator = "whfast" if integrator == "wh" else "leapfrog"
+    if integrator == "wh":
+        rsim.integrator.safe_mode = 0
+    rsim.dt = dt
+    n = rsim.N
+    buf = np.empty((n, 3))
+    t0 = time.perf_counter()
+    for i in range(1, n_out + 1):
+        rsim.integrate(i * k * dt, exact_finish_time=0)
+        rsim.serialize_particle_data(xyz=buf)
+        rsim.serialize_particle_data(vxvyvz=buf)
+        rsim.energy()
+    return time.perf_counter() - t0
+
+
+def _median(f, repeats):
+    return statistics.median(f() for _ in range(repeats))
+
+
+def _peak_rss(n_out):
+    child = textwrap.dedent(f"""
+        import resource, tempfile, os, astropy.units as u, orbits
+        sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "leapfrog", dt=10 * u.day)
+        path = os.path.join(tempfile.mkdtemp(), "run.h5")
+        sim.run(until={n_out} * 10 * u.day, outputs={n_out} + 1, output=path, progress=False)
+        print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+    """)
+    out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True,
+                         check=True)
+    return int(out.stdout.split()[-1]) / 1024.0     # MB (ru_maxrss in kB on Linux)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--outputs", type=int, default=100_000)
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--quick", action="store_true")
+    p.add_argument("--memory", action="store_true", help="also measure peak memory")
+    args = p.parse_args(argv)
+    n_out = 20_000 if args.quick else args.outputs
+    repeats = 1 if args.quick else args.repeats
+    path = os.path.join(tempfile.mkdtemp(), "bench.h5")
+    print(f"outer solar system, {n_out} outputs, median of {repeats}; "
+          f"us per output beyond its steps")
+    print(f"{'integrator':10s} {'k':>3s} {'steps us':>9s} {'memory':>8s} {'hdf5':>8s} "
+          f"{'REBOUND loop':>13s} {'REB/memory':>11s}")
+    worst = {"memory": 0.0, "hdf5": 0.0}
+    for integrator, dt in SCENES:
+        for k in (1, 10):
+            for f in (lambda: _ours(integrator, dt, 100, k),
+                      lambda: _ours(integrator, dt, 100, k, path)):
+                f()                                   # compile, warm the caches
+            base = _median(lambda: _ours(integrator, dt, 1, k * n_out), repeats)
+            mem = _median(lambda: _ours(integrator, dt, n_out, k), repeats)
+            h5 = _median(lambda: _ours(integrator, dt, n_out, k, path), repeats)
+            base_path = _median(lambda: _ours(integrator, dt, 1, k * n_out, path), repeats)
+            try:
+                reb_base = _median(lambda: _rebound(integrator, dt, 1, k * n_out), repeats)
+                reb = _median(lambda: _rebound(integrator, dt, n_out, k), repeats)
+                reb_cost = (reb - reb_base) / n_out * 1e6
+            except Exception as exc:  # REBOUND missing: say so, measure ours
+                print(f"  REBOUND: {exc}")
+                reb_cost = float("nan")
+            mem_cost = (mem - base) / n_out * 1e6
+            h5_cost = (h5 - base_path) / n_out * 1e6
+            worst["memory"] = max(worst["memory"], mem_cost)
+            worst["hdf5"] = max(worst["hdf5"], h5_cost)
+            print(f"{integrator:10s} {k:3d} {base / (k * n_out) * 1e6:9.3f} {mem_cost:8.3f} "
+                  f"{h5_cost:8.3f} {reb_cost:13.3f} {reb_cost / mem_cost:11.1f}")
+    ok = lambda c: "PASS" if c else "MISS"  # noqa: E731
+    print(f"\nworst output in memory: {worst['memory']:.3f} us (goal <= 0.5) "
+          f"{ok(worst['memory'] <= 0.5)}")
+    print(f"worst output streamed to HDF5: {worst['hdf5']:.3f} us (goal <= 2) "
+          f"{ok(worst['hdf5'] <= 2.0)}")
+    if args.memory:
+        small, large = _peak_rss(10_000), _peak_rss(1_000_000)
+        print(f"peak memory streaming 1e4 outputs: {small:.0f} MB, 1e6 outputs: {large:.0f} MB "
+              f"(goal: within 50 MB) {ok(large - small <= 50)}")
+
+
+if __name__ == "__main__":
+    main()
