@@ -698,17 +698,27 @@ def _final_elements(sim, names):
 
 # kernel bookkeeping: what this task had to compile or load before it could run
 
+_DISPATCHERS = [None, ()]
+
+
 def _dispatchers():
+    # walked again only when a module was imported or a loop specialised
+    # since the last walk (a walk of sys.modules costs milliseconds, which
+    # every member of a sweep would pay twice)
     import sys
 
     from numba.core.dispatcher import Dispatcher
 
     from ._kernels import _jit
+    state = (len(sys.modules), len(_jit._SPECIALISED))
+    if _DISPATCHERS[0] == state:
+        return _DISPATCHERS[1]
     found = [d for d in list(_jit._SPECIALISED.values()) if isinstance(d, Dispatcher)]
     for name, mod in list(sys.modules.items()):
         if name.startswith("orbits._kernels") and mod is not None:
             found.extend(d for d in vars(mod).values() if isinstance(d, Dispatcher))
-    return list({id(d): d for d in found}.values())
+    _DISPATCHERS[:] = [state, list({id(d): d for d in found}.values())]
+    return _DISPATCHERS[1]
 
 
 def _cache_loads():
