@@ -82,6 +82,8 @@ __all__ = [
     "short_step_anomaly",
     "advance_by_anomaly",
     "DRIFT_MAX_ITER",
+    "bracketed_anomaly",
+    "kepler_drift_tangent",
 ]
 
 STATUS_OK = 0
@@ -1301,4 +1303,285 @@ def _kepler_drift_bracketed(mu, x, v, i, dt):
     fdot = -mu * G1 / (r * r0)
     gdm1 = -mu * G2 / r
     _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
+    return STATUS_OK
+
+
+# --------------------------------------------------------------------------
+# The tangent of the Kepler drift (variational equations)
+# --------------------------------------------------------------------------
+
+# |z| below this: c4 and c5 from their series (to the z^8 term, whose
+# successor is below 1e-17 of the sum for |z| < 1); above it from c2, c3,
+# where (1/2 - c2) / z and (1/6 - c3) / z lose at most log2(12) bits.
+_STUMPFF45_SERIES_Z = 1.0
+
+
+@njit(inline="always")
+def _stumpff45(z):
+    """The next two Stumpff functions ``c4 = (1/2 - c2) / z``, ``c5 = (1/6 - c3) / z``
+    (``1/24``, ``1/120`` at ``z = 0``), which the derivatives of ``G_2`` and
+    ``G_3`` in ``beta`` need."""
+    if -_STUMPFF45_SERIES_Z < z < _STUMPFF45_SERIES_Z:
+        # c_k = sum_j (-z)^j / (k + 2j)!  (Horner)
+        c4 = (1.0 / 24 - z * (1.0 / 720 - z * (1.0 / 40320 - z * (1.0 / 3628800 - z * (
+            1.0 / 479001600 - z * (1.0 / 87178291200 - z * (1.0 / 20922789888000 - z * (
+                1.0 / 6402373705728000 - z * (1.0 / 2432902008176640000)))))))))
+        c5 = (1.0 / 120 - z * (1.0 / 5040 - z * (1.0 / 362880 - z * (1.0 / 39916800 - z * (
+            1.0 / 6227020800 - z * (1.0 / 1307674368000 - z * (1.0 / 355687428096000 - z * (
+                1.0 / 121645100408832000 - z * (1.0 / 51090942171709440000)))))))))
+        return c4, c5
+    c0, c1, c2, c3 = stumpff(z)
+    return (0.5 - c2) / z, (_SIXTH - c3) / z
+
+
+@njit
+def bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
+    """The universal anomaly of :func:`kepler_drift`'s bracketed solver.
+
+    The same iteration as the drift's bracketed path, stopped where it
+    stops, for the derivatives of the drift (:func:`kepler_drift_tangent`),
+    which need ``s`` and not only the state.  Returns ``(s, turns)``: on a
+    long elliptic step ``dt`` is first reduced modulo the period ``P`` and
+    ``s`` belongs to the reduced step ``dt - turns P`` (``turns`` a whole
+    number, 0.0 otherwise).  ``s`` is NaN where the drift fails (invalid
+    state, no convergence or a non-positive radius); ``s = 0`` for ``dt = 0``.
+    """
+    r0 = math.sqrt(x0 * x0 + y0 * y0 + z0 * z0)
+    v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
+    if not (mu > 0.0) or not (r0 > 0.0) or not math.isfinite(r0 + v2 + dt + mu):
+        return math.nan, 0.0
+    if dt == 0.0:
+        return 0.0, 0.0
+    eta = x0 * vx0 + y0 * vy0 + z0 * vz0
+    beta = 2.0 * mu / r0 - v2
+    zeta = mu - beta * r0
+    hx = y0 * vz0 - z0 * vy0
+    hy = z0 * vx0 - x0 * vz0
+    hz = x0 * vy0 - y0 * vx0
+    p = (hx * hx + hy * hy + hz * hz) / mu
+    e2 = 1.0 - p * beta / mu
+    q = p / (1.0 + math.sqrt(e2 if e2 > 0.0 else 0.0))
+    turns = 0.0
+    if beta > 0.0:
+        period = _TWO_PI * mu / (beta * math.sqrt(beta))
+        if abs(dt) > period:
+            reduced = np.fmod(dt, period)
+            turns = float(round((dt - reduced) / period))
+            dt = reduced
+    if dt > 0.0:
+        lo = 0.0
+        hi = dt / q if q > 0.0 else math.inf
+    else:
+        lo = dt / q if q > 0.0 else -math.inf
+        hi = 0.0
+    s = dt / r0 - 0.5 * eta * dt * dt / (r0 * r0 * r0)
+    if abs(dt) * math.sqrt(v2) > 0.2 * r0 or not (lo < s < hi):
+        if beta > 0.0:
+            s = dt * beta / mu
+        else:
+            b = -beta
+            sb = math.sqrt(b) if b > 0.0 else 0.0
+            scale = zeta + sb * (abs(eta) + sb * r0)
+            if sb > 0.0 and scale > 0.0:
+                s = math.log(1.0 + 2.0 * b * sb * abs(dt) / scale) / sb
+                s = s if dt > 0.0 else -s
+        if not (lo < s < hi):
+            s = 0.5 * (lo + hi) if math.isfinite(hi - lo) else dt / r0
+    r = r0
+    it = 0
+    width = hi - lo
+    for _ in range(DRIFT_MAX_ITER):
+        c0, c1, c2, c3 = stumpff(beta * s * s)
+        G0 = c0
+        G1 = s * c1
+        G2 = s * s * c2
+        G3 = s * s * s * c3
+        f = r0 * s + eta * G2 + zeta * G3 - dt
+        r = r0 + eta * G1 + zeta * G2
+        if f == 0.0:
+            return (s, turns) if r > 0.0 else (math.nan, 0.0)
+        if f < 0.0:
+            lo = s
+        else:
+            hi = s
+        fpp = eta * G0 + zeta * G1
+        fppp = zeta * G0 - beta * eta * G1
+        d1 = -f / r
+        d2 = -f / (r + 0.5 * d1 * fpp)
+        s_new = s - f / (r + 0.5 * d2 * fpp + d2 * d2 * fppp / 6.0)
+        it += 1
+        if it % 4 == 0:
+            slow = (hi - lo) > 0.5 * width
+            width = hi - lo
+        else:
+            slow = False
+        if slow or not (lo < s_new < hi):
+            if math.isfinite(lo) and math.isfinite(hi):
+                if lo > 0.0 and hi > 4.0 * lo:
+                    s_new = math.sqrt(lo * hi)
+                elif hi < 0.0 and lo < 4.0 * hi:
+                    s_new = -math.sqrt(lo * hi)
+                else:
+                    s_new = 0.5 * (lo + hi)
+            elif math.isfinite(lo):
+                s_new = 2.0 * lo + dt / r0
+            else:
+                s_new = 2.0 * hi + dt / r0
+        if abs(s_new - s) <= _DRIFT_STEP_TOL * abs(s):
+            return (s, turns) if r > 0.0 else (math.nan, 0.0)
+        s = s_new
+    return math.nan, 0.0
+
+
+@njit(inline="always")
+def _drift_tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, turns,
+                        c0, c1, c2, c3):
+    # the tangent rows i + n (1 + j) of body i, whose drift started at
+    # (x0, v0) and took the universal anomaly s (of a step reduced by `turns`
+    # periods) with the Stumpff functions c0..c3 of beta s^2: implicit
+    # differentiation of Kepler's equation (see kepler_drift_tangent)
+    r2 = x0 * x0 + y0 * y0 + z0 * z0
+    r0 = math.sqrt(r2)
+    sig = x0 * vx0 + y0 * vy0 + z0 * vz0
+    beta = 2.0 * mu / r0 - (vx0 * vx0 + vy0 * vy0 + vz0 * vz0)
+    zeta = mu - beta * r0
+    G0 = c0
+    G1 = s * c1
+    G2 = s * s * c2
+    G3 = s * s * s * c3
+    c4, c5 = _stumpff45(beta * s * s)
+    G4 = s * s * s * s * c4
+    G5 = s * s * s * s * s * c5
+    if turns != 0.0:
+        # many periods: G0, G1, G2 are periodic in s, the others are not, and
+        # the derivatives belong to the whole anomaly (the period depends on
+        # the state: that is the secular part of the tangent)
+        sf = s + turns * (_TWO_PI / math.sqrt(beta))
+        G3 = (sf - G1) / beta
+        G4 = (0.5 * sf * sf - G2) / beta
+        G5 = (sf * sf * sf * _SIXTH - G3) / beta
+        s = sf
+    r = r0 + sig * G1 + zeta * G2
+    # dG_k / dbeta = (k G_(k+2) - s G_(k+1)) / 2
+    b1 = 0.5 * (G3 - s * G2)
+    b2 = G4 - 0.5 * s * G3
+    b3 = 0.5 * (3.0 * G5 - s * G4)
+    fm1 = -mu * G2 / r0
+    g = r0 * G1 + sig * G2
+    fdot = -mu * G1 / (r * r0)
+    gdm1 = -mu * G2 / r
+    ir0 = 1.0 / r0
+    ir = 1.0 / r
+    for j in range(k):
+        o = i + n * (1 + j)
+        dx0 = x[o, 0]
+        dy0 = x[o, 1]
+        dz0 = x[o, 2]
+        dvx0 = v[o, 0]
+        dvy0 = v[o, 1]
+        dvz0 = v[o, 2]
+        dm = dmu[j, i]
+        dr0 = (x0 * dx0 + y0 * dy0 + z0 * dz0) * ir0
+        dsig = x0 * dvx0 + y0 * dvy0 + z0 * dvz0 + vx0 * dx0 + vy0 * dy0 + vz0 * dz0
+        dbeta = (2.0 * dm - 2.0 * mu * dr0 * ir0) * ir0 - 2.0 * (
+            vx0 * dvx0 + vy0 * dvy0 + vz0 * dvz0)
+        dzeta = dm - r0 * dbeta - beta * dr0
+        ds = -(s * dr0 + G2 * dsig + G3 * dzeta + (sig * b2 + zeta * b3) * dbeta) * ir
+        dG1 = G0 * ds + b1 * dbeta
+        dG2 = G1 * ds + b2 * dbeta
+        dr = dr0 + dsig * G1 + sig * dG1 + dzeta * G2 + zeta * dG2
+        df = -(dm * G2 + mu * dG2) * ir0 - fm1 * dr0 * ir0
+        dg = dr0 * G1 + r0 * dG1 + dsig * G2 + sig * dG2
+        dfdot = -(dm * G1 + mu * dG1) * ir * ir0 - fdot * (dr * ir + dr0 * ir0)
+        dgd = -(dm * G2 + mu * dG2) * ir - gdm1 * dr * ir
+        x[o, 0] = dx0 + (fm1 * dx0 + g * dvx0) + (df * x0 + dg * vx0)
+        x[o, 1] = dy0 + (fm1 * dy0 + g * dvy0) + (df * y0 + dg * vy0)
+        x[o, 2] = dz0 + (fm1 * dz0 + g * dvz0) + (df * z0 + dg * vz0)
+        v[o, 0] = dvx0 + (fdot * dx0 + gdm1 * dvx0) + (dfdot * x0 + dgd * vx0)
+        v[o, 1] = dvy0 + (fdot * dy0 + gdm1 * dvy0) + (dfdot * y0 + dgd * vy0)
+        v[o, 2] = dvz0 + (fdot * dz0 + gdm1 * dvz0) + (dfdot * z0 + dgd * vz0)
+
+
+@njit
+def kepler_drift_tangent(mu, x, v, i, dt, dmu, k):
+    """:func:`kepler_drift` of row ``i`` by ``dt``, and its tangent vectors carried
+    through the drift's exact derivative, in place.
+
+    Parameters
+    ----------
+    mu : float
+        Gravitational parameter of the orbit, > 0.
+    x, v : ndarray, shape (n (1 + k), 3)
+        Row ``i`` is the relative state that drifts; rows ``i + n (1 + j)``
+        (``j < K``) are its tangent vectors ``(dx, dv)``, ``n =
+        dmu.shape[1]`` rows apart (the bodies of a system, then ``k``
+        blocks of their tangent vectors).
+    i : int
+        The row.
+    dt : float
+        Time step, either sign, any size.
+    dmu : ndarray, shape (K, n)
+        The variation of ``mu`` that tangent vector ``j`` carries is
+        ``dmu[j, i]`` (zeros for none).
+    k : int
+        The tangent vectors carried: the first ``k <= K``.
+
+    Returns
+    -------
+    status : int
+        :data:`STATUS_OK`, or :data:`STATUS_INVALID_STATE` as
+        :func:`kepler_drift`; then row ``i`` and its tangent rows are NaN.
+
+    Notes
+    -----
+    Row ``i`` is advanced by :func:`kepler_drift`'s own arithmetic (its
+    short-step path, or its bracketed solver), so that it is bit for bit
+    the drift's.  The tangent differentiates the solution: with ``sigma =
+    x0 . v0``, ``beta = 2 mu / r0 - v0^2``, ``zeta = mu - beta r0`` and the
+    universal functions ``G_k = s^k c_k(beta s^2)`` (``dG_k/ds = G_(k-1)``,
+    ``dG_k/dbeta = (k G_(k+2) - s G_(k+1)) / 2``), Kepler's equation
+    ``r0 s + sigma G_2 + zeta G_3 = dt`` at fixed ``dt`` gives ::
+
+        r ds = -(s dr0 + G_2 dsigma + G_3 dzeta
+                 + (sigma dG_2/dbeta + zeta dG_3/dbeta) dbeta)
+
+    (``r`` the radius at the end), and the derivatives of ``f - 1 = -mu G_2
+    / r0``, ``g = r0 G_1 + sigma G_2``, ``fdot = -mu G_1 / (r r0)``, ``gdot - 1
+    = -mu G_2 / r`` give ``dx = df x0 + f dx0 + dg v0 + g dv0``, ``dv =
+    dfdot x0 + fdot dx0 + dgdot v0 + gdot dv0``.  ``dmu`` enters through
+    ``dbeta = 2 dmu / r0 - ...``, ``dzeta`` and the ``mu`` in ``f``, ``g``.
+    A long elliptic step, solved modulo the period, is differentiated at the
+    whole anomaly (the period depends on the state).
+
+    References
+    ----------
+    Danby, J. M. A. 1988, *Fundamentals of Celestial Mechanics*, 2nd ed.,
+    sect. 6.9 (universal variables); Rein, H. & Tamayo, D. 2016, MNRAS 459,
+    2275 (the tangent of the Wisdom-Holman map).
+    """
+    n = dmu.shape[1]
+    x0 = x[i, 0]
+    y0 = x[i, 1]
+    z0 = x[i, 2]
+    vx0 = v[i, 0]
+    vy0 = v[i, 1]
+    vz0 = v[i, 2]
+    s, r0, ir0, beta, zeta = short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
+    if s == s and advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
+        c0, c1, c2, c3 = _stumpff_short(beta * s * s)
+        turns = 0.0
+    else:
+        status = kepler_drift(mu, x, v, i, dt)
+        s, turns = bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
+        if status != STATUS_OK or not (s == s):
+            for j in range(k):
+                for d in range(3):
+                    x[i + n * (1 + j), d] = math.nan
+                    v[i + n * (1 + j), d] = math.nan
+            return STATUS_INVALID_STATE
+        r0 = math.sqrt(x0 * x0 + y0 * y0 + z0 * z0)
+        beta = 2.0 * mu / r0 - (vx0 * vx0 + vy0 * vy0 + vz0 * vz0)
+        c0, c1, c2, c3 = stumpff(beta * s * s)
+    _drift_tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, turns,
+                        c0, c1, c2, c3)
     return STATUS_OK

@@ -270,11 +270,11 @@ def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
         else:
             a = corr[m - 1 - k, 0] * h
             b = corr[m - 1 - k, 1] * h
-        kepler_drift_all(xj, vj, eta, a, x, acc)
+        drift(xj, vj, eta, a, x, acc, targs)  # noqa: F821 - bound by specialize
         perturbation(xj, vj, x, acc, gm, eta, n_active, -b, targs)  # noqa: F821 - bound
-        kepler_drift_all(xj, vj, eta, -2.0 * a, x, acc)
+        drift(xj, vj, eta, -2.0 * a, x, acc, targs)  # noqa: F821
         perturbation(xj, vj, x, acc, gm, eta, n_active, b, targs)  # noqa: F821
-        kepler_drift_all(xj, vj, eta, a, x, acc)
+        drift(xj, vj, eta, a, x, acc, targs)  # noqa: F821
 
 
 def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs):
@@ -287,10 +287,10 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, ta
             xs[i, d] = xj[i, d]
             vs[i, d] = vj[i, d]
     if owed != 0.0:
-        kepler_drift_all(xs, vs, eta, owed, x, acc)
+        drift(xs, vs, eta, owed, x, acc, targs)  # noqa: F821 - bound by specialize
     if corr.shape[0] > 0:
         apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, False, targs)
-    from_internal(xs, vs, gm, eta, x, v)  # noqa: F821 - bound by specialize
+    from_internal(xs, vs, gm, eta, x, v, targs)  # noqa: F821 - bound by specialize
 
 
 def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
@@ -305,7 +305,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
     n_mon = 0
     corrected = corr.shape[0] > 0
     if state[0] == 0:
-        to_internal(x, v, gm, eta, xj, vj)  # noqa: F821 - bound by specialize
+        to_internal(x, v, gm, eta, xj, vj, targs)  # noqa: F821 - bound by specialize
         state[0] = 1
         owed_box[0] = 0.0
         if corrected:
@@ -315,7 +315,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         # a new step size (a shorter last step): through the true state to the
         # mapping state of the new step's corrector
         if owed_box[0] != 0.0:
-            kepler_drift_all(xj, vj, eta, owed_box[0], xs, vs)
+            drift(xj, vj, eta, owed_box[0], xs, vs, targs)  # noqa: F821 - bound
             owed_box[0] = 0.0
         apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], False, targs)
         apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True, targs)
@@ -335,15 +335,17 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                 if op == n_ops - 1 and defer:
                     owed = h
                 else:
-                    kepler_drift_all(xj, vj, eta, h, xs, vs)
+                    drift(xj, vj, eta, h, xs, vs, targs)  # noqa: F821 - bound
             else:
                 perturbation(xj, vj, xs, acc, gm, eta, n_active, h, targs)  # noqa: F821
         # the shared epilogue checks the internal state; its recorder
-        # synchronises first, so the monitors see the inertial state at the time
+        # synchronises first, so the monitors see the inertial state at the
+        # time; the synchronisation's arguments are also its fargs, for the
+        # chaos indicators of a run with variations (orbits._kernels.wh_tangent)
+        sync = (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             xj, vj, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, (mon, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)),
-            n_mon, mon_t, mon_out, (), ())
+            every, (mon, sync), n_mon, mon_t, mon_out, (), sync)
         if status != GO:
             owed_box[0] = owed
             return status, done, n_mon
@@ -424,6 +426,17 @@ def _heliocentric_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
     vb[0, 2] += h * fz
 
 
+@njit(inline="always")
+def _plain_drift(xj, vj, eta, h, w1, w2, targs):
+    # the Kepler drift of a run without variations (a run with them binds
+    # orbits._kernels.wh_tangent's, which also carries the tangent rows)
+    kepler_drift_all(xj, vj, eta, h, w1, w2)
+
+
+def _plain_convert(a, b, gm, eta, c, d, targs):
+    convert(a, b, gm, eta, c, d)  # noqa: F821 - bound by specialize
+
+
 def _plain_perturbation(xj, vj, x, acc, gm, eta, n_active, h, targs):
     step(xj, vj, x, acc, gm, eta, n_active, h)  # noqa: F821 - bound by specialize
 
@@ -458,6 +471,10 @@ def _kernels(coordinates, terms=None):
     to_internal, from_internal, step, term_kick = COORDINATE_SYSTEMS[coordinates]
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
+    to_internal = specialize(_plain_convert, f"to_{coordinates}", inline=True,
+                             convert=to_internal)
+    from_internal = specialize(_plain_convert, f"from_{coordinates}", inline=True,
+                               convert=from_internal)
     # without numba's runtime: these allocate nothing, and the reference
     # counts of the inlined kernels' array arguments would cost more than a
     # two-body step's kick (see orbits._kernels._jit).  A user's term (not
@@ -474,9 +491,10 @@ def _kernels(coordinates, terms=None):
                                   nrt=nrt, term_kick=kick,
                                   HELIOCENTRIC=coordinates != "jacobi")
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
-                           perturbation=perturbation)
+                           drift=_plain_drift, perturbation=perturbation)
     sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt,
-                      from_internal=from_internal, apply_corrector=corrector)
+                      drift=_plain_drift, from_internal=from_internal,
+                      apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
 
 
@@ -500,7 +518,7 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
-                      perturbation=perturbation, apply_corrector=corrector,
+                      drift=_plain_drift, perturbation=perturbation, apply_corrector=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache))
 
 

@@ -19,7 +19,8 @@ import numpy as np
 from .._kernels.status import with_status
 from .._kernels import coordinates as _coordinates
 from .._kernels import wisdom_holman as _wh
-from .._kernels.stepping import DRIFT, KICK
+from .._kernels import wh_tangent as _wht
+from .._kernels.stepping import DRIFT, KICK, work_bound
 from ..errors import IntegratorOptionError
 from . import tableaux
 from .base import Integrator
@@ -142,6 +143,17 @@ class WisdomHolman(Integrator):
     (which outputs and monitors call), on a copy, so that the merged drifts
     go on.  :meth:`invalidate` makes the next step start again from ``x``, ``v``.
 
+    Variational equations (a force with variations, ``force.inner`` set;
+    :mod:`orbits._kernels.variational`): the tangent vectors in the rows
+    after the bodies' are carried through the exact derivative of every
+    operator, the map's own tangent as in WHFast (Rein & Tamayo 2016; see
+    :mod:`orbits._kernels.wh_tangent`), in both coordinate systems, with the
+    correctors and for SABA; the workspace's internal state then holds the
+    tangent rows too.  Mass variations are taken (not together with added
+    force terms).  With the chaos indicators, tangent vector 0 is
+    synchronised to the inertial frame after every step, as for an output.
+    The bodies' rows are bit for bit those of a run without variations.
+
     References
     ----------
     Wisdom, J. & Holman, M. 1991, "Symplectic maps for the N-body problem",
@@ -151,7 +163,8 @@ class WisdomHolman(Integrator):
     Inst. Commun. 10, 217.  Wisdom, J. 2006, "Symplectic correctors for
     canonical heliocentric coordinates", AJ 131, 2294.  Duncan, M. J.,
     Levison, H. F. & Lee, M. H. 1998, AJ 116, 2067 (democratic heliocentric
-    coordinates).
+    coordinates).  Rein, H. & Tamayo, D. 2016, "Second-order variational
+    equations for N-body simulations", MNRAS 459, 2275 (the tangent map).
 
     Examples
     --------
@@ -232,9 +245,39 @@ class WisdomHolman(Integrator):
 
     def bind(self, ws, force, fargs):
         """Keep the added terms' kernel and arguments in the workspace (not an
-        array, so neither saved nor restored: rebound from the simulation)."""
+        array, so neither saved nor restored: rebound from the simulation), and
+        for a force with variations its tangent arguments."""
+        if force.inner is not None:
+            self._bind_tangent(ws, force, fargs)
+            force, fargs = force.inner, fargs[0]
         if force.terms is not None:
             ws["terms"] = (force.terms, fargs[1])
+
+    def _bind_tangent(self, ws, force, fargs):
+        # the tangent arguments tp of orbits._kernels.wh_tangent, kept with the
+        # force (neither is an array: rebound, not saved); the chaos box in tp
+        # is the one fargs brings, replaced by the workspace's in advance
+        inner, (inner_fargs, vargs) = force.inner, fargs
+        n, dm, jx, jv, box, (G, eps2) = vargs
+        dm = np.ascontiguousarray(dm, dtype=np.float64)
+        k = dm.shape[0]
+        if dm.shape != (k, n):
+            raise ValueError(f"{self.name}: mass variations of shape {dm.shape}, "
+                             f"expected ({k}, {n})")
+        masses = bool(np.any(dm != 0.0))
+        if masses and inner.terms is not None:
+            raise IntegratorOptionError(
+                f"{self.name}: mass variations together with added force terms are not "
+                "supported (the terms' dependence on the masses is not differentiated); "
+                "use 'ias15'")
+        dgm = G * dm
+        if self.config["coordinates"] == "jacobi":
+            # each row's Kepler G M is the interior mass G eta_i
+            deta = np.cumsum(dgm, axis=1)
+        else:
+            # every row orbits G m_0
+            deta = np.repeat(dgm[:, :1], n, axis=1)
+        ws["tangent"] = (force, n, (dgm, np.ascontiguousarray(deta), k, masses, jx, jv, box))
 
     def _check_system(self, ws, force, fargs):
         if force.terms is not None:
@@ -264,7 +307,9 @@ class WisdomHolman(Integrator):
                     "does not split the motion, such as 'ias15' (adaptive, for close "
                     "encounters) or 'verlet'/'leapfrog' with a small step.",
                     NoDominantBodyWarning, stacklevel=4)
-        ws["gm"][:] = gm
+        # (a run with variations has a workspace of more rows than bodies: the
+        # rows after the bodies' are not used)
+        ws["gm"][:len(gm)] = gm
         ws["n_active"][0] = n_active
         if self.config["coordinates"] == "jacobi":
             _coordinates.interior_gm(gm, ws["eta"])
@@ -275,6 +320,9 @@ class WisdomHolman(Integrator):
 
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1):
+        if force.inner is not None:
+            return self._advance_tangent(ws, x, v, t, dt, nsteps, force, fargs, mon, step0,
+                                         mon_t, mon_out, check_every)
         if ws["state"][1] == 0:
             self._check_system(ws, force, fargs)
         terms, targs = ws.get("terms", (None, ()))
@@ -286,10 +334,43 @@ class WisdomHolman(Integrator):
                     ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
                     ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs))
 
+    def _advance_tangent(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t,
+                         mon_out, check_every):
+        # a force with variations (force.inner the gravity, fargs = (its
+        # fargs, vargs)): x, v hold the bodies and then the tangent vectors
+        # (orbits._kernels.wh_tangent), and the loop carries the tangent of
+        # every operator
+        fargs = work_bound(force, fargs, ws)
+        if ws["state"][1] == 0:
+            self._check_system(ws, force.inner, fargs[0])
+        if ws.get("tangent", (None,))[0] is not force:
+            self.bind(ws, force, fargs)
+        _, n, tp = ws["tangent"]
+        if x.shape[0] != n * (1 + tp[2]):
+            raise ValueError(f"{self.name}: {x.shape[0]} state rows for {n} bodies and "
+                             f"{tp[2]} tangent vectors")
+        tp = tp[:6] + (fargs[1][4],)
+        terms, targs = ws.get("terms", (None, ()))
+        gravity = fargs[0] if terms is None else fargs[0][0]
+        gm, n_active = gravity[0], gravity[1]
+        loop = _wht.wh_tangent_loop(self.name, self._kinds, self._coefs,
+                                    self.config["coordinates"], terms, force)
+        return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"][:n],
+                                 n_active, ws["acc"], ws["xs"], ws["vs"], ws["state"],
+                                 ws["owed"], self._corr, ws["cdt"], mon, step0, mon_t,
+                                 mon_out, check_every, (targs, tp)))
+
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
         its owed drift are kept, so that the following steps go on unchanged."""
-        if ws["state"][0]:
+        if ws["state"][0] and "tangent" in ws:
+            force, n, tp = ws["tangent"]
+            terms, targs = ws.get("terms", (None, ()))
+            sync = _wht.tangent_synchronizer(self.config["coordinates"], terms, force)
+            sync(ws["xj"], ws["vj"], ws["gm"][:n], ws["eta"][:n], ws["owed"][0], ws["xs"],
+                 ws["vs"], x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0],
+                 (targs, tp))
+        elif ws["state"][0]:
             terms, targs = ws.get("terms", (None, ()))
             sync = _wh.synchronizer(self.config["coordinates"], terms)
             sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],

@@ -1,0 +1,703 @@
+"""The tangent map of the Wisdom-Holman family: first-order variational equations.
+
+A tangent vector ``delta = (dx, dv)``, with a constant mass variation ``dm``,
+follows the derivative of the map itself (Rein & Tamayo 2016 [2]): every
+operator of a step (:mod:`orbits._kernels.wisdom_holman`) is a smooth map of
+the state and the masses, so the step's tangent is the chain of the
+operators' derivatives, applied in the same order.  This is the exact
+tangent of the symplectic map, not an integration of the variational
+equations of the true flow, so the pair (state, tangent) is itself the map
+of the variational system and the chaos indicators built on it see the
+map's dynamics (the symplectic tangent map of Mikkola & Innanen 1999 [3];
+WHFast's approach, Rein & Tamayo 2015 [1], 2016 [2]).
+
+Rows.  The state arrays ``x``, ``v`` of a run with ``k`` tangent vectors have
+``n (1 + k)`` rows: the ``n`` bodies, then tangent vector ``j`` in rows
+``[n (1 + j), n (2 + j))`` (``dx`` in ``x``, ``dv`` in ``v``), in the inertial
+frame.  The internal state (Jacobi or democratic heliocentric, the
+workspace's ``xj``, ``vj``) has the same layout, its tangent rows the
+derivative of the internal coordinates, so a checkpoint keeps both.
+
+The operators and their derivatives, for tangent vector ``j`` with ``dgm =
+G dm`` (mass variations may be zero):
+
+* coordinates: Jacobi and democratic heliocentric coordinates are linear in
+  the state with mass-dependent weights; the tangent applies the same
+  linear map to ``delta`` plus its derivative in the masses applied to the
+  state (``w_i = m_i / eta_i`` gives ``dw_i = (dm_i - w_i deta_i) / eta_i``;
+  the centre of mass ``X = sum m x / M`` gives ``dX = (sum dm x + m dx - X dM) / M``);
+* Kepler drift: :func:`~orbits._kernels.kepler.kepler_drift_tangent`, exact
+  derivative in the state and in ``G eta_i`` (Jacobi) or ``G m_0`` (democratic
+  heliocentric), whose variation is ``G`` times the cumulative ``dm`` or ``dm_0``;
+* interaction kick: the Jacobian of the pair accelerations it contains,
+  block ``G m_l (I / r^3 - 3 d d^T / r^5)`` of body ``i`` against ``l``
+  (``d = x_i - x_l``) and ``G dm_l d / r^3`` for the masses, transformed as
+  the kick transforms its accelerations, with the derivative of the Jacobi
+  Kepler term ``G eta_i x'_i / r'^3``;
+* jump (democratic heliocentric): linear, ``dQ_i += h (sum_l m_l dV_l + dm_l
+  V_l) / m_0 - h dm_0 sum_l m_l V_l / m_0^2``;
+* added force terms (position-only, :mod:`.terms`): their Jacobian
+  ``da/dx`` (``TermKernel.jacobian``) times the inertial ``dx``, transformed
+  as their kick; their dependence on the masses is not known, so mass
+  variations with terms are refused (by the integrator);
+* correctors: compositions of drifts and perturbation steps, so their
+  tangent is the composition of the tangents above.
+
+A mass variation of a test particle (a row at or after ``N_active``, which
+the map lets pull nothing) is differentiated as in the map in which every
+body is active, which at zero mass has the same values: the tangent feels
+its pull (as the variational equations of the other integrators do).
+
+The kernels take the tangent arguments as one tuple ``tp = (dgm, deta, k,
+masses, jx, jv, box)``: ``dgm`` (shape (K, n)) the variations of ``G m``,
+``deta`` (shape (K, n)) those of each row's Kepler ``G M``, ``k <= K`` the
+number of tangent vectors to carry (all of them in a step; 1 to synchronise
+the chaos indicators' vector; 0 for the bodies alone), ``masses`` whether
+any ``dm`` is non-zero, ``jx``, ``jv`` (shape (3n, 3n)) scratch for the
+terms' Jacobian, and ``box`` the chaos accumulators
+(:mod:`orbits._kernels.variational`).  The bound ``targs`` of the
+Wisdom-Holman templates is then ``(the terms' args, tp)``.
+
+Chaos indicators.  With them on (a compile-time flag of the force), after
+every step the loop synchronises the bodies and tangent vector 0 to the
+inertial frame (on a copy: the owed drift and the corrector applied with
+their tangents, as for an output) and hands that vector to
+:func:`~orbits._kernels.variational.chaos_update`, so the indicators see the
+same inertial ``|delta|`` as other integrators' (and REBOUND's WHFast, which
+synchronises every step for MEGNO).  When ``|delta|`` has grown large the
+internal rows of vector 0 are scaled by an exact power of two inside the
+loop (:func:`~orbits._kernels.variational.renormalise`, its exponent from
+the internal rows' norm); the tangent being linear, this is exact, and the
+loop never returns ``RENORMALISE``.
+
+References
+----------
+.. [1] Rein, H. & Tamayo, D. 2015, "WHFAST: a fast and unbiased
+   implementation of a symplectic Wisdom-Holman integrator for long-term
+   gravitational simulations", MNRAS 452, 376.
+.. [2] Rein, H. & Tamayo, D. 2016, "Second-order variational equations for
+   N-body simulations", MNRAS 459, 2275.
+.. [3] Mikkola, S. & Innanen, K. 1999, "Symplectic tangent map for
+   planetary motions", Celest. Mech. Dyn. Astron. 74, 59.
+"""
+
+import math
+
+from ._jit import njit, specialize
+from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democratic_heliocentric,
+                          to_jacobi)
+from .kepler import kepler_drift_tangent
+from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
+                            _synchronize, _wh_loop, heliocentric_interaction_kick,
+                            interaction_kick, jump)
+
+__all__ = ["drift_tangent", "interaction_kick_tangent", "jump_tangent",
+           "heliocentric_kick_tangent", "to_jacobi_tangent", "from_jacobi_tangent",
+           "to_heliocentric_tangent", "from_heliocentric_tangent", "wh_tangent_loop",
+           "tangent_synchronizer"]
+
+
+# -- coordinates -------------------------------------------------------------------------
+
+@njit(inline="always")
+def _to_jacobi_block(a, out, gm, eta, dgm, deta, j, masses):
+    # tangent block j of to_jacobi_one: a's rows o.. into out's, with the
+    # bodies' Jacobi components (out[:n], already computed) for the weights'
+    # mass derivative
+    n = gm.shape[0]
+    o = n * (1 + j)
+    sx = a[o, 0]
+    sy = a[o, 1]
+    sz = a[o, 2]
+    for i in range(1, n):
+        dx = a[o + i, 0] - sx
+        dy = a[o + i, 1] - sy
+        dz = a[o + i, 2] - sz
+        out[o + i, 0] = dx
+        out[o + i, 1] = dy
+        out[o + i, 2] = dz
+        w = gm[i] / eta[i]
+        sx += w * dx
+        sy += w * dy
+        sz += w * dz
+        if masses:
+            dw = (dgm[j, i] - w * deta[j, i]) / eta[i]
+            sx += dw * out[i, 0]
+            sy += dw * out[i, 1]
+            sz += dw * out[i, 2]
+    out[o, 0] = sx
+    out[o, 1] = sy
+    out[o, 2] = sz
+
+
+@njit(inline="always")
+def _from_jacobi_block(aj, out, gm, eta, dgm, deta, j, masses):
+    # tangent block j of from_jacobi_one, with the bodies' Jacobi aj[:n]
+    n = gm.shape[0]
+    o = n * (1 + j)
+    sx = aj[o, 0]
+    sy = aj[o, 1]
+    sz = aj[o, 2]
+    for i in range(n - 1, 0, -1):
+        w = gm[i] / eta[i]
+        sx -= w * aj[o + i, 0]
+        sy -= w * aj[o + i, 1]
+        sz -= w * aj[o + i, 2]
+        if masses:
+            dw = (dgm[j, i] - w * deta[j, i]) / eta[i]
+            sx -= dw * aj[i, 0]
+            sy -= dw * aj[i, 1]
+            sz -= dw * aj[i, 2]
+        out[o + i, 0] = aj[o + i, 0] + sx
+        out[o + i, 1] = aj[o + i, 1] + sy
+        out[o + i, 2] = aj[o + i, 2] + sz
+    out[o, 0] = sx
+    out[o, 1] = sy
+    out[o, 2] = sz
+
+
+@njit
+def to_jacobi_tangent(x, v, gm, eta, xj, vj, tp):
+    """:func:`~orbits._kernels.coordinates.to_jacobi` of the bodies (rows
+    ``[0, n)``, ``n = gm.shape[0]``) and of the first ``tp[2]`` tangent
+    vectors, with the transformation's derivative in the masses."""
+    n = gm.shape[0]
+    to_jacobi(x[:n], v[:n], gm, eta, xj[:n], vj[:n])
+    dgm, deta, k, masses = tp[0], tp[1], tp[2], tp[3]
+    for j in range(k):
+        _to_jacobi_block(x, xj, gm, eta, dgm, deta, j, masses)
+        _to_jacobi_block(v, vj, gm, eta, dgm, deta, j, masses)
+
+
+@njit
+def from_jacobi_tangent(xj, vj, gm, eta, x, v, tp):
+    """Inverse of :func:`to_jacobi_tangent`."""
+    n = gm.shape[0]
+    from_jacobi(xj[:n], vj[:n], gm, eta, x[:n], v[:n])
+    dgm, deta, k, masses = tp[0], tp[1], tp[2], tp[3]
+    for j in range(k):
+        _from_jacobi_block(xj, x, gm, eta, dgm, deta, j, masses)
+        _from_jacobi_block(vj, v, gm, eta, dgm, deta, j, masses)
+
+
+@njit
+def to_heliocentric_tangent(x, v, gm, eta, xh, vb, tp):
+    """:func:`~orbits._kernels.coordinates.to_democratic_heliocentric` of the
+    bodies and of the first ``tp[2]`` tangent vectors (``eta`` unused)."""
+    n = gm.shape[0]
+    to_democratic_heliocentric(x[:n], v[:n], gm, xh[:n], vb[:n])
+    dgm, k, masses = tp[0], tp[2], tp[3]
+    mt = 0.0
+    for i in range(n):
+        mt += gm[i]
+    for j in range(k):
+        o = n * (1 + j)
+        dmt = 0.0
+        if masses:
+            for i in range(n):
+                dmt += dgm[j, i]
+        for d in range(3):
+            # X = sum m x / M and V = sum m v / M are rows 0 of xh, vb
+            sx = 0.0
+            sv = 0.0
+            for i in range(n):
+                sx += gm[i] * x[o + i, d]
+                sv += gm[i] * v[o + i, d]
+                if masses:
+                    sx += dgm[j, i] * x[i, d]
+                    sv += dgm[j, i] * v[i, d]
+            dX = (sx - xh[0, d] * dmt) / mt
+            dV = (sv - vb[0, d] * dmt) / mt
+            for i in range(1, n):
+                xh[o + i, d] = x[o + i, d] - x[o, d]
+                vb[o + i, d] = v[o + i, d] - dV
+            xh[o, d] = dX
+            vb[o, d] = dV
+
+
+@njit
+def from_heliocentric_tangent(xh, vb, gm, eta, x, v, tp):
+    """Inverse of :func:`to_heliocentric_tangent`."""
+    n = gm.shape[0]
+    from_democratic_heliocentric(xh[:n], vb[:n], gm, x[:n], v[:n])
+    dgm, k, masses = tp[0], tp[2], tp[3]
+    mt = 0.0
+    for i in range(n):
+        mt += gm[i]
+    for j in range(k):
+        o = n * (1 + j)
+        dmt = 0.0
+        if masses:
+            for i in range(n):
+                dmt += dgm[j, i]
+        for d in range(3):
+            # x_0 = X - sum_{i>=1} m_i Q_i / M,  v_0 = V - sum_{i>=1} m_i V_i / m_0
+            sx = 0.0
+            sv = 0.0
+            for i in range(1, n):
+                sx += gm[i] * xh[o + i, d]
+                sv += gm[i] * vb[o + i, d]
+            dx0 = xh[o, d] - sx / mt
+            dv0 = vb[o, d] - sv / gm[0]
+            if masses:
+                s = 0.0
+                p = 0.0
+                dsx = 0.0
+                dsv = 0.0
+                for i in range(1, n):
+                    s += gm[i] * xh[i, d]
+                    p += gm[i] * vb[i, d]
+                    dsx += dgm[j, i] * xh[i, d]
+                    dsv += dgm[j, i] * vb[i, d]
+                dx0 += s * dmt / (mt * mt) - dsx / mt
+                dv0 += p * dgm[j, 0] / (gm[0] * gm[0]) - dsv / gm[0]
+            for i in range(1, n):
+                x[o + i, d] = xh[o + i, d] + dx0
+                v[o + i, d] = vb[o + i, d] + vb[o, d]
+            x[o, d] = dx0
+            v[o, d] = dv0
+
+
+# -- the Kepler drift ----------------------------------------------------------------------
+
+@njit
+def drift_tangent(xj, vj, eta, h, tp):
+    """:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` of the bodies
+    (``n = eta.shape[0]`` rows, bit for bit) with their first ``tp[2]``
+    tangent vectors; ``tp[1]`` holds the variations of ``eta``."""
+    n = eta.shape[0]
+    deta, k = tp[1], tp[2]
+    xj[0, 0] += h * vj[0, 0]
+    xj[0, 1] += h * vj[0, 1]
+    xj[0, 2] += h * vj[0, 2]
+    for j in range(k):
+        o = n * (1 + j)
+        xj[o, 0] += h * vj[o, 0]
+        xj[o, 1] += h * vj[o, 1]
+        xj[o, 2] += h * vj[o, 2]
+    for i in range(1, n):
+        kepler_drift_tangent(eta[i], xj, vj, i, h, deta, k)
+
+
+# -- interaction kicks and the jump --------------------------------------------------------
+
+@njit(inline="always")
+def _pair_tangent(x, acc, gm, n_active, first, skip_first_pair, dgm, k, masses):
+    # acc's tangent rows = the derivative of pair_accelerations(x, gm, n_active,
+    # 0, acc, first, skip_first_pair) along x's tangent rows (and dgm): per
+    # pair the block I / r^3 - 3 d d^T / r^5 applied to the difference of the
+    # tangent rows, weighted by the other body's mass, plus the pull of a
+    # mass variation
+    n = gm.shape[0]
+    for j in range(k):
+        o = n * (1 + j)
+        for i in range(n):
+            acc[o + i, 0] = 0.0
+            acc[o + i, 1] = 0.0
+            acc[o + i, 2] = 0.0
+    for i in range(first + 1, n):
+        # a mass variation of a test particle pulls too (the derivative of the
+        # map in which every body is active, which at zero mass is this one)
+        for l in range(first + 1 if (skip_first_pair and i == first + 1) else first,
+                       i if masses else min(i, n_active)):
+            dx = x[i, 0] - x[l, 0]
+            dy = x[i, 1] - x[l, 1]
+            dz = x[i, 2] - x[l, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            ir3 = 1.0 / (r2 * math.sqrt(r2))
+            ir5 = 3.0 * ir3 / r2
+            for j in range(k):
+                oi = i + n * (1 + j)
+                ol = l + n * (1 + j)
+                ex = x[oi, 0] - x[ol, 0]
+                ey = x[oi, 1] - x[ol, 1]
+                ez = x[oi, 2] - x[ol, 2]
+                p = (dx * ex + dy * ey + dz * ez) * ir5
+                tx = ir3 * ex - p * dx
+                ty = ir3 * ey - p * dy
+                tz = ir3 * ez - p * dz
+                if l < n_active:
+                    acc[oi, 0] -= gm[l] * tx
+                    acc[oi, 1] -= gm[l] * ty
+                    acc[oi, 2] -= gm[l] * tz
+                if i < n_active:
+                    acc[ol, 0] += gm[i] * tx
+                    acc[ol, 1] += gm[i] * ty
+                    acc[ol, 2] += gm[i] * tz
+                if masses:
+                    ql = dgm[j, l] * ir3
+                    qi = dgm[j, i] * ir3
+                    acc[oi, 0] -= ql * dx
+                    acc[oi, 1] -= ql * dy
+                    acc[oi, 2] -= ql * dz
+                    acc[ol, 0] += qi * dx
+                    acc[ol, 1] += qi * dy
+                    acc[ol, 2] += qi * dz
+
+
+@njit
+def interaction_kick_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
+    """The tangent of :func:`~orbits._kernels.wisdom_holman.interaction_kick`,
+    called after it: ``x[:n]`` and ``acc[:n]`` hold its inertial positions and
+    pair accelerations; their tangent rows are scratch."""
+    n = gm.shape[0]
+    dgm, deta, k, masses = tp[0], tp[1], tp[2], tp[3]
+    if n <= 2:
+        return
+    for j in range(k):
+        _from_jacobi_block(xj, x, gm, eta, dgm, deta, j, masses)
+    _pair_tangent(x, acc, gm, n_active, 0, True, dgm, k, masses)
+    for j in range(k):
+        o = n * (1 + j)
+        # the Jacobi transform of the accelerations (jacobi_velocity_kick)
+        # and its tangent side by side: the bodies' a_i for the weights'
+        # mass derivative
+        sx = acc[0, 0]
+        sy = acc[0, 1]
+        sz = acc[0, 2]
+        tx = acc[o, 0]
+        ty = acc[o, 1]
+        tz = acc[o, 2]
+        for i in range(1, n):
+            ax = acc[i, 0] - sx
+            ay = acc[i, 1] - sy
+            az = acc[i, 2] - sz
+            bx = acc[o + i, 0] - tx
+            by = acc[o + i, 1] - ty
+            bz = acc[o + i, 2] - tz
+            w = gm[i] / eta[i]
+            sx += w * ax
+            sy += w * ay
+            sz += w * az
+            tx += w * bx
+            ty += w * by
+            tz += w * bz
+            if masses:
+                dw = (dgm[j, i] - w * deta[j, i]) / eta[i]
+                tx += dw * ax
+                ty += dw * ay
+                tz += dw * az
+            if i >= 2:
+                # d(eta_i r / |r|^3)
+                rx = xj[i, 0]
+                ry = xj[i, 1]
+                rz = xj[i, 2]
+                ex = xj[o + i, 0]
+                ey = xj[o + i, 1]
+                ez = xj[o + i, 2]
+                r2 = rx * rx + ry * ry + rz * rz
+                ir3 = 1.0 / (r2 * math.sqrt(r2))
+                p = 3.0 * ir3 / r2 * (rx * ex + ry * ey + rz * ez)
+                q = eta[i] * ir3
+                bx += q * ex - eta[i] * p * rx
+                by += q * ey - eta[i] * p * ry
+                bz += q * ez - eta[i] * p * rz
+                if masses:
+                    qm = deta[j, i] * ir3
+                    bx += qm * rx
+                    by += qm * ry
+                    bz += qm * rz
+            vj[o + i, 0] += h * bx
+            vj[o + i, 1] += h * by
+            vj[o + i, 2] += h * bz
+
+
+@njit
+def jump_tangent(xh, vb, gm, n_active, h, tp):
+    """The tangent of :func:`~orbits._kernels.wisdom_holman.jump` (before or
+    after it: the jump moves positions and reads velocities)."""
+    n = gm.shape[0]
+    dgm, k, masses = tp[0], tp[2], tp[3]
+    for j in range(k):
+        o = n * (1 + j)
+        for d in range(3):
+            dp = 0.0
+            for i in range(1, n_active):
+                dp += gm[i] * vb[o + i, d]
+            shift = h * dp / gm[0]
+            if masses:
+                p = 0.0
+                q = 0.0
+                for i in range(1, n_active):
+                    p += gm[i] * vb[i, d]
+                for i in range(1, n):
+                    q += dgm[j, i] * vb[i, d]
+                shift += h * (q - p * dgm[j, 0] / gm[0]) / gm[0]
+            for i in range(1, n):
+                xh[o + i, d] += shift
+
+
+@njit
+def heliocentric_kick_tangent(xh, vb, acc, gm, n_active, h, tp):
+    """The tangent of
+    :func:`~orbits._kernels.wisdom_holman.heliocentric_interaction_kick`;
+    ``acc``'s tangent rows are scratch."""
+    n = gm.shape[0]
+    k = tp[2]
+    _pair_tangent(xh, acc, gm, n_active, 1, False, tp[0], k, tp[3])
+    for j in range(k):
+        o = n * (1 + j)
+        for i in range(1, n):
+            vb[o + i, 0] += h * acc[o + i, 0]
+            vb[o + i, 1] += h * acc[o + i, 1]
+            vb[o + i, 2] += h * acc[o + i, 2]
+
+
+@njit(inline="always")
+def _term_acc_tangent(x, acc, jx, n, j):
+    # acc's tangent block j = the terms' da/dx (jx) times x's tangent block j
+    o = n * (1 + j)
+    for i in range(n):
+        for a in range(3):
+            r = 3 * i + a
+            s = 0.0
+            for c in range(n):
+                s += (jx[r, 3 * c] * x[o + c, 0] + jx[r, 3 * c + 1] * x[o + c, 1]
+                      + jx[r, 3 * c + 2] * x[o + c, 2])
+            acc[o + i, a] = s
+
+
+def _terms_jacobian(x, targs):
+    # the terms' da/dx at the bodies' inertial positions x[:n] into tp's jx
+    tp = targs[1]
+    jx, jv = tp[4], tp[5]
+    n3 = jx.shape[0]
+    for p in range(n3):
+        for q in range(n3):
+            jx[p, q] = 0.0
+            jv[p, q] = 0.0
+    n = n3 // 3
+    # position-only terms: the kick passes the positions as velocities too
+    term_jacobian(x[:n], x[:n], 0.0, targs[0], jx, jv)  # noqa: F821 - bound by specialize
+
+
+def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
+    # the tangent of _jacobi_term_kick, after it: x[:n] are the bodies'
+    # inertial positions, acc[:n] the terms' accelerations (only their
+    # Jacobian is needed: mass variations are refused with terms)
+    tp = targs[1]
+    n = gm.shape[0]
+    k = tp[2]
+    jacobian(x, targs)  # noqa: F821 - bound by specialize
+    for j in range(k):
+        o = n * (1 + j)
+        _from_jacobi_block(xj, x, gm, eta, tp[0], tp[1], j, False)
+        _term_acc_tangent(x, acc, tp[4], n, j)
+        tx = acc[o, 0]
+        ty = acc[o, 1]
+        tz = acc[o, 2]
+        for i in range(1, n):
+            bx = acc[o + i, 0] - tx
+            by = acc[o + i, 1] - ty
+            bz = acc[o + i, 2] - tz
+            w = gm[i] / eta[i]
+            tx += w * bx
+            ty += w * by
+            tz += w * bz
+            vj[o + i, 0] += h * bx
+            vj[o + i, 1] += h * by
+            vj[o + i, 2] += h * bz
+        vj[o, 0] += h * tx
+        vj[o, 1] += h * ty
+        vj[o, 2] += h * tz
+
+
+def _heliocentric_term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs):
+    # the tangent of _heliocentric_term_kick, after it (x[:n], acc[:n] as
+    # there): dx_0 = dX - sum_{i>=1} m_i dQ_i / M, dx_i = dQ_i + dx_0, and the
+    # kick of P_i is F_i - (m_i / M) sum F, the centre of mass's sum F / M
+    tp = targs[1]
+    n = gm.shape[0]
+    k = tp[2]
+    mt = 0.0
+    for i in range(n_active):
+        mt += gm[i]
+    jacobian(x, targs)  # noqa: F821 - bound by specialize
+    for j in range(k):
+        o = n * (1 + j)
+        for d in range(3):
+            s = 0.0
+            for i in range(1, n_active):
+                s += gm[i] * xh[o + i, d]
+            x0 = xh[o, d] - s / mt
+            x[o, d] = x0
+            for i in range(1, n):
+                x[o + i, d] = xh[o + i, d] + x0
+        _term_acc_tangent(x, acc, tp[4], n, j)
+        for d in range(3):
+            f = 0.0
+            for i in range(n_active):
+                f += gm[i] * acc[o + i, d]
+            f /= mt
+            for i in range(1, n):
+                vb[o + i, d] += h * (acc[o + i, d] - f)
+            vb[o, d] += h * f
+
+
+def _jacobi_perturbation(xj, vj, x, acc, gm, eta, n_active, h, targs):
+    # the interaction kick (and the terms' kick) of the bodies, each followed
+    # by its tangent: the bodies' rows go through the plain kernels
+    n = gm.shape[0]
+    tp = targs[1]
+    interaction_kick(xj[:n], vj[:n], x[:n], acc[:n], gm, eta, n_active, h)
+    interaction_kick_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp)
+    if TERMS:  # noqa: F821 - bound by specialize
+        term_kick(xj[:n], vj[:n], x[:n], acc[:n], gm, eta, n_active, h,  # noqa: F821
+                  targs[0])
+        term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+
+
+def _heliocentric_perturbation(xh, vb, x, acc, gm, eta, n_active, h, targs):
+    # J(h/2) I(h) [terms] J(h/2), each operator followed by its tangent
+    n = gm.shape[0]
+    tp = targs[1]
+    jump_tangent(xh, vb, gm, n_active, 0.5 * h, tp)
+    jump(xh[:n], vb[:n], gm, n_active, 0.5 * h)
+    heliocentric_interaction_kick(xh[:n], vb[:n], acc[:n], gm, n_active, h)
+    heliocentric_kick_tangent(xh, vb, acc, gm, n_active, h, tp)
+    if TERMS:  # noqa: F821 - bound by specialize
+        term_kick(xh[:n], vb[:n], x[:n], acc[:n], gm, eta, n_active, h,  # noqa: F821
+                  targs[0])
+        term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+    jump_tangent(xh, vb, gm, n_active, 0.5 * h, tp)
+    jump(xh[:n], vb[:n], gm, n_active, 0.5 * h)
+
+
+# -- the bindings of the Wisdom-Holman templates -------------------------------------------
+
+@njit(inline="always")
+def _drift(xj, vj, eta, h, w1, w2, targs):
+    drift_tangent(xj, vj, eta, h, targs[1])
+
+
+@njit(inline="always")
+def _to_jacobi(x, v, gm, eta, xj, vj, targs):
+    to_jacobi_tangent(x, v, gm, eta, xj, vj, targs[1])
+
+
+@njit(inline="always")
+def _from_jacobi(xj, vj, gm, eta, x, v, targs):
+    from_jacobi_tangent(xj, vj, gm, eta, x, v, targs[1])
+
+
+@njit(inline="always")
+def _to_heliocentric(x, v, gm, eta, xh, vb, targs):
+    to_heliocentric_tangent(x, v, gm, eta, xh, vb, targs[1])
+
+
+@njit(inline="always")
+def _from_heliocentric(xh, vb, gm, eta, x, v, targs):
+    from_heliocentric_tangent(xh, vb, gm, eta, x, v, targs[1])
+
+
+@njit(inline="always")
+def _carrying(targs, k):
+    # targs with the tangent arguments set to carry k vectors
+    tp = targs[1]
+    return (targs[0], (tp[0], tp[1], k, tp[3], tp[4], tp[5], tp[6]))
+
+
+def _tangent_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
+    # the monitors' recorder: the bodies alone synchronised, then recorded
+    mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs) = mon
+    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+                _carrying(targs, 0))
+    _record(x, v, t, mon_args, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
+
+
+def _chaos_step(xj, vj, t, sync):
+    # after every step: the bodies and tangent vector 0 synchronised to the
+    # inertial frame, the chaos accumulators advanced with that vector, and
+    # the vector's internal rows scaled back when it has grown large
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
+    n = gm.shape[0]
+    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+                _carrying(targs, 1))
+    box = targs[1][6]
+    if chaos_update(x[n:2 * n], v[n:2 * n], t, box):  # noqa: F821 - bound by specialize
+        renormalise(xj, vj, n, box)  # noqa: F821 - bound by specialize
+    return False
+
+
+def _chaos_note(sync, mon_out, row):
+    # the chaos indicators into the monitor row just recorded, by the
+    # variational force's own note (its fargs[1][4] is the box)
+    note(((), (0, 0, 0, 0, sync[11][1][6])), mon_out, row)  # noqa: F821 - bound
+
+
+_CONVERSIONS = {"jacobi": (_to_jacobi, _from_jacobi, _jacobi_perturbation,
+                           _jacobi_term_kick, _jacobi_term_tangent),
+                "democratic-heliocentric": (_to_heliocentric, _from_heliocentric,
+                                            _heliocentric_perturbation,
+                                            _heliocentric_term_kick,
+                                            _heliocentric_term_tangent)}
+
+
+def _kernels(coordinates, terms, key, cache):
+    """The bound tangent kernels: (to internal, perturbation, corrector,
+    synchronize)."""
+    to_internal, from_internal, pert, term_kick, term_tangent = _CONVERSIONS[coordinates]
+    nrt = not cache
+    # the tangent kernels are calls, not inlined: a step's tangent costs far
+    # more than a call, and inlining them all into every loop and corrector
+    # took minutes to compile
+    if terms is None:
+        perturbation = specialize(pert, key, cache=cache, nrt=nrt, TERMS=False,
+                                  term_kick=None, term_tangent=None)
+    else:
+        kick = specialize(term_kick, key, cache=cache, inline=True, nrt=nrt,
+                          extra=terms.accel)
+        jac = specialize(_terms_jacobian, key, cache=cache, inline=True, nrt=nrt,
+                         term_jacobian=terms.jacobian)
+        tangent = specialize(term_tangent, key, cache=cache, nrt=nrt, jacobian=jac)
+        perturbation = specialize(pert, key, cache=cache, nrt=nrt, TERMS=True,
+                                  term_kick=kick, term_tangent=tangent)
+    corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
+                           drift=_drift, perturbation=perturbation)
+    sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt, drift=_drift,
+                      from_internal=from_internal, apply_corrector=corrector)
+    return to_internal, perturbation, corrector, sync
+
+
+def _key(coordinates, force):
+    return f"tangent_{coordinates}_{force.key}"
+
+
+def tangent_synchronizer(coordinates, terms, force):
+    """The compiled synchronisation (bodies and the tangent vectors that
+    ``targs[1][2]`` counts) for a force with variations, ``force``, whose
+    position-only ``terms`` (or None) join the perturbation step;
+    arguments as :func:`orbits._kernels.wisdom_holman.synchronizer`'s, with
+    ``targs = (terms' args, tp)``."""
+    return _kernels(coordinates, terms, _key(coordinates, force), force.cache)[3]
+
+
+def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
+    """The Wisdom-Holman loop of :func:`orbits._kernels.wisdom_holman.wh_loop`
+    compiled with the tangent of every operator, for a force with variations
+    ``force`` (its ``inner`` the gravity, with ``terms``); with the chaos
+    indicators after every step if ``force.chaos``.  Called with
+    ``targs = (terms' args, tp)`` (see the module notes), ``gm`` and ``eta`` of
+    the bodies alone (``n`` entries) and the state arrays of ``n (1 + K)``
+    rows."""
+    from .stepping import epilogue, work_kernels
+    from .variational import chaos_update, renormalise
+    key = _key(coordinates, force)
+    cache = force.cache
+    nrt = not cache
+    to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, key, cache)
+    recorder = specialize(_tangent_record, key, cache=cache, nrt=nrt, synchronize=sync,
+                          _record=force.recorder)
+    step = None   # the epilogue's default: nothing after a step
+    if force.chaos:
+        step = specialize(_chaos_step, key, cache=cache, inline=True, nrt=nrt,
+                          synchronize=sync, chaos_update=chaos_update,
+                          renormalise=renormalise)
+    note = specialize(_chaos_note, key, cache=cache, inline=True, nrt=nrt,
+                      note=work_kernels(force)["work_note"])
+    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
+                      KINDS=tuple(int(k) for k in kinds),
+                      COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
+                      drift=_drift, perturbation=perturbation, apply_corrector=corrector,
+                      step_end=epilogue(recorder, f"wh_{key}", cache=cache,
+                                        work_note=note, tangent_step=step))
