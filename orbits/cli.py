@@ -215,7 +215,7 @@ def _parser():
                      help="address of an existing Dask scheduler to run on")
     val.add_argument("--only", nargs="+", default=None, metavar="SECTION",
                      help="run only these sections: accuracy ephemeris dissipative "
-                          "work_precision drift stress guide")
+                          "work_precision drift stress guide chaos")
     val.add_argument("--no-progress", action="store_true")
 
     sub.add_parser("scenes", help="list the built-in scenes")

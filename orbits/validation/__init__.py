@@ -1,7 +1,9 @@
 """The validation report: accuracy against REBOUND, the solar system against
 the JPL DE421 ephemeris, the dissipative force terms against REBOUNDx and
 their analytic rates, work against precision, long-horizon drift, a stress
-suite and a check of a published guide.
+suite, a check of a published guide, and MEGNO maps and secular frequencies
+(chaos indicators beside REBOUND's, a map's wall time against REBOUND on a
+process pool, frequencies against published values).
 
 ``orbits validate [--quick] [--out DIR]`` (or :func:`validate`) runs it on
 this machine's cores and writes ``report.md`` with its PNG plots into ``DIR``.
@@ -39,7 +41,7 @@ __all__ = ["validate", "SECTIONS", "Task", "Pool", "run_tasks", "ValidationError
 
 #: the report's sections, in order (module names in this package)
 SECTIONS = ("accuracy", "ephemeris", "dissipative", "work_precision", "drift", "stress",
-            "guide")
+            "guide", "chaos")
 
 
 class ValidationError(RuntimeError):

@@ -8,6 +8,11 @@ kernels loaded from numba's cache once per worker), or serially with one
 worker, and returns their rows in the order given.  Each task times its own
 run, on a core of its own, so wall times are those of one core whatever the
 number of workers.
+
+A task that needs the whole machine (one that starts processes of its own
+and times them, such as a sweep against a process pool) is marked
+``exclusive``: it runs after all the others, in this process, with nothing
+else running, and is given the pool's size as ``workers=``.
 """
 
 import importlib
@@ -25,6 +30,8 @@ class Task(NamedTuple):
     function: str          # "orbits.validation.accuracy:measure"
     kwargs: dict
     cost: float = 1.0
+    # runs alone, after the others, in this process, with workers=<pool size>
+    exclusive: bool = False
 
 
 def _call(task):
@@ -82,22 +89,28 @@ def run_tasks(tasks, pool, progress=True, desc="measuring"):
 
     tasks = list(tasks)
     order = sorted(range(len(tasks)), key=lambda i: -tasks[i].cost)
+    shared = [i for i in order if not tasks[i].exclusive]
+    alone = [i for i in order if tasks[i].exclusive]
     rows = [None] * len(tasks)
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, leave=False)
     t0 = time.perf_counter()
     try:
-        if pool.serial:
-            for i in order:
+        if pool.serial or not shared:
+            for i in shared:
                 rows[i] = _call(tasks[i])
                 bar.update(1)
         else:
             from distributed import as_completed
             client = pool.client()
             futures = {client.submit(_call, tasks[i], pure=False, key=f"{desc}-{i}-{t0}"): i
-                       for i in order}
+                       for i in shared}
             for fut in as_completed(futures):
                 rows[futures[fut]] = fut.result()
                 bar.update(1)
+        for i in alone:     # the pool's workers are idle by now
+            task = tasks[i]
+            rows[i] = _call(task._replace(kwargs={**task.kwargs, "workers": pool.n_workers}))
+            bar.update(1)
     finally:
         bar.close()
     return rows
