@@ -112,6 +112,79 @@ def test_cheapest_ignores_failures_and_the_reference():
     assert work_precision.cheapest(rows, 1e-2)[0] == ("a", 0.1)
 
 
+def test_rebound_best_fixed_step_methods_beside_its_defaults():
+    # "cheapest at each accuracy" is against REBOUND's best: every fixed-step
+    # method of REBOUND's is swept over the same steps as its WHFast
+    rebound_tasks = [t.kwargs for t in work_precision.tasks(True) if t.kwargs.get("rebound")]
+    for key in work_precision.SWEEP:
+        steps = {name: sorted(t["dt"] for t in rebound_tasks
+                              if t["problem"] == key and t["integrator"] == name)
+                 for name in work_precision.REBOUND_FIXED_STEP}
+        assert all(steps[name] == steps["whfast"] and steps[name]
+                   for name in work_precision.REBOUND_FIXED_STEP), (key, steps)
+        assert any(t["problem"] == key and t["integrator"] == "ias15" for t in rebound_tasks)
+        # WHFast512 is swept exactly where it runs
+        assert (any(t["problem"] == key and t["integrator"] == "whfast512"
+                    for t in rebound_tasks) == work_precision.whfast512_status()[0])
+
+
+def test_whfast512_tried_and_its_refusal_given():
+    rebound = pytest.importorskip("rebound")
+    ok, why = work_precision.whfast512_status()
+    if not ok:
+        assert "Error" in why          # REBOUND's exception, by name and message
+        if not rebound.avx512_available:
+            assert "no AVX-512" in why
+        assert why.rstrip(".") in work_precision._whfast512_sentence()
+
+
+@pytest.mark.parametrize("method", ["whfast, corrector 11", "whckl", "SABA(10,6,4)"])
+def test_rebound_force_evaluations_are_counted_over_the_whole_run(method):
+    # the row's count (extrapolated from 32- and 64-step tallies) must equal a
+    # tally of the same whole run with its outputs; one a step would be wrong
+    # for all three (WHCKL's kernel and SABA's stages, the correctors at outputs)
+    from orbits.validation._measure import _set_options
+    key = "outer-solar-system"
+    dt = 8 * cases.problem(key).dt
+    row = work_precision.measure(key, method, True, dt=dt, rebound=True)
+    assert row["outcome"] == "completed" and row["series"] == f"REBOUND {method}"
+    integrator, options = work_precision.rebound_method(method)
+    options.setdefault("safe_mode", 0)
+    sim = cases.bodies(cases.problem(key)).to_rebound()
+    sim.gravity = "basic"
+    sim.integrator = integrator
+    _set_options(sim, integrator, options)
+    sim.dt = dt
+    count = [0]
+
+    def tally(_sim):
+        count[0] += 1
+
+    sim.additional_forces = tally
+    sim.force_is_velocity_dependent = 0
+    until = work_precision.SWEEP[key][1]
+    for t in on_steps(np.linspace(0.0, until, work_precision.OUTPUTS)[1:], dt):
+        sim.integrate(t - 0.5 * dt, exact_finish_time=0)
+    assert sim.steps_done == row["steps"]
+    assert row["force_evaluations"] == count[0] > row["steps"]
+
+
+def test_unit_g_runs_as_run_rebound_does():
+    # WHFast512's runner scales time so that G = 1; with WHFast in it, the
+    # run must be run_rebound's up to rounding: 3652 steps of 10 days leave
+    # ~1e-12 au between them (measured 1.6e-12), while a wrong scale or step
+    # count would show as > 1e-6 au
+    bodies = orbits.scenes.outer_solar_system()
+    ours = work_precision._run_unit_g(bodies, "whfast", {"safe_mode": 0}, dt=10.0,
+                                      until=36525.0, outputs=11)
+    theirs = run_rebound(bodies, "whfast", dt=10.0, until=36525.0, outputs=11)
+    assert ours["outcome"] == "completed" and ours["steps"] == theirs["steps"] == 3652
+    assert np.abs(ours["x"] - theirs["x"]).max() < 1e-10
+    assert math.isclose(ours["t_end"], theirs["t_end"], rel_tol=1e-12)
+    # relative energy errors do not depend on the time unit (measured: equal to 4e-7)
+    assert math.isclose(ours["energy_error_max"], theirs["energy_error_max"], rel_tol=1e-4)
+
+
 @pytest.mark.slow  # ~20 s: the validate command end to end on its cheapest section
 def test_guide_section_by_command(tmp_path):
     # the whole command on its cheapest section, in this process
