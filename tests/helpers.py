@@ -42,3 +42,15 @@ def adaptive_fixed_steps_error(name, n, e=0.2):
             np.zeros((0, 11)), None, 10)
         assert status == 0 and acc == 1 and rej == 0
     return np.abs(x - x0).max() + np.abs(v - v0).max()
+
+
+def jupiter_saturn(a_saturn, e_saturn=0.05):
+    """The Sun, Jupiter and a Saturn at ``a_saturn`` au (au, Msun, day): regular at
+    9.5 au, chaotic at 6.6 au (period ratio 1.37)."""
+    import astropy.units as u
+    b = orbits.BodySet()
+    b.add("Sun", 1 * u.Msun)
+    b.add("Jupiter", 9.55e-4 * u.Msun, primary="Sun", a=5.2 * u.au, e=0.05, f=0.3 * u.rad)
+    b.add("Saturn", 2.86e-4 * u.Msun, primary="Sun", a=a_saturn * u.au, e=e_saturn,
+          inc=0.01 * u.rad, f=2.1 * u.rad)
+    return b

@@ -22,6 +22,8 @@ import orbits
 from orbits import forces
 from orbits.errors import IntegratorOptionError
 
+from helpers import jupiter_saturn
+
 #: the goal: derivatives agree with central differences to this, per column
 RTOL = 1e-6
 SPAN = 2 * u.yr
@@ -196,13 +198,8 @@ def test_bad_variations_are_named_errors():
 
 # -- chaos indicators ----------------------------------------------------------------------
 
-def _planets(a_saturn):
-    b = orbits.BodySet()
-    b.add("Sun", 1 * u.Msun)
-    b.add("Jupiter", 9.55e-4 * u.Msun, primary="Sun", a=5.2 * u.au, e=0.05, f=0.3 * u.rad)
-    b.add("Saturn", 2.86e-4 * u.Msun, primary="Sun", a=a_saturn * u.au, e=0.05,
-          inc=0.01 * u.rad, f=2.1 * u.rad)
-    return b
+def _planets(a_saturn=6.6):
+    return jupiter_saturn(a_saturn)
 
 
 CHAOS = ["energy", "megno", "lyapunov", "fli"]

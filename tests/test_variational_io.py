@@ -19,6 +19,8 @@ import orbits
 from orbits.ensemble import Ensemble
 from orbits.io.hdf5 import TangentShapeError
 
+from helpers import jupiter_saturn
+
 # builds defined here travel to the workers by value (the workers cannot import
 # this test module by name)
 cloudpickle.register_pickle_by_value(sys.modules[__name__])
@@ -33,14 +35,7 @@ UNTIL = 400 * u.yr          # 7305 steps of DT exactly
 
 
 def _planets(a_saturn=6.6):
-    # Jupiter and a Saturn at a_saturn au: chaotic at 6.6 au (period ratio 1.37),
-    # regular at 9.5 au (see tests/test_variational.py)
-    b = orbits.BodySet()
-    b.add("Sun", 1 * u.Msun)
-    b.add("Jupiter", 9.55e-4 * u.Msun, primary="Sun", a=5.2 * u.au, e=0.05, f=0.3 * u.rad)
-    b.add("Saturn", 2.86e-4 * u.Msun, primary="Sun", a=a_saturn * u.au, e=0.05,
-          inc=0.01 * u.rad, f=2.1 * u.rad)
-    return b
+    return jupiter_saturn(a_saturn)
 
 
 def _sim(variations="state", seed=4, **kw):
