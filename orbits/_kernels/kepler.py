@@ -1182,122 +1182,31 @@ def kepler_drift(mu, x, v, i, dt):
 
 @njit
 def _kepler_drift_bracketed(mu, x, v, i, dt):
-    """:func:`kepler_drift` by the bracketed solver, for any step."""
+    """:func:`kepler_drift` by the bracketed solver, for any step: the anomaly
+    from :func:`bracketed_anomaly`, then f and g from the universal functions
+    there (the same values its last iteration tested)."""
     x0 = x[i, 0]
     y0 = x[i, 1]
     z0 = x[i, 2]
     vx0 = v[i, 0]
     vy0 = v[i, 1]
     vz0 = v[i, 2]
-    r0 = math.sqrt(x0 * x0 + y0 * y0 + z0 * z0)
-    v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
-    if not (mu > 0.0) or not (r0 > 0.0) or not math.isfinite(r0 + v2 + dt + mu):
+    s, turns = bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
+    if not (s == s):
         for d in range(3):
             x[i, d] = math.nan
             v[i, d] = math.nan
         return STATUS_INVALID_STATE
     if dt == 0.0:
         return STATUS_OK
+    r0 = math.sqrt(x0 * x0 + y0 * y0 + z0 * z0)
     eta = x0 * vx0 + y0 * vy0 + z0 * vz0
-    beta = 2.0 * mu / r0 - v2
+    beta = 2.0 * mu / r0 - (vx0 * vx0 + vy0 * vy0 + vz0 * vz0)
     zeta = mu - beta * r0
-
-    # pericentre distance q = p / (1 + e), p = h^2 / mu, 1 - e^2 = p beta / mu:
-    # f' = r >= q bounds the root, |s| <= |dt| / q
-    hx = y0 * vz0 - z0 * vy0
-    hy = z0 * vx0 - x0 * vz0
-    hz = x0 * vy0 - y0 * vx0
-    p = (hx * hx + hy * hy + hz * hz) / mu
-    e2 = 1.0 - p * beta / mu
-    q = p / (1.0 + math.sqrt(e2 if e2 > 0.0 else 0.0))
-
-    if beta > 0.0:
-        period = _TWO_PI * mu / (beta * math.sqrt(beta))
-        if abs(dt) > period:
-            dt = np.fmod(dt, period)
-    if dt > 0.0:
-        lo = 0.0
-        hi = dt / q if q > 0.0 else math.inf
-    else:
-        lo = dt / q if q > 0.0 else -math.inf
-        hi = 0.0
-
-    # starter
-    s = dt / r0 - 0.5 * eta * dt * dt / (r0 * r0 * r0)
-    if abs(dt) * math.sqrt(v2) > 0.2 * r0 or not (lo < s < hi):
-        if beta > 0.0:
-            # mean anomaly: s ~ E / sqrt(beta) with E ~ n dt
-            s = dt * beta / mu
-        else:
-            b = -beta
-            sb = math.sqrt(b) if b > 0.0 else 0.0
-            scale = zeta + sb * (abs(eta) + sb * r0)
-            if sb > 0.0 and scale > 0.0:
-                s = math.log(1.0 + 2.0 * b * sb * abs(dt) / scale) / sb
-                s = s if dt > 0.0 else -s
-        if not (lo < s < hi):
-            s = 0.5 * (lo + hi) if math.isfinite(hi - lo) else dt / r0
-
-    G1 = 0.0
-    G2 = 0.0
-    r = r0
-    converged = False
-    it = 0
-    width = hi - lo
-    for _ in range(DRIFT_MAX_ITER):
-        c0, c1, c2, c3 = stumpff(beta * s * s)
-        G0 = c0
-        G1 = s * c1
-        G2 = s * s * c2
-        G3 = s * s * s * c3
-        f = r0 * s + eta * G2 + zeta * G3 - dt
-        r = r0 + eta * G1 + zeta * G2              # f'(s), the radius
-        if f == 0.0:
-            converged = True
-            break
-        if f < 0.0:
-            lo = s
-        else:
-            hi = s
-        fpp = eta * G0 + zeta * G1
-        fppp = zeta * G0 - beta * eta * G1
-        d1 = -f / r
-        d2 = -f / (r + 0.5 * d1 * fpp)
-        s_new = s - f / (r + 0.5 * d2 * fpp + d2 * d2 * fppp / 6.0)
-        it += 1
-        if it % 4 == 0:
-            # every fourth iteration the bracket must have halved at least
-            # once; otherwise (Newton creeping down the exponential side of a
-            # hyperbola) bisect
-            slow = (hi - lo) > 0.5 * width
-            width = hi - lo
-        else:
-            slow = False
-        if slow or not (lo < s_new < hi):
-            # safeguard: bisect (geometrically over a wide bracket on one side
-            # of zero), or widen an unbounded side
-            if math.isfinite(lo) and math.isfinite(hi):
-                if lo > 0.0 and hi > 4.0 * lo:
-                    s_new = math.sqrt(lo * hi)
-                elif hi < 0.0 and lo < 4.0 * hi:
-                    s_new = -math.sqrt(lo * hi)
-                else:
-                    s_new = 0.5 * (lo + hi)
-            elif math.isfinite(lo):
-                s_new = 2.0 * lo + dt / r0
-            else:
-                s_new = 2.0 * hi + dt / r0
-        if abs(s_new - s) <= _DRIFT_STEP_TOL * abs(s):
-            # the G_k above belong to an s within two ulps of the root
-            converged = True
-            break
-        s = s_new
-    if not converged or not (r > 0.0):
-        for d in range(3):
-            x[i, d] = math.nan
-            v[i, d] = math.nan
-        return STATUS_INVALID_STATE
-
+    c0, c1, c2, c3 = stumpff(beta * s * s)
+    G1 = s * c1
+    G2 = s * s * c2
+    r = r0 + eta * G1 + zeta * G2
     fm1 = -mu * G2 / r0
     g = r0 * G1 + eta * G2
     fdot = -mu * G1 / (r * r0)
