@@ -527,16 +527,22 @@ class BodySet:
         >>> round(float(el["a"].value), 2), el["a"].unit, round(float(el["e"]), 3)
         (5.2, Unit("AU"), 0.048)
         """
-        i = self.index(name)
-        mp, xp, vp = self._primary_state(name, primary, before=i)
-        mu = self.units.G * (mp + self._m[i])
-        out = np.empty(7)
-        status = _kepler.state_to_elements(mu, self._x[i] - xp, self._v[i] - vp, out)
+        out, status = self._element_values(name, primary)
         if status != 0:
             raise ElementsError(_kepler.describe_status(status), body=name, field="elements")
         q = self.units.quantity
         return {"a": q(out[0], "length"), "e": out[1] << u.dimensionless_unscaled,
                 **{k: out[j] << u.rad for j, k in enumerate(_ELEMENT_NAMES[2:], start=2)}}
+
+    def _element_values(self, name, primary):
+        # (a, e, inc, Omega, omega, f, M) in internal units and rad, and the
+        # kernel's status
+        i = self.index(name)
+        mp, xp, vp = self._primary_state(name, primary, before=i)
+        mu = self.units.G * (mp + self._m[i])
+        out = np.empty(7)
+        status = _kepler.state_to_elements(mu, self._x[i] - xp, self._v[i] - vp, out)
+        return out, status
 
     def plot_orbits(self, primary=None, plane="xy", ax=None, path=None):
         """A sketch of the set: each body on its osculating Keplerian orbit.

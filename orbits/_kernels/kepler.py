@@ -1077,6 +1077,25 @@ def _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1):
 
 
 @njit(inline="always")
+def _short_coefficients(mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta):
+    # the f and g coefficients of a short step by the anomaly s (see
+    # advance_by_anomaly), with what the drift's tangent reuses: (c0 .. c3,
+    # sigma = x0 . v0, r, 1 / r, f - 1, g, fdot, gdot - 1); r <= 0 (or NaN)
+    # where the step must go to the bracketed solver
+    sig = x0 * vx0 + y0 * vy0 + z0 * vz0
+    c0, c1, c2, c3 = _stumpff_short(beta * s * s)
+    G1 = s * c1
+    G2 = s * s * c2
+    r = r0 + sig * G1 + zeta * G2
+    ir = 1.0 / r
+    fm1 = -mu * G2 * ir0
+    g = r0 * G1 + sig * G2
+    fdot = -mu * G1 * ir0 * ir
+    gdm1 = -mu * G2 * ir
+    return c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1
+
+
+@njit(inline="always")
 def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
     """Advance row ``i`` of ``x``, ``v`` by the universal anomaly ``s`` (the
     f and g functions of :func:`kepler_drift`); the other arguments from
@@ -1088,18 +1107,10 @@ def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
     vx0 = v[i, 0]
     vy0 = v[i, 1]
     vz0 = v[i, 2]
-    eta = x0 * vx0 + y0 * vy0 + z0 * vz0
-    c0, c1, c2, c3 = _stumpff_short(beta * s * s)
-    G1 = s * c1
-    G2 = s * s * c2
-    r = r0 + eta * G1 + zeta * G2
+    c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1 = _short_coefficients(
+        mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta)
     if not (r > 0.0):
         return False
-    ir = 1.0 / r
-    fm1 = -mu * G2 * ir0
-    g = r0 * G1 + eta * G2
-    fdot = -mu * G1 * ir0 * ir
-    gdm1 = -mu * G2 * ir
     _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
     return True
 
@@ -1343,12 +1354,66 @@ def bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
 
 
 @njit(inline="always")
+def _stumpff45_short(z):
+    """:func:`_stumpff45` for the short steps of a planetary integration:
+    four terms of each series for ``|z| <= _STUMPFF_SHORT_Z`` (the first
+    omitted, ``z^4 / 12!``, below 1e-18 of ``c4``), in Estrin's form."""
+    if -_STUMPFF_SHORT_Z <= z <= _STUMPFF_SHORT_Z:
+        z2 = z * z
+        c4 = (1.0 / 24 - z * (1.0 / 720)) + z2 * ((1.0 / 40320) - z * (1.0 / 3628800))
+        c5 = (1.0 / 120 - z * (1.0 / 5040)) + z2 * ((1.0 / 362880) - z * (1.0 / 39916800))
+        return c4, c5
+    return _stumpff45(z)
+
+
+@njit(inline="always")
+def _tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, sig, beta,
+                  zeta, G0, G1, G2, G3, G4, G5, ir, fm1, g, fdot, gdm1):
+    # the tangent rows i + n (1 + j) of body i, whose drift started at
+    # (x0, v0) and took the (whole) universal anomaly s with the universal
+    # functions G0 .. G5 and the coefficients f - 1, g, fdot, gdot - 1:
+    # implicit differentiation of Kepler's equation (see kepler_drift_tangent)
+    # dG_k / dbeta = (k G_(k+2) - s G_(k+1)) / 2
+    b1 = 0.5 * (G3 - s * G2)
+    b2 = G4 - 0.5 * s * G3
+    b3 = 0.5 * (3.0 * G5 - s * G4)
+    sb = sig * b2 + zeta * b3
+    for j in range(k):
+        o = i + n * (1 + j)
+        dx0 = x[o, 0]
+        dy0 = x[o, 1]
+        dz0 = x[o, 2]
+        dvx0 = v[o, 0]
+        dvy0 = v[o, 1]
+        dvz0 = v[o, 2]
+        dm = dmu[j, i]
+        dr0 = (x0 * dx0 + y0 * dy0 + z0 * dz0) * ir0
+        dsig = x0 * dvx0 + y0 * dvy0 + z0 * dvz0 + vx0 * dx0 + vy0 * dy0 + vz0 * dz0
+        dbeta = (2.0 * dm - 2.0 * mu * dr0 * ir0) * ir0 - 2.0 * (
+            vx0 * dvx0 + vy0 * dvy0 + vz0 * dvz0)
+        dzeta = dm - r0 * dbeta - beta * dr0
+        ds = -(s * dr0 + G2 * dsig + G3 * dzeta + sb * dbeta) * ir
+        dG1 = G0 * ds + b1 * dbeta
+        dG2 = G1 * ds + b2 * dbeta
+        dr = dr0 + dsig * G1 + sig * dG1 + dzeta * G2 + zeta * dG2
+        df = -(dm * G2 + mu * dG2) * ir0 - fm1 * dr0 * ir0
+        dg = dr0 * G1 + r0 * dG1 + dsig * G2 + sig * dG2
+        dfdot = -(dm * G1 + mu * dG1) * ir * ir0 - fdot * (dr * ir + dr0 * ir0)
+        dgd = -(dm * G2 + mu * dG2) * ir - gdm1 * dr * ir
+        x[o, 0] = dx0 + (fm1 * dx0 + g * dvx0) + (df * x0 + dg * vx0)
+        x[o, 1] = dy0 + (fm1 * dy0 + g * dvy0) + (df * y0 + dg * vy0)
+        x[o, 2] = dz0 + (fm1 * dz0 + g * dvz0) + (df * z0 + dg * vz0)
+        v[o, 0] = dvx0 + (fdot * dx0 + gdm1 * dvx0) + (dfdot * x0 + dgd * vx0)
+        v[o, 1] = dvy0 + (fdot * dy0 + gdm1 * dvy0) + (dfdot * y0 + dgd * vy0)
+        v[o, 2] = dvz0 + (fdot * dz0 + gdm1 * dvz0) + (dfdot * z0 + dgd * vz0)
+
+
+@njit(inline="always")
 def _drift_tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, turns,
                         c0, c1, c2, c3):
-    # the tangent rows i + n (1 + j) of body i, whose drift started at
-    # (x0, v0) and took the universal anomaly s (of a step reduced by `turns`
-    # periods) with the Stumpff functions c0..c3 of beta s^2: implicit
-    # differentiation of Kepler's equation (see kepler_drift_tangent)
+    # the tangent rows of body i after the bracketed solver took the universal
+    # anomaly s (of a step reduced by `turns` periods) with the Stumpff
+    # functions c0..c3 of beta s^2
     r2 = x0 * x0 + y0 * y0 + z0 * z0
     r0 = math.sqrt(r2)
     sig = x0 * vx0 + y0 * vy0 + z0 * vz0
@@ -1371,44 +1436,37 @@ def _drift_tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, tu
         G5 = (sf * sf * sf * _SIXTH - G3) / beta
         s = sf
     r = r0 + sig * G1 + zeta * G2
-    # dG_k / dbeta = (k G_(k+2) - s G_(k+1)) / 2
-    b1 = 0.5 * (G3 - s * G2)
-    b2 = G4 - 0.5 * s * G3
-    b3 = 0.5 * (3.0 * G5 - s * G4)
-    fm1 = -mu * G2 / r0
-    g = r0 * G1 + sig * G2
-    fdot = -mu * G1 / (r * r0)
-    gdm1 = -mu * G2 / r
-    ir0 = 1.0 / r0
     ir = 1.0 / r
-    for j in range(k):
-        o = i + n * (1 + j)
-        dx0 = x[o, 0]
-        dy0 = x[o, 1]
-        dz0 = x[o, 2]
-        dvx0 = v[o, 0]
-        dvy0 = v[o, 1]
-        dvz0 = v[o, 2]
-        dm = dmu[j, i]
-        dr0 = (x0 * dx0 + y0 * dy0 + z0 * dz0) * ir0
-        dsig = x0 * dvx0 + y0 * dvy0 + z0 * dvz0 + vx0 * dx0 + vy0 * dy0 + vz0 * dz0
-        dbeta = (2.0 * dm - 2.0 * mu * dr0 * ir0) * ir0 - 2.0 * (
-            vx0 * dvx0 + vy0 * dvy0 + vz0 * dvz0)
-        dzeta = dm - r0 * dbeta - beta * dr0
-        ds = -(s * dr0 + G2 * dsig + G3 * dzeta + (sig * b2 + zeta * b3) * dbeta) * ir
-        dG1 = G0 * ds + b1 * dbeta
-        dG2 = G1 * ds + b2 * dbeta
-        dr = dr0 + dsig * G1 + sig * dG1 + dzeta * G2 + zeta * dG2
-        df = -(dm * G2 + mu * dG2) * ir0 - fm1 * dr0 * ir0
-        dg = dr0 * G1 + r0 * dG1 + dsig * G2 + sig * dG2
-        dfdot = -(dm * G1 + mu * dG1) * ir * ir0 - fdot * (dr * ir + dr0 * ir0)
-        dgd = -(dm * G2 + mu * dG2) * ir - gdm1 * dr * ir
-        x[o, 0] = dx0 + (fm1 * dx0 + g * dvx0) + (df * x0 + dg * vx0)
-        x[o, 1] = dy0 + (fm1 * dy0 + g * dvy0) + (df * y0 + dg * vy0)
-        x[o, 2] = dz0 + (fm1 * dz0 + g * dvz0) + (df * z0 + dg * vz0)
-        v[o, 0] = dvx0 + (fdot * dx0 + gdm1 * dvx0) + (dfdot * x0 + dgd * vx0)
-        v[o, 1] = dvy0 + (fdot * dy0 + gdm1 * dvy0) + (dfdot * y0 + dgd * vy0)
-        v[o, 2] = dvz0 + (fdot * dz0 + gdm1 * dvz0) + (dfdot * z0 + dgd * vz0)
+    _tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, r0, 1.0 / r0, sig, beta,
+                  zeta, G0, G1, G2, G3, G4, G5, ir, -mu * G2 / r0, r0 * G1 + sig * G2,
+                  -mu * G1 / (r * r0), -mu * G2 * ir)
+
+
+@njit(inline="always")
+def advance_tangent_by_anomaly(mu, x, v, i, n, dmu, k, s, r0, ir0, beta, zeta):
+    """:func:`advance_by_anomaly` of row ``i`` (bit for bit) and of its first
+    ``k`` tangent vectors (``n`` rows apart, ``dmu`` as
+    :func:`kepler_drift_tangent`'s), from the same universal functions.
+    False, and nothing written, if the radius at the end is not positive."""
+    x0 = x[i, 0]
+    y0 = x[i, 1]
+    z0 = x[i, 2]
+    vx0 = v[i, 0]
+    vy0 = v[i, 1]
+    vz0 = v[i, 2]
+    c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1 = _short_coefficients(
+        mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta)
+    if not (r > 0.0):
+        return False
+    _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
+    z = beta * s * s
+    c4, c5 = _stumpff45_short(z)
+    s2 = s * s
+    s3 = s2 * s
+    _tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, sig, beta,
+                  zeta, c0, s * c1, s2 * c2, s3 * c3, s2 * s2 * c4, s3 * s2 * c5, ir, fm1, g,
+                  fdot, gdm1)
+    return True
 
 
 @njit
@@ -1476,21 +1534,19 @@ def kepler_drift_tangent(mu, x, v, i, dt, dmu, k):
     vy0 = v[i, 1]
     vz0 = v[i, 2]
     s, r0, ir0, beta, zeta = short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
-    if s == s and advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
-        c0, c1, c2, c3 = _stumpff_short(beta * s * s)
-        turns = 0.0
-    else:
-        status = kepler_drift(mu, x, v, i, dt)
-        s, turns = bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
-        if status != STATUS_OK or not (s == s):
-            for j in range(k):
-                for d in range(3):
-                    x[i + n * (1 + j), d] = math.nan
-                    v[i + n * (1 + j), d] = math.nan
-            return STATUS_INVALID_STATE
-        r0 = math.sqrt(x0 * x0 + y0 * y0 + z0 * z0)
-        beta = 2.0 * mu / r0 - (vx0 * vx0 + vy0 * vy0 + vz0 * vz0)
-        c0, c1, c2, c3 = stumpff(beta * s * s)
+    if s == s and advance_tangent_by_anomaly(mu, x, v, i, n, dmu, k, s, r0, ir0, beta, zeta):
+        return STATUS_OK
+    status = kepler_drift(mu, x, v, i, dt)
+    s, turns = bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
+    if status != STATUS_OK or not (s == s):
+        for j in range(k):
+            for d in range(3):
+                x[i + n * (1 + j), d] = math.nan
+                v[i + n * (1 + j), d] = math.nan
+        return STATUS_INVALID_STATE
+    r0 = math.sqrt(x0 * x0 + y0 * y0 + z0 * z0)
+    beta = 2.0 * mu / r0 - (vx0 * vx0 + vy0 * vy0 + vz0 * vz0)
+    c0, c1, c2, c3 = stumpff(beta * s * s)
     _drift_tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, turns,
                         c0, c1, c2, c3)
     return STATUS_OK
