@@ -1,10 +1,12 @@
-"""Body sets: names, masses and states, with astropy units at the edge.
+"""Body sets: names, masses, radii and states, with astropy units at the edge.
 
 A :class:`BodySet` stores its numbers as float64 arrays in its
 :class:`~orbits.units.UnitSystem`; its public properties give Quantities.
 Bodies enter by Cartesian state (:meth:`BodySet.add` with ``position`` and
 ``velocity``), by orbital elements about a primary (:meth:`BodySet.add` with
 ``a``, ``e``, ...), or all at once from arrays (:meth:`BodySet.from_arrays`).
+A body may also be given a physical radius (``radius=``; default 0, a point
+mass), which the set carries through copies, simulations and output files.
 Every value is checked where it enters; a bad one raises a
 :class:`~orbits.errors.BodyError` naming the body and the field.
 """
@@ -28,7 +30,7 @@ _REPR_ROWS = 5  # rows a repr shows at each end of a long set
 
 
 class BodySet:
-    """An ordered set of named point masses with positions and velocities.
+    """An ordered set of named bodies with masses, radii, positions and velocities.
 
     Parameters
     ----------
@@ -57,13 +59,14 @@ class BodySet:
         self._bare_ok = units is not None
         self._names = []
         self._m = np.zeros(0)
+        self._r = np.zeros(0)   # physical radii; 0 for a point mass
         self._x = np.zeros((0, 3))
         self._v = np.zeros((0, 3))
         self.history = []  # how the bodies were made, recorded with results
 
     # -- construction -----------------------------------------------------------
     def add(self, name, mass, *, position=None, velocity=None, primary=None, a=None,
-            e=None, inc=None, Omega=None, omega=None, f=None, M=None):
+            e=None, inc=None, Omega=None, omega=None, f=None, M=None, radius=None):
         """Add one body, by Cartesian state or by orbital elements.
 
         Parameters
@@ -89,6 +92,10 @@ class BodySet:
             Default 0.
         f, M : Quantity, angle
             True or mean anomaly (give at most one).  Default ``f = 0``.
+        radius : Quantity, scalar, length, optional
+            The body's physical radius: finite and >= 0.  Default 0 (a point
+            mass).  Gravity does not read it; it is kept for collision
+            detection and travels with the set into simulations and files.
 
         Notes
         -----
@@ -102,13 +109,16 @@ class BodySet:
         >>> import orbits
         >>> bodies = orbits.BodySet()
         >>> bodies.add("Sun", mass=1 * u.Msun)
-        >>> bodies.add("Earth", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, e=0.0167)
+        >>> bodies.add("Earth", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, e=0.0167,
+        ...            radius=1 * u.Rearth)
         >>> bodies.add("probe", mass=0 * u.kg, position=[0, 2, 0] * u.au,
         ...            velocity=[-20, 0, 0] * u.km / u.s)
         >>> bodies.names
         ['Sun', 'Earth', 'probe']
         >>> round(float(bodies.elements("Earth", primary="Sun")["e"]), 4)
         0.0167
+        >>> bodies.radii.to(u.km).round(1)
+        <Quantity [   0. , 6378.1,    0. ] km>
         """
         self._check_name(name)
         m = self._scalar(mass, "mass", name, "mass")
@@ -117,6 +127,10 @@ class BodySet:
         if m < 0:
             raise BodyError(f"mass must be >= 0, got {m} {self.units.mass}",
                             body=name, field="mass")
+        r = 0.0 if radius is None else self._scalar(radius, "length", name, "radius")
+        if not (math.isfinite(r) and r >= 0):
+            raise BodyError(f"radius must be finite and >= 0, got {r} {self.units.length}",
+                            body=name, field="radius")
         elements = dict(a=a, e=e, inc=inc, Omega=Omega, omega=omega, f=f, M=M)
         given = [k for k, val in elements.items() if val is not None]
         if given or primary is not None:
@@ -133,11 +147,11 @@ class BodySet:
             v = (np.zeros(3) if velocity is None
                  else self._vector(velocity, "velocity", name, "velocity"))
             how = {"name": name, "from": "state"}
-        self._append(name, m, x, v)
+        self._append(name, m, x, v, r)
         self.history.append(how)
 
     @classmethod
-    def from_arrays(cls, masses, positions, velocities, names=None, units=None):
+    def from_arrays(cls, masses, positions, velocities, names=None, units=None, radii=None):
         """Make a body set from arrays.
 
         Parameters
@@ -150,6 +164,8 @@ class BodySet:
             Default ``"0"``, ``"1"``, ...
         units : UnitSystem, optional
             If given, plain numbers are read in it; otherwise Quantities are needed.
+        radii : Quantity or array, shape (N,), length, optional
+            Physical radii, each finite and >= 0.  Default: all 0 (point masses).
 
         Returns
         -------
@@ -165,12 +181,18 @@ class BodySet:
         ...                                     units=U)
         >>> bodies.names, bodies.positions.shape
         (['A', 'B'], (2, 3))
+        >>> with_radii = orbits.BodySet.from_arrays([1.0, 1e-3], [[0, 0, 0], [1, 0, 0]],
+        ...                                         [[0, 0, 0], [0, 1, 0]], units=U,
+        ...                                         radii=[5e-3, 1e-4])
+        >>> with_radii.radii
+        <Quantity [0.005 , 0.0001]>
         """
         bs = cls(units)
         m = bs._array(masses, "mass", "masses", (None,))
         n = m.shape[0]
         x = bs._array(positions, "length", "positions", (n, 3))
         v = bs._array(velocities, "velocity", "velocities", (n, 3))
+        r = np.zeros(n) if radii is None else bs._array(radii, "length", "radii", (n,))
         if names is None:
             names = [str(i) for i in range(n)]
         names = list(names)
@@ -191,6 +213,11 @@ class BodySet:
             i = int(np.argmax(bad))
             raise BodyError(f"mass must be finite and >= 0, got {m[i]}", body=names[i],
                             field="mass")
+        bad = ~(np.isfinite(r) & (r >= 0))
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise BodyError(f"radius must be finite and >= 0, got {r[i]} {bs.units.length}",
+                            body=names[i], field="radius")
         for field, arr in (("position", x), ("velocity", v)):
             bad = ~np.all(np.isfinite(arr), axis=1)
             if bad.any():
@@ -199,6 +226,7 @@ class BodySet:
                                 field=field)
         bs._names = names
         bs._m = m.copy()
+        bs._r = r + 0.0     # a new array, with -0.0 stored as 0.0
         bs._x = x.copy()
         bs._v = v.copy()
         bs.history.append({"from": "arrays", "n": n})
@@ -209,8 +237,9 @@ class BodySet:
         """Make a body set from a ``rebound.Simulation``.
 
         REBOUND keeps plain numbers; they are read in ``units`` (default: a
-        dimensionless system with REBOUND's ``sim.G``).  Particle hashes are
-        not names, so names default to ``"0"``, ``"1"``, ...
+        dimensionless system with REBOUND's ``sim.G``).  Each particle's ``r``
+        becomes the body's radius.  Particle hashes are not names, so names
+        default to ``"0"``, ``"1"``, ...
 
         Examples
         --------
@@ -229,17 +258,19 @@ class BodySet:
         m = np.array([sim.particles[i].m for i in range(n)])
         x = np.array([sim.particles[i].xyz for i in range(n)], dtype=float).reshape(n, 3)
         v = np.array([sim.particles[i].vxyz for i in range(n)], dtype=float).reshape(n, 3)
+        r = np.array([sim.particles[i].r for i in range(n)], dtype=float)
         if units is None:
             units = UnitSystem.nbody(G=sim.G)
         elif not math.isclose(units.G, sim.G, rel_tol=1e-15):
             raise ValueError(f"units.G = {units.G!r} differs from the REBOUND "
                              f"simulation's G = {sim.G!r}")
-        bs = cls.from_arrays(m, x, v, names=names, units=units)
+        bs = cls.from_arrays(m, x, v, names=names, units=units, radii=r)
         bs.history[-1] = {"from": "rebound", "n": n}
         return bs
 
     def to_rebound(self):
-        """A ``rebound.Simulation`` with the same G, masses and states (plain floats).
+        """A ``rebound.Simulation`` with the same G, masses, radii (each
+        particle's ``r``) and states (plain floats).
 
         Massive bodies must come before massless ones in REBOUND's active/test
         particle split; the order of this set is kept as it is.
@@ -248,15 +279,15 @@ class BodySet:
         --------
         >>> import orbits
         >>> sim = orbits.scenes.kepler().to_rebound()
-        >>> sim.N, round(sim.particles[1].a, 12)
-        (2, 1.0)
+        >>> sim.N, round(sim.particles[1].a, 12), sim.particles[1].r
+        (2, 1.0, 0.0)
         """
         import rebound
         sim = rebound.Simulation()
         sim.G = self.units.G
         for i in range(len(self)):
-            sim.add(m=float(self._m[i]), x=self._x[i, 0], y=self._x[i, 1], z=self._x[i, 2],
-                    vx=self._v[i, 0], vy=self._v[i, 1], vz=self._v[i, 2])
+            sim.add(m=float(self._m[i]), r=float(self._r[i]), x=self._x[i, 0], y=self._x[i, 1],
+                    z=self._x[i, 2], vx=self._v[i, 0], vy=self._v[i, 1], vz=self._v[i, 2])
         return sim
 
     def copy(self):
@@ -335,9 +366,9 @@ class BodySet:
         return name in self._names
 
     def __repr__(self):
-        """The bodies with their masses and, for bound orbits, a, e and inc about the
-        bodies before each (the default primary of :meth:`elements`); a long set
-        shows its first and last rows."""
+        """The bodies with their masses, their radii where any is non-zero, and, for
+        bound orbits, a, e and inc about the bodies before each (the default
+        primary of :meth:`elements`); a long set shows its first and last rows."""
         head, rows = self._table()
         widths = [max(len(r[k]) for r in [head, *filter(None, rows)])
                   for k in range(len(head))]
@@ -373,8 +404,12 @@ class BodySet:
             shown = [*range(_REPR_ROWS), None, *range(n - _REPR_ROWS, n)]
         else:
             shown = list(range(n))
-        head = ["name", *(f"{label} [{unit}]" if unit else label for label, unit in
-                          (("mass", str(self.units.mass)), ("a", str(self.units.length)))),
+        # point masses (every radius 0, the usual case) get no radius column
+        sized = bool(np.any(self._r != 0))
+        length = str(self.units.length)
+        columns = (("mass", str(self.units.mass)),
+                   *((("radius", length),) if sized else ()), ("a", length))
+        head = ["name", *(f"{label} [{unit}]" if unit else label for label, unit in columns),
                 "e", "inc [deg]"]
         rows = []
         for i in shown:
@@ -383,6 +418,7 @@ class BodySet:
                 continue
             el = _bound_elements(self, i)
             rows.append([self._names[i], f"{self._m[i]:.6g}",
+                         *((f"{self._r[i]:.6g}",) if sized else ()),
                          *(("", "", "") if el is None else
                            (f"{el[0]:.6g}", f"{el[1]:.4g}", f"{math.degrees(el[2]):.4g}"))])
         return head, rows
@@ -410,6 +446,21 @@ class BodySet:
         <Quantity [1.   , 0.001] solMass>
         """
         return self.units.quantity(self._m.copy(), "mass")
+
+    @property
+    def radii(self):
+        """Physical radii: Quantity, shape (N,), length (0 for a point mass).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> bodies = orbits.scenes.kepler()
+        >>> bodies.add("moon", mass=0 * u.kg, position=[2, 0, 0] * u.au, radius=1737 * u.km)
+        >>> bodies.radii.to(u.km)
+        <Quantity [   0.,    0., 1737.] km>
+        """
+        return self.units.quantity(self._r.copy(), "length")
 
     @property
     def positions(self):
@@ -606,9 +657,10 @@ class BodySet:
                     f"positions", body=same[0], field="position")
 
     # -- internals ----------------------------------------------------------------
-    def _append(self, name, m, x, v):
+    def _append(self, name, m, x, v, r=0.0):
         self._names.append(name)
         self._m = np.append(self._m, m)
+        self._r = np.append(self._r, r + 0.0)     # -0.0 stored as 0.0
         self._x = np.vstack([self._x, np.asarray(x, dtype=float).reshape(1, 3)])
         self._v = np.vstack([self._v, np.asarray(v, dtype=float).reshape(1, 3)])
 

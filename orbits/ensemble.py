@@ -872,7 +872,9 @@ class _Perturbation:
     def fingerprint(self):
         b = self.bodies
         h = hashlib.sha1()
-        for a in (b._m, b._x, b._v):
+        # radii only where some body has one: a sweep of point masses keeps
+        # the fingerprint it had before bodies had sizes
+        for a in (b._m, b._x, b._v) + ((b._r,) if np.any(b._r) else ()):
             h.update(np.ascontiguousarray(a).tobytes())
         h.update(json.dumps([b.names, self.config.to_dict(), self.scale, self.seed],
                             sort_keys=True, default=str).encode())

@@ -219,20 +219,21 @@ class SimulationDescription(NamedTuple):
     """What an output file says about a simulation, beside its state: the
     bodies, units and set-up (:meth:`Simulation.description`).
 
-    Numbers are plain floats in the simulation's units; ``masses`` and
-    ``names`` are in the body set's order.
+    Numbers are plain floats in the simulation's units; ``names``,
+    ``masses`` and ``radii`` are in the body set's order.
 
     Examples
     --------
     >>> import astropy.units as u
     >>> import orbits
     >>> d = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day).description()
-    >>> d.names, d.masses.tolist(), d.dt, d.integrator.name
-    (('Star', 'Planet'), [1.0, 0.001], 1.0, 'leapfrog')
+    >>> d.names, d.masses.tolist(), d.radii.tolist(), d.dt, d.integrator.name
+    (('Star', 'Planet'), [1.0, 0.001], [0.0, 0.0], 1.0, 'leapfrog')
     """
 
     names: tuple
     masses: np.ndarray           # (N,) body-set order
+    radii: np.ndarray            # (N,) body-set order, length: physical radii (0: a point)
     units: object                # the UnitSystem
     integrator: object           # the Integrator (name, config, info())
     dt: float                    # 0 for an adaptive method left to choose

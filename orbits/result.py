@@ -51,6 +51,9 @@ class Result:
         States at the outputs, bodies in the order of the body set.
     names : list of str
     masses : Quantity, shape (N,)
+    radii : Quantity, shape (N,), length, or None
+        The bodies' physical radii (0 for a point mass; all 0 when read from a
+        file written before radii were kept); None where not recorded.
     energy : Quantity, shape (n,) or None
         Total energy at the outputs (None if the energy monitor is off).
     work : Quantity, shape (n,) or None
@@ -133,6 +136,7 @@ class Result:
         self.momentum = self.center_of_mass = None
         self.megno = self.lyapunov = self.fli = None
         self.jacobian = self.tangent_vectors = self.seed = None
+        self.radii = None
         self.status = "completed"
         self.steps_rejected = 0
         self.forces = ()

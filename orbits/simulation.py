@@ -153,6 +153,7 @@ class Simulation(Driven):
         m = bodies._m
         self._order = np.concatenate([np.flatnonzero(m > 0), np.flatnonzero(m == 0)])
         self._m = np.ascontiguousarray(m[self._order])
+        self._r = np.ascontiguousarray(bodies._r[self._order])
         self._x = np.ascontiguousarray(bodies._x[self._order])
         self._v = np.ascontiguousarray(bodies._v[self._order])
         self._n_active = int(np.count_nonzero(self._m > 0))
@@ -693,8 +694,8 @@ class Simulation(Driven):
         >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
         >>> b = sim.bodies
-        >>> b.names, b.positions.unit
-        (['Star', 'Planet'], Unit("AU"))
+        >>> b.names, b.positions.unit, b.radii.unit
+        (['Star', 'Planet'], Unit("AU"), Unit("AU"))
         """
         self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
         inv = np.argsort(self._order)
@@ -702,6 +703,7 @@ class Simulation(Driven):
         bs._bare_ok = self._bare_ok
         bs._names = list(self._names)
         bs._m = self._m[inv].copy()
+        bs._r = self._r[inv].copy()
         bs._x = self._x[inv].copy()
         bs._v = self._v[inv].copy()
         bs.history = list(self._history)
@@ -790,10 +792,10 @@ class Simulation(Driven):
         """
         inv = self._inverse
         return SimulationDescription(
-            tuple(self._names), self._m[inv].copy(), self.units, self.integrator, self._dt,
-            math.sqrt(self._eps2), self.monitors, self.monitor_every, self.parallel,
-            self.rebound_arithmetic, dict(self._stop_config), list(self._history),
-            self.config, self.forces)
+            tuple(self._names), self._m[inv].copy(), self._r[inv].copy(), self.units,
+            self.integrator, self._dt, math.sqrt(self._eps2), self.monitors,
+            self.monitor_every, self.parallel, self.rebound_arithmetic,
+            dict(self._stop_config), list(self._history), self.config, self.forces)
 
     @property
     def time_value(self):
@@ -1240,7 +1242,8 @@ class _Recorder:
         q = U.quantity
         fields = dict(
             times=q(self.t[:self.count], "time"), names=list(sim._names),
-            masses=q(sim._m[self.inv].copy(), "mass"), steps=sim.steps - self.steps0,
+            masses=q(sim._m[self.inv].copy(), "mass"),
+            radii=q(sim._r[self.inv].copy(), "length"), steps=sim.steps - self.steps0,
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
             integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
             monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,

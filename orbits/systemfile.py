@@ -19,6 +19,7 @@ optional ``[run]`` table of defaults for ``orbits run``::
     [[body]]
     name = "Sun"
     mass = "1 Msun"             # a string: a number and its unit
+    radius = "1 Rsun"           # optional: the physical radius; default 0
 
     [[body]]                    # by orbital elements about a primary
     name = "Jupiter"
@@ -48,9 +49,10 @@ optional ``[run]`` table of defaults for ``orbits run``::
     [run.options]               # the integrator's options
     corrector = 17
 
-Body fields are those of :meth:`orbits.BodySet.add`: ``name``, ``mass``, and
-either ``position`` and ``velocity`` (three components each) or ``a``, ``e``,
-``inc``, ``Omega``, ``omega``, ``f`` or ``M`` with an optional ``primary``.
+Body fields are those of :meth:`orbits.BodySet.add`: ``name``, ``mass``, an
+optional ``radius``, and either ``position`` and ``velocity`` (three
+components each) or ``a``, ``e``, ``inc``, ``Omega``, ``omega``, ``f`` or ``M``
+with an optional ``primary``.
 A value is a string with a unit (``"5.2 au"``, ``"30 km/s"``) or a plain
 number.  A plain number is read in the ``[units]`` table's units; without a
 ``[units]`` table only dimensionless values (``e``) and zero take no unit.
@@ -67,16 +69,18 @@ header gives the unit system (plain-number columns are then read in it)::
     Sun,1,0,0,0,0,0,0
     probe,0,1,0,0,0,30,0
 
-The columns are ``name``, ``mass``, ``x``, ``y``, ``z``, ``vx``, ``vy``, ``vz``,
-``primary``, ``a``, ``e``, ``inc``, ``Omega``, ``omega``, ``f``, ``M``; a row
-gives either the state or elements, and leaves the other cells empty.
+The columns are ``name``, ``mass``, ``radius``, ``x``, ``y``, ``z``, ``vx``,
+``vy``, ``vz``, ``primary``, ``a``, ``e``, ``inc``, ``Omega``, ``omega``, ``f``,
+``M``; a row gives either the state or elements, and leaves the other cells
+empty.  ``radius`` is optional (an empty cell or no column: 0).
 
 Exactness
 ---------
 :func:`write` writes the numbers the set holds, in its own units, with the
 shortest text that reads back as the same float64 (Python's ``repr``), and
-the unit system with its G.  A set written and read back is therefore the same
-bit for bit, and so is any run of it.
+the unit system with its G.  Radii are written where any body has a non-zero
+one.  A set written and read back is therefore the same bit for bit, and so
+is any run of it.
 
 Errors
 ------
@@ -113,9 +117,9 @@ __all__ = ["SystemFile", "read", "write", "loads", "dumps", "BODY_FIELDS", "UNIT
            "RUN_FIELDS", "CSV_COLUMNS"]
 
 #: ``[[body]]`` keys and the physical kind each is read as
-BODY_FIELDS = {"name": "text", "mass": "mass", "position": "length", "velocity": "velocity",
-               "primary": "text", "a": "length", "e": "dimensionless", "inc": "angle",
-               "Omega": "angle", "omega": "angle", "f": "angle", "M": "angle"}
+BODY_FIELDS = {"name": "text", "mass": "mass", "radius": "length", "position": "length",
+               "velocity": "velocity", "primary": "text", "a": "length", "e": "dimensionless",
+               "inc": "angle", "Omega": "angle", "omega": "angle", "f": "angle", "M": "angle"}
 
 #: ``[units]`` keys (the arguments of :class:`~orbits.units.UnitSystem`)
 UNIT_FIELDS = ("length", "mass", "time", "G", "G_source", "name")
@@ -126,8 +130,8 @@ RUN_FIELDS = {"integrator": "text", "dt": "time", "until": "time", "outputs": "i
               "escape_distance": "length", "options": "table"}
 
 #: CSV columns: the body fields, with the vectors as one column per component
-CSV_COLUMNS = ("name", "mass", "x", "y", "z", "vx", "vy", "vz", "primary", "a", "e", "inc",
-               "Omega", "omega", "f", "M")
+CSV_COLUMNS = ("name", "mass", "radius", "x", "y", "z", "vx", "vy", "vz", "primary", "a", "e",
+               "inc", "Omega", "omega", "f", "M")
 
 _VECTORS = {"position": ("x", "y", "z"), "velocity": ("vx", "vy", "vz")}
 _ELEMENTS = ("a", "e", "inc", "Omega", "omega", "f", "M")
@@ -848,8 +852,10 @@ def _dump_toml(bodies, run):
         if note:
             out.append(f"# {note}")
         out += [f"name = {_toml_value(name)}",
-                f"mass = {_toml_value(float(bodies._m[i]))}",
-                f"position = {_toml_value([float(c) for c in bodies._x[i]])}",
+                f"mass = {_toml_value(float(bodies._m[i]))}"]
+        if bodies._r[i] != 0:
+            out.append(f"radius = {_toml_value(float(bodies._r[i]))}")
+        out += [f"position = {_toml_value([float(c) for c in bodies._x[i]])}",
                 f"velocity = {_toml_value([float(c) for c in bodies._v[i]])}"]
     if run:
         out += ["", "[run]"]
@@ -912,10 +918,14 @@ def _dump_csv(bodies):
     def col(name, kind):
         unit = units.unit(kind).to_string()
         return f"{name} [{unit}]" if unit else name
-    writer.writerow(["name", col("mass", "mass"), *(col(c, "length") for c in "xyz"),
+    # a table of point masses, the usual case, keeps its columns as they were
+    sized = bool(np.any(bodies._r != 0))
+    writer.writerow(["name", col("mass", "mass"), *([col("radius", "length")] if sized else []),
+                     *(col(c, "length") for c in "xyz"),
                      *(col(c, "velocity") for c in ("vx", "vy", "vz"))])
     for i, name in enumerate(bodies.names):
         writer.writerow([name, repr(float(bodies._m[i])),
+                         *([repr(float(bodies._r[i]))] if sized else []),
                          *(repr(float(c)) for c in bodies._x[i]),
                          *(repr(float(c)) for c in bodies._v[i])])
     return buf.getvalue()

@@ -81,6 +81,109 @@ def test_rebound_round_trip():
     assert isinstance(sim, rebound.Simulation)
 
 
+# -- physical radii ------------------------------------------------------------------
+
+def sized():
+    # a massless body first, so that a simulation's internal order (massive
+    # bodies first) differs from the set's and a radius put back in the wrong
+    # row shows
+    b = orbits.BodySet()
+    b.add("probe", mass=0 * u.kg, position=[3, 0, 0] * u.au,
+          velocity=[0, 0.01, 0] * u.au / u.day, radius=10 * u.m)
+    b.add("Sun", mass=1 * u.Msun, radius=1 * u.Rsun)
+    b.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.048,
+          radius=71492 * u.km)
+    return b
+
+
+def test_radii_given_in_any_length_unit_come_back_in_the_sets_unit():
+    b = sized()
+    assert b.radii.unit == u.au and b.radii.shape == (3,)
+    assert b._r.dtype == np.float64
+    np.testing.assert_allclose(b.radii.to_value(u.km), [0.01, 695700, 71492], rtol=1e-14)
+    b.add("rock", mass=0 * u.kg, position=[7, 0, 0] * u.au)        # no radius: a point
+    assert b.radii[-1] == 0 * u.au
+    r = [0.5, 0.002] * u.km
+    a = orbits.BodySet.from_arrays([1, 1e-3] * u.Msun, [[0, 0, 0], [1, 0, 0]] * u.au,
+                                   np.zeros((2, 3)) * u.au / u.day, radii=r)
+    np.testing.assert_allclose(a.radii.to_value(u.km), [0.5, 0.002], rtol=1e-14)
+    default = orbits.BodySet.from_arrays([1, 1e-3] * u.Msun, [[0, 0, 0], [1, 0, 0]] * u.au,
+                                         np.zeros((2, 3)) * u.au / u.day)
+    assert np.array_equal(default.radii.value, [0.0, 0.0])
+    # plain numbers with an explicit unit system are read in it, as masses are
+    U = orbits.UnitSystem.nbody()
+    n = orbits.BodySet.from_arrays([1.0, 1.0], [[0, 0, 0], [1, 0, 0]], np.zeros((2, 3)),
+                                   units=U, radii=[0.25, 0.125])
+    assert n.radii.value.tolist() == [0.25, 0.125]
+
+
+@pytest.mark.parametrize("radius, error", [
+    (-1 * u.km, BodyError), (np.nan * u.km, BodyError), (np.inf * u.au, BodyError),
+    (1 * u.kg, BodyUnitsError), (1.0, BodyUnitsError), ([1, 2] * u.km, BodyError),
+])
+def test_bad_radius_names_the_body_and_the_field(radius, error):
+    b = orbits.BodySet()
+    with pytest.raises(error) as exc:
+        b.add("X", mass=1 * u.Msun, radius=radius)
+    assert exc.value.body == "X" and exc.value.field == "radius"
+    assert "'X'" in str(exc.value) and "radius" in str(exc.value)
+    assert len(b) == 0 and len(b._r) == 0  # nothing half-added
+
+
+def test_bad_radii_in_arrays():
+    U = orbits.UnitSystem.nbody()
+    m, x, v = [1.0, 1.0], [[0, 0, 0], [1, 0, 0]], np.zeros((2, 3))
+    with pytest.raises(BodyError, match="radii.*shape") as exc:
+        orbits.BodySet.from_arrays(m, x, v, units=U, radii=[1.0, 2.0, 3.0])
+    assert exc.value.field == "radii"
+    with pytest.raises(BodyError) as exc:
+        orbits.BodySet.from_arrays(m, x, v, names=["a", "b"], units=U, radii=[0.1, -0.1])
+    assert exc.value.body == "b" and exc.value.field == "radius"
+    with pytest.raises(BodyError) as exc:
+        orbits.BodySet.from_arrays(m, x, v, names=["a", "b"], units=U, radii=[np.nan, 0.1])
+    assert exc.value.body == "a" and exc.value.field == "radius"
+    with pytest.raises(BodyUnitsError) as exc:
+        orbits.BodySet.from_arrays([1, 1] * u.Msun, x * u.au, v * u.au / u.day,
+                                   radii=[1, 2] * u.s)
+    assert exc.value.field == "radii"
+
+
+def test_copy_and_subset_keep_radii():
+    b = sized()
+    c = b.copy()
+    assert np.array_equal(c.radii.value, b.radii.value)
+    c.add("moon", mass=0 * u.kg, position=[9, 0, 0] * u.au, radius=1737 * u.km)
+    assert len(b.radii) == 3 and len(c.radii) == 4          # independent
+    keep = [2, 0]
+    sub = orbits.BodySet.from_arrays(b.masses[keep], b.positions[keep], b.velocities[keep],
+                                     names=[b.names[k] for k in keep], radii=b.radii[keep])
+    assert np.array_equal(sub.radii.value, b.radii.value[keep])
+    b.move_to_com()                                          # moves states, not radii
+    assert np.array_equal(b.radii.value, c.radii.value[:3])
+
+
+def test_simulation_keeps_radii_in_the_sets_order():
+    b = sized()
+    sim = orbits.Simulation(b, integrator="leapfrog", dt=1 * u.day)
+    sim.run(until=20 * u.day, outputs=3, progress=False)
+    after = sim.bodies
+    assert after.names == b.names
+    assert np.array_equal(after.radii.value, b.radii.value)
+    assert after.radii.unit == u.au
+    assert np.array_equal(sim.description().radii, b.radii.value)
+    result = sim.run(until=30 * u.day, outputs=2, progress=False)
+    assert np.array_equal(result.radii.value, b.radii.value) and result.radii.unit == u.au
+
+
+def test_rebound_round_trip_keeps_radii():
+    b = sized()
+    sim = b.to_rebound()
+    assert [p.r for p in sim.particles] == b.radii.value.tolist()
+    sim.particles[1].r = 0.125
+    back = orbits.BodySet.from_rebound(sim, units=b.units, names=b.names)
+    assert back.radii.value.tolist() == [b.radii.value[0], 0.125, b.radii.value[2]]
+
+
 # -- bad input: each names the body and the field -------------------------------------
 
 @pytest.mark.parametrize("kwargs, field", [

@@ -28,6 +28,16 @@ def test_bodyset_repr_is_a_table_of_masses_and_elements(bodies):
     assert comet == ["comet", "<x>", "0"]                        # unbound: no a, e, inc
 
 
+def test_bodyset_repr_shows_radii_only_where_a_body_has_one(bodies):
+    assert "radius" not in repr(bodies) and "radius" not in bodies._repr_html_()
+    bodies.add("moon", mass=0 * u.kg, position=[9, 0, 0] * u.au, radius=0.5 * u.au)
+    lines = repr(bodies).splitlines()
+    assert lines[1].split()[:5] == ["name", "mass", "[solMass]", "radius", "[AU]"]
+    assert lines[2].split() == ["Sun", "1", "0"]
+    assert lines[-1].split()[:3] == ["moon", "0", "0.5"]
+    assert "<th>radius [AU]</th>" in bodies._repr_html_()
+
+
 def test_bodyset_repr_of_a_large_set_shows_its_ends():
     plummer = orbits.scenes.plummer(n=1000, seed=1)
     lines = repr(plummer).splitlines()

@@ -294,6 +294,34 @@ def test_run_table_round_trips():
         systemfile.dumps(orbits.scenes.kepler(), "csv", run=run)
 
 
+def test_radii_round_trip_and_a_set_without_them_is_written_as_before():
+    bodies = python_set()
+    plain = {kind: systemfile.dumps(bodies, kind) for kind in ("toml", "csv")}
+    assert "radius" not in plain["toml"] and "radius" not in plain["csv"]
+    bodies.add("moon", mass=0 * u.kg, position=[2, 0, 0] * u.au, radius=1737.4 * u.km)
+    for kind in ("toml", "csv"):
+        text = systemfile.dumps(bodies, kind)
+        assert "radius" in text, kind
+        back = systemfile.loads(text, kind).bodies
+        assert np.array_equal(back.radii.value, bodies.radii.value), kind
+        assert back.radii[:-1].value.tolist() == [0.0] * 4
+
+
+def one_body(line):
+    return f'[[body]]\nname = "Sun"\nmass = "1 Msun"\n{line}\n'
+
+
+def test_radius_field_is_read_with_its_unit_and_checked():
+    text = one_body('radius = "1 Rsun"')
+    b = systemfile.loads(text).bodies
+    assert b.radii[0].to(u.Rsun).value == pytest.approx(1.0, rel=1e-15)
+    with pytest.raises(SystemFileError, match="line 4: body 'Sun', field 'radius'"):
+        systemfile.loads(one_body('radius = "-1 km"'))
+    csv_text = "name,mass [Msun],radius [km],x [au],y [au],z [au]\nSun,1,696000,0,0,0\n"
+    assert systemfile.loads(csv_text, "csv").bodies.radii[0].to_value(u.km) \
+        == pytest.approx(696000, rel=1e-15)
+
+
 def test_names_with_quotes_commas_and_accents_round_trip():
     bodies = orbits.BodySet()
     for k, name in enumerate(['Béta "B", the second', "back\\slash", "tab\there"]):

@@ -11,6 +11,9 @@ adds two groups of its own::
     /particles/bodies
         names                (N,) str, in the order of the body set
         mass                 (N,) float, attr unit
+        radius               (N,) float, attr unit (length): the bodies' physical
+                             radii, 0 for a point mass (files written before it
+                             was kept lack it, and read as all 0)
         position/step        (T,) int64, steps since the simulation was made
         position/time        (T,) float, attr unit
         position/value       (T, N, 3) float, attr unit
@@ -457,8 +460,10 @@ _DATASETS = {
     "restart/plan": "the checkpoints' run plans",
     "restart/progress": "the checkpoints' progress",
 }
-_UNITS = ("particles/bodies/mass", "particles/bodies/position/time",
-          "particles/bodies/position/value", "particles/bodies/velocity/value")
+# (each checked where present: older files have no particles/bodies/radius)
+_UNITS = ("particles/bodies/mass", "particles/bodies/radius",
+          "particles/bodies/position/time", "particles/bodies/position/value",
+          "particles/bodies/velocity/value")
 _PARAMETERS = ("orbits_version", "written", "integrator", "integrator_options",
                "integrator_info", "dt", "dt_unit", "units", "monitors", "bodies_history")
 
@@ -1121,7 +1126,8 @@ class FileRecorder:
         t, step, x, v, row = self.last
         fields = dict(times=q(np.array([t]), "time"), positions=q(x[None], "length"),
                       velocities=q(v[None], "velocity"), names=list(self.desc.names),
-                      masses=q(self.desc.masses.copy(), "mass"), steps=sim.steps - self.steps0,
+                      masses=q(self.desc.masses.copy(), "mass"),
+                      radii=q(self.desc.radii.copy(), "length"), steps=sim.steps - self.steps0,
                       force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
                       steps_rejected=sim.steps_rejected - self.rejected0,
                       integrator=sim.integrator.info(), units=sim.units.to_dict(),
@@ -1359,6 +1365,7 @@ def _create(path, desc, state):
     b = f.create_group("particles/bodies")
     b.create_dataset("names", data=np.array(list(desc.names), dtype=h5py.string_dtype()))
     b.create_dataset("mass", data=desc.masses).attrs["unit"] = unit("mass")
+    b.create_dataset("radius", data=desc.radii).attrs["unit"] = unit("length")
     _element(b, "position", (n, 3), (unit("length"), unit("time")))
     _element(b, "velocity", (n, 3), (unit("velocity"), unit("time")))
     obs = f.create_group("observables")
@@ -1535,6 +1542,7 @@ def load(path):
             return ds[:rows] << u.Unit(ds.attrs["unit"])
 
         totals = _totals(f)
+        radii, radius_unit = _radii(b)
         if totals is None:
             step = b["position/step"]
             steps = int(step[n - 1] - step[0]) if n else 0
@@ -1542,7 +1550,8 @@ def load(path):
         fields = dict(
             times=q(b["position/time"]), positions=q(b["position/value"]),
             velocities=q(b["velocity/value"]), names=_decode(b["names"][()]),
-            masses=b["mass"][()] << u.Unit(b["mass"].attrs["unit"]), steps=totals[0],
+            masses=b["mass"][()] << u.Unit(b["mass"].attrs["unit"]),
+            radii=radii << u.Unit(radius_unit), steps=totals[0],
             force_evaluations=totals[1], steps_rejected=totals[2], wall_time=totals[3],
             integrator=json.loads(par.attrs["integrator_info"]),
             units=json.loads(par.attrs["units"]),
@@ -1585,6 +1594,15 @@ def load(path):
             fields["monitor"] = mon
         fields.update(_derivatives(f, path))
     return Result(**fields)
+
+
+def _radii(b):
+    """The bodies' radii from the group ``particles/bodies`` (float64 in the run's
+    unit of length) and that unit's name; all 0 in a file written before they
+    were kept."""
+    if "radius" in b:
+        return np.asarray(b["radius"][()], dtype=np.float64), b["radius"].attrs["unit"]
+    return np.zeros(b["names"].shape[0]), b["position/value"].attrs["unit"]
 
 
 def _series(group, name, rows):
@@ -1826,9 +1844,10 @@ def read_checkpoint(path):
         inv = np.argsort(order)
         names = _decode(f["particles/bodies/names"][()])
         m = f["particles/bodies/mass"][()]
+        radii, _ = _radii(f["particles/bodies"])
         x = r["x"][slot]
         v = r["v"][slot]
-        bodies = BodySet.from_arrays(m, x[inv], v[inv], names=names, units=units)
+        bodies = BodySet.from_arrays(m, x[inv], v[inv], names=names, units=units, radii=radii)
         bodies.history = json.loads(par.attrs["bodies_history"])
         config = (json.loads(par.attrs["config"]) if "config" in par.attrs
                   else _legacy_config(par, units))
