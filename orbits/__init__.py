@@ -13,11 +13,11 @@ from importlib.metadata import PackageNotFoundError, version as _version
 from . import analysis, errors, forces, integrators, io, monitors, scenes, systemfile
 from .bodies import BodySet
 from .custom import Trajectory, integrate
-from .errors import (BodyError, BodyUnitsError, CloseEncounter, ConvergenceFailure,
+from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
                      ElementsError, Escape, ForceTermError, IntegratorOptionError,
-                     NonFiniteState,
-                     OrbitsError, RunInterrupted, StepSizeUnderflow, SystemFileError,
-                     UnknownIntegratorError, WallTimeExceeded)
+                     NonFiniteState, OrbitsError, RunInterrupted, SimulationOptionError,
+                     StepSizeUnderflow, SystemFileError, UnknownIntegratorError,
+                     WallTimeExceeded)
 from .result import Result
 from .simulation import Simulation
 from .units import UnitSystem
@@ -33,7 +33,7 @@ __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajec
            "BodyError", "ForceTermError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",
            "UnknownIntegratorError", "NonFiniteState", "StepSizeUnderflow", "ConvergenceFailure",
-           "CloseEncounter", "Escape", "WallTimeExceeded", "RunInterrupted", "SystemFileError", "systemfile",
+           "CloseEncounter", "Collision", "Escape", "SimulationOptionError", "WallTimeExceeded", "RunInterrupted", "SystemFileError", "systemfile",
            "load", "io", "Ensemble", "__version__"]
 
 

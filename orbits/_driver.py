@@ -35,6 +35,10 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     """
     saved = (x.copy(), v.copy(), _copy_workspace(ws))
     kw = {} if stop is None else {"stop": stop}
+    # the stopping conditions' own arrays (the state a collision check keeps
+    # from the step before), so that a re-run checks as the run did
+    saved_stop = () if stop is None else tuple(
+        a.copy() if isinstance(a, np.ndarray) else None for a in stop)
     with restored_on_error(x, v, ws, saved):
         status, steps, n_mon = integ.advance(ws, x, v, t, dt, n, force, fargs, mon, step0,
                                              mon_t, mon_out, velocity_dependent, CHECK_EVERY,
@@ -48,6 +52,9 @@ def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, 
     def rerun(nsteps, monitors):
         x[...] = saved[0]
         v[...] = saved[1]
+        for a, b in zip(stop or (), saved_stop):
+            if b is not None:
+                a[...] = b
         work = _copy_workspace(saved[2])
         m = mon if monitors else (0,) + tuple(mon[1:])
         result = integ.advance(work, x, v, t, dt, nsteps, force, fargs, m, step0, mon_t,

@@ -27,7 +27,9 @@ __all__ = [
     "ConvergenceFailure",
     "WallTimeExceeded",
     "CloseEncounter",
+    "Collision",
     "Escape",
+    "SimulationOptionError",
     "RunInterrupted",
     "OrbitsWarning",
 ]
@@ -407,6 +409,58 @@ class CloseEncounter(SimulationStopped):
     ... except orbits.OrbitsError as exc:
     ...     print(type(exc).__name__, exc.bodies, exc.time)
     CloseEncounter ('Star', 'Planet') 1.0 d
+    """
+
+
+class Collision(SimulationStopped):
+    """Two bodies touched: their separation fell below the sum of their radii
+    (``collisions="halt"``).
+
+    Attributes
+    ----------
+    contact_time : astropy.units.Quantity
+        When the pair was closest inside the step in which they touched (the
+        end of that step if they already overlapped there).  ``time`` is the
+        end of the step, where the run stopped and the state is kept.
+    distance, speed : astropy.units.Quantity
+        Their separation and relative speed at ``contact_time``.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> b = orbits.BodySet()
+    >>> b.add("Star", mass=1 * u.Msun, radius=0.005 * u.au)
+    >>> b.add("Comet", mass=0 * u.kg, position=[1, 0, 0] * u.au,
+    ...       velocity=[-0.001, 0, 0] * u.au / u.day, radius=1 * u.km)
+    >>> sim = orbits.Simulation(b, "ias15", collisions="halt")
+    >>> try:
+    ...     sim.run(until=1 * u.yr, outputs=2, progress=False)
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, exc.bodies, exc.distance < 0.005 * u.au)
+    Collision ('Star', 'Comet') True
+    """
+
+    def __init__(self, message, time=None, step=None, result=None, bodies=(),
+                 contact_time=None, distance=None, speed=None):
+        self.contact_time = contact_time
+        self.distance = distance
+        self.speed = speed
+        super().__init__(message, time=time, step=step, result=result, bodies=bodies)
+
+
+class SimulationOptionError(OrbitsError, ValueError):
+    """An option of :class:`~orbits.Simulation` that cannot be taken as given
+    (which option, the value and what is expected are in the message).
+
+    Examples
+    --------
+    >>> import orbits
+    >>> try:
+    ...     orbits.Simulation(orbits.scenes.kepler(), "ias15", collisions="explode")
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__)
+    SimulationOptionError
     """
 
 

@@ -20,8 +20,9 @@ from ._driver import CHUNK_SECONDS, PROGRESS_DELAY, Driven  # noqa: F401 - docum
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
-from .errors import (BodyUnitsError, CloseEncounter, ConvergenceFailure, Escape,
-                     IntegratorOptionError, NonFiniteState, OrbitsWarning, StepSizeUnderflow)
+from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
+                     Escape, IntegratorOptionError, NonFiniteState, OrbitsWarning,
+                     SimulationOptionError, StepSizeUnderflow)
 from .monitors import DEFAULT_MONITORS, monitor_fields, monitor_mask
 from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
                       Snapshot)
@@ -91,6 +92,16 @@ class Simulation(Driven):
     escape_unbound : bool
         With ``escape_distance``: count a body beyond it only if it is also
         unbound (positive energy about the centre of mass).
+    collisions : {None, "halt"}
+        ``"halt"``: stop with :class:`~orbits.errors.Collision` when two bodies
+        touch, their separation below the sum of their radii
+        (:meth:`BodySet.add`'s ``radius``; a body without one is a point).
+        The pairs are looked at the end of every step and inside it, along
+        their relative motion between its ends
+        (:mod:`orbits._kernels.stopping`), so a grazing passage inside one
+        step is caught too.  The bodies must not touch at the start, and at
+        least one must have a radius.  For integrators that check stopping
+        conditions (not the Wisdom-Holman family).
 
     variations : {None, "state", "all"} or int, optional
         Integrate the first-order variational equations alongside
@@ -131,7 +142,8 @@ class Simulation(Driven):
     def __init__(self, bodies, integrator="verlet", dt=None, *, forces=(),
                  monitors=DEFAULT_MONITORS, monitor_every=None, softening=None, parallel=None,
                  encounter_distance=None, encounter_hill=None, escape_distance=None,
-                 escape_unbound=False, rebound_arithmetic=False, variations=None, seed=None):
+                 escape_unbound=False, collisions=None, rebound_arithmetic=False,
+                 variations=None, seed=None):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
@@ -193,7 +205,7 @@ class Simulation(Driven):
 
         self._stop_info = np.zeros(2, dtype=np.int64)
         self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
-                                     escape_unbound)
+                                     escape_unbound, collisions)
         # the force without variations, and its arguments
         self._base_force, self._base_fargs = self._force, self._fargs
         self._bind_variations(variations, seed)
@@ -497,7 +509,8 @@ class Simulation(Driven):
         return {"encounter_distance": q(c["encounter_distance"]),
                 "encounter_hill": c["encounter_hill"],
                 "escape_distance": q(c["escape_distance"]),
-                "escape_unbound": c["escape_unbound"]}
+                "escape_unbound": c["escape_unbound"],
+                "collisions": c["collisions"]}
 
     @property
     def softening(self):
@@ -522,7 +535,7 @@ class Simulation(Driven):
             raise ValueError(f"{field} must be a positive length, got {value}")
         return d
 
-    def _stop_args(self, distance, hill, escape, unbound):
+    def _stop_args(self, distance, hill, escape, unbound, collisions=None):
         from ._kernels import stopping as _s
         mask = 0
         d2 = esc2 = 0.0
@@ -546,17 +559,53 @@ class Simulation(Driven):
                 raise ValueError("escape_unbound needs escape_distance (the radius beyond "
                                  "which an unbound body counts as escaped)")
             mask |= _s.UNBOUND
+        if collisions is not None:
+            self._check_collisions(collisions)
+            mask |= _s.COLLISION
         self._stop_config = {"encounter_distance": d if distance is not None else None,
                              "encounter_hill": k or None,
                              "escape_distance": e if escape is not None else None,
-                             "escape_unbound": bool(unbound)}
+                             "escape_unbound": bool(unbound),
+                             "collisions": collisions}
+        n = len(self._m)
+        # the previous state and its time (for collisions inside a step),
+        # scratch, and where a collision was found
+        self._stop_clock = np.zeros(2)
+        self._stop_hit = np.zeros(3)
         if not mask:
             return None
         if not self.integrator.stop_conditions:
+            what = "collisions" if collisions is not None else "stopping conditions"
             raise IntegratorOptionError(f"integrator {self.integrator.name!r} does not check "
-                                        f"stopping conditions")
+                                        f"{what}; use 'ias15' or another method that does")
         central = int(np.argmax(self._m))
-        return (mask, d2, k, esc2, self._gm, central, self._stop_info)
+        return (mask, d2, k, esc2, self._gm, central, self._stop_info, self._r,
+                np.zeros((2, n, 3)), self._stop_clock, np.zeros((4, 3)), self._stop_hit)
+
+    #: the ways a collision can be resolved (Simulation's ``collisions``)
+    COLLISION_RESOLUTIONS = ("halt",)
+
+    def _check_collisions(self, collisions):
+        if not isinstance(collisions, str) or collisions not in self.COLLISION_RESOLUTIONS:
+            raise SimulationOptionError(
+                f"collisions={collisions!r} is not a resolution; expected one of "
+                f"{', '.join(map(repr, self.COLLISION_RESOLUTIONS))}")
+        r = self._r
+        if not np.any(r > 0):
+            raise BodyError("collisions need sizes: give the bodies that can collide a "
+                            "radius (BodySet.add(..., radius=...))", field="radius")
+        x = self._x
+        for i in range(1, len(r)):
+            d = np.sqrt(((x[:i] - x[i]) ** 2).sum(axis=1))
+            touch = np.flatnonzero(d < r[:i] + r[i])
+            if touch.size:
+                j = int(touch[0])
+                raise BodyError(f"{self._names[self._order[j]]!r} and "
+                                f"{self._names[self._order[i]]!r} touch at the start "
+                                f"(separation {d[j]:.6g} < radii {r[j] + r[i]:.6g} "
+                                f"{self.units.length}); with collisions= the bodies must "
+                                f"start apart", body=self._names[self._order[i]],
+                                field="radius")
 
     # -- files ------------------------------------------------------------------------
     @classmethod
@@ -1032,6 +1081,7 @@ class Simulation(Driven):
                   Status.STEP_UNDERFLOW: "step-size underflow",
                   Status.CLOSE_ENCOUNTER: "close encounter",
                   Status.ESCAPE: "escape",
+                  Status.COLLISION: "collision",
                   Status.NO_CONVERGENCE: "no convergence"}.get(status, f"status {status!r}")
         rec.end_status = int(status)
         rec.output(self, final=True)
@@ -1067,6 +1117,17 @@ class Simulation(Driven):
                                  f"t = {t:.10g} (step {self.steps}); the result up to here "
                                  f"is kept on .result", time=t, step=self.steps,
                                  result=result, bodies=bodies)
+        if status == Status.COLLISION:
+            bodies = (name(i), name(j))
+            q = self.units.quantity
+            tc, dist, speed = (float(a) for a in self._stop_hit)
+            raise Collision(f"{bodies[0]!r} and {bodies[1]!r} collided (closest at "
+                            f"t = {tc:.10g}, separation {dist:.6g} {self.units.length}) in the "
+                            f"step ending at t = {t:.10g} (step {self.steps}); the result up "
+                            f"to here is kept on .result", time=t, step=self.steps,
+                            result=result, bodies=bodies, contact_time=q(tc, "time"),
+                            distance=q(dist, "length"),
+                            speed=q(speed, "length") / self.units.time)
         if status == Status.ESCAPE:
             bodies = (name(i),)
             raise Escape(f"{bodies[0]!r} escaped at t = {t:.10g} (step {self.steps}); the "

@@ -20,6 +20,7 @@ class Status(IntEnum):
     # the chaos indicators' tangent vector wants scaling back (not a failure:
     # the driver renormalises it and carries on; orbits._kernels.variational)
     RENORMALISE = 6
+    COLLISION = 7   # two bodies closer than the sum of their radii (collisions=)
 
 
 def with_status(status, *rest):

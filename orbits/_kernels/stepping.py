@@ -133,7 +133,7 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
         _record(x, v, t, mon, n_mon, mon_t, mon_out)
         work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
         n_mon += 1
-    stop = stop_check(x, v, sargs)  # noqa: F821 - bound by specialize
+    stop = stop_check(x, v, t, sargs)  # noqa: F821 - bound by specialize
     if stop != 0:
         if check and not state_is_finite(x, v):
             return Status.NON_FINITE, k, until_check, until_record, n_mon

@@ -1,15 +1,17 @@
 """Stopping conditions checked inside the compiled loops.
 
-A check has the signature ``check(x, v, sargs) -> status`` and, when it
-fires, writes the bodies concerned into ``sargs[-1]`` (an int64 array of two:
-the pair for an encounter; the body and -1 for an escape).  Loops are compiled
+A check has the signature ``check(x, v, t, sargs) -> status`` (``t`` the
+time of the state) and, when it fires, writes the bodies concerned into
+``sargs[6]`` (an int64 array of two: the pair for an encounter or a
+collision; the body and -1 for an escape).  Loops are compiled
 with :func:`no_stop` when a simulation asks for no condition, which inlines to
 nothing, so such a scene pays nothing for the feature.
 
-``sargs = (mask, distance2, hill_k, escape2, gm, central, info)``:
+``sargs = (mask, distance2, hill_k, escape2, gm, central, info, radii, prev,
+clock, work, hit)``:
 
 * ``mask``: bits :data:`ENCOUNTER_DISTANCE`, :data:`ENCOUNTER_HILL`,
-  :data:`ESCAPE`, :data:`UNBOUND`;
+  :data:`ESCAPE`, :data:`UNBOUND`, :data:`COLLISION`;
 * ``distance2``: squared encounter distance;
 * ``hill_k``: encounter at ``k`` mutual Hill radii,
   ``R_H = ((m_i + m_j) / (3 m_c))^(1/3) (r_i + r_j) / 2`` with ``r`` the
@@ -17,35 +19,127 @@ nothing, so such a scene pays nothing for the feature.
 * ``escape2``: squared escape distance from the centre of mass; with
   :data:`UNBOUND` a body beyond it counts only if its energy about the centre
   of mass, ``v^2/2 - G M / r``, is positive;
-* ``gm``: G times the masses; ``central``: index of the central body.
+* ``gm``: G times the masses; ``central``: index of the central body;
+* ``radii`` (shape (n,)): the bodies' radii; with :data:`COLLISION` two
+  bodies collide when their separation falls below the sum of their radii,
+  at the end of a step or inside it (:func:`collision_check`);
+* ``prev`` (shape (2, n, 3)) and ``clock`` (``[t, valid]``): the positions
+  and velocities at the previous check and their time, for looking inside
+  the step; ``clock[1] = 0`` (set by the driver when the state was changed
+  from outside) makes the next check look at the end of its step only;
+* ``work`` (shape (4, 3)): scratch;
+* ``hit`` (``[t, d, speed]``): where a collision fired, its time (of the
+  closest approach inside the step, or the end of the step where the bodies
+  already overlap), the separation and the relative speed there.
 """
 
 import math
 
 from ._jit import njit
+from .encounters import closest_approach
 from .status import Status
 
-__all__ = ["no_stop", "check_stop", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE",
-           "UNBOUND"]
+__all__ = ["no_stop", "check_stop", "collision_check", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL",
+           "ESCAPE", "UNBOUND", "COLLISION"]
 
 ENCOUNTER_DISTANCE = 1
 ENCOUNTER_HILL = 2
 ESCAPE = 4
 UNBOUND = 8
+COLLISION = 16
 
 
 @njit(inline="always")
-def no_stop(x, v, sargs):
+def no_stop(x, v, t, sargs):
     """No condition: always carries on."""
     return 0
 
 
 @njit
-def check_stop(x, v, sargs):
+def collision_check(x, v, t, sargs):
+    """The first pair (in the order of the pair loop) whose separation fell
+    below the sum of their radii during the step that ended at ``t``: at its
+    end, or inside it, where :func:`~orbits._kernels.encounters.closest_approach`
+    of the pair from both ends of the step comes below it.  Writes the pair
+    into ``info`` and its time, separation and speed into ``hit``; returns
+    True if there was one.  Then (or not) keeps ``x``, ``v`` in ``prev`` for
+    the next step.
+
+    Inside a step, only pairs that could have closed the gap are examined:
+    with the relative speeds ``s0``, ``s1`` at the ends, a pair's separation
+    can fall by at most ``max(s0, s1) |h| + mu h^2 / (2 R^2)`` (its mutual
+    pull while at least ``R`` apart; the tides of the other bodies are left
+    out), and twice that is allowed for."""
+    radii, prev, clock, work, hit = sargs[7], sargs[8], sargs[9], sargs[10], sargs[11]
+    gm, info = sargs[4], sargs[6]
+    n = min(x.shape[0], gm.shape[0])
+    h = t - clock[0]
+    inside = clock[1] != 0.0 and h != 0.0
+    found = False
+    for i in range(1, n):
+        if found:
+            break
+        for j in range(i):
+            rs = radii[i] + radii[j]
+            if rs <= 0.0:
+                continue
+            dx = x[i, 0] - x[j, 0]
+            dy = x[i, 1] - x[j, 1]
+            dz = x[i, 2] - x[j, 2]
+            d1 = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if d1 < rs:
+                # overlapping at the end (or the state given at the start)
+                ux = v[i, 0] - v[j, 0]
+                uy = v[i, 1] - v[j, 1]
+                uz = v[i, 2] - v[j, 2]
+                info[0] = j
+                info[1] = i
+                hit[0] = t
+                hit[1] = d1
+                hit[2] = math.sqrt(ux * ux + uy * uy + uz * uz)
+                found = True
+                break
+            if not inside:
+                continue
+            for d in range(3):
+                work[0, d] = prev[0, i, d] - prev[0, j, d]
+                work[1, d] = prev[1, i, d] - prev[1, j, d]
+                work[2, d] = x[i, d] - x[j, d]
+                work[3, d] = v[i, d] - v[j, d]
+            d0 = math.sqrt(work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2)
+            s0 = math.sqrt(work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2)
+            s1 = math.sqrt(work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2)
+            mu = gm[i] + gm[j]
+            reach = max(s0, s1) * abs(h) + 0.5 * mu * h * h / (rs * rs)
+            if min(d0, d1) - rs > 2.0 * reach:
+                continue
+            tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
+            if dm < rs:
+                info[0] = j
+                info[1] = i
+                hit[0] = clock[0] + tm
+                hit[1] = dm
+                hit[2] = sm
+                found = True
+                break
+    for i in range(n):
+        for d in range(3):
+            prev[0, i, d] = x[i, d]
+            prev[1, i, d] = v[i, d]
+    clock[0] = t
+    clock[1] = 1.0
+    return found
+
+
+@njit
+def check_stop(x, v, t, sargs):
     """The conditions in ``sargs`` (see the module docstring); 0 to carry on."""
-    mask, d2, hill_k, esc2, gm, central, info = sargs
+    mask, d2, hill_k, esc2, gm, central, info = sargs[:7]
     # the bodies' rows (a run with variations has tangent rows after them)
     n = min(x.shape[0], gm.shape[0])
+    if mask & COLLISION:
+        if collision_check(x, v, t, sargs):
+            return Status.COLLISION
     if mask & (ENCOUNTER_DISTANCE | ENCOUNTER_HILL):
         third_gmc = 1.0 / (3.0 * gm[central])
         for i in range(1, n):

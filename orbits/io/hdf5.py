@@ -1906,7 +1906,8 @@ def _legacy_config(par, units):
                 "encounter_distance": unit(stop["encounter_distance"], "length"),
                 "encounter_hill": stop["encounter_hill"],
                 "escape_distance": unit(stop["escape_distance"], "length"),
-                "escape_unbound": stop["escape_unbound"]}}
+                "escape_unbound": stop["escape_unbound"],
+                "collisions": stop.get("collisions")}}
 
 
 class ResumePoint(NamedTuple):

@@ -1,0 +1,90 @@
+"""Collisions (``Simulation(..., collisions="halt")``): bodies with radii that
+touch, at the end of a step or inside it, stop the run with a named error
+that keeps the state; bad input is refused by name."""
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+import orbits
+from orbits.errors import BodyError, Collision, IntegratorOptionError, SimulationOptionError
+
+
+def _infall(star_radius=0.005):
+    # a massless comet falling straight onto a star of radius star_radius au
+    b = orbits.BodySet()
+    b.add("Star", mass=1 * u.Msun, radius=star_radius * u.au)
+    b.add("Comet", mass=0 * u.kg, position=[1, 0, 0] * u.au,
+          velocity=[-0.001, 0, 0] * u.au / u.day, radius=1 * u.km)
+    return b
+
+
+def _flyby(y0, x0=-1.05):
+    # a fast comet passing the star at about y0 au, its closest approach half
+    # way through the step of 0.5 d from 5.0 to 5.5 d (x0 / 0.2 au/d = 5.25 d)
+    b = orbits.BodySet()
+    b.add("Star", mass=1 * u.Msun, radius=0.01 * u.au)
+    b.add("Comet", mass=0 * u.kg, position=[x0, y0, 0] * u.au,
+          velocity=[0.2, 0, 0] * u.au / u.day)
+    return b
+
+
+def test_a_radial_infall_halts_at_contact_and_keeps_the_state():
+    sim = orbits.Simulation(_infall(), "ias15", collisions="halt")
+    with pytest.raises(Collision) as info:
+        sim.run(until=1 * u.yr, outputs=5, progress=False)
+    exc = info.value
+    assert exc.bodies == ("Star", "Comet")
+    # ias15's steps are short against the fall's last stretch: the contact is
+    # found at the end of the step in which the comet crossed the surface
+    assert exc.distance < 0.005 * u.au
+    assert exc.contact_time <= exc.time
+    assert sim.time == exc.time and exc.result.times[-1] == exc.time
+    x = sim.bodies.positions.to_value(u.au)
+    assert np.linalg.norm(x[1] - x[0]) < 0.005 + 1e-9
+
+
+def test_a_grazing_passage_inside_one_step_is_caught():
+    # the comet passes within the star's radius between two step ends, at
+    # both of which it is outside it (0.05 and 0.024 au, deflected): only the
+    # look inside the step sees it
+    sim = orbits.Simulation(_flyby(0.008), "leapfrog", dt=0.5 * u.day, collisions="halt")
+    with pytest.raises(Collision) as info:
+        sim.run(until=20 * u.day, outputs=2, progress=False)
+    exc = info.value
+    assert exc.time == 5.5 * u.day
+    assert 5.0 * u.day < exc.contact_time < 5.5 * u.day
+    assert exc.distance < 0.01 * u.au
+    x = sim.bodies.positions.to_value(u.au)
+    assert np.linalg.norm(x[1] - x[0]) > 0.01
+
+
+def test_a_passage_outside_the_radii_does_not_stop_the_run():
+    # closest approach about 0.03 au (gravitational focusing at 0.2 au/d
+    # pulls it in by under 1e-3 au), three times the star's radius
+    sim = orbits.Simulation(_flyby(0.03), "leapfrog", dt=0.5 * u.day, collisions="halt")
+    res = sim.run(until=20 * u.day, outputs=2, progress=False)
+    assert res.times[-1] == 20 * u.day
+
+
+def test_collisions_travel_with_the_configuration():
+    sim = orbits.Simulation(_infall(), "ias15", collisions="halt")
+    assert sim.stop_conditions["collisions"] == "halt"
+    twin = orbits.Simulation.from_config(_infall(), sim.config.to_dict())
+    assert twin.stop_conditions["collisions"] == "halt"
+    with pytest.raises(Collision):
+        twin.run(until=1 * u.yr, outputs=2, progress=False)
+
+
+def test_bad_collision_input_is_refused_by_name():
+    with pytest.raises(SimulationOptionError, match="explode"):
+        orbits.Simulation(_infall(), "ias15", collisions="explode")
+    points = orbits.scenes.kepler()
+    with pytest.raises(BodyError, match="radius") as info:
+        orbits.Simulation(points, "ias15", collisions="halt")
+    assert info.value.field == "radius"
+    touching = _infall(star_radius=2.0)
+    with pytest.raises(BodyError, match="touch at the start"):
+        orbits.Simulation(touching, "ias15", collisions="halt")
+    with pytest.raises(IntegratorOptionError, match="collisions"):
+        orbits.Simulation(_infall(), "wh", dt=1 * u.day, collisions="halt")
