@@ -555,7 +555,10 @@ def section(rows, out_dir, quick):
         lines += [
             "From our tangent the two codes integrate the same tangent map, and `<Y>` "
             "differs by what their quadratures of MEGNO's integral leave, of order "
-            "ln|δ| / steps; from REBOUND's own tangent the difference is that of the "
+            "ln|δ| / steps, and because our `wh` reads the tangent at the step's internal "
+            "point, before the half drift it defers to the next step (REBOUND synchronises "
+            "every step): a transient that fades as ln t / t, the same small offset at "
+            "every regular point; from REBOUND's own tangent the difference is that of the "
             "tangents, as large as the spread over seeds, and largest near resonances.", ""]
         w = mrow["workers"]
         n = mrow["a"].size * mrow["e"].size
