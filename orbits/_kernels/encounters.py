@@ -248,6 +248,13 @@ def _unit_roots(c, A):
 # --------------------------------------------------------------------------
 
 @njit(inline="always")
+def _ends(dx0, dv0, dx1, dv1):
+    # the twelve numbers of a step's two ends
+    return (dx0[0], dx0[1], dx0[2], dv0[0], dv0[1], dv0[2],
+            dx1[0], dx1[1], dx1[2], dv1[0], dv1[1], dv1[2])
+
+
+@njit(inline="always")
 def _norm3(x, y, z):
     return math.sqrt(x * x + y * y + z * z)
 
@@ -306,18 +313,7 @@ def hermite_closest(dx0, dv0, dx1, dv1, h):
     ----------
     Burden & Faires (2011), sect. 3.5.
     """
-    x0 = dx0[0]
-    y0 = dx0[1]
-    z0 = dx0[2]
-    u0 = dv0[0]
-    v0 = dv0[1]
-    w0 = dv0[2]
-    x1 = dx1[0]
-    y1 = dx1[1]
-    z1 = dx1[2]
-    u1 = dv1[0]
-    v1 = dv1[1]
-    w1 = dv1[2]
+    x0, y0, z0, u0, v0, w0, x1, y1, z1, u1, v1, w1 = _ends(dx0, dv0, dx1, dv1)
     total = x0 + y0 + z0 + u0 + v0 + w0 + x1 + y1 + z1 + u1 + v1 + w1
     if not math.isfinite(total * 0.0 + h):
         return _NAN, _NAN, _NAN
@@ -893,18 +889,7 @@ def closest_approach(mu, dx0, dv0, dx1, dv1, h):
     arcs), up to 2 ms where no field fits (end states that no orbit joins,
     or a bound pair drifted over many of its periods in one step).
     """
-    x0 = dx0[0]
-    y0 = dx0[1]
-    z0 = dx0[2]
-    u0 = dv0[0]
-    v0 = dv0[1]
-    w0 = dv0[2]
-    x1 = dx1[0]
-    y1 = dx1[1]
-    z1 = dx1[2]
-    u1 = dv1[0]
-    v1 = dv1[1]
-    w1 = dv1[2]
+    x0, y0, z0, u0, v0, w0, x1, y1, z1, u1, v1, w1 = _ends(dx0, dv0, dx1, dv1)
     total = x0 + y0 + z0 + u0 + v0 + w0 + x1 + y1 + z1 + u1 + v1 + w1
     if not math.isfinite(total * 0.0 + h + mu) or not (mu >= 0.0):
         return _NAN, _NAN, _NAN

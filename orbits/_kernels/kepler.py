@@ -1096,11 +1096,9 @@ def _short_coefficients(mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta):
 
 
 @njit(inline="always")
-def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
-    """Advance row ``i`` of ``x``, ``v`` by the universal anomaly ``s`` (the
-    f and g functions of :func:`kepler_drift`); the other arguments from
-    :func:`short_step_anomaly`.  False, and nothing written, if the radius
-    at the end is not positive."""
+def _advance_row(mu, x, v, i, s, r0, ir0, beta, zeta):
+    # advance_by_anomaly, returning besides whether it advanced the row's
+    # start and what the drift's tangent reuses (_short_coefficients')
     x0 = x[i, 0]
     y0 = x[i, 1]
     z0 = x[i, 2]
@@ -1109,10 +1107,20 @@ def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
     vz0 = v[i, 2]
     c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1 = _short_coefficients(
         mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta)
-    if not (r > 0.0):
-        return False
-    _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
-    return True
+    ok = r > 0.0
+    if ok:
+        _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
+    return (ok, (x0, y0, z0, vx0, vy0, vz0), (c0, c1, c2, c3), sig, ir,
+            (fm1, g, fdot, gdm1))
+
+
+@njit(inline="always")
+def advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
+    """Advance row ``i`` of ``x``, ``v`` by the universal anomaly ``s`` (the
+    f and g functions of :func:`kepler_drift`); the other arguments from
+    :func:`short_step_anomaly`.  False, and nothing written, if the radius
+    at the end is not positive."""
+    return _advance_row(mu, x, v, i, s, r0, ir0, beta, zeta)[0]
 
 
 @njit
@@ -1448,17 +1456,12 @@ def advance_tangent_by_anomaly(mu, x, v, i, n, dmu, k, s, r0, ir0, beta, zeta):
     ``k`` tangent vectors (``n`` rows apart, ``dmu`` as
     :func:`kepler_drift_tangent`'s), from the same universal functions.
     False, and nothing written, if the radius at the end is not positive."""
-    x0 = x[i, 0]
-    y0 = x[i, 1]
-    z0 = x[i, 2]
-    vx0 = v[i, 0]
-    vy0 = v[i, 1]
-    vz0 = v[i, 2]
-    c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1 = _short_coefficients(
-        mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta)
-    if not (r > 0.0):
+    ok, start, c, sig, ir, coef = _advance_row(mu, x, v, i, s, r0, ir0, beta, zeta)
+    if not ok:
         return False
-    _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
+    x0, y0, z0, vx0, vy0, vz0 = start
+    c0, c1, c2, c3 = c
+    fm1, g, fdot, gdm1 = coef
     z = beta * s * s
     c4, c5 = _stumpff45_short(z)
     s2 = s * s
