@@ -217,6 +217,7 @@ class Driven:
             bar.update(self.steps - plan.start_step)
         wall0 = _time.perf_counter()
         self._wall0 = wall0
+        self._encounters = []
         with Signals() as self._signals:
             try:
                 if adaptive:
@@ -226,7 +227,15 @@ class Driven:
             finally:
                 bar.close()
                 rec.close()
-        return rec.result(self, _time.perf_counter() - wall0)
+        return self._with_log(rec.result(self, _time.perf_counter() - wall0))
+
+    def _with_log(self, result):
+        """``result`` with the encounter log of the run (if the owner keeps one)."""
+        table = getattr(self, "_encounter_table", None)
+        if table is not None and result is not None:
+            self._drain_log()
+            result.encounters = table()
+        return result
 
     #: (k, origin): outputs are being recorded in the loop every k steps
     #: counted from step ``origin`` (see :meth:`execute`)
@@ -304,6 +313,10 @@ class Driven:
                 self._renormalise()
                 self._between_chunks(rec, wall0)
                 continue
+            if status == Status.LOG_FULL:
+                self._drain_log()
+                self._between_chunks(rec, wall0)
+                continue
             if status != Status.OK:
                 if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
                     self._stop_info[:] = self._ws["info"]
@@ -358,7 +371,8 @@ class Driven:
         name = _signal.Signals(signum).name
         rec.stopped(self)
         rec.close()
-        result = rec.result(self, _time.perf_counter() - wall0, status=f"stopped by {name}")
+        result = self._with_log(rec.result(self, _time.perf_counter() - wall0,
+                                           status=f"stopped by {name}"))
         if previous is _signal.default_int_handler:
             path = getattr(rec, "path", None)
             raise RunInterrupted(
@@ -377,7 +391,8 @@ class Driven:
             return
         rec.output(self, final=True)
         rec.close()
-        result = rec.result(self, _time.perf_counter() - wall0, status="wall-time limit")
+        result = self._with_log(rec.result(self, _time.perf_counter() - wall0,
+                                           status="wall-time limit"))
         raise WallTimeExceeded(
             f"the run passed its wall-time limit of {limit:g} s at t = {self.time:.10g} "
             f"(step {self.steps}); the result up to here is kept on .result and the "
@@ -414,12 +429,15 @@ class Driven:
                                 mon_out[:n_mon])
             elif n_mon:
                 rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
-            if status != Status.RENORMALISE:
+            if status != Status.RENORMALISE and status != Status.LOG_FULL:
                 break
-            # the chaos indicators' tangent vector grew large: scaled back, the
-            # rest of the chunk goes on
+            # the chaos indicators' tangent vector grew large, or the encounter
+            # log filled: scaled back or emptied, the rest of the chunk goes on
             self._count(steps, dt)
-            self._renormalise()
+            if status == Status.RENORMALISE:
+                self._renormalise()
+            else:
+                self._drain_log()
             left -= steps
             if left == 0:
                 return

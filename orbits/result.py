@@ -51,6 +51,11 @@ class Result:
         States at the outputs, bodies in the order of the body set.
     names : list of str
     masses : Quantity, shape (N,)
+    encounters : astropy.table.QTable or None
+        With ``encounter_log=``: one row per close approach inside the
+        threshold, ``time`` (of closest approach), ``body_1``, ``body_2``,
+        ``distance`` and ``speed`` (relative); None without the log.  Kept
+        with the result in memory (not yet in output files).
     radii : Quantity, shape (N,), length, or None
         The bodies' physical radii (0 for a point mass; all 0 when read from a
         file written before radii were kept); None where not recorded.
@@ -137,6 +142,7 @@ class Result:
         self.megno = self.lyapunov = self.fli = None
         self.jacobian = self.tangent_vectors = self.seed = None
         self.radii = None
+        self.encounters = None
         self.status = "completed"
         self.steps_rejected = 0
         self.forces = ()

@@ -102,6 +102,15 @@ class Simulation(Driven):
         step is caught too.  The bodies must not touch at the start, and at
         least one must have a radius.  For integrators that check stopping
         conditions (not the Wisdom-Holman family).
+    encounter_log : float or Quantity (length), optional
+        Log, without stopping, every closest approach of two bodies within
+        this many mutual Hill radii (a number; pairs without the central
+        body, Hill radii as for ``encounter_hill``) or this distance (a
+        length): ``result.encounters`` is a table of the time of closest
+        approach, the two bodies, their separation and relative speed.  The
+        minimum is found inside the step from both its ends
+        (:func:`orbits._kernels.encounters.closest_approach`).  For the
+        integrators that check stopping conditions.
 
     variations : {None, "state", "all"} or int, optional
         Integrate the first-order variational equations alongside
@@ -142,8 +151,8 @@ class Simulation(Driven):
     def __init__(self, bodies, integrator="verlet", dt=None, *, forces=(),
                  monitors=DEFAULT_MONITORS, monitor_every=None, softening=None, parallel=None,
                  encounter_distance=None, encounter_hill=None, escape_distance=None,
-                 escape_unbound=False, collisions=None, rebound_arithmetic=False,
-                 variations=None, seed=None):
+                 escape_unbound=False, collisions=None, encounter_log=None,
+                 rebound_arithmetic=False, variations=None, seed=None):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
@@ -205,7 +214,7 @@ class Simulation(Driven):
 
         self._stop_info = np.zeros(2, dtype=np.int64)
         self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
-                                     escape_unbound, collisions)
+                                     escape_unbound, collisions, encounter_log)
         # the force without variations, and its arguments
         self._base_force, self._base_fargs = self._force, self._fargs
         self._bind_variations(variations, seed)
@@ -510,7 +519,9 @@ class Simulation(Driven):
                 "encounter_hill": c["encounter_hill"],
                 "escape_distance": q(c["escape_distance"]),
                 "escape_unbound": c["escape_unbound"],
-                "collisions": c["collisions"]}
+                "collisions": c["collisions"],
+                "encounter_log": (q(c["encounter_log"][0]) if c["encounter_log"][0]
+                                  else c["encounter_log"][1])}
 
     @property
     def softening(self):
@@ -535,7 +546,7 @@ class Simulation(Driven):
             raise ValueError(f"{field} must be a positive length, got {value}")
         return d
 
-    def _stop_args(self, distance, hill, escape, unbound, collisions=None):
+    def _stop_args(self, distance, hill, escape, unbound, collisions=None, log=None):
         from ._kernels import stopping as _s
         mask = 0
         d2 = esc2 = 0.0
@@ -562,12 +573,29 @@ class Simulation(Driven):
         if collisions is not None:
             self._check_collisions(collisions)
             mask |= _s.COLLISION
+        log_hill = log_distance = 0.0
+        if log is not None:
+            mask |= _s.ENCOUNTER_LOG
+            if isinstance(log, u.Quantity):
+                log_distance = self._positive_length(log, "encounter_log")
+            else:
+                log_hill = float(log)
+                if not (log_hill > 0 and math.isfinite(log_hill)):
+                    raise SimulationOptionError(
+                        f"encounter_log must be a positive number of mutual Hill radii or "
+                        f"a length, got {log!r}")
         self._stop_config = {"encounter_distance": d if distance is not None else None,
                              "encounter_hill": k or None,
                              "escape_distance": e if escape is not None else None,
                              "escape_unbound": bool(unbound),
-                             "collisions": collisions}
+                             "collisions": collisions,
+                             "encounter_log": (log_distance or None, log_hill or None)}
         n = len(self._m)
+        # the encounter log's rows: room for every pair in one step beyond a
+        # reserve, emptied by the driver when the reserve is used
+        self._log = np.zeros((1024 + n * (n - 1) // 2, 5))
+        self._log_n = np.zeros(1, dtype=np.int64)
+        self._encounters = []
         # the previous state and its time (for collisions inside a step),
         # scratch, and where a collision was found
         self._stop_clock = np.zeros(2)
@@ -580,7 +608,32 @@ class Simulation(Driven):
                                         f"{what}; use 'ias15' or another method that does")
         central = int(np.argmax(self._m))
         return (mask, d2, k, esc2, self._gm, central, self._stop_info, self._r,
-                np.zeros((2, n, 3)), self._stop_clock, np.zeros((4, 3)), self._stop_hit)
+                np.zeros((2, n, 3)), self._stop_clock, np.zeros((4, 3)), self._stop_hit,
+                log_hill, log_distance, self._log, self._log_n)
+
+    def _drain_log(self):
+        """Move the encounter log's rows from the loop's buffer into the run's list."""
+        k = int(self._log_n[0])
+        if k:
+            name = lambda i: self._names[self._order[int(i)]]  # noqa: E731
+            for t, j, i, dist, speed in self._log[:k]:
+                self._encounters.append((float(t), name(j), name(i), float(dist),
+                                         float(speed)))
+            self._log_n[0] = 0
+
+    def _encounter_table(self):
+        """``result.encounters``: an astropy QTable (None without ``encounter_log``)."""
+        if self._stop_config.get("encounter_log", (None, None)) == (None, None):
+            return None
+        from astropy.table import QTable
+        rows = self._encounters
+        q = self.units.quantity
+        col = lambda k: [r[k] for r in rows]  # noqa: E731
+        return QTable({"time": q(np.array(col(0), dtype=float), "time"),
+                       "body_1": np.array(col(1), dtype=str),
+                       "body_2": np.array(col(2), dtype=str),
+                       "distance": q(np.array(col(3), dtype=float), "length"),
+                       "speed": q(np.array(col(4), dtype=float), "length") / self.units.time})
 
     #: the ways a collision can be resolved (Simulation's ``collisions``)
     COLLISION_RESOLUTIONS = ("halt",)
@@ -1086,8 +1139,8 @@ class Simulation(Driven):
         rec.end_status = int(status)
         rec.output(self, final=True)
         rec.close()
-        result = rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
-                            status=reason)
+        result = self._with_log(rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
+                                           status=reason))
         t = self.time
         if status == Status.NON_FINITE:
             raise NonFiniteState(

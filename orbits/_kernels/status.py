@@ -21,6 +21,9 @@ class Status(IntEnum):
     # the driver renormalises it and carries on; orbits._kernels.variational)
     RENORMALISE = 6
     COLLISION = 7   # two bodies closer than the sum of their radii (collisions=)
+    # the encounter log is nearly full (not a failure: the driver empties it
+    # and carries on; orbits._kernels.stopping)
+    LOG_FULL = 8
 
 
 def with_status(status, *rest):

@@ -8,7 +8,7 @@ with :func:`no_stop` when a simulation asks for no condition, which inlines to
 nothing, so such a scene pays nothing for the feature.
 
 ``sargs = (mask, distance2, hill_k, escape2, gm, central, info, radii, prev,
-clock, work, hit)``:
+clock, work, hit, log_hill, log_distance, log, log_n)``:
 
 * ``mask``: bits :data:`ENCOUNTER_DISTANCE`, :data:`ENCOUNTER_HILL`,
   :data:`ESCAPE`, :data:`UNBOUND`, :data:`COLLISION`;
@@ -30,7 +30,14 @@ clock, work, hit)``:
 * ``work`` (shape (4, 3)): scratch;
 * ``hit`` (``[t, d, speed]``): where a collision fired, its time (of the
   closest approach inside the step, or the end of the step where the bodies
-  already overlap), the separation and the relative speed there.
+  already overlap), the separation and the relative speed there;
+* with :data:`ENCOUNTER_LOG` (:func:`encounter_log`), every closest approach
+  of a pair inside ``log_hill`` mutual Hill radii (pairs without the central
+  body; 0: not used) or ``log_distance`` is written as a row ``(t, j, i,
+  distance, speed)`` of ``log`` (shape (capacity, 5)), ``log_n[0]`` counting
+  them; the run does not stop for it, but hands back
+  :data:`~orbits._kernels.status.Status.LOG_FULL` when fewer rows are left
+  than pairs, for the driver to empty it and carry on.
 """
 
 import math
@@ -39,14 +46,15 @@ from ._jit import njit
 from .encounters import closest_approach
 from .status import Status
 
-__all__ = ["no_stop", "check_stop", "collision_check", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL",
-           "ESCAPE", "UNBOUND", "COLLISION"]
+__all__ = ["no_stop", "check_stop", "collision_check", "encounter_log", "ENCOUNTER_DISTANCE",
+           "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG"]
 
 ENCOUNTER_DISTANCE = 1
 ENCOUNTER_HILL = 2
 ESCAPE = 4
 UNBOUND = 8
 COLLISION = 16
+ENCOUNTER_LOG = 32
 
 
 @njit(inline="always")
@@ -122,13 +130,82 @@ def collision_check(x, v, t, sargs):
                 hit[2] = sm
                 found = True
                 break
+    return found
+
+
+@njit(inline="always")
+def _keep(x, v, t, prev, clock, n):
+    # the state of this check, for the next one's look inside its step
     for i in range(n):
         for d in range(3):
             prev[0, i, d] = x[i, d]
             prev[1, i, d] = v[i, d]
     clock[0] = t
     clock[1] = 1.0
-    return found
+
+
+@njit
+def encounter_log(x, v, t, sargs):
+    """Log the closest approaches inside the step that ended at ``t`` (see the
+    module docstring); True when the log should be emptied.
+
+    A pair's separation has a minimum inside the step where it was closing at
+    the start (``dx . dv < 0``) and is not at the end (``>= 0``); that
+    minimum is found by :func:`~orbits._kernels.encounters.closest_approach`
+    from both ends and logged if it is inside the pair's threshold.  Pairs
+    that cannot have come within it (the bound of :func:`collision_check`)
+    are passed over.  The threshold in Hill radii is taken with the bodies'
+    distances from the central body at the end of the step."""
+    gm, central = sargs[4], sargs[5]
+    prev, clock, work = sargs[8], sargs[9], sargs[10]
+    k_hill, dist, log, log_n = sargs[12], sargs[13], sargs[14], sargs[15]
+    n = min(x.shape[0], gm.shape[0])
+    h = t - clock[0]
+    if clock[1] == 0.0 or h == 0.0:
+        return False
+    third_gmc = 1.0 / (3.0 * gm[central])
+    for i in range(1, n):
+        for j in range(i):
+            if dist > 0.0:
+                thr = dist
+            else:
+                mu = gm[i] + gm[j]
+                if i == central or j == central or not (mu > 0.0):
+                    continue
+                ri = math.sqrt((x[i, 0] - x[central, 0]) ** 2 + (x[i, 1] - x[central, 1]) ** 2
+                               + (x[i, 2] - x[central, 2]) ** 2)
+                rj = math.sqrt((x[j, 0] - x[central, 0]) ** 2 + (x[j, 1] - x[central, 1]) ** 2
+                               + (x[j, 2] - x[central, 2]) ** 2)
+                thr = k_hill * (mu * third_gmc) ** (1.0 / 3.0) * 0.5 * (ri + rj)
+            closing0 = 0.0
+            closing1 = 0.0
+            for d in range(3):
+                work[0, d] = prev[0, i, d] - prev[0, j, d]
+                work[1, d] = prev[1, i, d] - prev[1, j, d]
+                work[2, d] = x[i, d] - x[j, d]
+                work[3, d] = v[i, d] - v[j, d]
+                closing0 += work[0, d] * work[1, d]
+                closing1 += work[2, d] * work[3, d]
+            if not (closing0 < 0.0 and closing1 >= 0.0):
+                continue
+            d0 = math.sqrt(work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2)
+            d1 = math.sqrt(work[2, 0] ** 2 + work[2, 1] ** 2 + work[2, 2] ** 2)
+            s0 = math.sqrt(work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2)
+            s1 = math.sqrt(work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2)
+            mu = gm[i] + gm[j]
+            reach = max(s0, s1) * abs(h) + 0.5 * mu * h * h / (thr * thr)
+            if min(d0, d1) - thr > 2.0 * reach:
+                continue
+            tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
+            if dm < thr:
+                r = log_n[0]
+                log[r, 0] = clock[0] + tm
+                log[r, 1] = j
+                log[r, 2] = i
+                log[r, 3] = dm
+                log[r, 4] = sm
+                log_n[0] = r + 1
+    return log_n[0] > log.shape[0] - n * (n - 1) // 2
 
 
 @njit
@@ -137,9 +214,15 @@ def check_stop(x, v, t, sargs):
     mask, d2, hill_k, esc2, gm, central, info = sargs[:7]
     # the bodies' rows (a run with variations has tangent rows after them)
     n = min(x.shape[0], gm.shape[0])
-    if mask & COLLISION:
-        if collision_check(x, v, t, sargs):
+    if mask & (COLLISION | ENCOUNTER_LOG):
+        prev, clock = sargs[8], sargs[9]
+        if mask & COLLISION and collision_check(x, v, t, sargs):
+            _keep(x, v, t, prev, clock, n)
             return Status.COLLISION
+        full = (mask & ENCOUNTER_LOG) != 0 and encounter_log(x, v, t, sargs)
+        _keep(x, v, t, prev, clock, n)
+    else:
+        full = False
     if mask & (ENCOUNTER_DISTANCE | ENCOUNTER_HILL):
         third_gmc = 1.0 / (3.0 * gm[central])
         for i in range(1, n):
@@ -192,4 +275,4 @@ def check_stop(x, v, t, sargs):
                 info[0] = i
                 info[1] = -1
                 return Status.ESCAPE
-    return 0
+    return Status.LOG_FULL if full else 0

@@ -1907,7 +1907,16 @@ def _legacy_config(par, units):
                 "encounter_hill": stop["encounter_hill"],
                 "escape_distance": unit(stop["escape_distance"], "length"),
                 "escape_unbound": stop["escape_unbound"],
-                "collisions": stop.get("collisions")}}
+                "collisions": stop.get("collisions"),
+                "encounter_log": _encounter_log_option(stop.get("encounter_log"), unit)}}
+
+
+def _encounter_log_option(value, unit):
+    # (distance or None, Hill radii or None) as written -> the keyword's value
+    if not value:
+        return None
+    distance, hill = value
+    return unit(distance, "length") if distance else hill
 
 
 class ResumePoint(NamedTuple):
