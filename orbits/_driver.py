@@ -226,8 +226,15 @@ class Driven:
                     self._outputs_fixed(plan, rec, bar, first_mark)
             finally:
                 bar.close()
+                self._log_into(rec)
                 rec.close()
         return self._with_log(rec.result(self, _time.perf_counter() - wall0))
+
+    def _log_into(self, rec):
+        """The encounter log's last rows into the run's list and ``rec``'s file,
+        before it closes (an owner without a log has nothing to do)."""
+        if getattr(self, "_log_n", None) is not None:
+            self._drain_log(rec)
 
     def _with_log(self, result):
         """``result`` with the encounter log of the run (if the owner keeps one)."""
@@ -314,7 +321,7 @@ class Driven:
                 self._between_chunks(rec, wall0)
                 continue
             if status == Status.LOG_FULL:
-                self._drain_log()
+                self._drain_log(rec)
                 self._between_chunks(rec, wall0)
                 continue
             if status != Status.OK:
@@ -370,6 +377,7 @@ class Driven:
             return
         name = _signal.Signals(signum).name
         rec.stopped(self)
+        self._log_into(rec)
         rec.close()
         result = self._with_log(rec.result(self, _time.perf_counter() - wall0,
                                            status=f"stopped by {name}"))
@@ -390,6 +398,7 @@ class Driven:
         if limit is None or _time.perf_counter() - wall0 <= limit:
             return
         rec.output(self, final=True)
+        self._log_into(rec)
         rec.close()
         result = self._with_log(rec.result(self, _time.perf_counter() - wall0,
                                            status="wall-time limit"))
@@ -437,7 +446,7 @@ class Driven:
             if status == Status.RENORMALISE:
                 self._renormalise()
             else:
-                self._drain_log()
+                self._drain_log(rec)
             left -= steps
             if left == 0:
                 return

@@ -54,8 +54,8 @@ class Result:
     encounters : astropy.table.QTable or None
         With ``encounter_log=``: one row per close approach inside the
         threshold, ``time`` (of closest approach), ``body_1``, ``body_2``,
-        ``distance`` and ``speed`` (relative); None without the log.  Kept
-        with the result in memory (not yet in output files).
+        ``distance`` and ``speed`` (relative); None without the log.  Also in
+        output files (group ``encounters``), which :func:`orbits.load` reads.
     radii : Quantity, shape (N,), length, or None
         The bodies' physical radii (0 for a point mass; all 0 when read from a
         file written before radii were kept); None where not recorded.

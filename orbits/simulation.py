@@ -611,15 +611,19 @@ class Simulation(Driven):
                 np.zeros((2, n, 3)), self._stop_clock, np.zeros((4, 3)), self._stop_hit,
                 log_hill, log_distance, self._log, self._log_n)
 
-    def _drain_log(self):
-        """Move the encounter log's rows from the loop's buffer into the run's list."""
+    def _drain_log(self, rec=None):
+        """Move the encounter log's rows from the loop's buffer into the run's
+        list, and into ``rec``'s file if it keeps one."""
         k = int(self._log_n[0])
         if k:
             name = lambda i: self._names[self._order[int(i)]]  # noqa: E731
-            for t, j, i, dist, speed in self._log[:k]:
-                self._encounters.append((float(t), name(j), name(i), float(dist),
-                                         float(speed)))
+            rows = [(float(t), name(j), name(i), float(dist), float(speed))
+                    for t, j, i, dist, speed in self._log[:k]]
+            self._encounters.extend(rows)
             self._log_n[0] = 0
+            keep = getattr(rec, "encounter_rows", None)
+            if keep is not None:
+                keep(self, rows)
 
     def _encounter_table(self):
         """``result.encounters``: an astropy QTable (None without ``encounter_log``)."""
@@ -1137,6 +1141,7 @@ class Simulation(Driven):
                   Status.COLLISION: "collision",
                   Status.NO_CONVERGENCE: "no convergence"}.get(status, f"status {status!r}")
         rec.end_status = int(status)
+        self._drain_log(rec)
         rec.output(self, final=True)
         rec.close()
         result = self._with_log(rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,

@@ -132,3 +132,19 @@ def test_bad_encounter_log_input_is_refused_by_name():
         orbits.Simulation(orbits.scenes.kepler(), "ias15", encounter_log=-1)
     with pytest.raises(IntegratorOptionError):
         orbits.Simulation(orbits.scenes.kepler(), "wh", dt=1 * u.day, encounter_log=3)
+
+
+def test_the_log_goes_into_the_output_file(tmp_path):
+    gm, (y0,) = _system([0.02])
+    path = tmp_path / "flyby.h5"
+    sim = orbits.Simulation(_bodies(y0), "ias15", encounter_log=0.1 * u.au, monitors=())
+    res = sim.run(until=400 * u.day, outputs=5, progress=False, output=path)
+    back = orbits.load(path).encounters
+    assert len(back) == 1 == len(res.encounters)
+    for name in ("time", "distance", "speed"):
+        assert back[name][0] == res.encounters[name][0]
+    assert (back["body_1"][0], back["body_2"][0]) == ("Jupiter", "probe")
+    # a file without encounter_log has no log
+    plain = orbits.Simulation(_bodies(y0), "ias15", monitors=())
+    plain.run(until=10 * u.day, outputs=2, progress=False, output=tmp_path / "plain.h5")
+    assert orbits.load(tmp_path / "plain.h5").encounters is None

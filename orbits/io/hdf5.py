@@ -1057,6 +1057,33 @@ class FileRecorder:
         self.last = tuple(sim.snapshot())
         self._note_rows(self.last[4][None])
 
+    def encounter_rows(self, sim, rows):
+        """Append rows ``(t, body_1, body_2, distance, speed)`` of the encounter
+        log (internal units) to the file's group ``encounters``, made on first
+        use: datasets ``time``, ``distance``, ``speed`` (each with its
+        ``unit``) and ``body_1``, ``body_2`` (names), of a length that grows."""
+        if not rows or self.closed:
+            return
+        import h5py
+        U = sim.units
+        g = self.f.require_group("encounters")
+        cols = {"time": ([r[0] for r in rows], np.float64, U.unit("time").to_string()),
+                "body_1": ([r[1] for r in rows], h5py.string_dtype(), None),
+                "body_2": ([r[2] for r in rows], h5py.string_dtype(), None),
+                "distance": ([r[3] for r in rows], np.float64, U.unit("length").to_string()),
+                "speed": ([r[4] for r in rows], np.float64,
+                          (U.unit("length") / U.unit("time")).to_string())}
+        for name, (values, dtype, unit) in cols.items():
+            if name not in g:
+                ds = g.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype,
+                                      chunks=(256,))
+                if unit is not None:
+                    ds.attrs["unit"] = unit
+            ds = g[name]
+            k = ds.shape[0]
+            ds.resize((k + len(values),))
+            ds[k:] = np.asarray(values, dtype=object if dtype is not np.float64 else dtype)
+
     def close(self):
         """Flush what is buffered, close the file and release the writers' lock (idempotent).
 
@@ -1593,7 +1620,20 @@ def load(path):
                     mon[name] = _series(inloop[name], name, m)
             fields["monitor"] = mon
         fields.update(_derivatives(f, path))
+        if "encounters" in f:
+            fields["encounters"] = _encounters(f["encounters"])
     return Result(**fields)
+
+
+def _encounters(g):
+    """The encounter log of a file (group ``encounters``) as the QTable of
+    ``Result.encounters``."""
+    import astropy.units as u
+    from astropy.table import QTable
+    col = lambda name: g[name][()] << u.Unit(g[name].attrs["unit"])  # noqa: E731
+    return QTable({"time": col("time"), "body_1": np.array(_decode(g["body_1"][()]), dtype=str),
+                   "body_2": np.array(_decode(g["body_2"][()]), dtype=str),
+                   "distance": col("distance"), "speed": col("speed")})
 
 
 def _radii(b):
