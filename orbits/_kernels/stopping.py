@@ -63,6 +63,30 @@ def no_stop(x, v, t, sargs):
     return 0
 
 
+@njit(inline="always")
+def _pair_ends(x, v, prev, work, i, j):
+    # rows 0-3 of work: the pair's relative position and velocity at the
+    # previous check and now
+    for d in range(3):
+        work[0, d] = prev[0, i, d] - prev[0, j, d]
+        work[1, d] = prev[1, i, d] - prev[1, j, d]
+        work[2, d] = x[i, d] - x[j, d]
+        work[3, d] = v[i, d] - v[j, d]
+
+
+@njit(inline="always")
+def _within_reach(work, mu, h, r):
+    # whether the pair of _pair_ends could have come within r during the step
+    # h: its separation falls by at most max(s0, s1) |h| + mu h^2 / (2 r^2)
+    # while at least r apart (end speeds, mutual pull; twice that allowed)
+    d0 = math.sqrt(work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2)
+    d1 = math.sqrt(work[2, 0] ** 2 + work[2, 1] ** 2 + work[2, 2] ** 2)
+    s0 = math.sqrt(work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2)
+    s1 = math.sqrt(work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2)
+    reach = max(s0, s1) * abs(h) + 0.5 * mu * h * h / (r * r)
+    return min(d0, d1) - r <= 2.0 * reach
+
+
 @njit
 def collision_check(x, v, t, sargs):
     """The first pair (in the order of the pair loop) whose separation fell
@@ -109,17 +133,9 @@ def collision_check(x, v, t, sargs):
                 break
             if not inside:
                 continue
-            for d in range(3):
-                work[0, d] = prev[0, i, d] - prev[0, j, d]
-                work[1, d] = prev[1, i, d] - prev[1, j, d]
-                work[2, d] = x[i, d] - x[j, d]
-                work[3, d] = v[i, d] - v[j, d]
-            d0 = math.sqrt(work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2)
-            s0 = math.sqrt(work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2)
-            s1 = math.sqrt(work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2)
+            _pair_ends(x, v, prev, work, i, j)
             mu = gm[i] + gm[j]
-            reach = max(s0, s1) * abs(h) + 0.5 * mu * h * h / (rs * rs)
-            if min(d0, d1) - rs > 2.0 * reach:
+            if not _within_reach(work, mu, h, rs):
                 continue
             tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
             if dm < rs:
@@ -177,24 +193,13 @@ def encounter_log(x, v, t, sargs):
                 rj = math.sqrt((x[j, 0] - x[central, 0]) ** 2 + (x[j, 1] - x[central, 1]) ** 2
                                + (x[j, 2] - x[central, 2]) ** 2)
                 thr = k_hill * (mu * third_gmc) ** (1.0 / 3.0) * 0.5 * (ri + rj)
-            closing0 = 0.0
-            closing1 = 0.0
-            for d in range(3):
-                work[0, d] = prev[0, i, d] - prev[0, j, d]
-                work[1, d] = prev[1, i, d] - prev[1, j, d]
-                work[2, d] = x[i, d] - x[j, d]
-                work[3, d] = v[i, d] - v[j, d]
-                closing0 += work[0, d] * work[1, d]
-                closing1 += work[2, d] * work[3, d]
+            _pair_ends(x, v, prev, work, i, j)
+            closing0 = work[0, 0] * work[1, 0] + work[0, 1] * work[1, 1] + work[0, 2] * work[1, 2]
+            closing1 = work[2, 0] * work[3, 0] + work[2, 1] * work[3, 1] + work[2, 2] * work[3, 2]
             if not (closing0 < 0.0 and closing1 >= 0.0):
                 continue
-            d0 = math.sqrt(work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2)
-            d1 = math.sqrt(work[2, 0] ** 2 + work[2, 1] ** 2 + work[2, 2] ** 2)
-            s0 = math.sqrt(work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2)
-            s1 = math.sqrt(work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2)
             mu = gm[i] + gm[j]
-            reach = max(s0, s1) * abs(h) + 0.5 * mu * h * h / (thr * thr)
-            if min(d0, d1) - thr > 2.0 * reach:
+            if not _within_reach(work, mu, h, thr):
                 continue
             tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
             if dm < thr:
