@@ -88,3 +88,13 @@ def test_bad_collision_input_is_refused_by_name():
         orbits.Simulation(touching, "ias15", collisions="halt")
     with pytest.raises(IntegratorOptionError, match="collisions"):
         orbits.Simulation(_infall(), "wh", dt=1 * u.day, collisions="halt")
+
+
+def test_a_file_says_the_run_ended_in_a_collision(tmp_path):
+    path = tmp_path / "infall.h5"
+    sim = orbits.Simulation(_infall(), "ias15", collisions="halt")
+    with pytest.raises(Collision) as info:
+        sim.run(until=1 * u.yr, outputs=5, progress=False, output=path)
+    back = orbits.load(path)
+    assert back.status == "collision"
+    assert back.times[-1] == info.value.time

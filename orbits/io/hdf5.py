@@ -1701,7 +1701,9 @@ def _status(f, path=None):
     if code:
         return {Status.NON_FINITE: "non-finite state", Status.CLOSE_ENCOUNTER:
                 "close encounter", Status.ESCAPE: "escape",
-                Status.STEP_UNDERFLOW: "step-size underflow"}.get(code, f"stopped ({code})")
+                Status.STEP_UNDERFLOW: "step-size underflow",
+                Status.NO_CONVERGENCE: "no convergence",
+                Status.COLLISION: "collision"}.get(code, f"stopped ({code})")
     if finished:
         return "completed"
     rec, alive = _writer(path) if path is not None else (None, False)
