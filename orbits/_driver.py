@@ -237,12 +237,23 @@ class Driven:
             self._drain_log(rec)
 
     def _with_log(self, result):
-        """``result`` with the encounter log of the run (if the owner keeps one)."""
+        """``result`` with the encounter log and the collisions of the run (if
+        the owner keeps them)."""
         table = getattr(self, "_encounter_table", None)
         if table is not None and result is not None:
             self._drain_log()
             result.encounters = table()
+        table = getattr(self, "_collision_table", None)
+        if table is not None and result is not None:
+            result.collisions = table()
         return result
+
+    def _offset_rows(self, rows):
+        # monitor rows as the owner reports them (orbits.Simulation adds what
+        # resolved collisions took out); unchanged by default
+        return rows
+
+    _resolves_collisions = False
 
     #: (k, origin): outputs are being recorded in the loop every k steps
     #: counted from step ``origin`` (see :meth:`execute`)
@@ -275,7 +286,7 @@ class Driven:
         # k steps and can be recorded in the loop (see execute), else 0
         if (getattr(rec, "row_buffer", None) is None
                 or not getattr(rec, "records_in_loop", True) or self.monitor_every
-                or plan.outputs < 3):
+                or plan.outputs < 3 or self._resolves_collisions):
             return 0
         k = int(round(plan.ratio / (plan.outputs - 1)))
         # the marks are round(i ratio / (outputs - 1)): all i k when ratio is
@@ -311,7 +322,7 @@ class Driven:
                     self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)
             elapsed = _time.perf_counter() - t0
             if n_mon:
-                rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
+                rec.monitor_rows(mon_t[:n_mon], self._offset_rows(mon_out[:n_mon]))
             self._t_base = float(t_reached)
             self.steps += int(acc)
             self.steps_rejected += int(rej)
@@ -322,6 +333,10 @@ class Driven:
                 continue
             if status == Status.LOG_FULL:
                 self._drain_log(rec)
+                self._between_chunks(rec, wall0)
+                continue
+            if status == Status.COLLISION and self._resolves_collisions:
+                self._resolve_collisions(rec, wall0)
                 self._between_chunks(rec, wall0)
                 continue
             if status != Status.OK:
@@ -414,9 +429,9 @@ class Driven:
             width = MONITOR_WIDTH + 6 * len(self._x)
         else:
             every, origin, width = self.monitor_every or 0, 0, MONITOR_WIDTH
-        mon = self._mon(every)
         left = n
         while True:
+            mon = self._mon(every)   # anew: a collision may have changed the bodies
             s0 = self.steps - origin
             if every:
                 first = (s0 // every + 1) * every  # next step index that records
@@ -437,14 +452,18 @@ class Driven:
                                 self._t_base + (self._steps_since_base + ahead) * self._dt,
                                 mon_out[:n_mon])
             elif n_mon:
-                rec.monitor_rows(mon_t[:n_mon], mon_out[:n_mon])
-            if status != Status.RENORMALISE and status != Status.LOG_FULL:
+                rec.monitor_rows(mon_t[:n_mon], self._offset_rows(mon_out[:n_mon]))
+            resolve = status == Status.COLLISION and self._resolves_collisions
+            if status != Status.RENORMALISE and status != Status.LOG_FULL and not resolve:
                 break
-            # the chaos indicators' tangent vector grew large, or the encounter
-            # log filled: scaled back or emptied, the rest of the chunk goes on
+            # the chaos indicators' tangent vector grew large, the encounter
+            # log filled, or bodies collided: scaled back, emptied or
+            # resolved, the rest of the chunk goes on
             self._count(steps, dt)
             if status == Status.RENORMALISE:
                 self._renormalise()
+            elif resolve:
+                self._resolve_collisions(rec, wall0)
             else:
                 self._drain_log(rec)
             left -= steps

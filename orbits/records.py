@@ -126,7 +126,8 @@ class SimulationConfig(NamedTuple):
                 "integrator_options": dict(self.integrator_options),
                 "dt": _quantity_dict(self.dt), "forces": list(self.forces),
                 "monitors": list(self.monitors), "monitor_every": self.monitor_every,
-                "stop_conditions": {k: (_quantity_dict(v) if isinstance(v, u.Quantity) else v)
+                "stop_conditions": {k: (_quantity_dict(v) if isinstance(v, u.Quantity)
+                                        else _function_name(v) if callable(v) else v)
                                     for k, v in self.stop_conditions.items()},
                 "variations": self.variations, "seed": self.seed}
 
@@ -213,6 +214,12 @@ class Snapshot(NamedTuple):
     v: np.ndarray
     monitors: np.ndarray         # one monitor row (orbits._kernels.invariants layout,
                                  # the work of non-conservative terms in its last column)
+    # a simulation whose collisions change the bodies: their names, masses and
+    # radii now (body-set order), for recorders that keep the columns of the
+    # bodies at the start; None otherwise
+    names: tuple = None
+    masses: np.ndarray = None
+    radii: np.ndarray = None
 
 
 class SimulationDescription(NamedTuple):
@@ -246,3 +253,12 @@ class SimulationDescription(NamedTuple):
     history: list                # how the body set was made
     config: SimulationConfig     # the record that rebuilds the simulation
     forces: tuple                # the ForceTerms added to gravity
+
+
+#: how a plain record names a function it cannot hold (a collisions function)
+FUNCTION_PREFIX = "function:"
+
+
+def _function_name(func):
+    return FUNCTION_PREFIX + getattr(func, "__module__", "?") + "." + getattr(
+        func, "__qualname__", type(func).__name__)

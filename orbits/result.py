@@ -51,6 +51,20 @@ class Result:
         States at the outputs, bodies in the order of the body set.
     names : list of str
     masses : Quantity, shape (N,)
+        At the start of the run.
+    masses_at_outputs : Quantity, shape (n, N), or None
+        With ``collisions=`` that merge (``"merge"``, ``"bounce"`` or a
+        function): the masses at every output, NaN for a body merged away (its
+        positions and velocities are NaN from then on, and the merged body
+        keeps the survivor's column); None otherwise.
+    collisions : astropy.table.QTable or None
+        With ``collisions=`` resolved by the run: one row per collision,
+        ``time`` (of contact), ``step_time`` (the end of the step, where it
+        was resolved), ``body_1``, ``body_2``, ``resolution`` (``"merge"`` or
+        ``"bounce"``), ``survivor`` (of a merger), ``distance`` and ``speed``
+        at contact and ``energy_change`` (what the resolution changed the
+        bodies' energy by; the energy monitor books it as work).  Also in
+        output files (group ``collisions``).  None otherwise.
     encounters : astropy.table.QTable or None
         With ``encounter_log=``: one row per close approach inside the
         threshold, ``time`` (of closest approach), ``body_1``, ``body_2``,
@@ -143,6 +157,7 @@ class Result:
         self.jacobian = self.tangent_vectors = self.seed = None
         self.radii = None
         self.encounters = None
+        self.masses_at_outputs = self.collisions = None
         self.status = "completed"
         self.steps_rejected = 0
         self.forces = ()
@@ -507,6 +522,15 @@ class Result:
         total = m.sum()
         if not total > 0:
             raise NoMassiveBodyError("the barycentre needs a body with positive mass")
+        if self.masses_at_outputs is not None:
+            # bodies merged away: the masses of each output, without them
+            m = np.nan_to_num(self.masses_at_outputs.to_value(self.masses.unit))
+            w = m / m.sum(axis=1, keepdims=True)
+
+            def centre(a):
+                return np.einsum("kn,knd->kd", w, np.nan_to_num(a.value)) << a.unit
+            return self._shifted(centre(self.positions)[:, None],
+                                 centre(self.velocities)[:, None], "barycentric")
         w = m / total
         return self._shifted((w @ self.positions)[:, None], (w @ self.velocities)[:, None],
                              "barycentric")

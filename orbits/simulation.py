@@ -13,6 +13,7 @@ import warnings
 import astropy.units as u
 import numpy as np
 
+from . import collisions as _collisions
 from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
@@ -24,8 +25,8 @@ from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, Conve
                      Escape, IntegratorOptionError, NonFiniteState, OrbitsWarning,
                      SimulationOptionError, StepSizeUnderflow)
 from .monitors import DEFAULT_MONITORS, monitor_fields, monitor_mask
-from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
-                      Snapshot)
+from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDescription,
+                      SimulationState, Snapshot, _function_name)
 from .result import Result
 
 __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescription",
@@ -151,7 +152,7 @@ class Simulation(Driven):
     def __init__(self, bodies, integrator="verlet", dt=None, *, forces=(),
                  monitors=DEFAULT_MONITORS, monitor_every=None, softening=None, parallel=None,
                  encounter_distance=None, encounter_hill=None, escape_distance=None,
-                 escape_unbound=False, collisions=None, encounter_log=None,
+                 escape_unbound=False, collisions=None, restitution=None, encounter_log=None,
                  rebound_arithmetic=False, variations=None, seed=None):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
@@ -214,7 +215,12 @@ class Simulation(Driven):
 
         self._stop_info = np.zeros(2, dtype=np.int64)
         self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
-                                     escape_unbound, collisions, encounter_log)
+                                     escape_unbound, collisions, encounter_log, restitution)
+        if self._resolves_collisions and variations is not None:
+            raise SimulationOptionError(
+                f"collisions={collisions!r} changes the bodies during the run, which the "
+                f"variational equations cannot follow; use collisions='halt' with "
+                f"variations=")
         # the force without variations, and its arguments
         self._base_force, self._base_fargs = self._force, self._fargs
         self._bind_variations(variations, seed)
@@ -228,6 +234,13 @@ class Simulation(Driven):
             self._ws["work"] = self._base_fargs[2][3]
         if self._chaos_box is not None:
             self._ws["chaos"] = self._chaos_box
+        if self._resolves_collisions:
+            # what the resolved collisions took out of the bodies: energy, and
+            # angular momentum into the merged bodies' spins (orbits.collisions);
+            # in the workspace, so that it is checkpointed with the state
+            self._ws["collision_offset"] = np.zeros(4)
+        self._collisions = []
+        self._bodies_changed = 0    # how often collisions changed the set of bodies
         self.steps_rejected = 0
         self._t_base = 0.0          # time = t_base + steps_since_base * dt
         self._steps_since_base = 0
@@ -441,7 +454,7 @@ class Simulation(Driven):
             self._variations, self._seed)
 
     @classmethod
-    def from_config(cls, bodies, config):
+    def from_config(cls, bodies, config, _restoring=False):
         """A simulation of ``bodies`` made as ``config`` (a :class:`SimulationConfig`
         or its :meth:`~SimulationConfig.to_dict`) says.
 
@@ -460,9 +473,15 @@ class Simulation(Driven):
         integ = _integrators.get(config.integrator, **config.integrator_options)
         terms = [t if isinstance(t, _forces.ForceTerm) else _forces.from_dict(t)
                  for t in config.forces]
-        return cls(bodies, integ, dt=config.dt, forces=terms, monitors=config.monitors,
-                   monitor_every=config.monitor_every, variations=config.variations,
-                   seed=config.seed, **config.stop_conditions)
+        sim = cls.__new__(cls)
+        # a state restored from a file may hold bodies in contact (a bounce
+        # that had not yet separated them)
+        sim._touching_ok = _restoring
+        sim.__init__(bodies, integ, dt=config.dt, forces=terms, monitors=config.monitors,
+                     monitor_every=config.monitor_every, variations=config.variations,
+                     seed=config.seed, **config.stop_conditions)
+        del sim._touching_ok
+        return sim
 
     @property
     def forces(self):
@@ -520,6 +539,7 @@ class Simulation(Driven):
                 "escape_distance": q(c["escape_distance"]),
                 "escape_unbound": c["escape_unbound"],
                 "collisions": c["collisions"],
+                "restitution": c.get("restitution"),
                 "encounter_log": (q(c["encounter_log"][0]) if c["encounter_log"][0]
                                   else c["encounter_log"][1])}
 
@@ -546,7 +566,8 @@ class Simulation(Driven):
             raise ValueError(f"{field} must be a positive length, got {value}")
         return d
 
-    def _stop_args(self, distance, hill, escape, unbound, collisions=None, log=None):
+    def _stop_args(self, distance, hill, escape, unbound, collisions=None, log=None,
+                   restitution=None):
         from ._kernels import stopping as _s
         mask = 0
         d2 = esc2 = 0.0
@@ -573,6 +594,17 @@ class Simulation(Driven):
         if collisions is not None:
             self._check_collisions(collisions)
             mask |= _s.COLLISION
+        if restitution is not None:
+            if collisions is None or collisions in ("halt", "merge"):
+                raise SimulationOptionError(
+                    f"restitution={restitution!r} is for collisions='bounce' (or a "
+                    f"collisions function), not collisions={collisions!r}")
+            ok = (isinstance(restitution, numbers.Real) and not isinstance(restitution, bool)
+                  and 0.0 <= float(restitution) <= 1.0)
+            if not ok:
+                raise SimulationOptionError(f"restitution must be a number from 0 to 1 "
+                                            f"(1: elastic), got {restitution!r}")
+            restitution = float(restitution)
         log_hill = log_distance = 0.0
         if log is not None:
             mask |= _s.ENCOUNTER_LOG
@@ -589,6 +621,7 @@ class Simulation(Driven):
                              "escape_distance": e if escape is not None else None,
                              "escape_unbound": bool(unbound),
                              "collisions": collisions,
+                             "restitution": restitution,
                              "encounter_log": (log_distance or None, log_hill or None)}
         n = len(self._m)
         # the encounter log's rows: room for every pair in one step beyond a
@@ -639,19 +672,29 @@ class Simulation(Driven):
                        "distance": q(np.array(col(3), dtype=float), "length"),
                        "speed": q(np.array(col(4), dtype=float), "length") / self.units.time})
 
-    #: the ways a collision can be resolved (Simulation's ``collisions``)
-    COLLISION_RESOLUTIONS = ("halt",)
+    #: the ways a collision can be resolved (Simulation's ``collisions``; or a
+    #: function, see :mod:`orbits.collisions`)
+    COLLISION_RESOLUTIONS = _collisions.RESOLUTIONS
+
+    @property
+    def _resolves_collisions(self):
+        # collisions that the run resolves and goes on (not "halt")
+        c = self._stop_config.get("collisions")
+        return c is not None and c != "halt"
 
     def _check_collisions(self, collisions):
-        if not isinstance(collisions, str) or collisions not in self.COLLISION_RESOLUTIONS:
+        if not (callable(collisions) or (isinstance(collisions, str)
+                                         and collisions in self.COLLISION_RESOLUTIONS)):
             raise SimulationOptionError(
                 f"collisions={collisions!r} is not a resolution; expected one of "
-                f"{', '.join(map(repr, self.COLLISION_RESOLUTIONS))}")
+                f"{', '.join(map(repr, self.COLLISION_RESOLUTIONS))} or a function")
         r = self._r
         if not np.any(r > 0):
             raise BodyError("collisions need sizes: give the bodies that can collide a "
                             "radius (BodySet.add(..., radius=...))", field="radius")
         x = self._x
+        if getattr(self, "_touching_ok", False):
+            return   # bodies after a collision step, which may still touch
         for i in range(1, len(r)):
             d = np.sqrt(((x[:i] - x[i]) ** 2).sum(axis=1))
             touch = np.flatnonzero(d < r[:i] + r[i])
@@ -664,15 +707,210 @@ class Simulation(Driven):
                                 f"start apart", body=self._names[self._order[i]],
                                 field="radius")
 
+    # -- collisions that the run resolves ----------------------------------------------
+    def _invariants(self):
+        """Energy (gravity and the conservative terms) and angular momentum of
+        the current state, whatever monitors were asked for."""
+        row = np.zeros(_inv.MONITOR_WIDTH)
+        _inv.monitor_row(self._x, self._v, self._m, self.units.G, self._n_active, self._eps2,
+                         _inv.ENERGY | _inv.ANGULAR_MOMENTUM, row)
+        if self._eargs is not None:
+            row[0] += self._base_force.terms.energy(self._x, self._v, self._eargs)
+        return row[0], row[1:4].copy()
+
+    def _offset_rows(self, rows):
+        """Monitor rows written before this call carry the collisions' offsets
+        (see :mod:`orbits.collisions`)."""
+        off = self._ws.get("collision_offset")
+        if off is not None and len(rows) and off.any():
+            rows[:, _inv.WORK_COLUMN] += off[0]
+            rows[:, 1:4] += off[1:4]
+        return rows
+
+    def _resolve_collisions(self, rec, wall0):
+        """Resolve every collision of the step just taken, in the order of
+        their contact times (the loop stopped at the first it found); see
+        :mod:`orbits.collisions`.  A ``"halt"`` from a collisions function
+        stops the run there, after the collisions before it were resolved."""
+        from ._kernels import stopping as _s
+        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
+        t = self._now()
+        n = len(self._m)
+        out = np.zeros((max(1, min(n * (n - 1) // 2, 65536)), 5))
+        found = _s.collision_pairs(self._x, self._v, t, self._stop, out)
+        pairs = sorted(out[:found].tolist(), key=lambda row: row[2])
+        how = self._stop_config["collisions"]
+        e = self._stop_config.get("restitution")
+        e = 1.0 if e is None else e
+        m, r = self._m.copy(), self._r.copy()
+        x, v = self._x.copy(), self._v.copy()
+        alive = np.ones(n, dtype=bool)
+        into = np.arange(n)          # a merged body's survivor
+        internal = self._names_internal()
+        G = self.units.G
+        E0, L0 = self._invariants()
+        rows, halted = [], None
+
+        def root(k):
+            while into[k] != k:
+                k = into[k]
+            return k
+
+        def resolve(a, b, tc, dist, speed):
+            # one collision of bodies a, b (internal indices, both alive)
+            nonlocal halted
+            a, b = min(a, b), max(a, b)
+            answer = how
+            if callable(how):
+                answer = _collisions.check_answer(how(self._event(
+                    (a, b), m, r, x, v, tc, t, dist, speed)), (internal[a], internal[b]))
+            if answer == "halt":
+                halted = (a, b, tc, dist, speed)
+                return False
+            if answer == "bounce":
+                va, vb, closing = _collisions.bounce_pair(m, x, v, a, b, e)
+                dE = _collisions.pair_energy_change(m, x, v, a, b, va, vb)
+                v[a], v[b] = va, vb
+                rows.append((tc, t, internal[a], internal[b], "bounce", "", dist, speed, dE))
+                return False
+            # merge: the more massive survives (the first in the body set on a tie)
+            keep, gone = (a, b) if (m[a] > m[b] or (m[a] == m[b] and self._order[a]
+                                                    < self._order[b])) else (b, a)
+            dE = _merge_energy_change(m, x, v, alive, keep, gone, G, self._eps2)
+            m[keep], r[keep], x[keep], v[keep] = _collisions.merge_pair(m, r, x, v, keep, gone)
+            alive[gone] = False
+            into[gone] = keep
+            rows.append((tc, t, internal[a], internal[b], "merge", internal[keep], dist,
+                         speed, dE))
+            return True
+
+        merged = set()
+        for j, i, tc, dist, speed in pairs:
+            a, b = root(int(j)), root(int(i))
+            if a == b:
+                continue
+            if (a, b) != (int(j), int(i)):
+                # one of them merged earlier in this step: the merger, at the end
+                d = float(np.linalg.norm(x[a] - x[b]))
+                if d >= r[a] + r[b]:
+                    continue
+                tc, dist, speed = t, d, float(np.linalg.norm(v[a] - v[b]))
+            if resolve(a, b, tc, dist, speed):
+                merged.add(root(a))
+            if halted:
+                break
+        # chains: a merged body that now overlaps another collides again
+        while merged and not halted:
+            k = merged.pop()
+            if not alive[k]:
+                continue
+            d = np.linalg.norm(x - x[k], axis=1)
+            hit = np.flatnonzero(alive & (d < r + r[k]) & (np.arange(n) != k))
+            if hit.size:
+                o = int(hit[0])
+                if resolve(k, o, t, float(d[o]), float(np.linalg.norm(v[k] - v[o]))):
+                    merged.add(root(k))
+        if not alive.all():
+            self._drain_log(rec)
+            new_index = self._replace_bodies(m, r, x, v, alive)
+        else:
+            new_index = np.arange(n)
+            self._v[...] = v
+            self.integrator.invalidate(self._ws)
+        E1, L1 = self._invariants()
+        off = self._ws["collision_offset"]
+        off[0] -= E1 - E0
+        off[1:4] -= L1 - L0
+        _s.keep_state(self._x, self._v, t, self._stop)
+        self._collisions.extend(rows)
+        keep = getattr(rec, "collision_rows", None)
+        if keep is not None and rows:
+            keep(self, rows)
+        if halted:
+            a, b, tc, dist, speed = halted
+            self._stop_info[:] = (new_index[a], new_index[b])
+            self._stop_hit[:] = (tc, dist, speed)
+            self._fail(Status.COLLISION, rec, wall0)
+
+    def _names_internal(self):
+        return [self._names[k] for k in self._order]
+
+    def _event(self, pair, m, r, x, v, tc, t, dist, speed):
+        q = self.units.quantity
+        a, b = pair
+        names = self._names_internal()
+        return _collisions.CollisionEvent(
+            q(tc, "time"), q(t, "time"), (names[a], names[b]), q(m[[a, b]], "mass"),
+            q(r[[a, b]], "length"), q(x[[a, b]], "length"), q(v[[a, b]], "velocity"),
+            q(dist, "length"), q(speed, "velocity"))
+
+    def _replace_bodies(self, m, r, x, v, alive):
+        """Go on with the bodies ``alive`` of these arrays (internal order),
+        after mergers: the clock, counters, monitors' reference, encounter and
+        collision lists and the integrator's scalar state carry over; returns
+        each old internal index's new one (-1: gone)."""
+        user = np.flatnonzero(alive[self._inverse])     # survivors' places in the body set
+        old = self._inverse[user]                        # their internal indices
+        bs = BodySet(self.units)
+        bs._bare_ok = self._bare_ok
+        bs._names = [self._names[k] for k in user]
+        bs._m, bs._r = m[old].copy(), r[old].copy()
+        bs._x, bs._v = x[old].copy(), v[old].copy()
+        bs.history = list(self._history)
+        new = Simulation.__new__(Simulation)
+        new._touching_ok = True
+        stops = dict(self.stop_conditions)
+        stops = {k: val for k, val in stops.items() if val is not None and val is not False}
+        new.__init__(bs, self.integrator, dt=None if self._dt == 0 else self.dt,
+                     forces=list(self._terms), monitors=self.monitors, monitor_every=self.monitor_every,
+                     softening=self._softening, parallel=self.parallel,
+                     rebound_arithmetic=self.rebound_arithmetic, **stops)
+        # the integrator's state that does not depend on the number of bodies
+        # (an adaptive method's next step, the clock's compensation, the work)
+        for key, arr in self._ws.items():
+            mine = new._ws.get(key)
+            if isinstance(arr, np.ndarray) and isinstance(mine, np.ndarray) \
+                    and mine.shape == arr.shape and mine.dtype == arr.dtype:
+                mine[...] = arr
+        new.integrator.invalidate(new._ws)
+        carry = ("_t_base", "_steps_since_base", "steps", "force_evaluations",
+                 "steps_rejected", "_chunk", "output_path", "_resume", "_reference",
+                 "_E_scale", "_L_scale", "_encounters", "_collisions", "_wall0", "_signals",
+                 "_wall_limit", "_in_loop", "_history", "_bodies_changed")
+        for key in carry:
+            if key in self.__dict__:
+                new.__dict__[key] = self.__dict__[key]
+        del new.__dict__["_touching_ok"]
+        self.__dict__.clear()
+        self.__dict__.update(new.__dict__)
+        self._bodies_changed += 1
+        index = np.full(len(alive), -1)
+        index[old] = self._inverse
+        return index
+
+    def _collision_table(self):
+        """``result.collisions``: an astropy QTable (None when the run does
+        not resolve collisions)."""
+        if not self._resolves_collisions:
+            return None
+        return _collisions.table(self._collisions, self.units)
+
     # -- files ------------------------------------------------------------------------
     @classmethod
-    def from_file(cls, path):
+    def from_file(cls, path, collisions=None):
         """The simulation at the last checkpoint of an output file.
 
         Everything is restored, the integrator's internal state included, so
         that continuing gives bit for bit what an uninterrupted run gives.  If
         the run that wrote the file was interrupted, :meth:`resume` finishes
         it; :meth:`run` with ``output=path`` appends a new run to the file.
+
+        Parameters
+        ----------
+        path : str or path-like
+        collisions : callable, optional
+            The collisions function of a run that resolved collisions with one
+            (a file names it but cannot hold it).
 
         Examples
         --------
@@ -688,7 +926,17 @@ class Simulation(Driven):
         """
         from .io import hdf5
         cp = hdf5.read_checkpoint(path)
-        sim = cls.from_config(cp.bodies, cp.config)
+        config = cp.config
+        named = config["stop_conditions"].get("collisions")
+        if isinstance(named, str) and named.startswith(FUNCTION_PREFIX):
+            if collisions is None:
+                raise SimulationOptionError(
+                    f"{path}: its run resolved collisions with the function "
+                    f"{named[len(FUNCTION_PREFIX):]}, which a file cannot hold; pass it "
+                    f"again: Simulation.from_file(path, collisions=...)")
+            config = dict(config, stop_conditions=dict(config["stop_conditions"],
+                                                       collisions=collisions))
+        sim = cls.from_config(cp.bodies, config, _restoring=True)
         if not np.array_equal(sim._order, cp.state.order):
             raise hdf5.OrbitsFileError(f"{path}: the stored body order does not match the "
                                        f"masses")
@@ -897,11 +1145,15 @@ class Simulation(Driven):
         (('Star', 'Planet'), 1.0, 'au-Msun-day')
         """
         inv = self._inverse
+        stops = dict(self._stop_config)
+        if callable(stops.get("collisions")):
+            # a plain record names the function (a file cannot hold it)
+            stops["collisions"] = _function_name(stops["collisions"])
         return SimulationDescription(
             tuple(self._names), self._m[inv].copy(), self._r[inv].copy(), self.units,
             self.integrator, self._dt, math.sqrt(self._eps2), self.monitors,
             self.monitor_every, self.parallel, self.rebound_arithmetic,
-            dict(self._stop_config), list(self._history), self.config, self.forces)
+            stops, list(self._history), self.config, self.forces)
 
     @property
     def time_value(self):
@@ -936,6 +1188,9 @@ class Simulation(Driven):
         if self._mask:
             self._monitor_row(row)
         inv = self._inverse
+        if self._resolves_collisions:
+            return Snapshot(self._now(), self.steps, self._x[inv], self._v[inv], row,
+                            tuple(self._names), self._m[inv], self._r[inv])
         return Snapshot(self._now(), self.steps, self._x[inv], self._v[inv], row)
 
     def _now(self):
@@ -963,12 +1218,14 @@ class Simulation(Driven):
             from ._kernels.variational import chaos_values
             col = _inv.MONITOR_COLUMNS.index("megno")
             row[col:col + 3] = chaos_values(self._ws["chaos"])
+        self._offset_rows(row[None])
         return row
 
     @property
     def _has_work(self):
-        # non-conservative terms, whose work the loops integrate
-        return self._base_force.work is not None
+        # non-conservative terms, whose work the loops integrate, or collisions
+        # that take energy out of the bodies
+        return self._base_force.work is not None or self._resolves_collisions
 
     @property
     def work(self):
@@ -993,7 +1250,9 @@ class Simulation(Driven):
         >>> sim.work                               # no non-conservative terms
         <Quantity 0. AU2 solMass / d2>
         """
-        return self.units.quantity(_stepping.work_total(self._ws), "energy")
+        off = self._ws.get("collision_offset")
+        return self.units.quantity(_stepping.work_total(self._ws)
+                                   + (0.0 if off is None else off[0]), "energy")
 
     # -- running ------------------------------------------------------------------------
     def run(self, until, outputs=None, progress=None, output=None, overwrite=False,
@@ -1305,6 +1564,14 @@ class _Recorder:
         self.rejected0 = sim.steps_rejected
         self.t0 = sim._now()
         self.n = n
+        # the bodies at the start, whose columns the outputs keep when
+        # collisions merge some of them away (then NaN) and change masses
+        self.names0 = list(sim._names)
+        self.m0, self.r0 = sim._m[self.inv].copy(), sim._r[self.inv].copy()
+        self.version = sim._bodies_changed
+        self.slot_of = {name: k for k, name in enumerate(sim._names_internal())}
+        self.slots = None
+        self.mass_rows = [] if sim._resolves_collisions else None
         if initial:
             self.output(sim)
 
@@ -1336,8 +1603,26 @@ class _Recorder:
         w, n = _inv.MONITOR_WIDTH, self.n
         self.t[i] = snap.t
         self.rows[i, :w] = snap.monitors
-        self.rows[i, w:w + 3 * n] = snap.x[self.order].ravel()
-        self.rows[i, w + 3 * n:] = snap.v[self.order].ravel()
+        if sim._bodies_changed != self.version:
+            self.version = sim._bodies_changed
+            self.slots = np.array([self.slot_of[name] for name in sim._names_internal()])
+        if self.slots is None:
+            self.rows[i, w:w + 3 * n] = snap.x[self.order].ravel()
+            self.rows[i, w + 3 * n:] = snap.v[self.order].ravel()
+        else:
+            x = np.full((n, 3), np.nan)
+            v = np.full((n, 3), np.nan)
+            x[self.slots] = snap.x[sim._order]
+            v[self.slots] = snap.v[sim._order]
+            self.rows[i, w:w + 3 * n] = x.ravel()
+            self.rows[i, w + 3 * n:] = v.ravel()
+        if self.mass_rows is not None:
+            mass = np.full(n, np.nan)
+            if self.slots is None:
+                mass[:] = sim._m
+            else:
+                mass[self.slots] = sim._m
+            self.mass_rows.append(mass[self.inv])
         self.count += 1
 
     def row_buffer(self, k):
@@ -1360,9 +1645,9 @@ class _Recorder:
         U = sim.units
         q = U.quantity
         fields = dict(
-            times=q(self.t[:self.count], "time"), names=list(sim._names),
-            masses=q(sim._m[self.inv].copy(), "mass"),
-            radii=q(sim._r[self.inv].copy(), "length"), steps=sim.steps - self.steps0,
+            times=q(self.t[:self.count], "time"), names=list(self.names0),
+            masses=q(self.m0, "mass"), radii=q(self.r0, "length"),
+            steps=sim.steps - self.steps0,
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
             integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
             monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
@@ -1378,6 +1663,8 @@ class _Recorder:
         if not np.array_equal(self.inv, np.arange(n)):
             x, v = x[:, self.inv], v[:, self.inv]
         fields.update(positions=q(x, "length"), velocities=q(v, "velocity"))
+        if self.mass_rows is not None:
+            fields["masses_at_outputs"] = q(np.array(self.mass_rows).reshape(-1, n), "mass")
         ref = sim._reference
         if sim._mask:
             fields.update(_monitor_fields(rows[:, :w], sim, ref))
@@ -1396,3 +1683,23 @@ def _monitor_fields(rows, sim, ref):
 def _positive_number(value):
     return (isinstance(value, numbers.Real) and not isinstance(value, bool)
             and 0 < float(value) < math.inf)
+
+
+def _merge_energy_change(m, x, v, alive, a, b, G, eps2):
+    """The energy change (Newtonian gravity, softened as the simulation is)
+    when bodies ``a`` and ``b`` merge: their kinetic energy of relative motion
+    and their mutual binding go, and the others' pull on them now acts on the
+    centre of mass."""
+    M = m[a] + m[b]
+    if not M > 0:
+        return 0.0
+    X = (m[a] * x[a] + m[b] * x[b]) / M
+    u = v[a] - v[b]
+    dE = -0.5 * m[a] * m[b] / M * float(u @ u)
+    dE += G * m[a] * m[b] / math.sqrt(float((x[a] - x[b]) @ (x[a] - x[b])) + eps2)
+    others = alive.copy()
+    others[[a, b]] = False
+    mk, xk = m[others], x[others]
+    pot = lambda p: np.sqrt(((xk - p) ** 2).sum(axis=1) + eps2)  # noqa: E731
+    dE -= G * float(np.sum(mk * (M / pot(X) - m[a] / pot(x[a]) - m[b] / pot(x[b]))))
+    return dE

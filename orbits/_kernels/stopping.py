@@ -46,8 +46,8 @@ from ._jit import njit
 from .encounters import closest_approach
 from .status import Status
 
-__all__ = ["no_stop", "check_stop", "collision_check", "encounter_log", "ENCOUNTER_DISTANCE",
-           "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG"]
+__all__ = ["no_stop", "check_stop", "collision_check", "collision_pairs", "keep_state",
+           "encounter_log", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG"]
 
 ENCOUNTER_DISTANCE = 1
 ENCOUNTER_HILL = 2
@@ -87,6 +87,46 @@ def _within_reach(work, mu, h, r):
     return min(d0, d1) - r <= 2.0 * reach
 
 
+@njit(inline="always")
+def _pair_contact(x, v, t, sargs, i, j, inside, h):
+    # whether the pair (j, i) touched during the step that ended at t:
+    # (touched, time, separation, relative speed); see collision_check
+    radii, prev, clock, work, gm = sargs[7], sargs[8], sargs[9], sargs[10], sargs[4]
+    rs = radii[i] + radii[j]
+    if rs <= 0.0:
+        return False, 0.0, 0.0, 0.0
+    dx = x[i, 0] - x[j, 0]
+    dy = x[i, 1] - x[j, 1]
+    dz = x[i, 2] - x[j, 2]
+    ux = v[i, 0] - v[j, 0]
+    uy = v[i, 1] - v[j, 1]
+    uz = v[i, 2] - v[j, 2]
+    d1 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if inside:
+        d0 = math.sqrt((prev[0, i, 0] - prev[0, j, 0]) ** 2
+                       + (prev[0, i, 1] - prev[0, j, 1]) ** 2
+                       + (prev[0, i, 2] - prev[0, j, 2]) ** 2)
+        if d0 < rs:
+            # already in contact at the previous check (a bounce that has not
+            # yet separated them): a new collision only while still closing
+            if d1 < rs and dx * ux + dy * uy + dz * uz < 0.0:
+                return True, t, d1, math.sqrt(ux * ux + uy * uy + uz * uz)
+            return False, 0.0, 0.0, 0.0
+    if d1 < rs:
+        # overlapping at the end (or the state given at the start)
+        return True, t, d1, math.sqrt(ux * ux + uy * uy + uz * uz)
+    if not inside:
+        return False, 0.0, 0.0, 0.0
+    _pair_ends(x, v, prev, work, i, j)
+    mu = gm[i] + gm[j]
+    if not _within_reach(work, mu, h, rs):
+        return False, 0.0, 0.0, 0.0
+    tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
+    if dm < rs:
+        return True, clock[0] + tm, dm, sm
+    return False, 0.0, 0.0, 0.0
+
+
 @njit
 def collision_check(x, v, t, sargs):
     """The first pair (in the order of the pair loop) whose separation fell
@@ -94,59 +134,66 @@ def collision_check(x, v, t, sargs):
     end, or inside it, where :func:`~orbits._kernels.encounters.closest_approach`
     of the pair from both ends of the step comes below it.  Writes the pair
     into ``info`` and its time, separation and speed into ``hit``; returns
-    True if there was one.  Then (or not) keeps ``x``, ``v`` in ``prev`` for
-    the next step.
+    True if there was one.  The state of the step before (``prev``) is left
+    as it was, for :func:`collision_pairs`.
 
     Inside a step, only pairs that could have closed the gap are examined:
     with the relative speeds ``s0``, ``s1`` at the ends, a pair's separation
     can fall by at most ``max(s0, s1) |h| + mu h^2 / (2 R^2)`` (its mutual
     pull while at least ``R`` apart; the tides of the other bodies are left
-    out), and twice that is allowed for."""
-    radii, prev, clock, work, hit = sargs[7], sargs[8], sargs[9], sargs[10], sargs[11]
-    gm, info = sargs[4], sargs[6]
-    n = min(x.shape[0], gm.shape[0])
+    out), and twice that is allowed for.  A pair that was already in contact
+    at the previous check (bodies that bounced and have not yet separated)
+    counts again only if it overlaps at the end and is still closing."""
+    clock, hit, info = sargs[9], sargs[11], sargs[6]
+    n = min(x.shape[0], sargs[4].shape[0])
     h = t - clock[0]
     inside = clock[1] != 0.0 and h != 0.0
-    found = False
     for i in range(1, n):
-        if found:
-            break
         for j in range(i):
-            rs = radii[i] + radii[j]
-            if rs <= 0.0:
-                continue
-            dx = x[i, 0] - x[j, 0]
-            dy = x[i, 1] - x[j, 1]
-            dz = x[i, 2] - x[j, 2]
-            d1 = math.sqrt(dx * dx + dy * dy + dz * dz)
-            if d1 < rs:
-                # overlapping at the end (or the state given at the start)
-                ux = v[i, 0] - v[j, 0]
-                uy = v[i, 1] - v[j, 1]
-                uz = v[i, 2] - v[j, 2]
+            found, tc, d, s = _pair_contact(x, v, t, sargs, i, j, inside, h)
+            if found:
                 info[0] = j
                 info[1] = i
-                hit[0] = t
-                hit[1] = d1
-                hit[2] = math.sqrt(ux * ux + uy * uy + uz * uz)
-                found = True
-                break
-            if not inside:
-                continue
-            _pair_ends(x, v, prev, work, i, j)
-            mu = gm[i] + gm[j]
-            if not _within_reach(work, mu, h, rs):
-                continue
-            tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
-            if dm < rs:
-                info[0] = j
-                info[1] = i
-                hit[0] = clock[0] + tm
-                hit[1] = dm
-                hit[2] = sm
-                found = True
-                break
-    return found
+                hit[0] = tc
+                hit[1] = d
+                hit[2] = s
+                return True
+    return False
+
+
+@njit
+def collision_pairs(x, v, t, sargs, out):
+    """Every pair that touched during the step that ended at ``t`` (the test
+    of :func:`collision_check`), as rows ``(j, i, time, separation, speed)``
+    of ``out`` (shape (capacity, 5)); returns how many (at most the
+    capacity).  For resolving all the collisions of one step, after the loop
+    stopped at the first."""
+    clock = sargs[9]
+    n = min(x.shape[0], sargs[4].shape[0])
+    h = t - clock[0]
+    inside = clock[1] != 0.0 and h != 0.0
+    k = 0
+    for i in range(1, n):
+        for j in range(i):
+            if k == out.shape[0]:
+                return k
+            found, tc, d, s = _pair_contact(x, v, t, sargs, i, j, inside, h)
+            if found:
+                out[k, 0] = j
+                out[k, 1] = i
+                out[k, 2] = tc
+                out[k, 3] = d
+                out[k, 4] = s
+                k += 1
+    return k
+
+
+@njit
+def keep_state(x, v, t, sargs):
+    """Keep ``x``, ``v`` (the bodies' rows) as the state of a check at ``t``
+    (after the driver resolved the collisions of a step)."""
+    n = min(x.shape[0], sargs[4].shape[0])
+    _keep(x, v, t, sargs[8], sargs[9], n)
 
 
 @njit(inline="always")
@@ -222,7 +269,8 @@ def check_stop(x, v, t, sargs):
     if mask & (COLLISION | ENCOUNTER_LOG):
         prev, clock = sargs[8], sargs[9]
         if mask & COLLISION and collision_check(x, v, t, sargs):
-            _keep(x, v, t, prev, clock, n)
+            # prev stays the state before the step: the driver lists every
+            # pair of the step (collision_pairs) and then keeps the state
             return Status.COLLISION
         full = (mask & ENCOUNTER_LOG) != 0 and encounter_log(x, v, t, sargs)
         _keep(x, v, t, prev, clock, n)

@@ -802,6 +802,11 @@ class FileRecorder:
             self._restart = {name: r[name] for name in r if isinstance(r[name], h5py.Dataset)}
             self._ws = {name: r["ws"][name] for name in r["ws"]}
             self.rows = self.f["particles/bodies/position/value"].shape[0]
+            # the columns: the bodies when the file was made
+            b = self.f["particles/bodies"]
+            self.columns = _decode(b["names"][()])
+            self.masses0, self.radii0 = b["mass"][()], _radii(b)[0]
+            self.varying = "masses" in r
             self.last_checkpoint = _time.perf_counter()
             if resume_rows is not None:
                 self.outputs_written = resume_rows
@@ -820,6 +825,9 @@ class FileRecorder:
 
     def _check_same_layout(self):
         n = self.f["particles/bodies/names"].shape[0]
+        names = set(_decode(self.f["particles/bodies/names"][()]))
+        if "masses" in self.f["restart"] and set(self.desc.names) <= names:
+            n = len(self.desc.names)     # collisions merged some of the file's bodies
         if n != len(self.desc.names):
             raise OrbitsFileError(f"{self.path}: holds {n} bodies, the simulation "
                                   f"{len(self.desc.names)}")
@@ -855,6 +863,8 @@ class FileRecorder:
         p = self.f["particles/bodies"]
         obs = self.f["observables"]
         series = [(_datasets(p["position"]), 2, None), (_datasets(p["velocity"]), 3, None)]
+        if "masses_at_outputs" in p:
+            series.append((_datasets(p["masses_at_outputs"]), 5, None))
         names = self._series_names()
         series += [(_datasets(obs[name]), 4, name) for name in names]
         inloop = {name: _datasets(obs["in_loop"][name]) for name in names}
@@ -938,7 +948,7 @@ class FileRecorder:
         (2, 2)
         >>> rec.close()
         """
-        self.last = tuple(sim.snapshot())
+        self.last = self._columns_of(sim.snapshot())
         self.buffer.append(self.last)
         self.outputs_written += 1
         if len(self.buffer) >= BUFFER_ROWS:
@@ -1054,8 +1064,47 @@ class FileRecorder:
         <Quantity [4.] d>
         >>> rec.close()
         """
-        self.last = tuple(sim.snapshot())
+        self.last = self._columns_of(sim.snapshot())
         self._note_rows(self.last[4][None])
+
+    def _columns_of(self, snap):
+        """An output as the file keeps it: ``(t, steps, x, v, monitors)`` and,
+        where collisions change the bodies, the masses, in the columns of the
+        bodies at the start (NaN for one merged away)."""
+        if not self.varying:
+            return tuple(snap)[:5]
+        n = len(self.columns)
+        cols = [self.columns.index(name) for name in snap.names]
+        x, v, m = np.full((n, 3), np.nan), np.full((n, 3), np.nan), np.full(n, np.nan)
+        x[cols], v[cols], m[cols] = snap.x, snap.v, snap.masses
+        return (snap.t, snap.steps, x, v, snap.monitors, m)
+
+    def collision_rows(self, sim, rows):
+        """Append the collisions a run resolved (rows of
+        :func:`orbits.collisions.table`, internal units) to the file's group
+        ``collisions``, made on first use."""
+        if not rows or self.closed:
+            return
+        U = sim.units
+        g = self.f.require_group("collisions")
+        text = h5py.string_dtype()
+        unit = lambda kind: U.unit(kind).to_string()  # noqa: E731
+        cols = (("time", np.float64, unit("time")), ("step_time", np.float64, unit("time")),
+                ("body_1", text, None), ("body_2", text, None), ("resolution", text, None),
+                ("survivor", text, None), ("distance", np.float64, unit("length")),
+                ("speed", np.float64, unit("velocity")),
+                ("energy_change", np.float64, unit("energy")))
+        for k, (name, dtype, u_) in enumerate(cols):
+            values = [row[k] for row in rows]
+            if name not in g:
+                ds = g.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype,
+                                      chunks=(256,))
+                if u_ is not None:
+                    ds.attrs["unit"] = u_
+            ds = g[name]
+            start = ds.shape[0]
+            ds.resize((start + len(values),))
+            ds[start:] = np.asarray(values, dtype=object if dtype is text else dtype)
 
     def encounter_rows(self, sim, rows):
         """Append rows ``(t, body_1, body_2, distance, speed)`` of the encounter
@@ -1150,11 +1199,17 @@ class FileRecorder:
         """
         from ..result import Result
         q = sim.units.quantity
-        t, step, x, v, row = self.last
+        t, step, x, v, row = self.last[:5]
+        if self.varying:
+            # the columns of the bodies at the start, and their masses then
+            names, masses, radii = self.columns, self.masses0, self.radii0
+        else:
+            names, masses, radii = self.desc.names, self.desc.masses, self.desc.radii
         fields = dict(times=q(np.array([t]), "time"), positions=q(x[None], "length"),
-                      velocities=q(v[None], "velocity"), names=list(self.desc.names),
-                      masses=q(self.desc.masses.copy(), "mass"),
-                      radii=q(self.desc.radii.copy(), "length"), steps=sim.steps - self.steps0,
+                      velocities=q(v[None], "velocity"), names=list(names),
+                      masses=q(np.array(masses, dtype=float), "mass"),
+                      radii=q(np.array(radii, dtype=float), "length"),
+                      steps=sim.steps - self.steps0,
                       force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
                       steps_rejected=sim.steps_rejected - self.rejected0,
                       integrator=sim.integrator.info(), units=sim.units.to_dict(),
@@ -1169,6 +1224,8 @@ class FileRecorder:
         if tangents is not None:
             fields.update(jacobian=sim.jacobian, tangent_vectors=tangents,
                           seed=self.desc.config.seed)
+        if self.varying:
+            fields["masses_at_outputs"] = q(self.last[5][None], "mass")
         return Result(**fields)
 
     # writing ---------------------------------------------------------------------------
@@ -1245,7 +1302,8 @@ class FileRecorder:
         state = sim.state
         p = self.plan
         for name, value in (
-                ("x", state.x), ("v", state.v),
+                ("x", _padded(state.x, r["x"].shape[1])),
+                ("v", _padded(state.v, r["v"].shape[1])),
                 ("clock", (state.steps, state.steps_since_base, state.force_evaluations,
                            self.rows, state.steps_rejected)),
                 ("t_base", state.t_base),
@@ -1256,7 +1314,17 @@ class FileRecorder:
             if name in r:
                 _write_rows(r[name], slot, np.asarray(value)[None], extend=False)
         for name, arr in state.workspace.items():
-            _write_rows(self._ws[name], slot, arr[None], extend=False)
+            _write_box(self._ws[name], slot, arr)
+        if self.varying:
+            desc = sim.description()
+            n = len(self.columns)
+            cols = [self.columns.index(name) for name in desc.names]
+            m, rad = np.full(n, np.nan), np.full(n, np.nan)
+            m[cols], rad[cols] = desc.masses, desc.radii
+            order = np.full(n, -1, dtype=np.int64)
+            order[:len(state.order)] = state.order
+            for name, value in (("masses", m), ("radii", rad), ("orders", order)):
+                _write_rows(r[name], slot, value[None], extend=False)
         if "tangent_vectors" in r:
             _write_rows(r["tangent_vectors"], slot, sim.tangent_vectors[None], extend=False)
         self.f.flush()
@@ -1267,14 +1335,58 @@ class FileRecorder:
         self.last_checkpoint = _time.perf_counter()
 
 
+def _bodies_vary(desc):
+    """Whether the described simulation's collisions may merge bodies away
+    (a resolution other than ``"halt"``)."""
+    c = desc.stop_conditions.get("collisions")
+    return c is not None and c != "halt"
+
+
+def _body_axes(integrator, n):
+    """The axes of each workspace array that run over the bodies (those whose
+    length differs between a workspace of ``n`` and of ``n + 1`` bodies)."""
+    a, b = integrator.workspace(n), integrator.workspace(n + 1)
+    return {name: tuple(k for k, (p, q) in enumerate(zip(arr.shape, b[name].shape)) if p != q)
+            for name, arr in a.items() if isinstance(arr, np.ndarray)}
+
+
+def _padded(x, n):
+    """Rows of ``x`` followed by NaN rows up to ``n`` (a state after mergers,
+    in a dataset made for the bodies at the start)."""
+    if len(x) == n:
+        return x
+    out = np.full((n,) + x.shape[1:], np.nan)
+    out[:len(x)] = x
+    return out
+
+
+def _write_box(d, slot, arr):
+    """``d[slot]`` gets ``arr``, in its leading corner where ``arr`` is smaller
+    (a workspace of fewer bodies than the file was made for)."""
+    if arr.shape == d.shape[1:]:
+        _write_rows(d, slot, arr[None], extend=False)
+    else:
+        d[(slot,) + tuple(slice(0, k) for k in arr.shape)] = arr
+
+
+def _read_box(d, slot, n, n0):
+    """``d[slot]`` for ``n`` bodies where it was made for ``n0`` (its
+    ``body_axes`` attribute says which axes run over them)."""
+    axes = set(d.attrs.get("body_axes", ())) if n != n0 else set()
+    return d[(slot,) + tuple(slice(0, n if k in axes else size)
+                             for k, size in enumerate(d.shape[1:]))]
+
+
 def _datasets(group):
     return group["step"], group["time"], group["value"]
 
 
 def _keeps_work(desc):
     """Whether a file of the simulation ``desc`` describes keeps the work series:
-    with the energy monitor and a non-conservative force term."""
-    return "energy" in desc.monitors and any(not t.conservative for t in desc.forces)
+    with the energy monitor and a non-conservative force term, or collisions
+    that the run resolves (what they take out of the bodies' energy)."""
+    return "energy" in desc.monitors and (any(not t.conservative for t in desc.forces)
+                                          or _bodies_vary(desc))
 
 
 def _append(dsets, n0, steps, t, values):
@@ -1395,6 +1507,11 @@ def _create(path, desc, state):
     b.create_dataset("radius", data=desc.radii).attrs["unit"] = unit("length")
     _element(b, "position", (n, 3), (unit("length"), unit("time")))
     _element(b, "velocity", (n, 3), (unit("velocity"), unit("time")))
+    varying = _bodies_vary(desc)
+    if varying:
+        # collisions may merge bodies away: the outputs keep the columns of
+        # the bodies at the start (NaN for one that is gone) and the masses
+        _element(b, "masses_at_outputs", (n,), (unit("mass"), unit("time")))
     obs = f.create_group("observables")
     inloop = obs.create_group("in_loop")
     for name in tuple(desc.monitors) + (("work",) if _keeps_work(desc) else ()):
@@ -1457,12 +1574,22 @@ def _create(path, desc, state):
         d.attrs["unit"] = "internal"
         d.attrs["layout"] = np.array(layout, dtype=np.int64)
     ws = r.create_group("ws")
+    axes = _body_axes(desc.integrator, n) if varying else {}
     for name, arr in state.workspace.items():
         if isinstance(arr, np.ndarray):
             d = ws.create_dataset(name, shape=(_SLOTS,) + arr.shape, dtype=arr.dtype)
             if arr.dtype.kind == "f":
                 # the integrator's own state, in the run's units (see /parameters/units)
                 d.attrs["unit"] = "internal"
+            if varying:
+                d.attrs["body_axes"] = np.array(axes.get(name, ()), dtype=np.int64)
+    if varying:
+        # the bodies at each checkpoint, in the columns of those at the start:
+        # masses and radii (NaN: merged away) and the internal order
+        for name, kind in (("masses", "mass"), ("radii", "length")):
+            r.create_dataset(name, shape=(_SLOTS, n), dtype=np.float64).attrs["unit"] = \
+                unit(kind)
+        r.create_dataset("orders", shape=(_SLOTS, n), dtype=np.int64)
     f.flush()
     f.close()
     os.replace(tmp, path)
@@ -1622,7 +1749,26 @@ def load(path):
         fields.update(_derivatives(f, path))
         if "encounters" in f:
             fields["encounters"] = _encounters(f["encounters"])
+        if "masses_at_outputs" in b:
+            fields["masses_at_outputs"] = q(b["masses_at_outputs/value"])
+        if "masses" in f["restart"]:
+            fields["collisions"] = _collisions(f.get("collisions"), par)
     return Result(**fields)
+
+
+def _collisions(g, par):
+    """The collisions a run resolved (group ``collisions``; none yet: an
+    empty table) as the QTable of ``Result.collisions``."""
+    from ..collisions import table
+    from ..units import UnitSystem
+    units = UnitSystem.from_dict(json.loads(par.attrs["units"]))
+    if g is None:
+        return table([], units)
+    text = lambda name: _decode(g[name][()])  # noqa: E731
+    cols = [g["time"][()], g["step_time"][()], text("body_1"), text("body_2"),
+            text("resolution"), text("survivor"), g["distance"][()], g["speed"][()],
+            g["energy_change"][()]]
+    return table(list(zip(*cols)), units)
 
 
 def _encounters(g):
@@ -1887,8 +2033,19 @@ def read_checkpoint(path):
         names = _decode(f["particles/bodies/names"][()])
         m = f["particles/bodies/mass"][()]
         radii, _ = _radii(f["particles/bodies"])
+        n0 = len(names)
         x = r["x"][slot]
         v = r["v"][slot]
+        if "masses" in r:
+            # the bodies at this checkpoint: those of the start that collisions left
+            m = r["masses"][slot]
+            alive = np.isfinite(m)
+            n = int(alive.sum())
+            names = [name for name, keep in zip(names, alive) if keep]
+            m, radii = m[alive], r["radii"][slot][alive]
+            order = r["orders"][slot][:n]
+            inv = np.argsort(order)
+            x, v = x[:n], v[:n]
         bodies = BodySet.from_arrays(m, x[inv], v[inv], names=names, units=units, radii=radii)
         bodies.history = json.loads(par.attrs["bodies_history"])
         config = (json.loads(par.attrs["config"]) if "config" in par.attrs
@@ -1897,7 +2054,8 @@ def read_checkpoint(path):
         clock = r["clock"][slot]
         state = SimulationState(
             x, v, order, float(r["t_base"][slot]), int(clock[1]), int(clock[0]),
-            int(clock[2]), int(clock[4]), {name: r["ws"][name][slot] for name in r["ws"]},
+            int(clock[2]), int(clock[4]),
+            {name: _read_box(r["ws"][name], slot, len(names), n0) for name in r["ws"]},
             par["reference"][()], tuple(par["scales"][()]))
         p = r["plan"][slot]
         plan = RunPlan(float(p[0]), int(p[1]), float(p[2]), int(p[3]), bool(p[4]), int(p[5]),
