@@ -160,6 +160,11 @@ def _parser():
     stops.add_argument("--escape-distance", type=_length, default=None,
                        help="stop when a body is farther than this from the centre of mass "
                             "(1000au)")
+    stops.add_argument("--collisions", choices=("halt", "merge", "bounce"), default=None,
+                       help="bodies with radii that touch: stop ('halt'), merge them, or "
+                            "bounce them as hard spheres")
+    stops.add_argument("--restitution", type=float, default=None,
+                       help="coefficient of restitution of --collisions bounce (1: elastic)")
     run.add_argument("--com", action="store_true",
                      help="move the bodies to their centre-of-mass frame first (scenes in "
                           "a published frame, such as outer-solar-system, drift otherwise)")
@@ -382,7 +387,8 @@ def _run(args, orbits):
     stops = {"encounter_distance": _in_scene_units(given("encounter_distance"), bodies,
                                                    "length"),
              "encounter_hill": args.encounter_hill,
-             "escape_distance": _in_scene_units(given("escape_distance"), bodies, "length")}
+             "escape_distance": _in_scene_units(given("escape_distance"), bodies, "length"),
+             "collisions": args.collisions, "restitution": args.restitution}
     sim = orbits.Simulation(bodies, integrator=integrator,
                             dt=_in_scene_units(dt, bodies), forces=forces,
                             **{k: v for k, v in stops.items() if v is not None})

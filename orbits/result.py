@@ -302,6 +302,14 @@ class Result:
         if lerr is not None:
             lines.append(f"ang. momentum   largest relative error {lerr:.3e}"
                          + _final(self.angular_momentum_error))
+        if self.collisions is not None:
+            kinds = ", ".join(f"{k} {int(np.sum(self.collisions['resolution'] == k))}"
+                              for k in ("merge", "bounce")
+                              if np.any(self.collisions["resolution"] == k))
+            lines.append(f"collisions      {len(self.collisions)}"
+                         + (f" ({kinds})" if kinds else ""))
+        if self.encounters is not None:
+            lines.append(f"encounters      {len(self.encounters)} logged")
         lines.append(f"status          {self.status}")
         return "\n".join(lines)
 

@@ -821,6 +821,9 @@ class Simulation(Driven):
         off = self._ws["collision_offset"]
         off[0] -= E1 - E0
         off[1:4] -= L1 - L0
+        if self._stop[0] & _s.ENCOUNTER_LOG and _s.encounter_log(self._x, self._v, t,
+                                                                  self._stop):
+            self._drain_log(rec)      # the step's approaches, which the loop left
         _s.keep_state(self._x, self._v, t, self._stop)
         self._collisions.extend(rows)
         keep = getattr(rec, "collision_rows", None)
@@ -857,6 +860,7 @@ class Simulation(Driven):
         bs._m, bs._r = m[old].copy(), r[old].copy()
         bs._x, bs._v = x[old].copy(), v[old].copy()
         bs.history = list(self._history)
+        prev, clock = self._stop[8], self._stop[9]   # the state before the step
         new = Simulation.__new__(Simulation)
         new._touching_ok = True
         stops = dict(self.stop_conditions)
@@ -881,6 +885,10 @@ class Simulation(Driven):
             if key in self.__dict__:
                 new.__dict__[key] = self.__dict__[key]
         del new.__dict__["_touching_ok"]
+        # the survivors' state before the step, for the encounter log's look
+        # inside it (a merged body's own)
+        new._stop[8][...] = prev[:, old[new._order]]
+        new._stop[9][...] = clock
         self.__dict__.clear()
         self.__dict__.update(new.__dict__)
         self._bodies_changed += 1

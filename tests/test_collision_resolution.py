@@ -254,3 +254,21 @@ def test_a_file_names_the_collisions_function_and_asks_for_it_back(tmp_path):
     again = orbits.Simulation.from_file(path, collisions=merge_all)
     assert again.bodies.names == ["Star", "P1"]
     again.run(until=6 * u.day, outputs=2, progress=False)
+
+
+def test_the_barycentre_and_the_summary_follow_the_bodies_left():
+    sim = orbits.Simulation(_crossing(), "ias15", collisions="merge", monitors=MONITORS,
+                            encounter_log=0.05 * u.au)
+    res = sim.run(until=10 * u.day, outputs=11, progress=False)
+    bary = res.barycentric()
+    m = np.nan_to_num(res.masses_at_outputs.value)
+    com = np.einsum("kn,knd->kd", m, np.nan_to_num(bary.positions.value))
+    # the bodies started in their centre-of-mass frame and the merger keeps
+    # it: the barycentre of what is left is the origin to round-off of 1 au
+    assert np.abs(com).max() < 1e-15
+    assert np.isnan(bary.positions[-1, 2].value).all()
+    lines = res.summary().splitlines()
+    assert "collisions      1 (merge 1)" in lines
+    # the pair merged while still closing: it had no closest approach to log
+    # (the collisions table has it), and the log goes on with the bodies left
+    assert len(res.encounters) == 0
