@@ -14,6 +14,9 @@ QUICK_ARGV = {
     "stability_map.py": ["--n", "8", "--until", "3000", "--scheduler", "serial",
                          "--png", os.path.join(tempfile.gettempdir(),
                                                "stability_map_quick.png")],
+    "planetesimal_accretion.py": ["--n", "30", "--years", "60", "--outputs", "61",
+                                  "--png", os.path.join(tempfile.gettempdir(),
+                                                        "planetesimal_accretion_quick.png")],
     "megno_map.py": ["--n", "10", "--until", "3000", "--scheduler", "serial",
                      "--png", os.path.join(tempfile.gettempdir(), "megno_map_quick.png")],
 }

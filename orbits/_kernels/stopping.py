@@ -75,16 +75,43 @@ def _pair_ends(x, v, prev, work, i, j):
 
 
 @njit(inline="always")
+def _pericentre(work, row, mu):
+    # the pericentre distance of the two-body orbit of the relative state in
+    # rows row, row + 1 of work (mu = G (m_i + m_j) > 0)
+    dx, dy, dz = work[row, 0], work[row, 1], work[row, 2]
+    ux, uy, uz = work[row + 1, 0], work[row + 1, 1], work[row + 1, 2]
+    hx = dy * uz - dz * uy
+    hy = dz * ux - dx * uz
+    hz = dx * uy - dy * ux
+    h2 = hx * hx + hy * hy + hz * hz
+    d = math.sqrt(dx * dx + dy * dy + dz * dz)
+    energy = 0.5 * (ux * ux + uy * uy + uz * uz) - mu / d
+    e = math.sqrt(max(0.0, 1.0 + 2.0 * energy * h2 / (mu * mu)))
+    return h2 / mu / (1.0 + e)
+
+
+@njit(inline="always")
 def _within_reach(work, mu, h, r):
     # whether the pair of _pair_ends could have come within r during the step
     # h: its separation falls by at most max(s0, s1) |h| + mu h^2 / (2 r^2)
-    # while at least r apart (end speeds, mutual pull; twice that allowed)
+    # while at least r apart (end speeds, mutual pull; twice that allowed).
+    # A pair whose two-body pericentre stays beyond r at both ends, by more
+    # than it changed over the step (the other bodies' pull), cannot have
+    # come within r either: a planetesimal's orbit about the star, whose pull
+    # makes the first bound useless, is passed over by the second.
     d0 = math.sqrt(work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2)
     d1 = math.sqrt(work[2, 0] ** 2 + work[2, 1] ** 2 + work[2, 2] ** 2)
     s0 = math.sqrt(work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2)
     s1 = math.sqrt(work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2)
     reach = max(s0, s1) * abs(h) + 0.5 * mu * h * h / (r * r)
-    return min(d0, d1) - r <= 2.0 * reach
+    if min(d0, d1) - r > 2.0 * reach:
+        return False
+    if mu > 0.0:
+        q0 = _pericentre(work, 0, mu)
+        q1 = _pericentre(work, 2, mu)
+        if min(q0, q1) - r > 2.0 * abs(q1 - q0):
+            return False
+    return True
 
 
 @njit(inline="always")
