@@ -1950,6 +1950,14 @@ def describe(path):
         if totals is not None:
             lines.append(f"work            {totals[0]} steps, {totals[1]} force evaluations, "
                          f"wall time {totals[3]:.3g} s")
+        if "masses" in f["restart"]:
+            k = f["collisions/time"].shape[0] if "collisions" in f else 0
+            left = (int(np.isfinite(f["restart/masses"][(count - 1) % _SLOTS]).sum())
+                    if count else None)
+            lines.append(f"collisions      {k} resolved" + (
+                f"; {left} bodies at the last checkpoint" if left is not None else ""))
+        if "encounters" in f:
+            lines.append(f"encounters      {f['encounters/time'].shape[0]} logged")
         lines.append(f"status          {_status(f, path)}")
         return "\n".join(lines)
 
