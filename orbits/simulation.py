@@ -866,7 +866,8 @@ class Simulation(Driven):
         stops = dict(self.stop_conditions)
         stops = {k: val for k, val in stops.items() if val is not None and val is not False}
         new.__init__(bs, self.integrator, dt=None if self._dt == 0 else self.dt,
-                     forces=list(self._terms), monitors=self.monitors, monitor_every=self.monitor_every,
+                     forces=list(self._terms), monitors=self.monitors,
+                     monitor_every=self.monitor_every,
                      softening=self._softening, parallel=self.parallel,
                      rebound_arithmetic=self.rebound_arithmetic, **stops)
         # the integrator's state that does not depend on the number of bodies
