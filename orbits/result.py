@@ -376,15 +376,21 @@ class Result:
         i = self._index(body)
         U, x, v, m = self._internal()
         n = x.shape[0]
+        # masses at each output where collisions changed them (NaN: merged
+        # away), else the masses at the start for every output
+        mh = (np.nan_to_num(self.masses_at_outputs.to_value(U.unit("mass")))
+              if self.masses_at_outputs is not None else np.broadcast_to(m, (n, len(m))))
         if primary is None:
             interior = m[:i]
             if i == 0 or not np.any(interior > 0):
                 raise BodyError("orbital elements need a primary: no massive body comes "
                                 "before this one in the set; name one with primary=",
                                 body=body, field="primary")
-            mp = interior.sum()
-            xp = (interior @ x[:, :i]) / mp
-            vp = (interior @ v[:, :i]) / mp
+            w = mh[:, :i]
+            mp = w.sum(axis=1)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                xp = np.einsum("kj,kjd->kd", w, np.nan_to_num(x[:, :i])) / mp[:, None]
+                vp = np.einsum("kj,kjd->kd", w, np.nan_to_num(v[:, :i])) / mp[:, None]
         else:
             if not isinstance(primary, str) or primary not in self.names:
                 raise UnknownBodyError(f"unknown primary {primary!r}; known bodies: "
@@ -394,15 +400,27 @@ class Result:
             if j == i:
                 raise BodyError("a body has no orbit about itself; name another primary",
                                 body=body, field="primary")
-            mp, xp, vp = m[j], x[:, j], v[:, j]
-        mu = U.G * (mp + m[i])
-        if not mu > 0:
+            mp, xp, vp = mh[:, j], x[:, j], v[:, j]
+        mu = U.G * (mp + mh[:, i])
+        if not np.any(mu > 0):
             raise ElementsError("the primary and the body are both massless; an orbit "
                                 "needs mass", body=body, field="primary")
-        out = np.empty((n, 7))
+        # outputs after a collision merged the body (or its primary) away: NaN
+        here = np.isfinite(x[:, i, 0]) & np.isfinite(xp[:, 0])
+        out = np.full((n, 7), np.nan)
         status = np.zeros(n, dtype=np.int64)
-        _kepler.state_to_elements_many(np.full(n, mu), np.ascontiguousarray(x[:, i] - xp),
-                                       np.ascontiguousarray(v[:, i] - vp), out, status)
+        if here.all():
+            _kepler.state_to_elements_many(np.ascontiguousarray(mu, dtype=float),
+                                           np.ascontiguousarray(x[:, i] - xp),
+                                           np.ascontiguousarray(v[:, i] - vp), out, status)
+        elif here.any():
+            part = np.empty((int(here.sum()), 7))
+            st = np.zeros(len(part), dtype=np.int64)
+            _kepler.state_to_elements_many(np.ascontiguousarray(mu[here], dtype=float),
+                                           np.ascontiguousarray(x[here, i] - xp[here]),
+                                           np.ascontiguousarray(v[here, i] - vp[here]),
+                                           part, st)
+            out[here], status[here] = part, st
         bad = np.flatnonzero(status)
         if bad.size:
             k = int(bad[0])
@@ -413,7 +431,7 @@ class Result:
         a = out[:, 0]
         period = np.full(n, np.nan)
         bound = a > 0
-        period[bound] = 2.0 * math.pi * np.sqrt(a[bound] ** 3 / mu)
+        period[bound] = 2.0 * math.pi * np.sqrt(a[bound] ** 3 / mu[bound])
         q = U.quantity
         elements = {"a": q(a, "length"), "e": out[:, 1] << u.dimensionless_unscaled}
         for k, key in enumerate(_ELEMENT_KEYS[2:], start=2):

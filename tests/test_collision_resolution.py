@@ -272,3 +272,17 @@ def test_the_barycentre_and_the_summary_follow_the_bodies_left():
     # the pair merged while still closing: it had no closest approach to log
     # (the collisions table has it), and the log goes on with the bodies left
     assert len(res.encounters) == 0
+
+
+def test_elements_follow_the_masses_and_end_where_a_body_merged_away():
+    sim = orbits.Simulation(_crossing(), "ias15", collisions="merge")
+    res = sim.run(until=10 * u.day, outputs=11, progress=False)
+    gone = res.times > res.collisions["step_time"][0]
+    el2 = res.elements("P2", primary="Star")
+    assert np.isnan(el2["a"][gone].value).all() and np.isfinite(el2["a"][~gone].value).all()
+    # the merger's elements use its mass at each output: at the last output
+    # they equal those of the body set the run ended with (same state, same mu)
+    el1 = res.elements("P1", primary="Star")
+    end = sim.bodies.elements("P1", primary="Star")
+    assert el1["a"][-1].value == pytest.approx(end["a"].value, rel=1e-14)
+    assert el1["e"][-1].value == pytest.approx(float(end["e"]), rel=1e-12, abs=1e-15)
