@@ -41,7 +41,7 @@ __all__ = ["validate", "SECTIONS", "Task", "Pool", "run_tasks", "ValidationError
 
 #: the report's sections, in order (module names in this package)
 SECTIONS = ("accuracy", "ephemeris", "dissipative", "work_precision", "drift", "stress",
-            "guide", "chaos")
+            "collisions", "guide", "chaos")
 
 
 class ValidationError(RuntimeError):
