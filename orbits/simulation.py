@@ -677,6 +677,14 @@ class Simulation(Driven):
     COLLISION_RESOLUTIONS = _collisions.RESOLUTIONS
 
     @property
+    def _keeps_previous(self):
+        # the stopping conditions keep the state of the step before
+        # (collisions, the encounter log)
+        from ._kernels import stopping as _s
+        return self._stop is not None and bool(self._stop[0] & (_s.COLLISION
+                                                                | _s.ENCOUNTER_LOG))
+
+    @property
     def _resolves_collisions(self):
         # collisions that the run resolves and goes on (not "halt")
         c = self._stop_config.get("collisions")
@@ -1091,8 +1099,13 @@ class Simulation(Driven):
             self._saved_workspace(), self._reference.copy(), (self._E_scale, self._L_scale))
 
     def _saved_workspace(self):
-        # the workspace's arrays, and the tangent rows of a run with variations
+        # the workspace's arrays, the tangent rows of a run with variations, and
+        # the state the collision check and the encounter log keep from the
+        # step before (so that a restart looks inside its first step too)
         ws = {k: a.copy() for k, a in self._ws.items() if isinstance(a, np.ndarray)}
+        if self._keeps_previous:
+            ws["stop_prev"] = self._stop[8].copy()
+            ws["stop_clock"] = self._stop_clock.copy()
         if self._n_tangent:
             n = len(self._m)
             ws["tangent"] = np.stack([self._rows_x[n:], self._rows_v[n:]])
@@ -1126,6 +1139,9 @@ class Simulation(Driven):
         for name, arr in state.workspace.items():
             if name in self._ws:
                 self._ws[name][...] = arr
+        if self._keeps_previous and "stop_prev" in state.workspace:
+            self._stop[8][...] = state.workspace["stop_prev"]
+            self._stop_clock[...] = state.workspace["stop_clock"]
         if self._n_tangent:
             tangent = state.workspace.get("tangent")
             if tangent is None or tangent.shape != (2,) + self._rows_x[len(self._m):].shape:

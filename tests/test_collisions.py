@@ -98,3 +98,20 @@ def test_a_file_says_the_run_ended_in_a_collision(tmp_path):
     back = orbits.load(path)
     assert back.status == "collision"
     assert back.times[-1] == info.value.time
+
+
+def test_a_restart_looks_inside_its_first_step(tmp_path):
+    # the grazing passage falls inside the first step after a checkpoint at
+    # 5.0 d: the file keeps the state the check compares with, so that the
+    # restarted run finds it as the uninterrupted one does
+    path = tmp_path / "graze.h5"
+    whole = orbits.Simulation(_flyby(0.008), "leapfrog", dt=0.5 * u.day, collisions="halt")
+    with pytest.raises(Collision) as first:
+        whole.run(until=20 * u.day, outputs=2, progress=False)
+    sim = orbits.Simulation(_flyby(0.008), "leapfrog", dt=0.5 * u.day, collisions="halt")
+    sim.run(until=5 * u.day, outputs=2, progress=False, output=path)
+    again = orbits.Simulation.from_file(path)
+    with pytest.raises(Collision) as second:
+        again.run(until=20 * u.day, outputs=2, progress=False)
+    assert second.value.time == first.value.time == 5.5 * u.day
+    assert second.value.contact_time == first.value.contact_time

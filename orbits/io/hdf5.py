@@ -1346,8 +1346,11 @@ def _body_axes(integrator, n):
     """The axes of each workspace array that run over the bodies (those whose
     length differs between a workspace of ``n`` and of ``n + 1`` bodies)."""
     a, b = integrator.workspace(n), integrator.workspace(n + 1)
-    return {name: tuple(k for k, (p, q) in enumerate(zip(arr.shape, b[name].shape)) if p != q)
+    axes = {name: tuple(k for k, (p, q) in enumerate(zip(arr.shape, b[name].shape)) if p != q)
             for name, arr in a.items() if isinstance(arr, np.ndarray)}
+    # the collision check's state of the step before: (positions and velocities, bodies, 3)
+    axes["stop_prev"] = (1,)
+    return axes
 
 
 def _padded(x, n):
