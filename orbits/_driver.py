@@ -255,6 +255,16 @@ class Driven:
 
     _resolves_collisions = False
 
+    @property
+    def _loop_may_raise(self):
+        # whether the compiled loop can raise: it calls a user's function
+        # (a Python force, or a force term the user wrote); the package's own
+        # kernels are compiled with numpy's error model and raise nothing
+        # (a user's function is never cached on disk, and a loop that calls
+        # one is not either: orbits._kernels.stepping.with_terms)
+        force = self._force
+        return force.opaque or not force.jit or not force.cache
+
     #: (k, origin): outputs are being recorded in the loop every k steps
     #: counted from step ``origin`` (see :meth:`execute`)
     _in_loop = None
@@ -316,7 +326,11 @@ class Driven:
             mon_out = np.zeros((size, MONITOR_WIDTH))
             mon = self._mon(every)
             t0 = _time.perf_counter()
-            with restored_on_error(self._X, self._V, self._ws):
+            # a copy to put back is taken only where the loop can raise (a
+            # user's function in it): the package's kernels cannot
+            guard = (restored_on_error(self._X, self._V, self._ws) if self._loop_may_raise
+                     else contextlib.nullcontext())
+            with guard:
                 status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
                     self._ws, self._X, self._V, self._t_base, t_end, self._force,
                     self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)

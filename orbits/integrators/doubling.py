@@ -5,6 +5,7 @@ import numpy as np
 from .._kernels.status import with_status
 from .._kernels import doubling as _doubling
 from .._kernels import stepping as _stepping
+from ._loops import loop_for
 from .base import AdaptiveIntegrator
 
 __all__ = ["RK4Doubling"]
@@ -56,7 +57,7 @@ class RK4Doubling(AdaptiveIntegrator):
 
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
                    max_steps):
-        loop = _doubling.doubling_loop(force, stop=stop is not None)
+        loop = loop_for(_doubling.doubling_loop, force, stop=stop is not None)
         fargs = _stepping.work_bound(force, fargs, ws)
         w = ws
         return with_status(*loop(x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"],

@@ -7,6 +7,7 @@ from .._kernels import embedded as _embedded
 from .._kernels import stepping as _stepping
 from . import dop853_coefficients as _dop853
 from . import tableaux
+from ._loops import loop_for
 from .base import AdaptiveIntegrator
 
 __all__ = ["EmbeddedRungeKutta", "Dopri5", "DOP853"]
@@ -46,7 +47,8 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
                    max_steps):
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
-        loop = _embedded.embedded_loop(force, self.E3 is not None, stop=stop is not None)
+        loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None,
+                        stop=stop is not None)
         fargs = _stepping.work_bound(force, fargs, ws)
         return with_status(*loop(x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
                     float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],

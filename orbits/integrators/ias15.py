@@ -6,6 +6,7 @@ from .._kernels.status import Status
 from .._kernels import ias15 as _k
 from .._kernels.stepping import NO_STOP_ARGS, work_bound
 from ..errors import IntegratorOptionError
+from ._loops import loop_for
 from .base import AdaptiveIntegrator
 
 __all__ = ["IAS15"]
@@ -136,7 +137,7 @@ class IAS15(AdaptiveIntegrator):
 
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out,
                    stop, max_steps):
-        loop = _k.ias15_loop(force, stop=stop is not None)
+        loop = loop_for(_k.ias15_loop, force, stop=stop is not None)
         fargs = work_bound(force, fargs, ws)
         status, t_reached, n_mon = loop(
             x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
