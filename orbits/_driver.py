@@ -308,13 +308,70 @@ class Driven:
 
     def _outputs_adaptive(self, plan, rec, bar, first_mark):
         wall0 = self._wall0
-        for k in range(first_mark + 1, plan.outputs):
+        first = first_mark + 1
+        if self._marks_in_loop(plan, rec):
+            # the outputs before the last, recorded inside the compiled loop
+            last = plan.outputs - 1
+            while first < last:
+                first = self._advance_marks(plan, first, last, rec, bar, wall0)
+        for k in range(first, plan.outputs):
             self._advance_adaptive(plan.output_time(k), rec, wall0)
             bar.update(1)
             rec.output(self, final=k == plan.outputs - 1)
         if plan.outputs == 1:
             self._advance_adaptive(plan.until, rec, wall0)
             rec.output(self, final=True)
+
+    def _marks_in_loop(self, plan, rec):
+        # whether an adaptive run's outputs can be recorded in its loop: a
+        # method that lands on them there, a recorder that takes rows, and
+        # nothing an output adds beyond the state and its monitors (chaos
+        # indicators, collision offsets, a monitor series)
+        return (getattr(self.integrator, "records_marks", False)
+                and getattr(rec, "row_buffer", None) is not None
+                and getattr(rec, "records_in_loop", True) and not self.monitor_every
+                and plan.outputs >= 3 and len(self._X) == len(self._x)
+                and not self._resolves_collisions)
+
+    def _advance_marks(self, plan, first, last, rec, bar, wall0):
+        """Outputs ``first`` to ``last - 1`` of an adaptive run, as many as one
+        call of the compiled loop takes (see :meth:`execute`); returns the
+        next output's index."""
+        integ = self.integrator
+        cap = getattr(rec, "max_rows", None) or 65536
+        m = min(last - first, cap)
+        marks = np.array([plan.output_time(j) for j in range(first, first + m)])
+        rows = rec.row_buffer(m)
+        mon_t = np.empty(m)
+        steps = np.zeros(m, dtype=np.int64)
+        t0 = _time.perf_counter()
+        guard = (restored_on_error(self._X, self._V, self._ws) if self._loop_may_raise
+                 else contextlib.nullcontext())
+        with guard:
+            status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
+                self._ws, self._X, self._V, self._t_base, marks[-1], self._force,
+                self._fargs, self._mon(0), self.steps, mon_t, rows, self._stop, self._chunk,
+                marks, steps)
+        elapsed = _time.perf_counter() - t0
+        if n_mon:
+            rec.output_rows(self, steps[:n_mon], mon_t[:n_mon], rows[:n_mon])
+            bar.update(n_mon)
+        self._t_base = float(t_reached)
+        self.steps += int(acc)
+        self.steps_rejected += int(rej)
+        self.force_evaluations += int(fev)
+        if status == Status.LOG_FULL:
+            self._drain_log(rec)
+        elif status != Status.OK:
+            if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
+                self._stop_info[:] = self._ws["info"]
+            self._fail(status, rec, wall0)
+        if acc == self._chunk and elapsed < CHUNK_SECONDS / 4:
+            self._chunk *= 4
+        elif elapsed > CHUNK_SECONDS:
+            self._chunk = max(16, self._chunk // 2)
+        self._between_chunks(rec, wall0)
+        return first + n_mon
 
     def _advance_adaptive(self, t_end, rec, wall0):
         integ = self.integrator

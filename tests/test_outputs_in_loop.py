@@ -148,3 +148,73 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch)
     assert np.array_equal(a.positions.value, b.positions.value)
     assert np.array_equal(a.energy_error, b.energy_error)
     assert b.status == "completed" and len(b) == 41
+
+
+# -- adaptive runs: ias15 lands on the outputs inside its loop --------------------------
+
+def _adaptive_pair(make, **run):
+    # (outputs recorded in the loop, the same run taking each between calls)
+    inloop = make().run(progress=False, **run)
+    sim = make()
+    sim.monitor_every = 10 ** 9       # switches the recording in the loop off
+    between = sim.run(progress=False, **run)
+    return inloop, between, sim
+
+
+def test_ias15_outputs_in_the_loop_equal_those_taken_between_calls():
+    # the loop lands on each output time as it lands on the end of a call:
+    # same steps, same state, same monitors (with GR, and migration's work)
+    scene = orbits.scenes.outer_solar_system()
+
+    def make():
+        return orbits.Simulation(scene, "ias15", monitors=["energy", "angular_momentum"],
+                                 forces=[forces.GR("Sun"),
+                                         forces.Migration("Saturn", tau_a=1e6 * u.yr)])
+    a, b, sim = _adaptive_pair(make, until=2000 * u.yr, outputs=1001)
+    assert len(a) == 1001 and a.steps == b.steps and a.work is not None
+    _same(a, b)
+
+
+def test_ias15_outputs_in_the_loop_stop_where_the_run_stops():
+    # a stopping condition between two outputs: the outputs before it, then
+    # the state where it stopped, as between calls
+    from orbits.errors import Collision
+    b = orbits.BodySet()
+    b.add("Star", mass=1 * u.Msun, radius=0.005 * u.au)
+    b.add("Comet", mass=0 * u.kg, position=[1, 0, 0] * u.au,
+          velocity=[-0.001, 0, 0] * u.au / u.day, radius=1 * u.km)
+
+    def make():
+        return orbits.Simulation(b, "ias15", collisions="halt")
+    results = []
+    for off in (False, True):
+        sim = make()
+        if off:
+            sim.monitor_every = 10 ** 9
+        with pytest.raises(Collision) as info:
+            sim.run(until=1 * u.yr, outputs=366, progress=False)
+        results.append(info.value.result)
+    assert 50 < len(results[0]) < 366
+    _same(*results)
+
+
+def test_ias15_outputs_streamed_to_a_file_in_pieces(tmp_path, monkeypatch):
+    from orbits.io import hdf5
+    monkeypatch.setattr(hdf5.FileRecorder, "max_rows", 7)
+    scene = orbits.scenes.outer_solar_system()
+
+    def make():
+        return orbits.Simulation(scene, "ias15")
+    mem = make().run(until=500 * u.yr, outputs=101, progress=False)
+    path = tmp_path / "run.h5"
+    make().run(until=500 * u.yr, outputs=101, output=path, progress=False)
+    back = orbits.load(path)
+    _same(mem, back)
+    # the file's step counts are those of the outputs, as between calls
+    path2 = tmp_path / "between.h5"
+    make().run(until=500 * u.yr, outputs=101, output=path2, progress=False,
+               checkpoint_interval=0)
+    import h5py
+    with h5py.File(path, "r") as f, h5py.File(path2, "r") as g:
+        assert np.array_equal(f["particles/bodies/position/step"][()],
+                              g["particles/bodies/position/step"][()])

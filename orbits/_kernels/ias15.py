@@ -288,7 +288,7 @@ def _b6_rounding(x, xs, a0, acc, n):
 
 def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, dtp, ref,
                 tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
-                epsilon, min_dt, mode):
+                epsilon, min_dt, mode, marks=None, mark_steps=None):
     # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
     # ref = (length of the reference step, time from its start to now).
     # tc = (time, the part of it that t + dt rounded away): the time is carried
@@ -296,6 +296,12 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     # the state is still at the time it is labelled with.  The compensation is
     # used only when the loop is called again at the time it returned.
     # counts: (accepted, rejected, force evaluations) of this call.
+    # marks (outputs recorded in the loop): the loop lands on each of these
+    # times in turn, as it lands on t_end, and records there a row of
+    # mon_out (monitors and state, orbits._kernels.stepping.record_state) with
+    # its time in mon_t and its step count in mark_steps; t_end is then the
+    # last mark.  The rows count in n_mon.  Without marks (None) this compiles
+    # to the loop that lands on t_end alone.
     n = x.shape[0]
     # the step control measures the bodies' rows (not the tangent rows of variations)
     ne = rows(x, fargs)  # noqa: F821 - bound by specialize
@@ -312,11 +318,17 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         return Status.OK, t, n_mon
     direction = 1.0 if t_end > t else -1.0
     ct = tc[1] if t == tc[0] else 0.0
+    target = t_end
+    k_mark = 0
+    if marks is not None:
+        target = marks[0]
     eps7 = epsilon ** (1.0 / 7.0)
     prs7 = (_FACT7 * epsilon) ** (1.0 / 7.0)
     while True:
         if counts[0] >= max_steps:
             return Status.OK, t, n_mon
+        if marks is not None and n_mon >= mon_out.shape[0]:
+            return Status.OK, t, n_mon               # caller collects the rows first
         if until_record == 1 and n_mon >= cap:
             return Status.OK, t, n_mon               # caller collects the rows first
         if flags[0] == 0:
@@ -331,9 +343,9 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 return Status.NON_FINITE, t, n_mon
         proposed = dtp[0]
         if proposed == 0.0 or not math.isfinite(proposed):
-            proposed = _first_step(x[:ne], a0[:ne], t_end - t)
+            proposed = _first_step(x[:ne], a0[:ne], target - t)
         proposed = abs(proposed) * direction
-        remaining = (t_end - t) - ct
+        remaining = (target - t) - ct
         trimmed = abs(proposed) >= abs(remaining)
         dt = remaining if trimmed else proposed
         if not trimmed and (abs(dt) < min_dt or t + dt == t):
@@ -528,7 +540,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         if HAS_WORK:  # noqa: F821
             work_add(fargs, -dt * pw)  # noqa: F821
         if trimmed:
-            t = t_end
+            t = target
             ct = 0.0
         else:
             # t + (dt + ct) and what its rounding lost, exactly (Knuth's two-sum:
@@ -571,8 +583,19 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         if abs(proposed) < min_dt:
             info[0] = worst
             return Status.STEP_UNDERFLOW, t, n_mon
-        if t == t_end:
-            return Status.OK, t, n_mon
+        if t == target:
+            if marks is None:
+                return Status.OK, t, n_mon
+            # an output: recorded as the driver would record it on return
+            mon_t[n_mon] = t
+            record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
+            work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+            mark_steps[n_mon] = step0 + counts[0]
+            n_mon += 1
+            k_mark += 1
+            if k_mark == marks.shape[0]:
+                return Status.OK, t, n_mon
+            target = marks[k_mark]
 
 
 def _first_step(x, a0, span):
@@ -615,7 +638,7 @@ def ias15_loop(force, stop=False):
 
     The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
     dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs,
-    max_steps, epsilon, min_dt, mode)`` with the arrays of
+    max_steps, epsilon, min_dt, mode[, marks, mark_steps])`` with the arrays of
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
@@ -626,4 +649,5 @@ def ias15_loop(force, stop=False):
     return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force, stop), PREDICT_V=predict_v,
+                      record_row=force.recorder,
                       rows=measured_rows(force), **work_kernels(force), **helpers)

@@ -135,17 +135,26 @@ class IAS15(AdaptiveIntegrator):
             "P": np.zeros((7, 7)), "counts": np.zeros(3, dtype=np.int64),
         }
 
+    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
+    records_marks = True
+
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out,
-                   stop, max_steps):
+                   stop, max_steps, marks=None, mark_steps=None):
+        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
+        on each and record there a row of ``mon_out`` (monitors and state),
+        its time in ``mon_t`` and its step count in ``mark_steps``."""
         loop = loop_for(_k.ias15_loop, force, stop=stop is not None)
         fargs = work_bound(force, fargs, ws)
-        status, t_reached, n_mon = loop(
-            x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
-            ws["er"], ws["csx"], ws["csv"], ws["xs"], ws["vs"], ws["acc"], ws["P"],
-            ws["dt"], ws["ref"], ws["tc"], ws["flags"], ws["info"], ws["counts"], fargs, mon,
-            int(step0), mon_t, mon_out, NO_STOP_ARGS if stop is None else stop,
-            int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
-            ADAPTIVE_MODES[self.config["adaptive_mode"]])
+        args = (x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
+                ws["er"], ws["csx"], ws["csv"], ws["xs"], ws["vs"], ws["acc"], ws["P"],
+                ws["dt"], ws["ref"], ws["tc"], ws["flags"], ws["info"], ws["counts"], fargs,
+                mon, int(step0), mon_t, mon_out, NO_STOP_ARGS if stop is None else stop,
+                int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
+                ADAPTIVE_MODES[self.config["adaptive_mode"]])
+        if marks is None:
+            status, t_reached, n_mon = loop(*args)
+        else:
+            status, t_reached, n_mon = loop(*args, marks, mark_steps)
         c = ws["counts"]
         return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
 
