@@ -47,7 +47,8 @@ from .encounters import closest_approach
 from .status import Status
 
 __all__ = ["no_stop", "check_stop", "collision_check", "collision_pairs", "keep_state",
-           "encounter_log", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG"]
+           "encounter_log", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE", "UNBOUND",
+           "COLLISION", "ENCOUNTER_LOG"]
 
 ENCOUNTER_DISTANCE = 1
 ENCOUNTER_HILL = 2
