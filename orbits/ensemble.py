@@ -67,6 +67,7 @@ import json
 import linecache
 import math
 import multiprocessing
+import numbers
 import os
 import pathlib
 import socket
@@ -80,8 +81,9 @@ import numpy as np
 from . import integrators as _integrators
 from .errors import OrbitsError, RunError
 
-__all__ = ["Ensemble", "local_cluster", "MissingMainGuard", "INDEX_FILE", "SWEEP_FILE",
-           "ELEMENTS_MAX_BODIES", "PROGRESS_DELAY", "WORKER_ENVIRONMENT"]
+__all__ = ["Ensemble", "local_cluster", "MissingMainGuard", "EnsembleOptionError",
+           "INDEX_FILE", "SWEEP_FILE", "ELEMENTS_MAX_BODIES", "PROGRESS_DELAY",
+           "WORKER_ENVIRONMENT"]
 
 #: The index of finished runs in ``out_dir``: one CSV row per run, appended as
 #: each finishes (one write of a whole line, then fsync), so that an interrupted
@@ -152,6 +154,25 @@ class MissingMainGuard(OrbitsError, RuntimeError):
         self.script = script
         self.line = line
         super().__init__(message)
+
+
+class EnsembleOptionError(OrbitsError, ValueError):
+    """An argument of :meth:`Ensemble.run` that cannot be taken as given (the
+    message names it, the value and what is expected).
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.ensemble import EnsembleOptionError
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "wh", dt=1 * u.day)
+    >>> try:
+    ...     orbits.Ensemble.perturbed(sim, n=2).run(until=1 * u.yr, client="serial",
+    ...                                             batch=0)
+    ... except EnsembleOptionError as exc:
+    ...     print(exc)
+    batch must be None or a whole number of systems per batch >= 1, got 0
+    """
 
 
 class Ensemble:
@@ -294,7 +315,7 @@ class Ensemble:
 
     # -- running --------------------------------------------------------------------
     def run(self, until, client=None, *, outputs=100, out_dir=None, n_workers=None,
-            elements=None, progress=None):
+            elements=None, progress=None, batch=None):
         """Run every simulation to ``until`` and tabulate how each went.
 
         Parameters
@@ -325,6 +346,18 @@ class Ensemble:
         progress : bool, optional
             A bar counting finished runs.  Default: shown once the sweep has
             gone on for :data:`PROGRESS_DELAY` seconds.
+        batch : int, optional
+            Integrate up to this many runs together in one compiled loop, one
+            system per vector lane (:mod:`orbits._kernels.wh_batch`): runs
+            that use ``wh`` with its default options, the same number of
+            bodies (and massive bodies), step, units, monitors and start, and
+            no added force terms, stopping conditions, variations, chaos
+            monitors, ``monitor_every`` or softening.  The other runs go on
+            alone as without it.  The rows are those of the runs made one by
+            one, bit for bit (``wall_time_s`` is the batch's time shared out
+            among its runs); a run whose state turns non-finite is run again
+            alone, so that its row is that of its own failure.  Default None:
+            every run alone.
 
         Returns
         -------
@@ -337,6 +370,8 @@ class Ensemble:
 
         Raises
         ------
+        EnsembleOptionError
+            ``batch`` is not None or a whole number >= 1.
         MissingMainGuard
             With ``client=None``, when called from the top level of a script
             outside ``if __name__ == "__main__":``: each worker process imports
@@ -357,6 +392,7 @@ class Ensemble:
         """
         import pandas as pd
 
+        batch = _check_batch(batch)
         spec = _Spec(until, int(outputs), None if elements is None else tuple(elements))
         n = len(self.parameters)
         done = {}
@@ -367,25 +403,40 @@ class Ensemble:
         rows = dict(done)
         if todo:
             if isinstance(client, str) and client == "serial":
-                self._run_serial(todo, spec, out_dir, rows, progress)
+                self._run_serial(todo, spec, out_dir, rows, progress, batch)
             else:
-                self._run_dask(todo, spec, out_dir, rows, progress, client, n_workers)
+                self._run_dask(todo, spec, out_dir, rows, progress, client, n_workers, batch)
         frame = pd.DataFrame([rows[i] for i in range(n)])
         frame = frame[_column_order(frame.columns, self.parameters)].set_index("run")
         frame.attrs.update(_frame_attrs(spec, frame))
         return frame
 
-    def _run_serial(self, todo, spec, out_dir, rows, progress):
+    def _run_serial(self, todo, spec, out_dir, rows, progress, batch=None):
         bar = _bar(len(todo), progress)
         try:
-            for i in todo:
-                row = run_one(self.build, self.parameters[i], i, spec, _path(out_dir, i))
-                _finish(row, rows, out_dir)
-                bar.update(1)
+            if batch is None:
+                for i in todo:
+                    row = run_one(self.build, self.parameters[i], i, spec, _path(out_dir, i))
+                    _finish(row, rows, out_dir)
+                    bar.update(1)
+                return
+            # a few batches' worth at a time, so that runs of one kind that are
+            # not neighbours in the list still fill a batch
+            size = batch * max(1, CHUNK_MAX // batch)
+            for k in range(0, len(todo), size):
+                chunk = todo[k:k + size]
+                done, error = run_chunk(self.build, [self.parameters[i] for i in chunk],
+                                        chunk, spec, [_path(out_dir, i) for i in chunk],
+                                        batch)
+                for row in done:
+                    _finish(row, rows, out_dir)
+                bar.update(len(done))
+                if error is not None:
+                    raise error
         finally:
             bar.close()
 
-    def _run_dask(self, todo, spec, out_dir, rows, progress, client, n_workers):
+    def _run_dask(self, todo, spec, out_dir, rows, progress, client, n_workers, batch=None):
         from distributed import Client, as_completed
 
         own = None
@@ -399,11 +450,11 @@ class Ensemble:
         try:
             [build] = client.scatter([self.build], broadcast=True, hash=False)
             workers = max(1, len(client.scheduler_info().get("workers", ())))
-            chunks = _Chunks(todo, workers)
+            chunks = _Chunks(todo, workers, batch)
 
             def submit(chunk):
                 fut = client.submit(run_chunk, build, [self.parameters[i] for i in chunk],
-                                    chunk, spec, [_path(out_dir, i) for i in chunk],
+                                    chunk, spec, [_path(out_dir, i) for i in chunk], batch,
                                     key=f"orbits-run-{token}-{chunk[0]}-{len(chunk)}",
                                     pure=False)
                 futures.append(fut)
@@ -598,19 +649,23 @@ RUN_OVERHEAD_S = 2e-3
 
 class _Chunks:
     """The runs still to submit, cut into tasks (lists of run numbers) sized
-    from the time the finished runs took (see :data:`TASK_SECONDS`)."""
+    from the time the finished runs took (see :data:`TASK_SECONDS`); with
+    ``batch``, tasks of whole batches."""
 
-    def __init__(self, todo, workers):
+    def __init__(self, todo, workers, batch=None):
         self.todo = list(todo)
         self.workers = workers
         self.seconds = 0.0
         self.runs = 0
+        self.unit = batch or 1
 
     def first(self):
-        # one run a task until some have finished
-        k = min(len(self.todo), QUEUED_PER_WORKER * self.workers)
-        first, self.todo = self.todo[:k], self.todo[k:]
-        return [[i] for i in first]
+        # one run (one batch) a task until some have finished
+        out = []
+        while self.todo and len(out) < QUEUED_PER_WORKER * self.workers:
+            out.append(self.todo[:self.unit])
+            self.todo = self.todo[self.unit:]
+        return out
 
     def took(self, rows):
         for row in rows:
@@ -627,15 +682,20 @@ class _Chunks:
             # the last tasks smaller, so that the workers finish together
             share = len(self.todo) // (QUEUED_PER_WORKER * self.workers)
             size = max(1, min(size, CHUNK_MAX, share))
+            size = -(-size // self.unit) * self.unit
             chunk, self.todo = self.todo[:size], self.todo[size:]
             out.append(chunk)
         return out
 
 
-def run_chunk(build, params, indices, spec, paths):
+def run_chunk(build, params, indices, spec, paths, batch=None):
     """:func:`run_one` for several runs in one task: ``(rows, error)``, the rows
     of the runs done and the exception that stopped the task (None), so that
-    the rows finished before an error are kept."""
+    the rows finished before an error are kept.  With ``batch``, the runs
+    that can are integrated that many at a time (:mod:`orbits._batch`)."""
+    if batch is not None:
+        from ._batch import run_batched
+        return run_batched(build, params, indices, spec, paths, batch)
     rows = []
     for p, i, path in zip(params, indices, paths):
         try:
@@ -652,22 +712,39 @@ def run_one(build, params, index, spec, path=None):
     from ``build`` is the outcome ``"invalid"``.
     """
     _sync_numba_config()
-    row = {"run": index}
-    for k, val in params.items():
-        if isinstance(val, u.Quantity):
-            row[_column(k, val.unit)] = float(val.value)
-        else:
-            row[k] = _plain(val)
+    row = _parameter_row(params, index)
     loaded0 = _cache_loads()
     with _CompileRecorder() as log:
         try:
             sim = build(**params)
             outcome, exc, wall, result = _advance(sim, spec, path)
         except OrbitsError as err:     # parameters that make no simulation
-            row.update(outcome="invalid", message=str(err), stop_bodies="", steps=0,
-                       energy_error_max=math.nan, angular_momentum_error_max=math.nan,
-                       wall_time_s=0.0, **_worker_fields(loaded0, log), file="")
-            return row
+            return _invalid_row(row, err, _worker_fields(loaded0, log))
+    return _run_row(row, sim, spec, path, outcome, exc, wall, result,
+                    lambda: _worker_fields(loaded0, log))
+
+
+def _parameter_row(params, index):
+    """A row's run number and parameter columns."""
+    row = {"run": index}
+    for k, val in params.items():
+        if isinstance(val, u.Quantity):
+            row[_column(k, val.unit)] = float(val.value)
+        else:
+            row[k] = _plain(val)
+    return row
+
+
+def _invalid_row(row, err, worker):
+    """The row of a run whose parameters made no simulation (``err``)."""
+    row.update(outcome="invalid", message=str(err), stop_bodies="", steps=0,
+               energy_error_max=math.nan, angular_momentum_error_max=math.nan,
+               wall_time_s=0.0, **worker, file="")
+    return row
+
+
+def _run_row(row, sim, spec, path, outcome, exc, wall, result, worker):
+    """The row of a run that ran (``worker()``: where, and its kernels)."""
     row["outcome"] = outcome
     row["message"] = "" if exc is None else str(exc)
     row["stop_bodies"] = ",".join(getattr(exc, "bodies", ()) or ())
@@ -685,7 +762,7 @@ def run_one(build, params, index, spec, path=None):
     row.update(_chaos_indicators(sim, result))
     row.update(_final_elements(sim, spec.elements))
     row["wall_time_s"] = wall
-    row.update(_worker_fields(loaded0, log))
+    row.update(worker())
     row["file"] = "" if path is None else path.name
     return row
 
@@ -1102,6 +1179,15 @@ def _path(out_dir, i):
 
 
 # -- small helpers ----------------------------------------------------------------------
+
+def _check_batch(batch):
+    if batch is None:
+        return None
+    if isinstance(batch, bool) or not isinstance(batch, numbers.Integral) or batch < 1:
+        raise EnsembleOptionError(f"batch must be None or a whole number of systems per "
+                                  f"batch >= 1, got {batch!r}")
+    return int(batch)
+
 
 def _bar(total, progress):
     from tqdm.auto import tqdm

@@ -100,6 +100,13 @@ class Integrator:
     #: shared step epilogue, :mod:`orbits._kernels.variational`)
     chaos_indicators = True
 
+    @property
+    def batchable(self):
+        """Whether several systems integrated by this method with these options
+        can share one compiled loop, each in a vector lane
+        (``Ensemble.run(..., batch=B)``); False unless a method says otherwise."""
+        return False
+
     def __init__(self, **options):
         unknown = sorted(set(options) - set(self.options))
         if unknown:

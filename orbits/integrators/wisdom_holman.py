@@ -193,6 +193,23 @@ class WisdomHolman(Integrator):
         super().__init_subclass__(**kwargs)
         cls._prepare_table()
 
+    @property
+    def batchable(self):
+        """True for ``wh`` itself with its default options (Jacobi coordinates,
+        no corrector): the map that :mod:`orbits._kernels.wh_batch` advances
+        for many systems at once, bit for bit as this class does for one.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.integrators.get("wh").batchable
+        True
+        >>> orbits.integrators.get("wh", corrector=3).batchable
+        False
+        """
+        return (self.operators == tableaux.WH_DKD and self.config["coordinates"] == "jacobi"
+                and self.config["corrector"] == 0)
+
     @classmethod
     def _prepare_table(cls):
         ops = tuple(cls.operators)

@@ -1,0 +1,794 @@
+"""The Wisdom-Holman map for many systems at once, one system per vector lane.
+
+:func:`advance_lanes` advances ``B`` independent systems of the same number
+of bodies by the map ``K(h/2) I(h) K(h/2)`` in Jacobi coordinates (the
+``wh`` integrator with its default options; see
+:mod:`orbits._kernels.wisdom_holman` for the split), all with the same step.
+The state is kept as structure of arrays with the systems in the innermost
+axis: Jacobi positions and velocities of shape (N, 3, B), masses of shape
+(N, B).  Inside a call the loop works on a copy laid out component first,
+``X[c, i B + b]``: the Kepler drifts, independent of each other, are then
+loops over all ``(N - 1) B`` rows of all systems at once, and the
+interaction kick is a few loops over the B systems per body and per pair
+(its sums over bodies run in the scalar kernel's order).  Every such loop
+does the same operations for each element, so that LLVM turns it into
+vector instructions (four systems in an AVX2 register, eight with AVX-512)
+without a line of hand-written vector code.  Two things keep LLVM from doing
+so and are avoided: a loop whose index numba cannot prove non-negative (it
+then tests for negative indices, which Python allows, element by element:
+the loops over the systems use unsigned indices) and a branch inside the
+loop on a flag that is the same for every element (the drift's loops are
+written out once for each value of it).  Measured on the 2-core AVX2
+reference machine (``benchmarks/bench_batch.py``): the loops pay a fixed
+cost each time they start, so that batches of 16 systems or more gain most
+and a batch of one is several times slower than ``wh`` on its own.
+
+Each system gets, bit for bit, the arithmetic of the scalar kernels of
+:mod:`orbits._kernels.wisdom_holman`: the same operations in the same order
+(fastmath is off, so LLVM neither reassociates nor fuses them, and a vector
+instruction rounds each element as its scalar form does).  Where the
+scalar code branches, the lanes compute both sides and keep one with a
+select, never a branch per lane:
+
+* The Kepler drift (:func:`kepler_drift_lanes`) is
+  :func:`~orbits._kernels.kepler.kepler_drift`'s short-step path: the
+  third-order Taylor starter of the universal anomaly and Danby's quartic
+  iteration, repeated until every lane has converged (at most
+  ``_SHORT_STEP_ITER`` times; a lane that has converged keeps its anomaly
+  while the others go on, as the scalar loop would have stopped there).
+  The Stumpff functions take the same branch-free form: the four-term
+  series everywhere and, only when some lane's argument is beyond it, the
+  seven-term series after a masked number of quarterings of the argument
+  (at most three, which covers ``|z| <= 4``).
+* A lane outside that domain (a step long against its orbit, ``|dt| |v| >=
+  r / 2`` or more than a radian of eccentric anomaly; no convergence in
+  three iterations; a Stumpff argument beyond 4; a non-positive radius at
+  the end) is drifted by the scalar
+  :func:`~orbits._kernels.kepler.kepler_drift` on its own, from the same
+  start, which is what the scalar map does for it too, so that accuracy is
+  never lost: high eccentricities, near-parabolic and hyperbolic orbits are
+  solved by its bracketed solver.
+
+A system whose state turns non-finite is frozen at its last good state and
+reported (``status``, ``good``); the others go on.  The state is tested,
+as the scalar loops test it, every :data:`CHECK_EVERY` steps, and a copy of
+all lanes taken at the start of each such block lets a failed lane be
+replayed alone, step by step, to the step that failed.
+
+References
+----------
+Wisdom, J. & Holman, M. 1991, AJ 102, 1528 (the map).  Rein, H. & Tamayo, D.
+2015, MNRAS 452, 376 (WHFast: lazy synchronisation, the Kepler solver's
+starter and iteration).  Javaheri, P., Rein, H. & Tamayo, D. 2023, "WHFast512:
+a symplectic N-body integrator for planetary systems optimized with AVX512
+instructions", Open J. Astrophys. 6 (systems in vector lanes, an iteration
+count that does not branch per lane).  Danby, J. M. A. 1988, *Fundamentals of
+Celestial Mechanics*, 2nd ed., sect. 6.9 (universal variables).
+"""
+
+import math
+
+import numpy as np
+
+from ._jit import njit
+from .coordinates import interior_gm, to_jacobi
+from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL,
+                                    _SHORT_STEP_Z, _SIXTH, _STUMPFF_DIRECT_Z,
+                                    _STUMPFF_SERIES_Z, _STUMPFF_SHORT_Z, kepler_drift)
+from .invariants import MONITOR_WIDTH, monitor_row
+from .status import Status
+from .wisdom_holman import synchronize
+
+__all__ = ["CHECK_EVERY", "lanes_workspace", "kepler_drift_lanes", "interaction_kick_lanes",
+           "advance_lanes", "record_lanes", "to_lanes", "from_lanes", "lane_inertial"]
+
+#: Steps between the tests of the lanes' states for NaN and inf (as the
+#: scalar loops' ``check_every``): a block of this many steps is replayed for
+#: a lane that failed in it.
+CHECK_EVERY = 16
+
+# quarterings of a Stumpff argument the lanes can take: |z| <= 4 (the
+# scalar code's direct trigonometric form is used above) needs at most 3,
+# as 4 / 4^3 < _STUMPFF_SERIES_Z
+_QUARTERINGS = 3
+
+
+@njit(inline="always")
+def _estrin(z):
+    # orbits._kernels.kepler._stumpff_short's four-term series, as written there
+    z2 = z * z
+    c2 = (0.5 - z * (1.0 / 24)) + z2 * ((1.0 / 720) - z * (1.0 / 40320))
+    c3 = (1.0 / 6 - z * (1.0 / 120)) + z2 * ((1.0 / 5040) - z * (1.0 / 362880))
+    return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+
+
+@njit(inline="always")
+def _stumpff_lane(z, general):
+    """``orbits._kernels.kepler._stumpff_short(z)`` without a branch, and
+    whether ``z`` is in the lanes' domain (``|z| <= 4``).  ``general``
+    (the same for every lane) False: only the four-term series, valid when
+    every lane has ``|z| <= _STUMPFF_SHORT_Z``."""
+    e0, e1, e2, e3 = _estrin(z)
+    if not general:
+        return e0, e1, e2, e3, True
+    # orbits._kernels.kepler.stumpff: quarter until |z| <= 0.1 (masked), the
+    # seven-term series there, and the quarter-argument identities back
+    zq = z
+    n = 0
+    for _ in range(_QUARTERINGS):
+        big = abs(zq) > _STUMPFF_SERIES_Z
+        zq = zq * 0.25 if big else zq
+        n += 1 if big else 0
+    c2 = (1.0 / 2 - zq * (1.0 / 24 - zq * (1.0 / 720 - zq * (1.0 / 40320 - zq * (
+        1.0 / 3628800 - zq * (1.0 / 479001600 - zq * (1.0 / 87178291200)))))))
+    c3 = (1.0 / 6 - zq * (1.0 / 120 - zq * (1.0 / 5040 - zq * (1.0 / 362880 - zq * (
+        1.0 / 39916800 - zq * (1.0 / 6227020800 - zq * (1.0 / 1307674368000)))))))
+    c0 = 1.0 - zq * c2
+    c1 = 1.0 - zq * c3
+    for k in range(_QUARTERINGS):
+        up = k < n
+        d3 = 0.25 * (c2 + c0 * c3)
+        d2 = 0.5 * c1 * c1
+        zu = zq * 4.0
+        c3 = d3 if up else c3
+        c2 = d2 if up else c2
+        zq = zu if up else zq
+        d0 = 1.0 - zq * c2
+        d1 = 1.0 - zq * c3
+        c0 = d0 if up else c0
+        c1 = d1 if up else c1
+    short = -_STUMPFF_SHORT_Z <= z <= _STUMPFF_SHORT_Z
+    ok = not (z > _STUMPFF_DIRECT_Z or z < -_STUMPFF_DIRECT_Z)
+    if short:
+        return e0, e1, e2, e3, ok
+    return c0, c1, c2, c3, ok
+
+
+def lanes_workspace(n, b):
+    """The scratch arrays of :func:`advance_lanes` for ``b`` systems of ``n``
+    bodies, as a tuple in the order of its arguments (pass them as ``*ws``).
+
+    Examples
+    --------
+    >>> from orbits._kernels.wh_batch import lanes_workspace
+    >>> [a.shape for a in lanes_workspace(3, 4)][:2]
+    [(3, 12), (3, 12)]
+    """
+    m = n * b
+    return (np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)),
+            np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((8, m)), np.zeros((3, m)),
+            np.zeros((3, b)), np.zeros((3, b)), np.zeros((4, b)), np.zeros((3, m)),
+            np.zeros((3, m)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((1, 3)),
+            np.zeros((1, 3)), np.zeros(m))
+
+
+@njit(inline="always")
+def _needs_general(beta, s, ok, live, k0, m):
+    # whether some element that iterates has a Stumpff argument beyond the
+    # four-term series
+    wide = 0
+    for k in range(np.uint64(k0), np.uint64(m)):
+        z = beta[k] * s[k] * s[k]
+        wide += 1 if (ok[k] * live[k] != 0.0 and not (abs(z) <= _STUMPFF_SHORT_Z)) else 0
+    return wide > 0
+
+
+@njit(inline="always")
+def _iterate(s_, r0_, et_, be_, ze_, ok_, cv_, LF, h, nb, m, general):
+    # one quartic iteration in every element still iterating (see
+    # kepler_drift_lanes); returns how many have not converged
+    pending = 0
+    for k in range(np.uint64(nb), np.uint64(m)):
+        s = s_[k]
+        r0 = r0_[k]
+        et = et_[k]
+        beta = be_[k]
+        zeta = ze_[k]
+        c0, c1, c2, c3, inside = _stumpff_lane(beta * s * s, general)
+        G1 = s * c1
+        G2 = s * s * c2
+        G3 = s * s * s * c3
+        f = r0 * s + et * G2 + zeta * G3 - h
+        ir = 1.0 / (r0 + et * G1 + zeta * G2)
+        d1 = -f * ir
+        a = 0.5 * (et * c0 + zeta * G1) * ir
+        bb = (zeta * c0 - beta * et * G1) * ir * _SIXTH
+        dd = d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - bb)))
+        sn = s + dd
+        done = abs(dd) <= _SHORT_STEP_TOL * abs(sn)
+        going = ok_[k] * LF[k] != 0.0 and cv_[k] == 0.0
+        s_[k] = sn if going else s
+        cv_[k] = (1.0 if done else 0.0) if going else cv_[k]
+        ok_[k] = (1.0 if inside else 0.0) if going else ok_[k]
+        pending += 1 if (going and inside and not done) else 0
+    return pending
+
+
+@njit(inline="always")
+def _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF, alone, nb, m,
+             general):
+    # every converged element advanced by its anomaly with the f and g
+    # functions (see kepler_drift_lanes); returns how many are left to the
+    # scalar drift
+    n_alone = 0
+    for k in range(np.uint64(nb), np.uint64(m)):
+        mu = MU[k]
+        s = s_[k]
+        r0 = r0_[k]
+        ir0 = ir0_[k]
+        beta = be_[k]
+        zeta = ze_[k]
+        x0 = X0[k]
+        y0 = X1[k]
+        z0 = X2[k]
+        vx0 = V0[k]
+        vy0 = V1[k]
+        vz0 = V2[k]
+        sig = x0 * vx0 + y0 * vy0 + z0 * vz0
+        c0, c1, c2, c3, inside = _stumpff_lane(beta * s * s, general)
+        G1 = s * c1
+        G2 = s * s * c2
+        r = r0 + sig * G1 + zeta * G2
+        ir = 1.0 / r
+        fm1 = -mu * G2 * ir0
+        g = r0 * G1 + sig * G2
+        fdot = -mu * G1 * ir0 * ir
+        gdm1 = -mu * G2 * ir
+        live = LF[k] != 0.0
+        take = live and ok_[k] != 0.0 and cv_[k] != 0.0 and inside and r > 0.0
+        X0[k] = x0 + (fm1 * x0 + g * vx0) if take else x0
+        X1[k] = y0 + (fm1 * y0 + g * vy0) if take else y0
+        X2[k] = z0 + (fm1 * z0 + g * vz0) if take else z0
+        V0[k] = vx0 + (fdot * x0 + gdm1 * vx0) if take else vx0
+        V1[k] = vy0 + (fdot * y0 + gdm1 * vy0) if take else vy0
+        V2[k] = vz0 + (fdot * z0 + gdm1 * vz0) if take else vz0
+        leave = live and not take
+        alone[k] = 1.0 if leave else 0.0
+        n_alone += 1 if leave else 0
+    return n_alone
+
+
+@njit
+def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
+    """Drift every system's Jacobi rows by ``h``: row ``i >= 1`` on its orbit
+    about its ``mu``, the centre of mass (row 0) in a straight line; elements
+    with ``LF == 0`` (frozen lanes) are left as they are.
+
+    Parameters
+    ----------
+    X, V : ndarray, shape (3, N B)
+        Jacobi positions and velocities, component first, then body ``i`` of
+        system ``b`` at ``i B + b``: every body of every system in one
+        contiguous row, so that the drifts (independent of each other) run
+        in one loop of ``(N - 1) B`` elements.  In place.
+    MU : ndarray, shape (N B,)
+        G times the interior masses (each row's Kepler ``mu``), laid out alike.
+    h : float
+        The step.
+    LF : ndarray, shape (N B,)
+        1.0 for the elements of the lanes to drift, 0.0 for frozen ones.
+    nb : int
+        B, the systems.
+    d, fl : ndarray, shapes (8, N B) and (3, N B)
+        Scratch (the drift uses rows 0 to 5 of ``d``).
+    one_x, one_v : ndarray, shape (1, 3)
+        Scratch for the scalar drift of an element outside the lanes' domain.
+
+    Notes
+    -----
+    Per element, bit for bit :func:`orbits._kernels.kepler.kepler_drift`
+    (see the module notes): its short-step path in every element at once,
+    and its own call for an element that path declines.
+    """
+    m = X.shape[1]
+    X0 = X[0]
+    X1 = X[1]
+    X2 = X[2]
+    V0 = V[0]
+    V1 = V[1]
+    V2 = V[2]
+    for k in range(nb):
+        if LF[k] != 0.0:
+            X0[k] += h * V0[k]
+            X1[k] += h * V1[k]
+            X2[k] += h * V2[k]
+    s_ = d[0]
+    r0_ = d[1]
+    ir0_ = d[2]
+    et_ = d[3]
+    be_ = d[4]
+    ze_ = d[5]
+    ok_ = fl[0]
+    cv_ = fl[1]
+    alone = fl[2]
+    # the starter (orbits._kernels.kepler.short_step_anomaly)
+    for k in range(np.uint64(nb), np.uint64(m)):
+        mu = MU[k]
+        x0 = X0[k]
+        y0 = X1[k]
+        z0 = X2[k]
+        vx0 = V0[k]
+        vy0 = V1[k]
+        vz0 = V2[k]
+        r2 = x0 * x0 + y0 * y0 + z0 * z0
+        v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
+        r0 = math.sqrt(r2)
+        ir0 = 1.0 / r0
+        et = x0 * vx0 + y0 * vy0 + z0 * vz0
+        beta = 2.0 * mu * ir0 - v2
+        zeta = mu - beta * r0
+        w = h * ir0
+        s = w * (1.0 + w * (-0.5 * et * ir0
+                            + w * ((3.0 * et * et * ir0 * ir0 - zeta * ir0) * _SIXTH)))
+        good = (h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2 and mu > 0.0 and h != 0.0
+                and abs(beta * s * s) <= _SHORT_STEP_Z)
+        s_[k] = s
+        r0_[k] = r0
+        ir0_[k] = ir0
+        et_[k] = et
+        be_[k] = beta
+        ze_[k] = zeta
+        ok_[k] = 1.0 if good else 0.0
+        cv_[k] = 0.0
+    # Danby's quartic iteration, until every element has converged; the
+    # loop is written out twice, with and without the general Stumpff form,
+    # so that the usual case carries none of the other's work
+    for _ in range(_SHORT_STEP_ITER):
+        if _needs_general(be_, s_, ok_, LF, nb, m):
+            pending = _iterate(s_, r0_, et_, be_, ze_, ok_, cv_, LF, h, nb, m, True)
+        else:
+            pending = _iterate(s_, r0_, et_, be_, ze_, ok_, cv_, LF, h, nb, m, False)
+        if pending == 0:
+            break
+    # the f and g functions (orbits._kernels.kepler._short_coefficients)
+    if _needs_general(be_, s_, ok_, LF, nb, m):
+        n_alone = _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF,
+                           alone, nb, m, True)
+    else:
+        n_alone = _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF,
+                           alone, nb, m, False)
+    # the elements outside the domain: the scalar drift, from the same start
+    if n_alone:
+        for k in range(np.uint64(nb), np.uint64(m)):
+            if alone[k] != 0.0:
+                for c in range(3):
+                    one_x[0, c] = X[c, k]
+                    one_v[0, c] = V[c, k]
+                kepler_drift(MU[k], one_x, one_v, 0, h)
+                for c in range(3):
+                    X[c, k] = one_x[0, c]
+                    V[c, k] = one_v[0, c]
+
+
+@njit
+def interaction_kick_lanes(X, V, XI, ACC, GM, MU, WQ, n_active, h, LF, nb, s3, a3, t4):
+    """Kick every system's Jacobi velocities by ``h`` times the interaction
+    accelerations (:func:`orbits._kernels.wisdom_holman.interaction_kick`,
+    bit for bit, per lane); frozen lanes (``LF == 0``) are left as they are.
+
+    Parameters
+    ----------
+    X, V : ndarray, shape (3, N B)
+        Jacobi positions and velocities, laid out as in
+        :func:`kepler_drift_lanes`; ``V`` in place.
+    XI, ACC : ndarray, shape (3, N B)
+        Scratch: the inertial positions and accelerations.
+    GM, MU : ndarray, shape (N B,)
+        G times the masses, and the interior masses.
+    WQ : ndarray, shape (N B,)
+        ``GM / MU``, the weights of the Jacobi transformation.
+    n_active : int
+        Massive bodies (the first ``n_active`` rows), the same in every system.
+    h : float
+    LF : ndarray, shape (N B,)
+    nb : int
+    s3, a3, t4 : ndarray, shapes (3, B), (3, B) and (4, B)
+        Scratch.
+    """
+    m = X.shape[1]
+    n = m // nb
+    if n <= 2:
+        return
+    # unsigned indices: numba then adds no test for negative ones, which
+    # would keep LLVM from vectorising the loops over the systems
+    unb = np.uint64(nb)
+    # inertial positions (orbits._kernels.coordinates.from_jacobi_one)
+    J0 = X[0]
+    J1 = X[1]
+    J2 = X[2]
+    X0 = XI[0]
+    X1 = XI[1]
+    X2 = XI[2]
+    S0 = s3[0]
+    S1 = s3[1]
+    S2 = s3[2]
+    for b in range(unb):
+        S0[b] = J0[b]
+        S1[b] = J1[b]
+        S2[b] = J2[b]
+    for i in range(n - 1, 0, -1):
+        o = np.uint64(i * nb)
+        for b in range(unb):
+            k = o + b
+            w = WQ[k]
+            S0[b] -= w * J0[k]
+            X0[k] = J0[k] + S0[b]
+            S1[b] -= w * J1[k]
+            X1[k] = J1[k] + S1[b]
+            S2[b] -= w * J2[k]
+            X2[k] = J2[k] + S2[b]
+    for b in range(unb):
+        X0[b] = S0[b]
+        X1[b] = S1[b]
+        X2[b] = S2[b]
+    # every pair but (0, 1) (orbits._kernels.gravity.pair_accelerations):
+    # three short loops over the systems a pair (the separation, the pull on
+    # the later body, the reaction on the earlier one), which LLVM vectorises
+    # better than one loop with all three (measured)
+    A0 = ACC[0]
+    A1 = ACC[1]
+    A2 = ACC[2]
+    for k in range(m):
+        A0[k] = 0.0
+        A1[k] = 0.0
+        A2[k] = 0.0
+    p0 = a3[0]
+    p1 = a3[1]
+    p2 = a3[2]
+    t0 = t4[0]
+    t1 = t4[1]
+    t2 = t4[2]
+    q = t4[3]
+    for i in range(1, n):
+        oi = np.uint64(i * nb)
+        for b in range(unb):
+            p0[b] = 0.0
+            p1[b] = 0.0
+            p2[b] = 0.0
+        for j in range(1 if i == 1 else 0, min(i, n_active)):
+            oj = np.uint64(j * nb)
+            for b in range(unb):
+                dx = X0[oi + b] - X0[oj + b]
+                dy = X1[oi + b] - X1[oj + b]
+                dz = X2[oi + b] - X2[oj + b]
+                r2 = dx * dx + dy * dy + dz * dz
+                t0[b] = dx
+                t1[b] = dy
+                t2[b] = dz
+                q[b] = 1.0 / (r2 * math.sqrt(r2))
+            for b in range(unb):
+                sj = GM[oj + b] * q[b]
+                p0[b] -= sj * t0[b]
+                p1[b] -= sj * t1[b]
+                p2[b] -= sj * t2[b]
+            if i < n_active:
+                for b in range(unb):
+                    si = GM[oi + b] * q[b]
+                    A0[oj + b] += si * t0[b]
+                    A1[oj + b] += si * t1[b]
+                    A2[oj + b] += si * t2[b]
+        for b in range(unb):
+            A0[oi + b] += p0[b]
+            A1[oi + b] += p1[b]
+            A2[oi + b] += p2[b]
+    # to Jacobi components, with the Kepler terms of rows i >= 2
+    # (orbits._kernels.wisdom_holman.jacobi_velocity_kick)
+    for b in range(unb):
+        S0[b] = A0[b]
+        S1[b] = A1[b]
+        S2[b] = A2[b]
+    W0 = V[0]
+    W1 = V[1]
+    W2 = V[2]
+    for i in range(1, n):
+        o = np.uint64(i * nb)
+        for b in range(unb):
+            k = o + b
+            w = WQ[k]
+            ax = A0[k] - S0[b]
+            ay = A1[k] - S1[b]
+            az = A2[k] - S2[b]
+            S0[b] += w * ax
+            S1[b] += w * ay
+            S2[b] += w * az
+            if i >= 2:
+                rx = J0[k]
+                ry = J1[k]
+                rz = J2[k]
+                r2 = rx * rx + ry * ry + rz * rz
+                s = MU[k] / (r2 * math.sqrt(r2))
+                ax += s * rx
+                ay += s * ry
+                az += s * rz
+            keep = LF[k] != 0.0
+            W0[k] = W0[k] + h * ax if keep else W0[k]
+            W1[k] = W1[k] + h * ay if keep else W1[k]
+            W2[k] = W2[k] + h * az if keep else W2[k]
+
+
+@njit(inline="always")
+def _step(X, V, GM, MU, n_active, dt, owed, LF, nb, XI, ACC, d, fl, s3, a3, t4, one_x,
+          one_v):
+    # one step of K(h/2) I(h) K(h/2) with the closing half drift deferred (as
+    # orbits._kernels.wisdom_holman's loop does with the table WH_DKD):
+    # returns the drift now owed
+    kepler_drift_lanes(X, V, MU, 0.5 * dt + owed, LF, nb, d, fl, one_x, one_v)
+    interaction_kick_lanes(X, V, XI, ACC, GM, MU, d[6], n_active, 1.0 * dt, LF, nb, s3, a3,
+                           t4)
+    return 0.5 * dt
+
+
+@njit(inline="always")
+def _lane_finite(X, V, nb, b):
+    # orbits._kernels.stepping.state_is_finite, of lane b
+    s = 0.0
+    for i in range(X.shape[1] // nb):
+        k = i * nb + b
+        s += X[0, k] + X[1, k] + X[2, k] + V[0, k] + V[1, k] + V[2, k]
+    return math.isfinite(s)
+
+
+@njit
+def advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, good, X, V, XI,
+                  ACC, GM, MU, LF, d, fl, s3, a3, t4, ckx, ckv, px, pv, one_x, one_v, lf1):
+    """Advance every live system ``nsteps`` steps of the Wisdom-Holman map.
+
+    Parameters
+    ----------
+    xj, vj : ndarray, shape (N, 3, B)
+        The systems' Jacobi positions and velocities (lane ``b`` is system
+        ``b``), advanced in place.
+    gm, eta : ndarray, shape (N, B)
+        G times the masses, and the interior masses
+        (:func:`orbits._kernels.coordinates.interior_gm` of each column).
+    n_active : int
+        Massive bodies, the first rows (the same in every system).
+    dt : float
+        The step.
+    nsteps : int
+    owed : ndarray, shape (B,)
+        The closing half drift each lane still owes (0 before its first
+        step; :func:`orbits._kernels.wisdom_holman.synchronize` applies it),
+        in place.  The live lanes owe the same.
+    live : ndarray, shape (B,)
+        1.0 for a system that goes on, 0.0 for one that is frozen; in place.
+    status, good : ndarray, shape (B,), int64
+        ``good``: the steps of this call each lane completed.  A lane that
+        fails here gets ``Status.NON_FINITE`` in ``status``; ``xj``, ``vj``
+        and ``owed`` keep its state after its good steps, and ``live``
+        turns 0.
+    X .. lf1
+        Scratch: :func:`lanes_workspace`'s arrays.  The loop works on the
+        state laid out as :func:`kepler_drift_lanes` says, copied in at the
+        start of the call and out at its end.
+
+    Returns
+    -------
+    failed : int
+        Lanes that failed in this call.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits._kernels import wh_batch
+    >>> gm = np.array([[1.0, 1.0], [1e-3, 2e-3], [1e-3, 1e-3]])   # (N, B): two systems
+    >>> x = np.zeros((3, 3, 2)); v = np.zeros((3, 3, 2))
+    >>> x[1, 0], v[1, 1] = 1.0, 1.0                               # circular planets
+    >>> x[2, 0], v[2, 1] = 2.0, 0.5 ** 0.5
+    >>> xj, vj, eta = wh_batch.to_lanes(x, v, gm)
+    >>> ws = wh_batch.lanes_workspace(3, 2)
+    >>> owed, live = np.zeros(2), np.ones(2)
+    >>> status, good = np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64)
+    >>> wh_batch.advance_lanes(xj, vj, gm, eta, 3, 0.01, 100, owed, live, status, good, *ws)
+    0
+    >>> owed, good
+    (array([0.005, 0.005]), array([100, 100]))
+    """
+    n = xj.shape[0]
+    nb = xj.shape[2]
+    failed = 0
+    for b in range(nb):
+        if live[b] != 0.0:
+            good[b] = 0
+    if nsteps <= 0:
+        return failed
+    for i in range(n):
+        for b in range(nb):
+            k = i * nb + b
+            for c in range(3):
+                X[c, k] = xj[i, c, b]
+                V[c, k] = vj[i, c, b]
+            GM[k] = gm[i, b]
+            MU[k] = eta[i, b]
+            # the kick's mass ratios, once a call rather than twice a step
+            d[6, k] = gm[i, b] / eta[i, b]
+            LF[k] = live[b]
+    # every live lane owes the same: that of the first live one
+    ow = 0.0
+    for b in range(nb):
+        if live[b] != 0.0:
+            ow = owed[b]
+            break
+    step = 0
+    while step < nsteps:
+        blk = min(CHECK_EVERY, nsteps - step)
+        # the block's start, for a lane that fails in it
+        for c in range(3):
+            for k in range(n * nb):
+                ckx[c, k] = X[c, k]
+                ckv[c, k] = V[c, k]
+        ow0 = ow
+        for _ in range(blk):
+            ow = _step(X, V, GM, MU, n_active, dt, ow, LF, nb, XI, ACC, d, fl, s3, a3, t4,
+                       one_x, one_v)
+        for b in range(nb):
+            if live[b] == 0.0 or _lane_finite(X, V, nb, b):
+                continue
+            # replay lane b alone from the block's start, to its last good step
+            for i in range(n):
+                k = i * nb + b
+                for c in range(3):
+                    X[c, k] = ckx[c, k]
+                    V[c, k] = ckv[c, k]
+            for k in range(n * nb):
+                lf1[k] = 0.0
+            for i in range(n):
+                lf1[i * nb + b] = 1.0
+            owr = ow0
+            done = 0
+            for _ in range(blk):
+                for i in range(n):
+                    k = i * nb + b
+                    for c in range(3):
+                        px[i, c] = X[c, k]
+                        pv[i, c] = V[c, k]
+                nxt = _step(X, V, GM, MU, n_active, dt, owr, lf1, nb, XI, ACC, d, fl, s3, a3,
+                            t4, one_x, one_v)
+                if not _lane_finite(X, V, nb, b):
+                    for i in range(n):
+                        k = i * nb + b
+                        for c in range(3):
+                            X[c, k] = px[i, c]
+                            V[c, k] = pv[i, c]
+                    break
+                owr = nxt
+                done += 1
+            live[b] = 0.0
+            for i in range(n):
+                LF[i * nb + b] = 0.0
+            owed[b] = owr
+            status[b] = Status.NON_FINITE
+            good[b] = step + done
+            failed += 1
+        step += blk
+    for i in range(n):
+        for b in range(nb):
+            k = i * nb + b
+            for c in range(3):
+                xj[i, c, b] = X[c, k]
+                vj[i, c, b] = V[c, k]
+    for b in range(nb):
+        if live[b] != 0.0:
+            owed[b] = ow
+            good[b] = nsteps
+    return failed
+
+
+def to_lanes(x, v, gm):
+    """The lanes' Jacobi state of systems given in inertial coordinates.
+
+    Parameters
+    ----------
+    x, v : ndarray, shape (N, 3, B)
+        Inertial positions and velocities of B systems (massive bodies first,
+        the central one at row 0).
+    gm : ndarray, shape (N, B)
+        G times the masses.
+
+    Returns
+    -------
+    xj, vj : ndarray, shape (N, 3, B)
+        Jacobi positions and velocities
+        (:func:`orbits._kernels.coordinates.to_jacobi` of each system).
+    eta : ndarray, shape (N, B)
+        G times the interior masses.
+    """
+    n, _, nb = x.shape
+    xj = np.zeros((n, 3, nb))
+    vj = np.zeros((n, 3, nb))
+    eta = np.zeros((n, nb))
+    for b in range(nb):
+        g = np.ascontiguousarray(gm[:, b])
+        e = np.zeros(n)
+        interior_gm(g, e)
+        a = np.zeros((n, 3))
+        w = np.zeros((n, 3))
+        to_jacobi(np.ascontiguousarray(x[:, :, b]), np.ascontiguousarray(v[:, :, b]), g, e,
+                  a, w)
+        xj[:, :, b] = a
+        vj[:, :, b] = w
+        eta[:, b] = e
+    return xj, vj, eta
+
+
+def from_lanes(xj, vj, gm, eta, owed, n_active):
+    """Inertial positions and velocities, shape (N, 3, B), of the lanes' state
+    (:func:`orbits._kernels.wisdom_holman.synchronize` of each system: its
+    owed drift applied to a copy, then back from Jacobi coordinates)."""
+    n, _, nb = xj.shape
+    x = np.zeros((n, 3, nb))
+    v = np.zeros((n, 3, nb))
+    for b in range(nb):
+        a, w = lane_inertial(xj, vj, gm, eta, owed, n_active, b)
+        x[:, :, b] = a
+        v[:, :, b] = w
+    return x, v
+
+
+def lane_inertial(xj, vj, gm, eta, owed, n_active, b):
+    """Inertial positions and velocities, each of shape (N, 3), of lane ``b``
+    (see :func:`from_lanes`)."""
+    n = xj.shape[0]
+    x = np.zeros((n, 3))
+    v = np.zeros((n, 3))
+    _synchronize_lane(xj, vj, gm, eta, owed, n_active, b, np.zeros((6, n, 3)),
+                      np.zeros((2, n)), np.zeros((0, 2)), x, v)
+    return x, v
+
+
+@njit
+def _synchronize_lane(xj, vj, gm, eta, owed, n_active, b, sc, ge, corr, x, v):
+    # the scalar synchronisation of lane b into x, v (shape (N, 3)); sc
+    # (shape (6, N, 3)) and ge (shape (2, N)) are scratch: the lane's Jacobi
+    # state, masses and interior masses, the copy that drifts, and the
+    # drift's scratch
+    n = xj.shape[0]
+    g = ge[0]
+    e = ge[1]
+    for i in range(n):
+        for c in range(3):
+            sc[0, i, c] = xj[i, c, b]
+            sc[1, i, c] = vj[i, c, b]
+        g[i] = gm[i, b]
+        e[i] = eta[i, b]
+    synchronize(sc[0], sc[1], g, e, owed[b], sc[2], sc[3], x, v, sc[5], n_active, corr,
+                0.0, ())
+
+
+@njit
+def record_lanes(xj, vj, gm, eta, owed, live, n_active, m, G, which, sc, ge, corr, x, v,
+                 rows):
+    """One output row of every live lane: its inertial state at the current
+    time (:func:`orbits._kernels.wisdom_holman.synchronize`, on a copy) and
+    the monitors of :func:`orbits._kernels.invariants.monitor_row`, in the
+    layout of the rows that the scalar loops record
+    (:func:`orbits._kernels.stepping.record_state`).
+
+    Parameters
+    ----------
+    xj, vj, gm, eta, owed, live, n_active
+        As :func:`advance_lanes`.
+    m : ndarray, shape (B, N)
+        Each system's masses.
+    G : float
+    which : int
+        The monitors' bits (:mod:`orbits._kernels.invariants`).
+    sc, ge, corr : ndarray, shapes (6, N, 3), (2, N) and (0, 2)
+        Scratch, and the (empty) corrector table.
+    x, v : ndarray, shape (N, 3)
+        Scratch: a lane's inertial state.
+    rows : ndarray, shape (B, MONITOR_WIDTH + 6 N)
+        Row ``b`` written for each live lane ``b`` (the others left).
+    """
+    n = xj.shape[0]
+    w = MONITOR_WIDTH
+    for b in range(xj.shape[2]):
+        if live[b] == 0.0:
+            continue
+        _synchronize_lane(xj, vj, gm, eta, owed, n_active, b, sc, ge, corr, x, v)
+        row = rows[b]
+        monitor_row(x, v, m[b], G, n_active, 0.0, which, row)
+        for i in range(n):
+            for c in range(3):
+                row[w + 3 * i + c] = x[i, c]
+                row[w + 3 * (n + i) + c] = v[i, c]

@@ -1,0 +1,268 @@
+"""The Wisdom-Holman map across systems (orbits._kernels.wh_batch): every lane
+against the scalar kernels, bit for bit, and the Kepler drift against 50-digit
+arithmetic."""
+
+import importlib.util
+import math
+import pathlib
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+import orbits
+from orbits._kernels import kepler as K
+from orbits._kernels import wh_batch as W
+from orbits._kernels.invariants import MONITOR_WIDTH
+from orbits._kernels.status import Status
+
+# the 50-digit drift of the scalar Kepler tests (bisection on the universal
+# Kepler equation in mpmath)
+_spec = importlib.util.spec_from_file_location(
+    "_kepler_drift_tests", pathlib.Path(__file__).with_name("test_kepler_drift.py"))
+_mod = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_mod)
+mp_drift = _mod.mp_drift
+
+#: eccentricities: those of the validation problems (the giant planets below
+#: 0.06, Mercury 0.21, the Kepler problems 0.5 and 0.9), then beyond them,
+#: near-parabolic and hyperbolic orbits, which the lanes leave to the scalar
+#: drift where its short-step path does not apply
+ECCENTRICITIES = (0.0, 0.05, 0.21, 0.5, 0.9, 0.99, 0.999, 1.5, 5.0)
+#: steps as fractions of the period (of 2 pi / n for a hyperbola): the
+#: validation problems' (kepler-e0.9 P/1000, the outer solar system's 10 days
+#: P_Jupiter/433, kepler-e0.5 P/200, the Sun and eight planets' 1 day
+#: P_Mercury/88), then longer ones
+STEP_RATIOS = (1 / 1000, 1 / 433, 1 / 200, 1 / 88, 1 / 20, 1 / 5)
+VALIDATION_E = 0.9
+VALIDATION_RATIO = 1 / 88
+
+LANES = 12
+
+
+def orbit_lanes(e, ratio, lanes=LANES):
+    """Jacobi arrays (2, 3, lanes) of a body on an orbit of eccentricity e about
+    mu = 1 (row 0 the centre of mass at rest), spread over the orbit, and the
+    step ratio * period."""
+    a = 1.0 if e < 1 else -1.0
+    xj, vj = np.zeros((2, 3, lanes)), np.zeros((2, 3, lanes))
+    for b in range(lanes):
+        M = -math.pi + 2 * math.pi * (b + 0.5) / lanes
+        if e < 1:
+            f = K.true_from_mean(M, e)
+        else:
+            f = K.true_from_mean(M * 2.0, e)    # both branches of the hyperbola
+        x, v = np.zeros(3), np.zeros(3)
+        assert K.elements_to_state(1.0, a, e, 0.3, 1.1, 2.3, f, x, v) == 0
+        xj[1, :, b], vj[1, :, b] = x, v
+    return xj, vj, ratio * 2 * math.pi
+
+
+def drift_lanes(xj, vj, h):
+    """kepler_drift_lanes on the (N, 3, B) arrays, in place; the lanes of row 1
+    that took the scalar drift."""
+    n, _, nb = xj.shape
+    X = np.ascontiguousarray(xj.transpose(1, 0, 2).reshape(3, n * nb))
+    V = np.ascontiguousarray(vj.transpose(1, 0, 2).reshape(3, n * nb))
+    fl = np.zeros((3, n * nb))
+    W.kepler_drift_lanes(X, V, np.ones(n * nb), h, np.ones(n * nb), nb, np.zeros((8, n * nb)),
+                         fl, np.zeros((1, 3)), np.zeros((1, 3)))
+    xj[...] = X.reshape(3, n, nb).transpose(1, 0, 2)
+    vj[...] = V.reshape(3, n, nb).transpose(1, 0, 2)
+    return fl[2, nb:2 * nb].copy()
+
+
+@pytest.mark.parametrize("e", ECCENTRICITIES)
+def test_drift_lanes_are_the_scalar_drift_bit_for_bit(e):
+    # each lane does kepler_drift's operations in its order (the module notes),
+    # and a lane outside the lanes' domain is kepler_drift itself
+    for ratio in STEP_RATIOS:
+        for sign in (1, -1):
+            xj, vj, h = orbit_lanes(e, ratio)
+            x0, v0 = xj.copy(), vj.copy()
+            drift_lanes(xj, vj, sign * h)
+            for b in range(LANES):
+                xs = np.ascontiguousarray(x0[1:, :, b])
+                vs = np.ascontiguousarray(v0[1:, :, b])
+                K.kepler_drift(1.0, xs, vs, 0, sign * h)
+                assert np.array_equal(xj[1, :, b], xs[0]), (e, ratio, sign, b)
+                assert np.array_equal(vj[1, :, b], vs[0]), (e, ratio, sign, b)
+
+
+def test_lanes_take_every_validation_step_and_leave_long_or_extreme_ones_to_the_scalar_drift():
+    for e in ECCENTRICITIES:
+        for ratio in STEP_RATIOS:
+            xj, vj, h = orbit_lanes(e, ratio)
+            alone = drift_lanes(xj, vj, h)
+            if e <= VALIDATION_E and ratio <= VALIDATION_RATIO:
+                assert not alone.any(), (e, ratio)
+    # a fifth of an orbit is no short step but near apocentre (measured: 10 of
+    # the 12 lanes go to the scalar drift), and neither is the hyperbola's
+    # passage of its pericentre in such a step
+    xj, vj, h = orbit_lanes(0.5, 1 / 5)
+    assert drift_lanes(xj, vj, h).sum() >= LANES // 2
+    for e in (0.99, 1.5):
+        xj, vj, h = orbit_lanes(e, 1 / 5)
+        assert drift_lanes(xj, vj, h).any(), e
+
+
+@pytest.mark.parametrize("e", [x for x in ECCENTRICITIES if x <= VALIDATION_E])
+def test_drift_lanes_reach_round_off_on_the_validation_orbits(e):
+    worst = 0.0
+    for ratio in [r for r in STEP_RATIOS if r <= VALIDATION_RATIO]:
+        xj, vj, h = orbit_lanes(e, ratio, lanes=4)
+        x0, v0 = xj.copy(), vj.copy()
+        drift_lanes(xj, vj, h)
+        for b in range(4):
+            xr, vr = mp_drift(1.0, x0[1, :, b], v0[1, :, b], h)
+            err = max(np.linalg.norm(xj[1, :, b] - xr) / np.linalg.norm(xr),
+                      np.linalg.norm(vj[1, :, b] - vr) / np.linalg.norm(vr))
+            worst = max(worst, err)
+    # one short step is a handful of roundings: measured at most 1.3e-16 here;
+    # the bound is that of the scalar drift's test against mpmath (1e-13),
+    # far below any integration error and far above a wrong root
+    assert worst < 1e-13
+
+
+ZS = [0.0, 1e-7, 1e-4, 2e-3, np.nextafter(2e-3, 1), 0.05, 0.1, np.nextafter(0.1, 1), 0.3,
+      0.4, np.nextafter(0.4, 1), 1.0, 1.6, np.nextafter(1.6, 2), 3.9, 4.0]
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_stumpff_lanes_are_the_scalar_stumpff_functions_bit_for_bit(sign):
+    # every branch of kepler._stumpff_short and its boundaries (the series, the
+    # quartered argument 1, 2 and 3 times), taken without a branch
+    for z in ZS:
+        z = sign * z
+        *c, inside = W._stumpff_lane(z, True)
+        assert inside
+        assert c == list(K._stumpff_short(z)), z
+        if abs(z) <= 2e-3:
+            *c, _ = W._stumpff_lane(z, False)
+            assert c == list(K._stumpff_short(z)), z
+    for z in (np.nextafter(4.0, 5), 10.0, -10.0):
+        assert not W._stumpff_lane(z, True)[-1]     # beyond 4: the scalar drift
+
+
+def systems(b, scale=1e-7, monitors=()):
+    """b perturbed outer solar systems with masses scaled differently, as
+    simulations (wh, 10 days) and as lanes."""
+    sims = []
+    for k in range(b):
+        bodies = orbits.scenes.outer_solar_system()
+        rng = np.random.default_rng(k)
+        bodies._x = bodies._x * (1 + scale * rng.standard_normal(bodies._x.shape))
+        bodies._m = bodies._m * (1 + 0.1 * k * np.r_[0, np.ones(len(bodies) - 1)])
+        sims.append(orbits.Simulation(bodies, "wh", dt=10 * u.day, monitors=monitors))
+    return sims
+
+
+def masses(sim):
+    return sim.description().masses[sim.state.order]
+
+
+def lanes_of(sims):
+    x = np.stack([s.state.x for s in sims], 2)
+    v = np.stack([s.state.v for s in sims], 2)
+    gm = np.ascontiguousarray(np.stack([s.units.G * masses(s) for s in sims], 1))
+    xj, vj, eta = W.to_lanes(x, v, gm)
+    return xj, vj, gm, eta
+
+
+def advance(xj, vj, gm, eta, n_active, dt, steps, owed=None):
+    nb = xj.shape[2]
+    owed = np.zeros(nb) if owed is None else owed
+    live = np.ones(nb)
+    status, good = np.zeros(nb, dtype=np.int64), np.zeros(nb, dtype=np.int64)
+    failed = W.advance_lanes(xj, vj, gm, eta, n_active, dt, steps, owed, live, status, good,
+                             *W.lanes_workspace(xj.shape[0], nb))
+    return failed, owed, live, status, good
+
+
+@pytest.mark.parametrize("nb", [1, 3, 5])
+def test_advance_lanes_is_wh_bit_for_bit(nb):
+    sims = systems(nb)
+    xj, vj, gm, eta = lanes_of(sims)
+    n = xj.shape[0]
+    failed, owed, live, status, good = advance(xj, vj, gm, eta, n, 10.0, 500)
+    assert failed == 0 and live.all() and (good == 500).all()
+    for b, sim in enumerate(sims):
+        sim.run(until=5000 * u.day, outputs=2, progress=False)
+        ws = sim.state.workspace
+        assert np.array_equal(ws["xj"], xj[:, :, b])
+        assert np.array_equal(ws["vj"], vj[:, :, b])
+        assert ws["owed"][0] == owed[b]
+        x, v = W.lane_inertial(xj, vj, gm, eta, owed, n, b)
+        assert np.array_equal(x, sim.state.x) and np.array_equal(v, sim.state.v)
+
+
+def test_test_particles_and_a_short_last_step_bit_for_bit():
+    sims = []
+    for k in range(3):
+        bodies = orbits.scenes.outer_solar_system()
+        bodies.add("tp", mass=0 * u.Msun, primary="Sun", a=(30 + k) * u.au, e=0.1,
+                   f=1 * u.rad)
+        sims.append(orbits.Simulation(bodies, "wh", dt=10 * u.day, monitors=()))
+    xj, vj, gm, eta = lanes_of(sims)
+    n_active = len(sims[0].state.order) - 1
+    _, owed, *_ = advance(xj, vj, gm, eta, n_active, 10.0, 300)
+    advance(xj, vj, gm, eta, n_active, 3.5, 1, owed)
+    for b, sim in enumerate(sims):
+        sim.run(until=3003.5 * u.day, outputs=2, progress=False)
+        ws = sim.state.workspace
+        assert np.array_equal(ws["xj"], xj[:, :, b]) and np.array_equal(ws["vj"], vj[:, :, b])
+        assert ws["owed"][0] == owed[b] == 1.75
+
+
+def runaway(far):
+    # a test particle about a star: on a circle, or flying out from 1.3e154 at
+    # 1e76 a step of 1e76, so that |x|^2 overflows in its fifth step
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("star", mass=1.0, position=[0, 0, 0], velocity=[0, 0, 0])
+    if far:
+        b.add("q", mass=0.0, position=[1.3e154, 0, 0], velocity=[1e76, 0, 0])
+    else:
+        b.add("q", mass=0.0, position=[2.0, 0, 0], velocity=[0.0, 0.7, 0])
+    return orbits.Simulation(b, "wh", dt=1e76, monitors=())
+
+
+def test_a_lane_that_turns_non_finite_is_frozen_at_its_last_good_step():
+    sims = [runaway(False), runaway(True), runaway(False)]
+    xj, vj, gm, eta = lanes_of(sims)
+    failed, owed, live, status, good = advance(xj, vj, gm, eta, 1, 1e76, 40)
+    assert failed == 1
+    assert list(live) == [1, 0, 1] and list(status) == [0, Status.NON_FINITE, 0]
+    with pytest.raises(orbits.NonFiniteState) as info:
+        sims[1].run(until=40e76, outputs=2, progress=False)
+    # the step the scalar loop reports, in the middle of a block of CHECK_EVERY
+    assert good[1] == info.value.step == 5
+    ws = sims[1].state.workspace
+    assert np.array_equal(ws["xj"], xj[:, :, 1]) and np.array_equal(ws["vj"], vj[:, :, 1])
+    assert ws["owed"][0] == owed[1]
+    # the others went on, as alone
+    for b in (0, 2):
+        sims[b].run(until=40e76, outputs=2, progress=False)
+        assert good[b] == 40
+        assert np.array_equal(sims[b].state.workspace["xj"], xj[:, :, b])
+    # a frozen lane stays as it is
+    before = xj[:, :, 1].copy()
+    advance(xj, vj, gm, eta, 1, 1e76, 3, owed)
+    assert np.array_equal(xj[:, :, 1], before, equal_nan=True)
+
+
+def test_record_lanes_gives_the_rows_an_output_records():
+    sims = systems(3, monitors=("energy", "angular_momentum"))
+    xj, vj, gm, eta = lanes_of(sims)
+    n = xj.shape[0]
+    _, owed, live, *_ = advance(xj, vj, gm, eta, n, 10.0, 123)
+    m = np.ascontiguousarray(np.stack([masses(s) for s in sims]))
+    rows = np.zeros((3, MONITOR_WIDTH + 6 * n))
+    W.record_lanes(xj, vj, gm, eta, owed, live, n, m, sims[0].units.G, 3,
+                   np.zeros((6, n, 3)), np.zeros((2, n)), np.zeros((0, 2)), np.zeros((n, 3)),
+                   np.zeros((n, 3)), rows)
+    for b, sim in enumerate(sims):
+        sim.run(until=1230 * u.day, outputs=2, progress=False)
+        snap = sim.snapshot()
+        assert np.array_equal(rows[b, :4], snap.monitors[:4])
+        assert np.array_equal(rows[b, MONITOR_WIDTH:MONITOR_WIDTH + 3 * n], snap.x.ravel())
+        assert np.array_equal(rows[b, MONITOR_WIDTH + 3 * n:], snap.v.ravel())
