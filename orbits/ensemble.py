@@ -41,6 +41,10 @@ parameters
 ``<body>_a_<length unit>``, ``<body>_e``, ``<body>_inc_rad``
     Osculating elements at the end, of every body but the most massive one,
     about the most massive one; NaN where no orbit is defined.
+``collisions``, ``bodies_left``
+    With ``collisions=`` that the run resolves (``"merge"``, ``"bounce"``, a
+    function): how many it resolved, and how many bodies were left at the end;
+    a body merged away has NaN elements.
 ``wall_time_s``
     Seconds the run itself took (building and elements excluded).
 ``worker``, ``kernels_compiled``, ``kernels_loaded``
@@ -760,6 +764,10 @@ def _run_row(row, sim, spec, path, outcome, exc, wall, result, worker):
     row["energy_error_max"] = math.nan if e is None else e
     row["angular_momentum_error_max"] = math.nan if lerr is None else lerr
     row.update(_chaos_indicators(sim, result))
+    if result is not None and getattr(result, "collisions", None) is not None:
+        # collisions the run resolved (merged or bounced) and the bodies left
+        row["collisions"] = len(result.collisions)
+        row["bodies_left"] = len(sim.bodies.names)
     row.update(_final_elements(sim, spec.elements))
     row["wall_time_s"] = wall
     row.update(worker())

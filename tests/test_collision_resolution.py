@@ -286,3 +286,19 @@ def test_elements_follow_the_masses_and_end_where_a_body_merged_away():
     end = sim.bodies.elements("P1", primary="Star")
     assert el1["a"][-1].value == pytest.approx(end["a"].value, rel=1e-14)
     assert el1["e"][-1].value == pytest.approx(float(end["e"]), rel=1e-12, abs=1e-15)
+
+
+def _crossing_sim(m2):
+    return orbits.Simulation(_crossing(m2=m2), "ias15", collisions="merge")
+
+
+def test_ensemble_rows_count_the_collisions_and_the_bodies_left():
+    df = orbits.Ensemble.grid(_crossing_sim, m2=[1e-3, 1e-6]).run(
+        10 * u.day, client="serial", outputs=3, progress=False)
+    assert df["collisions"].tolist() == [1, 1]
+    assert df["bodies_left"].tolist() == [2, 2]
+    # the merged-away body has no elements; the survivor has (m2 = 1e-6:
+    # P1 keeps nearly its circular orbit at 1 au)
+    assert "P2_a_au" not in df or df["P2_a_au"].isna().all()
+    assert df["P1_a_au"][1] == pytest.approx(1.0, abs=0.01)
+    assert (df["energy_error_max"] < 1e-13).all()
