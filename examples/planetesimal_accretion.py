@@ -3,7 +3,8 @@
 
 A ring of planetesimals between 0.9 and 1.1 au about a Sun-mass star, two
 Earth masses in all, on nearly circular and nearly coplanar orbits (Rayleigh
-distributed eccentricities and inclinations, 0.01 and 0.005 rad).  Their
+distributed eccentricities and inclinations, 0.01 and 0.005 rad): the scene
+``orbits.scenes.planetesimal_ring``.  Their
 radii are inflated to 5e-4 au (75 000 km) so that collisions, rare for real
 sizes, come within a few hundred orbits; the run is a picture of the
 bookkeeping, not a model of planet formation.  ``ias15`` with
@@ -36,26 +37,11 @@ import numpy as np
 import orbits
 
 HERE = pathlib.Path(__file__).resolve().parent
-EARTH_MASS = 3.003e-6   # solar masses
-
-
-def ring(n=80, seed=1):
-    """The star and ``n`` planetesimals (a BodySet in its centre-of-mass frame)."""
-    rng = np.random.default_rng(seed)
-    b = orbits.BodySet()
-    b.add("Sun", mass=1 * u.Msun, radius=0.00465 * u.au)
-    for k in range(n):
-        b.add(f"p{k:03d}", mass=2 * EARTH_MASS / n * u.Msun, primary="Sun",
-              a=rng.uniform(0.9, 1.1) * u.au, e=rng.rayleigh(0.01),
-              inc=rng.rayleigh(0.005) * u.rad, Omega=rng.uniform(0, 360) * u.deg,
-              omega=rng.uniform(0, 360) * u.deg, M=rng.uniform(0, 360) * u.deg,
-              radius=5e-4 * u.au)
-    b.move_to_com()
-    return b
+EARTH_MASS = (1 * u.Mearth).to_value(u.Msun)
 
 
 def main(n=80, years=400, outputs=201, png=None, show=True):
-    bodies = ring(n)
+    bodies = orbits.scenes.planetesimal_ring(n)
     sim = orbits.Simulation(bodies, "ias15", collisions="merge")
     result = sim.run(until=years * u.yr, outputs=outputs, progress=False)
     print(result.summary())

@@ -42,6 +42,7 @@ __all__ = [
     "pythagorean",
     "figure_eight",
     "plummer",
+    "planetesimal_ring",
     "SCENES",
     "get",
     "describe",
@@ -97,6 +98,63 @@ _DE440_REFERENCE = ("JPL DE440 GM values (NAIF gm_de440.tpc; Park et al. 2021, "
 # untruncated model has no outer edge, and one star at r ~ 1000 would set the
 # size of every plot and the step of every integrator.
 PLUMMER_MASS_CUT = 0.999
+
+def planetesimal_ring(n=80, seed=1, radius=5e-4 * u.au, total_mass=2 * u.Mearth):
+    """A ring of planetesimals with radii between 0.9 and 1.1 au about a Sun-mass star.
+
+    ``n`` equal masses (``total_mass`` in all) on nearly circular, nearly
+    coplanar orbits: semi-major axes uniform in [0.9, 1.1] au, eccentricities
+    and inclinations Rayleigh distributed with scales 0.01 and 0.005 rad,
+    the angles uniform.  The radii are inflated (5e-4 au by default, 75 000
+    km) so that collisions come within a few hundred orbits: a scene for
+    ``collisions="merge"`` (``examples/planetesimal_accretion.py``).
+
+    Parameters
+    ----------
+    n : int
+        Number of planetesimals, ``>= 1``.  Default 80.
+    seed : int or None
+        Passed to :func:`numpy.random.default_rng`; equal seeds give equal sets.
+    radius : Quantity, length
+        Each planetesimal's radius; the star's is the Sun's.
+    total_mass : Quantity, mass
+
+    Returns
+    -------
+    BodySet
+        ``"Sun"`` and ``"p000"`` ... in au, Msun and days, moved to the
+        centre-of-mass frame.
+
+    References
+    ----------
+    Ida & Makino (1992), Icarus 96, 107: Rayleigh distributions of the
+    planetesimals' eccentricities and inclinations.  Kokubo & Ida (1996),
+    Icarus 123, 180: planetesimal radii enlarged so that collisions come
+    within an affordable run.
+
+    Examples
+    --------
+    >>> from orbits import scenes
+    >>> ring = scenes.planetesimal_ring(n=20)
+    >>> len(ring), ring.names[:2], ring.radii[1]
+    (21, ['Sun', 'p000'], <Quantity 0.0005 AU>)
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"n must be a whole number of planetesimals >= 1, got {n!r}")
+    rng = np.random.default_rng(seed)
+    b = BodySet()
+    b.add("Sun", mass=1 * u.Msun, radius=1 * u.Rsun)
+    for k in range(int(n)):
+        b.add(f"p{k:03d}", mass=total_mass / n, primary="Sun",
+              a=rng.uniform(0.9, 1.1) * u.au, e=rng.rayleigh(0.01),
+              inc=rng.rayleigh(0.005) * u.rad, Omega=rng.uniform(0, 360) * u.deg,
+              omega=rng.uniform(0, 360) * u.deg, M=rng.uniform(0, 360) * u.deg,
+              radius=radius)
+    b.move_to_com()
+    return _record(b, "planetesimal-ring", n=int(n), seed=seed,
+                   radius=float(radius.to_value(u.au)),
+                   total_mass=float(total_mass.to_value(u.Mearth)))
+
 
 # Bound on g(q) = q^2 (1 - q^2)^(7/2) for the rejection sampling of speeds;
 # its maximum is 0.0922 at q^2 = 2/9 (Aarseth, Henon & Wielen 1974 use 0.1).
@@ -984,6 +1042,7 @@ SCENES = {
     "pythagorean": pythagorean,
     "figure-eight": figure_eight,
     "plummer": plummer,
+    "planetesimal-ring": planetesimal_ring,
 }
 
 

@@ -38,8 +38,6 @@ TITLE = "Close encounters and collisions"
 
 #: a Julian year in days
 YEAR = 365.25
-#: Earth's mass in solar masses
-EARTH_MASS = 3.003e-6
 #: Jupiter's mass and radius (solar masses, au), the Sun's radius (au)
 JUPITER_MASS, JUPITER_RADIUS, SUN_RADIUS = 9.547919e-4, 4.779e-4, 4.6505e-3
 #: the scattering ensemble's spacing in mutual Hill radii and inner orbit (au)
@@ -60,21 +58,9 @@ def _sizes(quick):
 
 
 def ring(n, seed=1):
-    """A Sun-mass star and ``n`` planetesimals between 0.9 and 1.1 au, two
-    Earth masses in all, radii 5e-4 au (a BodySet, centre-of-mass frame)."""
-    import astropy.units as u
-    import orbits
-    rng = np.random.default_rng(seed)
-    b = orbits.BodySet()
-    b.add("Sun", mass=1 * u.Msun, radius=SUN_RADIUS * u.au)
-    for k in range(n):
-        b.add(f"p{k:03d}", mass=2 * EARTH_MASS / n * u.Msun, primary="Sun",
-              a=rng.uniform(0.9, 1.1) * u.au, e=rng.rayleigh(0.01),
-              inc=rng.rayleigh(0.005) * u.rad, Omega=rng.uniform(0, 360) * u.deg,
-              omega=rng.uniform(0, 360) * u.deg, M=rng.uniform(0, 360) * u.deg,
-              radius=5e-4 * u.au)
-    b.move_to_com()
-    return b
+    """The planetesimal ring of ``n`` bodies (:func:`orbits.scenes.planetesimal_ring`)."""
+    from .. import scenes
+    return scenes.planetesimal_ring(n, seed=seed)
 
 
 def three_planets(member):
@@ -113,7 +99,7 @@ def merge_run(code, quick):
         sim.run(until=1 * u.day, outputs=2, progress=False)      # compiled, warmed
         sim = orbits.Simulation(bodies, "ias15", collisions="merge")
         t0 = time.perf_counter()
-        res = sim.run(until=years * u.yr, outputs=2, progress=False)
+        res = sim.run(until=years * u.yr, outputs=101, progress=False)
         wall = time.perf_counter() - t0
         c = res.collisions
         events = [(float(t), str(a), str(b)) for t, a, b in
