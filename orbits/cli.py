@@ -44,7 +44,8 @@ def _length(text):
 #: ``orbits run`` option -> (type, help); the option is passed under its own name
 INTEGRATOR_OPTIONS = {
     "epsilon": (float, "IAS15's precision parameter, default 1e-9"),
-    "rtol": (float, "relative tolerance of the embedded methods, default 1e-9"),
+    "rtol": (float, "relative tolerance of the embedded methods, default 1e-9 (trace's "
+                    "encounter integrator: 1e-12)"),
     "atol": (float, "absolute tolerance, in the scene's units, default 1e-12"),
     "corrector": (int, "Wisdom-Holman symplectic corrector order: 0, 3, 5, 7, 11 or 17"),
     "coordinates": (str, "Wisdom-Holman coordinates: jacobi or democratic-heliocentric"),
@@ -54,7 +55,7 @@ INTEGRATOR_OPTIONS = {
 #: the registry; the help is built without importing the integrators)
 OPTION_TAKEN_BY = {
     "epsilon": ("ias15",),
-    "rtol": ("dopri5", "dop853", "rk4-doubling", "radau", "lsoda"),
+    "rtol": ("dopri5", "dop853", "rk4-doubling", "radau", "lsoda", "trace"),
     "atol": ("dopri5", "dop853", "rk4-doubling", "radau", "lsoda"),
     "corrector": ("wh",),
     "coordinates": ("wh", "saba2", "saba3", "saba4"),

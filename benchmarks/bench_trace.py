@@ -1,0 +1,179 @@
+"""``trace`` against ``wh``, ``ias15`` and REBOUND's TRACE and IAS15: energy error
+and wall time, side by side.
+
+Three parts, each timed around the public ``Simulation.run`` (warm: every
+loop compiled by a short run first) and, for REBOUND, around ``integrate``:
+
+1. **Far from encounters** (outer solar system, 100-day step): ``trace``
+   against ``wh`` with ``coordinates="democratic-heliocentric"``, whose map
+   it is when nothing is flagged: microseconds per step, the median of the
+   paired ratios over ``--repeats`` runs, and whether the two trajectories
+   are equal.  Goal (issue 12): at most 1.3 times ``wh``'s time per step.
+2. **Close encounters**: the stress suite's encounter (two Earth-mass
+   planets about a Sun-mass star passing at 1e-3 to 1e-8 au at t = 5 days,
+   the run ending at 10 days; :func:`orbits.validation.stress.encounter_bodies`),
+   ``trace`` and ``wh`` (DH) at a 0.5-day step and ``ias15``: the energy
+   error at the end (after the pass; at the pass itself the energy of any
+   state in heliocentric float64 carries ~1e-6 of rounding at 1e-8 au) and
+   the whole run's wall time.  Goal: ``trace`` at most 1e-9 where ``wh``
+   fails, in at most 0.2 of ``ias15``'s time.
+3. **A violently unstable three-planet system**: three Jupiter masses two
+   mutual Hill radii apart from 5 au about a Sun-mass star (member 0 of the
+   validation report's scattering ensemble,
+   :func:`orbits.validation.collisions.three_planets`, as point masses),
+   ``--years`` years (2000; 200 with ``--quick``) at a 20-day step for the
+   two TRACEs: the relative energy error at the end and the wall time of
+   ``trace``, our ``ias15``, and REBOUND's ``trace`` and ``ias15``.
+
+Run ``python benchmarks/bench_trace.py`` (a few minutes) or ``--quick``.
+"""
+
+import argparse
+import statistics
+import time
+
+import astropy.units as u
+import numpy as np
+
+import orbits
+
+WH_RATIO_GOAL = 1.3
+IAS15_RATIO_GOAL = 0.2
+ENERGY_GOAL = 1e-9
+DH = "democratic-heliocentric"
+ENCOUNTER_DISTANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+ENCOUNTER_DT = 0.5            # days
+SCATTER_DT = 20.0             # days
+YEAR = 365.25
+
+
+def _timed_run(make, until, outputs=2, clock=time.perf_counter):
+    sim = make()
+    t0 = clock()
+    res = sim.run(until=until, outputs=outputs, progress=False)
+    return clock() - t0, sim, res
+
+
+def far_from_encounters(repeats, steps, clock):
+    b = orbits.scenes.outer_solar_system()
+    dt = 100 * u.day
+    wh = orbits.integrators.get("wh", coordinates=DH)
+    makers = {"wh": lambda: orbits.Simulation(b, wh, dt=dt, monitors=()),
+              "trace": lambda: orbits.Simulation(b, "trace", dt=dt, monitors=())}
+    for make in makers.values():
+        make().run(until=2 * dt, outputs=2, progress=False)
+    times = {k: [] for k in makers}
+    last = {}
+    for _ in range(repeats):
+        for k, make in makers.items():
+            wall, sim, res = _timed_run(make, steps * dt, clock=clock)
+            times[k].append(wall / steps)
+            last[k] = (sim, res)
+    ratio = statistics.median(a / b for a, b in zip(times["trace"], times["wh"]))
+    same = bool(np.array_equal(last["wh"][1].positions, last["trace"][1].positions))
+    flagged = int(last["trace"][0]._ws["counts"][0])
+    print(f"1. outer solar system, dt = 100 d, {steps} steps, median of {repeats}")
+    print(f"   wh (DH) {1e6 * statistics.median(times['wh']):.3f} us/step, trace "
+          f"{1e6 * statistics.median(times['trace']):.3f} us/step, ratio {ratio:.2f} "
+          f"(goal <= {WH_RATIO_GOAL}: {'PASS' if ratio <= WH_RATIO_GOAL else 'MISS'}); "
+          f"trajectories equal bit for bit: {same}; segments flagged: {flagged}")
+    return {"ratio": ratio, "same": same}
+
+
+def encounters(repeats, clock):
+    from orbits.validation.stress import ENCOUNTER_TIME, encounter_bodies
+    until = 2 * ENCOUNTER_TIME * u.day
+    dt = ENCOUNTER_DT * u.day
+    wh = orbits.integrators.get("wh", coordinates=DH)
+    codes = {"wh": (wh, dt), "trace": ("trace", dt), "ias15": ("ias15", None)}
+    print(f"2. close encounters (stress suite), {until}, trace and wh at dt = {dt}; "
+          f"energy error at the end, wall time (median of {repeats})")
+    print(f"   {'pass (au)':>9s} " + " ".join(f"{k + ' dE':>11s} {k + ' s':>9s}" for k in codes)
+          + f" {'trace/ias15':>11s}")
+    rows = []
+    for d in ENCOUNTER_DISTANCES:
+        b = encounter_bodies(d)
+        row = {"distance": d}
+        for k, (integ, step) in codes.items():
+            def make(integ=integ, step=step):
+                return orbits.Simulation(b, integ, dt=step)
+            make().run(until=1 * u.day, outputs=2, progress=False)
+            walls = []
+            for _ in range(repeats):
+                wall, sim, res = _timed_run(make, until, clock=clock)
+                walls.append(wall)
+            row[k] = (abs(float(res.energy_error[-1])), statistics.median(walls))
+        row["ratio"] = row["trace"][1] / row["ias15"][1]
+        rows.append(row)
+        print(f"   {d:9.0e} " + " ".join(f"{row[k][0]:11.2e} {row[k][1]:9.5f}" for k in codes)
+              + f" {row['ratio']:11.2f}")
+    worst_e = max(r["trace"][0] for r in rows)
+    worst_r = max(r["ratio"] for r in rows)
+    wh_fails = min(r["wh"][0] for r in rows)
+    print(f"   goal trace dE <= {ENERGY_GOAL:g}: worst {worst_e:.2e} "
+          f"{'PASS' if worst_e <= ENERGY_GOAL else 'MISS'}; wh's smallest {wh_fails:.2e}; "
+          f"goal trace <= {IAS15_RATIO_GOAL} x ias15 time: worst {worst_r:.2f} "
+          f"{'PASS' if worst_r <= IAS15_RATIO_GOAL else 'MISS'}")
+    return rows
+
+
+def scattering(years, member, clock):
+    from orbits.validation.collisions import three_planets
+    b = three_planets(member)
+    until = years * u.yr
+    print(f"3. three Jupiters 2 mutual Hill radii apart (member {member}), {years:g} yr, "
+          f"TRACE at dt = {SCATTER_DT:g} d; point masses, no collisions")
+    rows = []
+    for label, integ, dt in (("trace", "trace", SCATTER_DT * u.day), ("ias15", "ias15", None)):
+        def make(integ=integ, dt=dt):
+            return orbits.Simulation(b, integ, dt=dt)
+        make().run(until=1 * u.yr, outputs=2, progress=False)
+        wall, sim, res = _timed_run(make, until, clock=clock)
+        extra = ""
+        if label == "trace":
+            c = sim._ws["counts"]
+            extra = (f"(steps {int(sim.steps)}, flagged {int(c[0])}, redone {int(c[1])}, "
+                     f"inner steps {int(c[2])})")
+        rows.append((f"orbits {label}", abs(float(res.energy_error[-1])), wall, extra))
+    for name in ("trace", "ias15"):
+        sim = b.to_rebound()
+        sim.integrator = name
+        if name == "trace":
+            sim.dt = SCATTER_DT
+        e0 = sim.energy()
+        t0 = clock()
+        sim.integrate(years * YEAR, exact_finish_time=1)
+        wall = clock() - t0
+        rows.append((f"REBOUND {name}", abs((sim.energy() - e0) / e0), wall,
+                     f"(steps {int(sim.steps_done)})"))
+    ias = {r[0]: r[2] for r in rows}
+    for name, de, wall, extra in rows:
+        rel = wall / ias["orbits ias15"]
+        print(f"   {name:16s} dE {de:9.2e}  wall {wall:8.3f} s  ({rel:5.2f} x our ias15) {extra}")
+    print(f"   our trace / REBOUND trace time: "
+          f"{ias['orbits trace'] / ias['REBOUND trace']:.2f}; REBOUND trace / its ias15: "
+          f"{ias['REBOUND trace'] / ias['REBOUND ias15']:.2f}")
+    return rows
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--steps", type=int, default=200_000)
+    ap.add_argument("--years", type=float, default=2000.0)
+    ap.add_argument("--member", type=int, default=0)
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--clock", choices=("wall", "cpu"), default="wall",
+                    help="wall clock (default) or this process's CPU time")
+    args = ap.parse_args(argv)
+    clock = time.perf_counter if args.clock == "wall" else time.process_time
+    if args.quick:
+        args.repeats, args.steps, args.years = 3, 50_000, 200.0
+    far = far_from_encounters(args.repeats, args.steps, clock)
+    enc = encounters(args.repeats, clock)
+    scat = scattering(args.years, args.member, clock)
+    return {"far": far, "encounters": enc, "scattering": scat}
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,732 @@
+"""The compiled loop of ``trace``: a time-reversible hybrid of the democratic
+heliocentric Wisdom-Holman map and an adaptive integrator for close encounters
+(after Lu, Hernandez & Rein 2024 [1]).
+
+The split is that of :mod:`orbits._kernels.wisdom_holman` in democratic
+heliocentric coordinates (heliocentric positions ``Q``, barycentric
+velocities ``V``): Kepler drifts ``K`` about ``G m_0``, the planets' mutual
+interaction ``I`` and the jump ``J``.  A pair ``(i, j)`` of non-central bodies
+is *flagged* when its separation is below the switching radius ::
+
+    r_crit = max(k_hill R_H, k_speed |V_i - V_j| |h|),
+    R_H = ((m_i + m_j) / (3 m_0))^(1/3) (|Q_i| + |Q_j|) / 2
+
+(the mutual Hill radius of Chambers 1996, and a term for fast flybys).  A
+flagged pair's interaction moves from the kick into the drift: the bodies of
+flagged pairs (each connected group of them apart) are integrated over the
+drift with their Kepler motion about ``G m_0`` and their flagged mutual pulls
+by an adaptive 8th-order Runge-Kutta method (Dormand & Prince's DOP853, with
+the error measured per body, relative to its position and speed in the
+group's own frame), in coordinates relative to the group's first body, so
+that a pass at 1e-8 au keeps its separation to 1e-16 relative.  A body whose
+heliocentric distance falls below ``k_peri (G m_0 h^2)^(1/3)`` (the radius at
+which the circular orbit turns one radian in a step) flags a close pericentre
+passage: the whole segment is then integrated, all bodies and all pulls, in
+inertial coordinates by the same method.
+
+Where the criterion is evaluated.  The map is the Wisdom-Holman map of
+:mod:`.wisdom_holman`, ``K(h/2) [J(h/2) I(h) J(h/2)] K(h/2)`` a step, with the
+closing drift deferred into the next step's opening one.  Regrouped, the
+chain is a sequence of kick-drift-kick *segments*
+``I(h/2) J(h/2) K(h) J(h/2) I(h/2)`` whose ends lie in the middle of the
+perturbation steps (positions after the first half jump, velocities after
+half the kick): the segment is the unit TRACE switches, and these ends are
+where the criterion is evaluated.  A segment takes the flags of its start;
+if its end flags a pair (or a pericentre) the start did not, it is redone
+from its start with the union flagged, as in [1], so that a step and its
+reverse (``-h`` from the end) take the same flags: time reversible, up to
+the adaptive integrator's tolerance.  Outputs lie in the middle of a
+segment's drift: they are synchronised (on a copy) with the flags of the
+segment's start.  When neither of two successive segments has a flag, the
+two half kicks between them are the single kick ``I(h)`` of the
+Wisdom-Holman map, with its arithmetic: far from encounters ``trace`` is
+bit for bit ``wh`` with ``coordinates="democratic-heliocentric"``.
+
+References
+----------
+.. [1] Lu, T., Hernandez, D. M. & Rein, H. 2024, "TRACE: a time-reversible
+   hybrid integrator for close encounters", MNRAS 533, 3708.
+.. [2] Duncan, M. J., Levison, H. F. & Lee, M. H. 1998, AJ 116, 2067.
+.. [3] Hairer, E., Nørsett, S. P. & Wanner, G. 1993, "Solving Ordinary
+   Differential Equations I", section II.10 (DOP853).
+"""
+
+import math
+
+import numpy as np
+
+from ._jit import njit, specialize
+from .coordinates import from_democratic_heliocentric, to_democratic_heliocentric
+from .gravity import pair_accelerations
+from .status import Status
+from .stepping import GO, _record, epilogue
+from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
+
+__all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
+           "inner_arrays",
+           "SAFETY", "FAC_MIN", "FAC_MAX", "MAX_REDO", "MODE_GROUP", "MODE_ALL"]
+
+SAFETY = 0.9        # inner step-size safety factor (HNW II.4)
+FAC_MIN = 0.2       # a rejected inner step shrinks by at most 5
+FAC_MAX = 6.0       # an accepted inner step grows by at most 6
+#: a segment is redone at most this many times with more flags (each redo
+#: adds at least one pair; the criterion rarely changes twice)
+MAX_REDO = 8
+#: the inner integrator's force: a group of flagged bodies about the star
+#: (relative to the group's first body), or every body and every pull
+MODE_GROUP = 0
+MODE_ALL = 1
+_CBRT2 = 1.2599210498948732
+_TINY = 1e-300
+_EPS = 2.220446049250313e-16
+
+
+@njit(inline="always")
+def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, r_peri, enc):
+    """Flag the pairs in a close encounter and say whether a pericentre is close.
+
+    ``enc`` (uint8, shape (N, N)) gets 1 at ``[i, j]`` (``i > j >= 1``) for a
+    flagged pair, 0 elsewhere below the diagonal; ``hill[i] = (m_i / 3
+    m_0)^(1/3)``; ``r2`` (N,) is scratch (the squared heliocentric
+    distances).  Returns ``(pairs flagged, 1 if a body is closer to the
+    central one than r_peri)``.  Square roots and cube roots are taken only
+    for the pairs that a bound on the switching radius leaves in doubt, so
+    that a system far from encounters pays a few multiplications a pair.
+    """
+    n = xh.shape[0]
+    peri = 0
+    rp2 = r_peri * r_peri
+    vmax2 = 0.0
+    for i in range(1, n):
+        ri2 = xh[i, 0] * xh[i, 0] + xh[i, 1] * xh[i, 1] + xh[i, 2] * xh[i, 2]
+        r2[i] = ri2
+        if ri2 < rp2:
+            peri = 1
+        vmax2 = max(vmax2, vb[i, 0] * vb[i, 0] + vb[i, 1] * vb[i, 1] + vb[i, 2] * vb[i, 2])
+    count = 0
+    kv = k_speed * abs(h)
+    kv2 = kv * kv
+    # |V_i - V_j| <= 2 max |V|: pairs farther apart than that many steps of
+    # it skip the relative speed
+    reach2 = 4.0 * kv2 * vmax2
+    kh2 = (k_hill * _CBRT2) ** 2
+    third = 1.0 / 3.0
+    g3 = 3.0 * gm[0]
+    for i in range(2, n):
+        ri2 = r2[i]
+        hi = hill[i]
+        for j in range(1, min(i, n_active)):
+            dx = xh[i, 0] - xh[j, 0]
+            dy = xh[i, 1] - xh[j, 1]
+            dz = xh[i, 2] - xh[j, 2]
+            d2 = dx * dx + dy * dy + dz * dz
+            # (r_i + r_j) / 2 <= max(r_i, r_j) and ((m_i + m_j) / 3 m_0)^(1/3)
+            # <= 2^(1/3) max(hill_i, hill_j): the exact radius only inside
+            hmax = max(hi, hill[j])
+            bound = kh2 * hmax * hmax * max(ri2, r2[j])
+            flag = 0
+            if d2 < reach2:
+                ux = vb[i, 0] - vb[j, 0]
+                uy = vb[i, 1] - vb[j, 1]
+                uz = vb[i, 2] - vb[j, 2]
+                if d2 < kv2 * (ux * ux + uy * uy + uz * uz):
+                    flag = 1
+            if flag == 0 and d2 < bound:
+                rh = (k_hill * ((gm[i] + gm[j]) / g3) ** third
+                      * 0.5 * (math.sqrt(ri2) + math.sqrt(r2[j])))
+                if d2 < rh * rh:
+                    flag = 1
+            enc[i, j] = flag
+            count += flag
+    return count, peri
+
+
+@njit
+def _new_flags(enc, enc_new, n, n_active):
+    # whether enc_new flags a pair enc does not; enc becomes their union
+    grew = False
+    for i in range(2, n):
+        for j in range(1, min(i, n_active)):
+            if enc_new[i, j] and not enc[i, j]:
+                enc[i, j] = 1
+                grew = True
+    return grew
+
+
+@njit
+def _kick_unflagged(xh, vb, acc, gm, n_active, enc, h):
+    """``V_i += h`` times the pull of the other non-central bodies, leaving out
+    the flagged pairs (their pull is in the drift); ``acc`` is scratch."""
+    n = xh.shape[0]
+    for i in range(n):
+        acc[i, 0] = 0.0
+        acc[i, 1] = 0.0
+        acc[i, 2] = 0.0
+    for i in range(2, n):
+        for j in range(1, min(i, n_active)):
+            if enc[i, j]:
+                continue
+            dx = xh[i, 0] - xh[j, 0]
+            dy = xh[i, 1] - xh[j, 1]
+            dz = xh[i, 2] - xh[j, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+            sj = gm[j] * inv_r3
+            si = gm[i] * inv_r3
+            acc[i, 0] -= sj * dx
+            acc[i, 1] -= sj * dy
+            acc[i, 2] -= sj * dz
+            acc[j, 0] += si * dx
+            acc[j, 1] += si * dy
+            acc[j, 2] += si * dz
+    for i in range(1, n):
+        vb[i, 0] += h * acc[i, 0]
+        vb[i, 1] += h * acc[i, 1]
+        vb[i, 2] += h * acc[i, 2]
+
+
+# -- the inner integrator ---------------------------------------------------------------
+
+@njit
+def _accel(mode, y, ns, idx, gm, n_active, enc, out):
+    """Accelerations of the inner integrator's state ``y[:ns]``.
+
+    MODE_GROUP: row 0 is the group's first body's heliocentric position, row
+    k > 0 body ``idx[k]``'s position relative to it; the bodies feel the
+    central body and their flagged partners in the group; ``out`` gets row 0's
+    acceleration and the others' relative to it.  MODE_ALL: ``y`` holds every
+    body's inertial position; every pull.
+    """
+    if mode == MODE_GROUP:
+        x0 = y[0, 0]
+        y0 = y[0, 1]
+        z0 = y[0, 2]
+        for k in range(ns):
+            qx = x0
+            qy = y0
+            qz = z0
+            if k > 0:
+                qx += y[k, 0]
+                qy += y[k, 1]
+                qz += y[k, 2]
+            r2 = qx * qx + qy * qy + qz * qz
+            s = gm[0] / (r2 * math.sqrt(r2))
+            out[k, 0] = -s * qx
+            out[k, 1] = -s * qy
+            out[k, 2] = -s * qz
+        for k in range(1, ns):
+            bk = idx[k]
+            for m in range(k):
+                bm = idx[m]
+                if bk > bm:
+                    flagged = enc[bk, bm]
+                else:
+                    flagged = enc[bm, bk]
+                if not flagged:
+                    continue
+                # the separation from the relative rows alone (row 0 is 0)
+                dx = y[k, 0]
+                dy = y[k, 1]
+                dz = y[k, 2]
+                if m > 0:
+                    dx -= y[m, 0]
+                    dy -= y[m, 1]
+                    dz -= y[m, 2]
+                r2 = dx * dx + dy * dy + dz * dz
+                inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+                sm = gm[bm] * inv_r3
+                sk = gm[bk] * inv_r3
+                out[k, 0] -= sm * dx
+                out[k, 1] -= sm * dy
+                out[k, 2] -= sm * dz
+                out[m, 0] += sk * dx
+                out[m, 1] += sk * dy
+                out[m, 2] += sk * dz
+        for k in range(1, ns):
+            out[k, 0] -= out[0, 0]
+            out[k, 1] -= out[0, 1]
+            out[k, 2] -= out[0, 2]
+    else:
+        for i in range(ns):
+            out[i, 0] = 0.0
+            out[i, 1] = 0.0
+            out[i, 2] = 0.0
+        for i in range(1, ns):
+            for j in range(min(i, n_active)):
+                dx = y[i, 0] - y[j, 0]
+                dy = y[i, 1] - y[j, 1]
+                dz = y[i, 2] - y[j, 2]
+                r2 = dx * dx + dy * dy + dz * dz
+                inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+                sj = gm[j] * inv_r3
+                si = gm[i] * inv_r3
+                out[i, 0] -= sj * dx
+                out[i, 1] -= sj * dy
+                out[i, 2] -= sj * dz
+                out[j, 0] += si * dx
+                out[j, 1] += si * dy
+                out[j, 2] += si * dz
+
+
+@njit
+def _row_norm(a, k):
+    return math.sqrt(a[k, 0] ** 2 + a[k, 1] ** 2 + a[k, 2] ** 2)
+
+
+@njit
+def _dop853(mode, y, u, ns, idx, gm, n_active, enc, span, rtol, A, b, c, e5, e3, ky, ku,
+            y1, u1, ys, us, hbox, counts):
+    """Integrate ``y' = u, u' = a(y)`` (:func:`_accel`) over ``span`` (either
+    sign) with DOP853, in place on rows ``[:ns]``; True on success.
+
+    The error of a step is measured per row, against ``rtol`` times the
+    row's position and velocity sizes (in MODE_GROUP the relative rows are
+    the separations within the group, so the tolerance is relative to the
+    encounter, not to the orbit).  ``hbox[0]`` keeps the last step size
+    proposed, tried first next time; ``counts[2]`` counts accepted steps.
+    """
+    if span == 0.0 or ns == 0:
+        return True
+    s = b.shape[0]
+    direction = 1.0 if span > 0.0 else -1.0
+    _accel(mode, y, ns, idx, gm, n_active, enc, ku[0])
+    for i in range(ns):
+        for d in range(3):
+            ky[0, i, d] = u[i, d]
+    h = abs(hbox[0])
+    if h == 0.0:
+        # a first step from the shortest time scale of the rows
+        tau = abs(span)
+        for i in range(ns):
+            rn = _row_norm(y, i)
+            un = _row_norm(u, i)
+            an = _row_norm(ku[0], i)
+            if un > 0.0:
+                tau = min(tau, rn / un)
+            if an > 0.0:
+                tau = min(tau, math.sqrt(rn / an))
+        h = 0.01 * tau
+    t = 0.0
+    total = abs(span)
+    ncomp = 6.0 * ns
+    while t < total:
+        last = False
+        if t + 1.01 * h >= total:
+            hs = total - t
+            last = True
+        else:
+            hs = h
+        hh = direction * hs
+        for st in range(1, s):
+            for i in range(ns):
+                for d in range(3):
+                    yi = y[i, d]
+                    ui = u[i, d]
+                    for j in range(st):
+                        a = A[st, j]
+                        if a != 0.0:
+                            yi += hh * a * ky[j, i, d]
+                            ui += hh * a * ku[j, i, d]
+                    ys[i, d] = yi
+                    us[i, d] = ui
+                    ky[st, i, d] = ui
+            _accel(mode, ys, ns, idx, gm, n_active, enc, ku[st])
+        for i in range(ns):
+            for d in range(3):
+                dy = 0.0
+                du = 0.0
+                for j in range(s):
+                    dy += b[j] * ky[j, i, d]
+                    du += b[j] * ku[j, i, d]
+                y1[i, d] = y[i, d] + hh * dy
+                u1[i, d] = u[i, d] + hh * du
+                ky[s, i, d] = u1[i, d]
+        _accel(mode, y1, ns, idx, gm, n_active, enc, ku[s])
+        err5 = 0.0
+        err3 = 0.0
+        for i in range(ns):
+            sy = rtol * max(_row_norm(y, i), _row_norm(y1, i)) + _TINY
+            su = rtol * max(_row_norm(u, i), _row_norm(u1, i)) + _TINY
+            for d in range(3):
+                ey = 0.0
+                eu = 0.0
+                fy = 0.0
+                fu = 0.0
+                for j in range(s + 1):
+                    ey += e5[j] * ky[j, i, d]
+                    eu += e5[j] * ku[j, i, d]
+                    fy += e3[j] * ky[j, i, d]
+                    fu += e3[j] * ku[j, i, d]
+                err5 += (ey / sy) ** 2 + (eu / su) ** 2
+                err3 += (fy / sy) ** 2 + (fu / su) ** 2
+        denom = err5 + 0.01 * err3
+        err = 0.0 if denom == 0.0 else hs * err5 / math.sqrt(denom * ncomp)
+        if not math.isfinite(err):
+            err = math.inf
+        if err == 0.0:
+            fac = FAC_MAX
+        elif err == math.inf:
+            fac = FAC_MIN
+        else:
+            fac = min(FAC_MAX, max(FAC_MIN, SAFETY * err ** (-1.0 / 8.0)))
+        if err <= 1.0:
+            for i in range(ns):
+                for d in range(3):
+                    y[i, d] = y1[i, d]
+                    u[i, d] = u1[i, d]
+                    ky[0, i, d] = ky[s, i, d]
+                    ku[0, i, d] = ku[s, i, d]
+            counts[2] += 1
+            if last:
+                break
+            t += hs
+            h = hs * fac
+        else:
+            h = hs * fac
+            if h <= 4.0 * _EPS * total:
+                return False
+    hbox[0] = h
+    return True
+
+
+@njit
+def _groups(enc, n, n_active, label):
+    """Label the connected groups of flagged pairs: ``label[i]`` is the group
+    of body i (-1: in none); returns the number of groups."""
+    for i in range(n):
+        label[i] = -1
+    groups = 0
+    changed = True
+    for i in range(2, n):
+        for j in range(1, min(i, n_active)):
+            if enc[i, j]:
+                if label[i] < 0 and label[j] < 0:
+                    label[i] = groups
+                    label[j] = groups
+                    groups += 1
+                elif label[i] < 0:
+                    label[i] = label[j]
+                elif label[j] < 0:
+                    label[j] = label[i]
+    # merge groups joined by a pair found after both were labelled
+    while changed:
+        changed = False
+        for i in range(2, n):
+            for j in range(1, min(i, n_active)):
+                if enc[i, j] and label[i] != label[j]:
+                    lo = min(label[i], label[j])
+                    hi = max(label[i], label[j])
+                    for k in range(n):
+                        if label[k] == hi:
+                            label[k] = lo
+                    changed = True
+    return groups
+
+
+@njit
+def inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol):
+    """The drift of a segment with flagged pairs: every body on its Kepler orbit
+    about ``G m_0``, then the bodies of each group of flagged pairs replaced by
+    their integration with the group's pulls.  Returns False if the inner
+    integrator failed (step-size underflow)."""
+    A, b, c, e5, e3 = tabs
+    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts = inner
+    n = xh.shape[0]
+    groups = _groups(enc, n, n_active, label)
+    # the groups' starting rows, before the Kepler drift moves them
+    for i in range(n):
+        for d in range(3):
+            ys[i, d] = xh[i, d]
+            us[i, d] = vb[i, d]
+    kepler_drift_all(xh, vb, eta, h, w1, w2)
+    ok = True
+    for g in range(groups):
+        ns = 0
+        for i in range(1, n):
+            if label[i] == g:
+                idx[ns] = i
+                ns += 1
+        if ns == 0:
+            continue
+        c0 = idx[0]
+        for d in range(3):
+            y[0, d] = ys[c0, d]
+            u[0, d] = us[c0, d]
+        for k in range(1, ns):
+            bk = idx[k]
+            for d in range(3):
+                y[k, d] = ys[bk, d] - ys[c0, d]
+                u[k, d] = us[bk, d] - us[c0, d]
+        if not _dop853(MODE_GROUP, y, u, ns, idx, gm, n_active, enc, h, rtol, A, b, c, e5,
+                       e3, ky, ku, y1, u1, w1, w2, hbox, counts):
+            ok = False
+        for d in range(3):
+            xh[c0, d] = y[0, d]
+            vb[c0, d] = u[0, d]
+        for k in range(1, ns):
+            bk = idx[k]
+            for d in range(3):
+                xh[bk, d] = y[0, d] + y[k, d]
+                vb[bk, d] = u[0, d] + u[k, d]
+    return ok
+
+
+@njit
+def exact_flow(xh, vb, gm, n_active, enc, h, x, v, inner, tabs, rtol):
+    """Every body and every pull over ``h`` by the inner integrator, in inertial
+    coordinates (a close pericentre passage); ``x``, ``v`` are scratch."""
+    A, b, c, e5, e3 = tabs
+    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts = inner
+    n = xh.shape[0]
+    from_democratic_heliocentric(xh, vb, gm, x, v)
+    for i in range(n):
+        for d in range(3):
+            y[i, d] = x[i, d]
+            u[i, d] = v[i, d]
+    ok = _dop853(MODE_ALL, y, u, n, idx, gm, n_active, enc, h, rtol, A, b, c, e5, e3,
+                 ky, ku, y1, u1, ys, us, hbox, counts)
+    for i in range(n):
+        for d in range(3):
+            x[i, d] = y[i, d]
+            v[i, d] = u[i, d]
+    to_democratic_heliocentric(x, v, gm, xh, vb)
+    return ok
+
+
+@njit
+def _drift(xh, vb, gm, eta, n_active, enc, flagged, peri, h, w1, w2, x, v, inner, tabs,
+           rtol):
+    # the segment's drift of h: Kepler drifts, with the flagged groups
+    # integrated, or (peri) the exact flow of everything
+    if peri:
+        return exact_flow(xh, vb, gm, n_active, enc, h, x, v, inner, tabs, rtol)
+    if flagged:
+        return inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol)
+    kepler_drift_all(xh, vb, eta, h, w1, w2)
+    return True
+
+
+@njit(inline="always")
+def _copy(a, b):
+    for i in range(a.shape[0]):
+        b[i, 0] = a[i, 0]
+        b[i, 1] = a[i, 1]
+        b[i, 2] = a[i, 2]
+
+
+@njit
+def trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v, w1, w2,
+                      inner, tabs, rtol):
+    """Inertial ``x``, ``v`` at the current time: the owed part of the current
+    segment's drift, with its flags, applied to a copy of the internal state
+    (the whole gravity if the segment integrates everything)."""
+    n = xh.shape[0]
+    _copy(xh, xs)
+    _copy(vb, vs)
+    if owed != 0.0:
+        # the inner integrator's step memory and counts are the run's: kept
+        # as they were, so that looking does not change the trajectory
+        hbox = inner[10]
+        counts = inner[11]
+        h_kept = hbox[0]
+        steps_kept = counts[2]
+        _drift(xs, vs, gm, eta, n_active, enc, state[4] != 0, state[3] != 0, owed, w1, w2,
+               x, v, inner, tabs, rtol)
+        hbox[0] = h_kept
+        counts[2] = steps_kept
+    from_democratic_heliocentric(xs, vs, gm, x, v)
+    return n
+
+
+def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active, acc, xs, vs,
+                w1, w2, state, owed_box, enc, enc_new, params, inner, tabs, mon, step0, mon_t,
+                mon_out, check_every, sargs, targs):
+    # state: [0] internal state current, [1] system checked, [2] the segment
+    # started at a criterion point (else at a synchronised state: no opening
+    # kick), [3] the segment integrates everything (a close pericentre),
+    # [4] the segment has flagged pairs.  xc, vc: the segment's start.
+    # owed_box[0]: the part of the segment's drift before the current time.
+    # params: (k_hill, k_speed, k_peri, rtol); inner: the inner integrator's
+    # arrays, whose counts (segments with flags, redos, inner steps) add up.
+    # targs: the added terms' arguments (kicked with gravity's interaction,
+    # HAS_TERMS and term_kick bound by specialize).
+    k_hill, k_speed, k_peri, rtol = params
+    counts = inner[11]
+    n = xh.shape[0]
+    every = mon[0]
+    n_mon = 0
+    r_peri = k_peri * (gm[0] * dt * dt) ** (1.0 / 3.0)
+    if state[0] == 0:
+        to_democratic_heliocentric(x, v, gm, xh, vb)
+        _copy(xh, xc)
+        _copy(vb, vc)
+        state[0] = 1
+        state[2] = 0
+        owed_box[0] = 0.0
+        npairs, peri = criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed,
+                                 dt, r_peri, enc)
+        state[3] = peri
+        state[4] = 1 if npairs > 0 else 0
+    owed = owed_box[0]
+    half = 0.5 * dt
+    until_check = check_every
+    until_record = every - step0 % every if every > 0 else -1
+    for k in range(nsteps):
+        seg = owed + half
+        flagged = state[4] != 0
+        peri = state[3] != 0
+        redo = 0
+        ok = True
+        while True:
+            # the segment from its start (xc, vc) or from the opening kick
+            # already applied (xh, vb)
+            if flagged or peri:
+                ok = _drift(xh, vb, gm, eta, n_active, enc, flagged, peri, seg, w1, w2, x, v,
+                            inner, tabs, rtol)
+            else:
+                kepler_drift_all(xh, vb, eta, seg, w1, w2)
+            if peri:
+                # the exact flow of gravity ends on the criterion point, less
+                # the added terms' half kick
+                _copy(vb, vs)
+                if HAS_TERMS:  # noqa: F821 - bound by specialize
+                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+            else:
+                jump(xh, vb, gm, n_active, half)
+                if flagged:
+                    _copy(vb, vs)
+                    _kick_unflagged(xh, vs, acc, gm, n_active, enc, half)
+                else:
+                    pair_accelerations(xh, gm, n_active, 0.0, acc, 1, False)
+                    for i in range(n):
+                        vs[i, 0] = vb[i, 0] + half * acc[i, 0]
+                        vs[i, 1] = vb[i, 1] + half * acc[i, 1]
+                        vs[i, 2] = vb[i, 2] + half * acc[i, 2]
+                if HAS_TERMS:  # noqa: F821
+                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+            npairs, peri_end = criterion(xh, vs, gm, hill, r2, n_active, k_hill,
+                                         k_speed, dt, r_peri, enc_new)
+            grew = npairs > 0 and _new_flags(enc, enc_new, n, n_active)
+            if (grew or (peri_end and not peri)) and redo < MAX_REDO:
+                # the end flags what the start did not: the segment again from
+                # its start with the union flagged
+                redo += 1
+                counts[1] += 1
+                if grew:
+                    flagged = True
+                if peri_end:
+                    peri = True
+                _copy(xc, xh)
+                _copy(vc, vb)
+                if state[2] and HAS_TERMS:  # noqa: F821
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)  # noqa: F821
+                if state[2] and not peri:
+                    if flagged:
+                        _kick_unflagged(xh, vb, acc, gm, n_active, enc, owed)
+                    else:
+                        pair_accelerations(xh, gm, n_active, 0.0, acc, 1, False)
+                        for i in range(n):
+                            vb[i, 0] += owed * acc[i, 0]
+                            vb[i, 1] += owed * acc[i, 1]
+                            vb[i, 2] += owed * acc[i, 2]
+                    jump(xh, vb, gm, n_active, owed)
+                continue
+            break
+        if flagged or peri:
+            counts[0] += 1
+        # the criterion point: the next segment's start and flags
+        new_flagged = npairs > 0
+        if new_flagged:
+            for i in range(2, n):
+                for j in range(1, min(i, n_active)):
+                    enc[i, j] = enc_new[i, j]
+        elif flagged:
+            for i in range(2, n):
+                for j in range(1, min(i, n_active)):
+                    enc[i, j] = 0
+        _copy(xh, xc)
+        _copy(vs, vc)
+        state[2] = 1
+        state[3] = peri_end
+        state[4] = 1 if new_flagged else 0
+        if peri_end:
+            # the next segment integrates gravity whole from the criterion
+            # point, after the added terms' half kick
+            _copy(vs, vb)
+            if HAS_TERMS:  # noqa: F821
+                term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+        else:
+            if not flagged and not peri and not new_flagged:
+                # no flags either side: the Wisdom-Holman kick I(h), its arithmetic
+                for i in range(1, n):
+                    vb[i, 0] += dt * acc[i, 0]
+                    vb[i, 1] += dt * acc[i, 1]
+                    vb[i, 2] += dt * acc[i, 2]
+                if HAS_TERMS:  # noqa: F821
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, dt, targs)  # noqa: F821
+            else:
+                _copy(vs, vb)
+                if new_flagged:
+                    _kick_unflagged(xh, vb, acc, gm, n_active, enc, half)
+                else:
+                    pair_accelerations(xh, gm, n_active, 0.0, acc, 1, False)
+                    for i in range(n):
+                        vb[i, 0] += half * acc[i, 0]
+                        vb[i, 1] += half * acc[i, 1]
+                        vb[i, 2] += half * acc[i, 2]
+                if HAS_TERMS:  # noqa: F821
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+            jump(xh, vb, gm, n_active, half)
+        owed = half
+        owed_box[0] = owed
+        if not ok:
+            return Status.STEP_UNDERFLOW, k, n_mon
+        # the epilogue sees the inertial state when it records or checks the
+        # stopping conditions, else the internal one (the finite check)
+        if STOP or until_record == 1:  # noqa: F821 - bound by specialize
+            trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v, w1,
+                              w2, inner, tabs, rtol)
+            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+                x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every,
+                until_record, every, mon, n_mon, mon_t, mon_out, sargs, ())
+        else:
+            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+                xh, vb, t + (k + 1) * dt, k, nsteps, True, until_check, check_every,
+                until_record, every, mon, n_mon, mon_t, mon_out, sargs, ())
+        if status != GO:
+            return status, done, n_mon
+    return Status.OK, nsteps, n_mon
+
+
+@njit(inline="always")
+def _no_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
+    pass
+
+
+def trace_loop(stop=False, record=_record, terms=None):
+    """The ``trace`` loop, compiled with (``stop``) or without the stopping
+    conditions of :mod:`.stopping`, ``record`` recording the monitors, and
+    ``terms`` (a :class:`~orbits._kernels.terms.TermKernel` of position-only
+    terms, or None) kicked with the interaction, as ``wh`` kicks them."""
+    key = "trace_stop" if stop else "trace"
+    if terms is None:
+        kick, cache = _no_term_kick, True
+    else:
+        key = f"{key}_{terms.key}"
+        cache = terms.cache
+        kick = specialize(_heliocentric_term_kick, f"trace_{terms.key}", cache=cache,
+                          inline=True, nrt=not cache, extra=terms.accel)
+    return specialize(_trace_loop, key, cache=cache, nrt=not cache, STOP=bool(stop),
+                      HAS_TERMS=terms is not None, term_kick=kick,
+                      step_end=epilogue(record, key, cache=cache, runtime=not cache,
+                                        stop=stop))
+
+
+def inner_arrays(n, stages):
+    """The inner integrator's arrays for ``n`` bodies and a method of
+    ``stages`` stages: ``(label, idx, ky, ku, y, u, y1, u1, ys, us, hbox,
+    counts)``."""
+    return (np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
+            np.zeros((stages + 1, n, 3)), np.zeros((stages + 1, n, 3)),
+            np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)),
+            np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(1), np.zeros(3, dtype=np.int64))
