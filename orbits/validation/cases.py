@@ -29,7 +29,7 @@ __all__ = ["Problem", "PROBLEMS", "problem", "applies", "WISDOM_HOLMAN", "PYTHON
            "DIVERGENT", "mass_ratio", "bodies"]
 
 #: Integrators that split the motion into Kepler orbits about one body.
-WISDOM_HOLMAN = ("wh", "saba2", "saba3", "saba4")
+WISDOM_HOLMAN = ("wh", "saba2", "saba3", "saba4", "trace")
 
 #: Integrators whose force is called from Python (scipy's solve_ivp).
 PYTHON_FORCE = ("radau", "lsoda")

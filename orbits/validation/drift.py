@@ -79,6 +79,9 @@ LEFT_OUT = {
                       "a Newton solve every step makes a million years take hours",
     "implicit-midpoint": "for stiff problems: symplectic like the leapfrog but a Newton "
                          "solve every step makes a million years take hours",
+    "trace": "on the outer solar system no encounter is ever flagged, and it then follows "
+             "wh's democratic heliocentric map bit for bit (tests/integrators/test_trace.py): "
+             "its drift is that map's",
 }
 
 #: growth-exponent classes: upper bounds, between the laws they separate
