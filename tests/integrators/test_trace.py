@@ -167,10 +167,11 @@ def test_bad_options_are_named_errors(options):
         orbits.integrators.get("trace", **options)
 
 
+@pytest.mark.slow  # compiles trace and wh with the term: ~100 s on a cold cache
 def test_takes_position_only_terms_as_wh_does():
     # GRPotential joins the interaction kicks as in wh: without encounters
     # the two maps are the same operation for operation (equal bit for bit,
-    # measured), and the velocity-dependent GR is refused with wh's named error
+    # measured)
     b = orbits.scenes.solar_system(moon=False)
     gr = [orbits.forces.GRPotential("Sun")]
     wh = orbits.integrators.get("wh", coordinates=DH)
@@ -178,6 +179,10 @@ def test_takes_position_only_terms_as_wh_does():
     sim, res = _run(b, "trace", 2 * u.day, 2000 * u.day, forces=gr)
     assert np.array_equal(ref.positions, res.positions)
     assert sim._ws["counts"][0] == 0
+
+
+def test_refuses_velocity_dependent_terms_as_wh_does():
+    b = orbits.scenes.solar_system(moon=False)
     with pytest.raises(IntegratorOptionError, match="GRPotential"):
         orbits.Simulation(b, "trace", dt=2 * u.day, forces=[orbits.forces.GR("Sun")])
 
