@@ -36,7 +36,8 @@ import numpy as np
 
 import orbits
 
-HERE = pathlib.Path(__file__).resolve().parent
+# beside this script (the current folder where there is no __file__: the docs' gallery)
+HERE = pathlib.Path(globals().get("__file__", "planetesimal_accretion.py")).resolve().parent
 EARTH_MASS = (1 * u.Mearth).to_value(u.Msun)
 
 
