@@ -3,7 +3,6 @@ integrator for close encounters (after Lu, Hernandez & Rein 2024)."""
 
 import math
 import numbers
-import warnings
 
 import numpy as np
 
@@ -13,7 +12,7 @@ from .._kernels.stepping import NO_STOP_ARGS
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
 from .base import RTOL_FLOOR, Integrator
-from .wisdom_holman import MASS_RATIO_LIMIT, NoDominantBodyWarning
+from .wisdom_holman import split_gravity
 
 __all__ = ["Trace", "HILL", "SPEED", "PERICENTRE", "RTOL"]
 
@@ -230,32 +229,7 @@ class Trace(Integrator):
         if force.inner is not None:
             raise IntegratorOptionError(
                 f"{self.name} does not integrate variational equations; use 'wh' or 'ias15'")
-        if force.terms is not None:
-            force, fargs = force.base, fargs[0]
-        if force.opaque:
-            raise IntegratorOptionError(
-                f"{self.name} splits Newtonian gravity into Kepler drifts and kicks and "
-                "cannot integrate another force; use a general method such as 'ias15'")
-        gm, n_active, eps2 = fargs[0], fargs[1], fargs[2]
-        if eps2 != 0.0:
-            raise IntegratorOptionError(
-                f"{self.name} needs unsoftened gravity (its Kepler drifts are exact "
-                "two-body orbits); use 'leapfrog' or 'verlet' with softening")
-        if n_active < 1 or not gm[0] > 0.0:
-            raise IntegratorOptionError(
-                f"{self.name} needs a massive central body first; the first body has no mass")
-        if n_active > 2:
-            ratio = float(np.max(gm[1:n_active]) / gm[0])
-            if ratio > MASS_RATIO_LIMIT:
-                warnings.warn(
-                    f"{self.name}: no dominant central body (the largest other mass is "
-                    f"{ratio:.3g} times the first body's, above {MASS_RATIO_LIMIT}): the "
-                    "Wisdom-Holman split treats the pull between the other bodies as a "
-                    "small perturbation of Kepler orbits about the first, which it is "
-                    "not here, so the error will be large. Use an integrator that "
-                    "does not split the motion, such as 'ias15' (adaptive, for close "
-                    "encounters) or 'verlet'/'leapfrog' with a small step.",
-                    NoDominantBodyWarning, stacklevel=4)
+        gm, n_active = split_gravity(self.name, force, fargs)
         n = len(gm)
         ws["gm"][:n] = gm
         ws["eta"][:n] = gm[0]

@@ -26,6 +26,7 @@ from . import tableaux
 from .base import Integrator
 
 __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
+           "split_gravity",
            "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS", "CORRECTOR_SPACING",
            "corrector_stages"]
 
@@ -72,6 +73,42 @@ def corrector_stages(order):
 
 class NoDominantBodyWarning(UserWarning):
     """The Wisdom-Holman split is used on a system without one dominant mass."""
+
+
+def split_gravity(name, force, fargs, alternative="'ias15'"):
+    """The ``(G m, N_active)`` of the gravity a Wisdom-Holman split (method
+    ``name``) takes apart, after the checks it needs: Newtonian gravity, with
+    or without position-only terms (a user's function replacing it is refused,
+    pointing to ``alternative``), unsoftened, a massive first body, and a
+    :class:`NoDominantBodyWarning` where another mass is above
+    :data:`MASS_RATIO_LIMIT` of it."""
+    if force.terms is not None:
+        force, fargs = force.base, fargs[0]
+    if force.opaque:
+        raise IntegratorOptionError(
+            f"{name} splits Newtonian gravity into Kepler drifts and kicks and "
+            f"cannot integrate another force; use a general method such as {alternative}")
+    gm, n_active, eps2 = fargs[0], fargs[1], fargs[2]
+    if eps2 != 0.0:
+        raise IntegratorOptionError(
+            f"{name} needs unsoftened gravity (its Kepler drifts are exact "
+            "two-body orbits); use 'leapfrog' or 'verlet' with softening")
+    if n_active < 1 or not gm[0] > 0.0:
+        raise IntegratorOptionError(
+            f"{name} needs a massive central body first; the first body has no mass")
+    if n_active > 2:
+        ratio = float(np.max(gm[1:n_active]) / gm[0])
+        if ratio > MASS_RATIO_LIMIT:
+            warnings.warn(
+                f"{name}: no dominant central body (the largest other mass is "
+                f"{ratio:.3g} times the first body's, above {MASS_RATIO_LIMIT}): the "
+                "Wisdom-Holman split treats the pull between the other bodies as a "
+                "small perturbation of Kepler orbits about the first, which it is "
+                "not here, so the error will be large. Use an integrator that "
+                "does not split the motion, such as 'ias15' (adaptive, for close "
+                "encounters) or 'verlet'/'leapfrog' with a small step.",
+                NoDominantBodyWarning, stacklevel=5)
+    return gm, n_active
 
 
 class WisdomHolman(Integrator):
@@ -297,33 +334,7 @@ class WisdomHolman(Integrator):
         ws["tangent"] = (force, n, (dgm, np.ascontiguousarray(deta), k, masses, jx, jv, box))
 
     def _check_system(self, ws, force, fargs):
-        if force.terms is not None:
-            force, fargs = force.base, fargs[0]
-        if force.opaque:
-            raise IntegratorOptionError(
-                f"{self.name} splits Newtonian gravity into Kepler drifts and kicks and "
-                "cannot integrate another force; use a general method such as 'leapfrog' "
-                "or 'yoshida4'")
-        gm, n_active, eps2 = fargs[0], fargs[1], fargs[2]
-        if eps2 != 0.0:
-            raise IntegratorOptionError(
-                f"{self.name} needs unsoftened gravity (its Kepler drifts are exact "
-                "two-body orbits); use 'leapfrog' or 'verlet' with softening")
-        if n_active < 1 or not gm[0] > 0.0:
-            raise IntegratorOptionError(
-                f"{self.name} needs a massive central body first; the first body has no mass")
-        if n_active > 2:
-            ratio = float(np.max(gm[1:n_active]) / gm[0])
-            if ratio > MASS_RATIO_LIMIT:
-                warnings.warn(
-                    f"{self.name}: no dominant central body (the largest other mass is "
-                    f"{ratio:.3g} times the first body's, above {MASS_RATIO_LIMIT}): the "
-                    "Wisdom-Holman split treats the pull between the other bodies as a "
-                    "small perturbation of Kepler orbits about the first, which it is "
-                    "not here, so the error will be large. Use an integrator that "
-                    "does not split the motion, such as 'ias15' (adaptive, for close "
-                    "encounters) or 'verlet'/'leapfrog' with a small step.",
-                    NoDominantBodyWarning, stacklevel=4)
+        gm, n_active = split_gravity(self.name, force, fargs, "'leapfrog' or 'yoshida4'")
         # (a run with variations has a workspace of more rows than bodies: the
         # rows after the bodies' are not used)
         ws["gm"][:len(gm)] = gm
