@@ -107,15 +107,7 @@ def main(argv=None):
         return (clock() - t0) / (n * b)
 
     def time_reb(sim, n):
-        vzeroupper()
-        t_start = sim.t
-        t0 = clock()
-        if sim.exact_finish_time:
-            sim.steps(n)
-        else:
-            sim.integrate(sim.t + n * sim.dt, exact_finish_time=0)
-        elapsed = clock() - t0
-        return elapsed / max(1, round((sim.t - t_start) / sim.dt))
+        return bench_wh.rebound_step_time(sim, n, clock, vzeroupper)
 
     # compile (or load) everything once, then size the runs from WHFast
     time_ours(10)

@@ -91,6 +91,22 @@ def whfast512_status():
         return False, f"REBOUND refused it: {exc}"
 
 
+def rebound_step_time(sim, n, clock, before=None):
+    """Seconds a step of REBOUND's ``sim`` over about ``n`` steps (``before()``
+    runs first, untimed: the ``vzeroupper`` of the module notes)."""
+    if before is not None:
+        before()
+    t_start = sim.t
+    t0 = clock()
+    if sim.exact_finish_time:
+        sim.steps(n)
+    else:
+        # whfast512 fuses steps: integrate to a time, count the steps it took
+        sim.integrate(sim.t + n * sim.dt, exact_finish_time=0)
+    elapsed = clock() - t0
+    return elapsed / max(1, round((sim.t - t_start) / sim.dt))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
@@ -131,16 +147,7 @@ def main(argv=None):
             return (clock() - t0) / n
 
         def time_reb(sim, n):
-            vzeroupper()
-            t_start = sim.t
-            t0 = clock()
-            if sim.exact_finish_time:
-                sim.steps(n)
-            else:
-                # whfast512 fuses steps: integrate to a time, count the steps it took
-                sim.integrate(sim.t + n * sim.dt, exact_finish_time=0)
-            elapsed = clock() - t0
-            return elapsed / max(1, round((sim.t - t_start) / sim.dt))
+            return rebound_step_time(sim, n, clock, vzeroupper)
 
         time_ours(10)
         vzeroupper()
