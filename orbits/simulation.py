@@ -745,8 +745,23 @@ class Simulation(Driven):
         t = self._now()
         n = len(self._m)
         out = np.zeros((max(1, min(n * (n - 1) // 2, 65536)), 5))
+        found_rows = []
+        seen = self.integrator.checked_state(self._ws, t)
+        if seen is not None:
+            # the loop looked (and found the first pair) at a state before t:
+            # the pairs up to there, then those of the rest of the step
+            xk, vk, tk = seen
+            found = _s.collision_pairs(xk, vk, tk, self._stop, out)
+            found_rows += out[:found].tolist()
+            if self._stop[0] & _s.ENCOUNTER_LOG and _s.encounter_log(xk, vk, tk, self._stop):
+                self._drain_log(rec)
+            _s.keep_state(xk, vk, tk, self._stop)
         found = _s.collision_pairs(self._x, self._v, t, self._stop, out)
-        pairs = sorted(out[:found].tolist(), key=lambda row: row[2])
+        found_rows += out[:found].tolist()
+        first = {}
+        for row in sorted(found_rows, key=lambda row: row[2]):
+            first.setdefault((row[0], row[1]), row)    # a pair once, at its first contact
+        pairs = list(first.values())
         how = self._stop_config["collisions"]
         e = self._stop_config.get("restitution")
         e = 1.0 if e is None else e

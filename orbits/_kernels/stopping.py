@@ -100,12 +100,14 @@ def _within_reach(work, mu, h, r):
     # than it changed over the step (the other bodies' pull), cannot have
     # come within r either: a planetesimal's orbit about the star, whose pull
     # makes the first bound useless, is passed over by the second.
-    d0 = math.sqrt(work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2)
-    d1 = math.sqrt(work[2, 0] ** 2 + work[2, 1] ** 2 + work[2, 2] ** 2)
-    s0 = math.sqrt(work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2)
-    s1 = math.sqrt(work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2)
-    reach = max(s0, s1) * abs(h) + 0.5 * mu * h * h / (r * r)
-    if min(d0, d1) - r > 2.0 * reach:
+    # (compared squared: min(d0, d1) > r + 2 reach, one square root a pair)
+    d0 = work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2
+    d1 = work[2, 0] ** 2 + work[2, 1] ** 2 + work[2, 2] ** 2
+    s0 = work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2
+    s1 = work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2
+    reach = math.sqrt(max(s0, s1)) * abs(h) + 0.5 * mu * h * h / (r * r)
+    far = r + 2.0 * reach
+    if min(d0, d1) > far * far:
         return False
     if mu > 0.0:
         q0 = _pericentre(work, 0, mu)
@@ -129,20 +131,21 @@ def _pair_contact(x, v, t, sargs, i, j, inside, h):
     ux = v[i, 0] - v[j, 0]
     uy = v[i, 1] - v[j, 1]
     uz = v[i, 2] - v[j, 2]
-    d1 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    # separations compared squared (a square root only for a contact)
+    d1 = dx * dx + dy * dy + dz * dz
+    rs2 = rs * rs
     if inside:
-        d0 = math.sqrt((prev[0, i, 0] - prev[0, j, 0]) ** 2
-                       + (prev[0, i, 1] - prev[0, j, 1]) ** 2
-                       + (prev[0, i, 2] - prev[0, j, 2]) ** 2)
-        if d0 < rs:
+        d0 = ((prev[0, i, 0] - prev[0, j, 0]) ** 2 + (prev[0, i, 1] - prev[0, j, 1]) ** 2
+              + (prev[0, i, 2] - prev[0, j, 2]) ** 2)
+        if d0 < rs2:
             # already in contact at the previous check (a bounce that has not
             # yet separated them): a new collision only while still closing
-            if d1 < rs and dx * ux + dy * uy + dz * uz < 0.0:
-                return True, t, d1, math.sqrt(ux * ux + uy * uy + uz * uz)
+            if d1 < rs2 and dx * ux + dy * uy + dz * uz < 0.0:
+                return True, t, math.sqrt(d1), math.sqrt(ux * ux + uy * uy + uz * uz)
             return False, 0.0, 0.0, 0.0
-    if d1 < rs:
+    if d1 < rs2:
         # overlapping at the end (or the state given at the start)
-        return True, t, d1, math.sqrt(ux * ux + uy * uy + uz * uz)
+        return True, t, math.sqrt(d1), math.sqrt(ux * ux + uy * uy + uz * uz)
     if not inside:
         return False, 0.0, 0.0, 0.0
     _pair_ends(x, v, prev, work, i, j)

@@ -37,7 +37,13 @@ from its start with the union flagged, as in [1], so that a step and its
 reverse (``-h`` from the end) take the same flags: time reversible, up to
 the adaptive integrator's tolerance.  Outputs lie in the middle of a
 segment's drift: they are synchronised (on a copy) with the flags of the
-segment's start.  When neither of two successive segments has a flag, the
+segment's start.  The stopping conditions are checked at the criterion
+points, whose states are synchronised already (the kick-drift-kick form of
+the map, half a step before the step's end), and at the end of the last
+step of each call; so that they cost no synchronisation (a Kepler drift of
+every body, or an inner integration during an encounter) a step.  The
+checks' windows (from one check to the next) still cover the whole run.
+When neither of two successive segments has a flag, the
 two half kicks between them are the single kick ``I(h)`` of the
 Wisdom-Holman map, with its arithmetic: far from encounters ``trace`` is
 bit for bit ``wh`` with ``coordinates="democratic-heliocentric"``.
@@ -539,13 +545,16 @@ def trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v,
 
 
 def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active, acc, xs, vs,
-                w1, w2, state, owed_box, enc, enc_new, params, inner, tabs, mon, step0, mon_t,
-                mon_out, check_every, sargs, targs):
+                w1, w2, state, owed_box, checked, enc, enc_new, params, inner, tabs, mon, step0,
+                mon_t, mon_out, check_every, sargs, targs):
     # state: [0] internal state current, [1] system checked, [2] the segment
     # started at a criterion point (else at a synchronised state: no opening
     # kick), [3] the segment integrates everything (a close pericentre),
     # [4] the segment has flagged pairs.  xc, vc: the segment's start.
     # owed_box[0]: the part of the segment's drift before the current time.
+    # checked: [time, 1] when the epilogue last checked the stopping
+    # conditions at a criterion point (x, v then hold that state), [., 0]
+    # when at the end of the step.
     # params: (k_hill, k_speed, k_peri, rtol); inner: the inner integrator's
     # arrays, whose counts (segments with flags, redos, inner steps) add up.
     # targs: the added terms' arguments (kicked with gravity's interaction,
@@ -681,13 +690,28 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
         owed_box[0] = owed
         if not ok:
             return Status.STEP_UNDERFLOW, k, n_mon
-        # the epilogue sees the inertial state when it records or checks the
-        # stopping conditions, else the internal one (the finite check)
-        if STOP or until_record == 1:  # noqa: F821 - bound by specialize
+        # the epilogue sees the inertial state when it records, and at the
+        # last step of the call when it checks the stopping conditions;
+        # otherwise these are checked at the criterion point, where the state
+        # is synchronised already (xc, vc: a kick-drift-kick state at the
+        # step's end less the owed half drift), without synchronising a copy
+        # (a Kepler drift of every body, or an inner integration in an
+        # encounter, every step); else the epilogue sees the internal state
+        # (the finite check)
+        if until_record == 1 or (STOP and k + 1 == nsteps):  # noqa: F821 - by specialize
             trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v, w1,
                               w2, inner, tabs, rtol)
+            checked[1] = 0.0
             status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
                 x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every,
+                until_record, every, mon, n_mon, mon_t, mon_out, sargs, ())
+        elif STOP:  # noqa: F821
+            from_democratic_heliocentric(xc, vc, gm, x, v)
+            t_check = t + (k + 1) * dt - owed
+            checked[0] = t_check
+            checked[1] = 1.0
+            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+                x, v, t_check, k, nsteps, True, until_check, check_every,
                 until_record, every, mon, n_mon, mon_t, mon_out, sargs, ())
         else:
             status, done, until_check, until_record, n_mon = step_end(  # noqa: F821

@@ -26,7 +26,8 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
 5. implements ``synchronize(ws, x, v)`` (bring x and v to the same time
    where the method keeps them apart; a no-op for methods that never do) and
    ``invalidate(ws)`` (forget cached forces after the state was changed from
-   outside);
+   outside); a method whose loop checks the stopping conditions elsewhere
+   than at the ends of its steps says where in ``checked_state(ws, t)``;
 6. is registered in :mod:`orbits.integrators` and documented with its update
    equations, its reference and an example.
 
@@ -274,6 +275,13 @@ class Integrator:
         >>> int(ws["cache"][0])
         0
         """
+
+    def checked_state(self, ws, t):
+        """The state the stopping conditions last looked at, if the loop that
+        ended at ``t`` checked them elsewhere than at ``t``: ``(x, v, time)``;
+        None (the default) when they were checked at the end of its last step,
+        on the state that :meth:`synchronize` gives."""
+        return None
 
     def info(self):
         """The integrator and its options, for results and files.

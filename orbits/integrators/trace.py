@@ -7,6 +7,7 @@ import numbers
 import numpy as np
 
 from .._kernels import trace as _trace
+from .._kernels.coordinates import from_democratic_heliocentric
 from .._kernels.status import with_status
 from .._kernels.stepping import NO_STOP_ARGS
 from ..errors import IntegratorOptionError
@@ -196,6 +197,9 @@ class Trace(Integrator):
                 # [internal state current, system checked, segment opened at a
                 # criterion point, segment integrated whole, segment has flags]
                 "state": np.zeros(5, dtype=np.int64), "owed": np.zeros(1),
+                # [time, 1] where the last step checked the stopping
+                # conditions at its criterion point, [., 0] at its end
+                "checked": np.zeros(2),
                 "n_active": np.zeros(1, dtype=np.int64),
                 "enc": np.zeros((n, n), dtype=np.uint8),
                 "enc_new": np.zeros((n, n), dtype=np.uint8),
@@ -273,7 +277,8 @@ class Trace(Integrator):
         return with_status(*loop(
             x, v, ws["xh"], ws["vb"], ws["xc"], ws["vc"], float(t), float(dt), int(nsteps),
             ws["gm"], ws["eta"], ws["hill"], ws["r2"], int(ws["n_active"][0]), ws["acc"],
-            ws["xs"], ws["vs"], ws["w1"], ws["w2"], ws["state"], ws["owed"], ws["enc"],
+            ws["xs"], ws["vs"], ws["w1"], ws["w2"], ws["state"], ws["owed"], ws["checked"],
+            ws["enc"],
             ws["enc_new"], params, self._inner(ws), self._tabs, mon, step0, mon_t, mon_out,
             check_every, NO_STOP_ARGS if stop is None else stop, targs))
 
@@ -286,6 +291,18 @@ class Trace(Integrator):
                 int(ws["n_active"][0]), ws["enc"], ws["state"], float(ws["owed"][0]),
                 ws["xs"], ws["vs"], x, v, ws["w1"], ws["w2"], self._inner(ws), self._tabs,
                 self.config["rtol"])
+
+    def checked_state(self, ws, t):
+        """The criterion point where the last step's stopping conditions were
+        checked (half a step before ``t``, synchronised by the map itself), or
+        None where they were checked at ``t`` (an output, a call's last step)."""
+        if not ws["state"][0] or ws["checked"][1] == 0.0:
+            return None
+        tc = float(ws["checked"][0])
+        n = len(ws["gm"])
+        x, v = np.zeros((n, 3)), np.zeros((n, 3))
+        from_democratic_heliocentric(ws["xc"], ws["vc"], ws["gm"], x, v)
+        return x, v, tc
 
     def invalidate(self, ws):
         """The state was changed from outside (a merger, say): start again from

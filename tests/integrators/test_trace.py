@@ -157,6 +157,33 @@ def test_collisions_merge():
     assert np.abs(p1 - p0).max() < 1e-15
 
 
+def test_stopping_conditions_leave_the_trajectory_alone():
+    # the conditions are checked on the criterion points' states, which the
+    # map computes anyway, and on a synchronised copy at a call's end: with
+    # conditions that never fire, the run through an encounter is the same
+    # bit for bit
+    b = _encounter_bodies(1e-4)
+    _, plain = _run(b, "trace", 0.5 * u.day, 30 * u.day, monitors=())
+    sim, checked = _run(b, "trace", 0.5 * u.day, 30 * u.day, monitors=(),
+                        escape_distance=1e3 * u.au, encounter_distance=1e-9 * u.au)
+    assert sim._ws["counts"][0] > 0
+    assert np.array_equal(plain.positions[-1], checked.positions[-1])
+    assert np.array_equal(plain.velocities[-1], checked.velocities[-1])
+
+
+def test_a_contact_in_the_last_half_step_is_found():
+    # radii of 2e-5 au on the 1e-5 au pass at t = 5 days: the planets first
+    # overlap after the last criterion point (4.75 days) of a run that ends
+    # at 5 days; its last step is checked at its end, so the run halts there
+    from orbits.errors import Collision
+    b = _encounter_bodies(1e-5, radii=np.array([0.005, 2e-5, 2e-5]))
+    with pytest.raises(Collision) as info:
+        _run(b, "trace", 0.5 * u.day, 5 * u.day, collisions="halt")
+    assert info.value.distance.to_value(u.au) < 4e-5
+    # a run that ends before the contact does not see one
+    _run(b, "trace", 0.5 * u.day, 4.5 * u.day, collisions="halt")
+
+
 @pytest.mark.parametrize("options", [
     {"hill": 0.0}, {"hill": -3.0}, {"hill": float("nan")}, {"hill": "3"}, {"hill": True},
     {"speed": -1.0}, {"pericentre": float("inf")}, {"rtol": 0.0}, {"rtol": 2.0},
