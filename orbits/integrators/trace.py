@@ -104,8 +104,13 @@ class Trace(Integrator):
 
     Second order (that of the map) away from encounters; symplectic there,
     time-symmetric throughout up to the adaptive integrator's tolerance.
-    Takes the stopping conditions and ``collisions=``; outputs and stopping
-    conditions see the state synchronised with the current segment's flags.
+    Takes the stopping conditions and ``collisions=``.  Outputs see the state
+    synchronised with the current segment's flags.  The stopping conditions
+    are checked at the criterion points (half a step before each step's end,
+    where the map's own state is synchronised) and at the end of each run
+    call, so that they cost no synchronisation a step; a run that stops for
+    one stops at the end of that step, and a collision's listed contact time
+    is where the check found it.
     Only Newtonian gravity without softening, and the conservative force
     terms that depend on positions alone (``GRPotential``, ``ZonalHarmonics``),
     kicked with the interaction as ``wh`` kicks them (a segment integrated
