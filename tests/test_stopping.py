@@ -120,3 +120,47 @@ def test_bad_conditions(kwargs, match):
 def test_wrong_unit_for_a_distance():
     with pytest.raises(orbits.BodyUnitsError, match="escape_distance"):
         orbits.Simulation(comet(1.5), dt=1 * u.day, escape_distance=3 * u.day)
+
+
+def test_the_collision_filter_never_passes_over_a_contact():
+    # a pair on its exact two-body orbit (the filter's own model, with its
+    # factor two for the other bodies' tides unused): whenever the true
+    # closest approach inside the step (2000 samples of the exact orbit) is
+    # below r, the filter must examine the pair.  Relative states from
+    # grazing flybys to a planet about its star, steps from a small to a
+    # large part of the orbit.
+    from orbits._kernels.kepler import kepler_drift
+    from orbits._kernels.stopping import _within_reach
+    rng = np.random.default_rng(7)
+    examined = 0
+    for _ in range(300):
+        mu = 10 ** rng.uniform(-9, 0)
+        d = 10 ** rng.uniform(-4, 0.5)
+        x0 = rng.normal(size=3)
+        x0 *= d / np.linalg.norm(x0)
+        v_circ = np.sqrt(mu / d)
+        v0 = rng.normal(size=3) * v_circ * 10 ** rng.uniform(-1, 1)
+        h = d / np.linalg.norm(v0) * 10 ** rng.uniform(-2, 0.3)
+        xs = np.repeat(x0[None], 2000, axis=0)
+        vs = np.repeat(v0[None], 2000, axis=0)
+        for k, tk in enumerate(np.linspace(0.0, h, 2000)):
+            kepler_drift(mu, xs, vs, k, tk)
+        dist = np.linalg.norm(xs, axis=1)
+        r = dist.min() * rng.uniform(1.0001, 1.5)
+        work = np.array([x0, v0, xs[-1], vs[-1]])
+        assert _within_reach(work, mu, h, r)
+        examined += 1
+    assert examined == 300
+
+
+def test_a_planet_about_its_star_is_passed_over():
+    # Jupiter at 5.2 au about the Sun (radius 0.00465 au), a 20-day step: the
+    # pull bound taken at half the separation leaves the pair out without
+    # its two-body pericentre
+    from orbits._kernels.stopping import _within_reach
+    mu = 4 * np.pi ** 2 * (1 + 1e-3) / 365.25 ** 2          # au^3 / day^2
+    x0 = np.array([5.2, 0.0, 0.0])
+    v0 = np.array([0.0, np.sqrt(mu / 5.2), 0.0])
+    h = 20.0
+    work = np.array([x0, v0, x0 + h * v0, v0])
+    assert not _within_reach(work, mu, h, 0.00465)

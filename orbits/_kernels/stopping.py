@@ -94,20 +94,24 @@ def _pericentre(work, row, mu):
 @njit(inline="always")
 def _within_reach(work, mu, h, r):
     # whether the pair of _pair_ends could have come within r during the step
-    # h: its separation falls by at most max(s0, s1) |h| + mu h^2 / (2 r^2)
-    # while at least r apart (end speeds, mutual pull; twice that allowed).
-    # A pair whose two-body pericentre stays beyond r at both ends, by more
-    # than it changed over the step (the other bodies' pull), cannot have
-    # come within r either: a planetesimal's orbit about the star, whose pull
-    # makes the first bound useless, is passed over by the second.
-    # (compared squared: min(d0, d1) > r + 2 reach, one square root a pair)
+    # h: while at least D apart its separation falls by at most
+    # max(s0, s1) |h| + mu h^2 / (2 D^2) (end speeds, mutual pull; twice that
+    # allowed), with D = max(r, half the nearer end's separation): if that
+    # cannot take it below D, it never got there (up to the first time it
+    # did, the bound held), so it stayed beyond r.  With D = r alone a
+    # planet's pair with its star, whose radius makes mu / r^2 useless,
+    # would always be examined.  A pair whose two-body pericentre stays
+    # beyond r at both ends, by more than it changed over the step (the
+    # other bodies' pull), cannot have come within r either: a
+    # planetesimal's orbit about the star is passed over by this second test.
     d0 = work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2
     d1 = work[2, 0] ** 2 + work[2, 1] ** 2 + work[2, 2] ** 2
     s0 = work[1, 0] ** 2 + work[1, 1] ** 2 + work[1, 2] ** 2
     s1 = work[3, 0] ** 2 + work[3, 1] ** 2 + work[3, 2] ** 2
-    reach = math.sqrt(max(s0, s1)) * abs(h) + 0.5 * mu * h * h / (r * r)
-    far = r + 2.0 * reach
-    if min(d0, d1) > far * far:
+    dmin = math.sqrt(min(d0, d1))
+    near = max(r, 0.5 * dmin)
+    reach = math.sqrt(max(s0, s1)) * abs(h) + 0.5 * mu * h * h / (near * near)
+    if dmin - near > 2.0 * reach:
         return False
     if mu > 0.0:
         q0 = _pericentre(work, 0, mu)
