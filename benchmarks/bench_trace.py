@@ -15,7 +15,8 @@ loop compiled by a short run first) and, for REBOUND, around ``integrate``:
    ``trace`` and ``wh`` (DH) at a 0.5-day step and ``ias15``: the energy
    error at the end (after the pass; at the pass itself the energy of any
    state in heliocentric float64 carries ~1e-6 of rounding at 1e-8 au) and
-   the whole run's wall time.  Goal: ``trace`` at most 1e-9 where ``wh``
+   the whole run's wall time; REBOUND's TRACE at the same step and its IAS15
+   beside them, for the peer's own ratio on the same work.  Goal: ``trace`` at most 1e-9 where ``wh``
    fails, in at most 0.2 of ``ias15``'s time.
 3. **A violently unstable three-planet system**: three Jupiter masses two
    mutual Hill radii apart from 5 au about a Sun-mass star (member 0 of the
@@ -87,7 +88,8 @@ def encounters(repeats, clock):
     wh = orbits.integrators.get("wh", coordinates=DH)
     codes = {"wh": (wh, dt), "trace": ("trace", dt), "ias15": ("ias15", None)}
     print(f"2. close encounters (stress suite), {until}, trace and wh at dt = {dt}; "
-          f"energy error at the end, wall time (median of {repeats})")
+          f"energy error at the end, wall time (median of {repeats}); below each row "
+          f"REBOUND's TRACE (same step) and IAS15 on the same bodies")
     print(f"   {'pass (au)':>9s} " + " ".join(f"{k + ' dE':>11s} {k + ' s':>9s}" for k in codes)
           + f" {'trace/ias15':>11s}")
     rows = []
@@ -104,9 +106,24 @@ def encounters(repeats, clock):
                 walls.append(wall)
             row[k] = (abs(float(res.energy_error[-1])), statistics.median(walls))
         row["ratio"] = row["trace"][1] / row["ias15"][1]
+        for name in ("trace", "ias15"):
+            walls = []
+            for _ in range(repeats):
+                sim = b.to_rebound()
+                sim.integrator = name
+                sim.dt = ENCOUNTER_DT if name == "trace" else sim.dt
+                e0 = sim.energy()
+                t0 = clock()
+                sim.integrate(2 * ENCOUNTER_TIME)
+                walls.append(clock() - t0)
+            row[f"REBOUND {name}"] = (abs((sim.energy() - e0) / e0), statistics.median(walls))
+        row["peer ratio"] = row["REBOUND trace"][1] / row["REBOUND ias15"][1]
         rows.append(row)
         print(f"   {d:9.0e} " + " ".join(f"{row[k][0]:11.2e} {row[k][1]:9.5f}" for k in codes)
               + f" {row['ratio']:11.2f}")
+        print(f"   {'':9s} REBOUND: trace dE {row['REBOUND trace'][0]:9.2e} "
+              f"{row['REBOUND trace'][1]:9.5f} s, ias15 dE {row['REBOUND ias15'][0]:9.2e} "
+              f"{row['REBOUND ias15'][1]:9.5f} s, its trace/ias15 {row['peer ratio']:5.2f}")
     worst_e = max(r["trace"][0] for r in rows)
     worst_r = max(r["ratio"] for r in rows)
     wh_fails = min(r["wh"][0] for r in rows)
