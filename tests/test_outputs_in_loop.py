@@ -150,7 +150,9 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch)
     assert b.status == "completed" and len(b) == 41
 
 
-# -- adaptive runs: ias15 lands on the outputs inside its loop --------------------------
+# -- adaptive runs: ias15 and the embedded methods land on the outputs inside their loop --
+
+ADAPTIVE = ["ias15", "dopri5", "dop853"]
 
 def _adaptive_pair(make, **run):
     # (outputs recorded in the loop, the same run taking each between calls)
@@ -161,20 +163,23 @@ def _adaptive_pair(make, **run):
     return inloop, between, sim
 
 
-def test_ias15_outputs_in_the_loop_equal_those_taken_between_calls():
+@pytest.mark.parametrize("integrator", ADAPTIVE)
+def test_adaptive_outputs_in_the_loop_equal_those_taken_between_calls(integrator):
     # the loop lands on each output time as it lands on the end of a call:
     # same steps, same state, same monitors (with a force term and its work)
     scene = orbits.scenes.outer_solar_system()
 
     def make():
-        return orbits.Simulation(scene, "ias15", monitors=["energy", "angular_momentum"],
+        return orbits.Simulation(scene, integrator, monitors=["energy", "angular_momentum"],
                                  forces=[forces.Migration("Saturn", tau_a=1e6 * u.yr)])
     a, b, sim = _adaptive_pair(make, until=2000 * u.yr, outputs=1001)
     assert len(a) == 1001 and a.steps == b.steps and a.work is not None
+    assert sim.integrator.records_marks
     _same(a, b)
 
 
-def test_ias15_outputs_in_the_loop_stop_where_the_run_stops():
+@pytest.mark.parametrize("integrator", ADAPTIVE)
+def test_adaptive_outputs_in_the_loop_stop_where_the_run_stops(integrator):
     # a stopping condition between two outputs: the outputs before it, then
     # the state where it stopped, as between calls
     from orbits.errors import Collision
@@ -184,7 +189,7 @@ def test_ias15_outputs_in_the_loop_stop_where_the_run_stops():
           velocity=[-0.001, 0, 0] * u.au / u.day, radius=1 * u.km)
 
     def make():
-        return orbits.Simulation(b, "ias15", collisions="halt")
+        return orbits.Simulation(b, integrator, collisions="halt")
     results = []
     for off in (False, True):
         sim = make()

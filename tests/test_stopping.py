@@ -87,6 +87,20 @@ def test_escape_distance_and_unbound():
     assert r.status == "completed"
 
 
+@pytest.mark.parametrize("integrator", ["dopri5", "dop853", "rk4-doubling", "ias15"])
+def test_adaptive_methods_name_the_body(integrator):
+    # the last of three bodies leaves: the error names the body the
+    # condition found (not row 0), in every adaptive loop
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("star", mass=1.0, position=[0, 0, 0], velocity=[0, 0, 0])
+    b.add("planet", mass=1e-6, position=[1, 0, 0], velocity=[0, 1, 0])
+    b.add("comet", mass=0.0, position=[0, 3, 0], velocity=[0, 2, 0])
+    sim = orbits.Simulation(b, integrator=integrator, escape_distance=20.0)
+    with pytest.raises(Escape) as exc:
+        sim.run(until=100.0, outputs=2, progress=False)
+    assert exc.value.bodies == ("comet",)
+
+
 def test_rk_methods_check_too():
     with pytest.raises(CloseEncounter):
         head_on(encounter_distance=1.0).run(until=10.0, progress=False, outputs=2)

@@ -137,8 +137,8 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
                 sargs, fargs)
             if stop != GO:
-                info[0] = sargs[-1][0]
-                info[1] = sargs[-1][1]
+                info[0] = sargs[6][0]       # the bodies the condition names
+                info[1] = sargs[6][1]
                 status = stop
                 break
         else:

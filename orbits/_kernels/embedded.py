@@ -74,7 +74,14 @@ def step_underflow(h, t, t_end):
 
 
 def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
-                   info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps, rtol, atol):
+                   info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps, rtol, atol,
+                   marks=None, mark_steps=None):
+    # marks (outputs recorded in the loop): the loop lands on each of these
+    # times in turn, as it lands on t_end, and records there a row of
+    # mon_out (monitors and state) with its time in mon_t and its step count
+    # in mark_steps; t_end is then the last mark.  Landing on a mark in the
+    # loop is landing on it at the end of a call: the same steps, bit for
+    # bit.  Without marks (None) this compiles to the loop without them.
     n = x.shape[0]
     s = b.shape[0]
     every = mon[0]
@@ -102,12 +109,18 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     p0 = 0.0
     if HAS_WORK:  # noqa: F821 - bound by specialize
         p0 = work_rate(x, v, t, fargs)  # noqa: F821
+    target = t_end
+    k_mark = 0
+    if marks is not None:
+        target = marks[0]
     while steps < max_steps and t < t_end:
+        if marks is not None and n_mon >= mon_out.shape[0]:
+            break                                    # caller collects the rows first
         h = h_prop
         shortened = False
-        if t + 1.01 * h >= t_end:
-            # land on t_end, also when only a sliver would be left (HNW's DOPRI5)
-            h = t_end - t
+        if t + 1.01 * h >= target:
+            # land on the target, also when only a sliver would be left (HNW's DOPRI5)
+            h = target - t
             shortened = True
         pw = b[0] * p0
         for st in range(1, s):
@@ -170,7 +183,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
                     v[i, d] = v1[i, d]
                     kx[0, i, d] = kx[s, i, d]
                     kv[0, i, d] = kv[s, i, d]
-            t = t_end if shortened else t + h
+            t = target if shortened else t + h
             steps += 1
             if not shortened:
                 h_prop = next_step(h, err, q)
@@ -181,10 +194,21 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
                 sargs, fargs)
             if stop != GO:
-                info[0] = sargs[-1][0]
-                info[1] = sargs[-1][1]
+                info[0] = sargs[6][0]       # the bodies the condition names
+                info[1] = sargs[6][1]
                 status = stop
                 break
+            if marks is not None and t == target:
+                # an output: recorded as the driver would record it on return
+                mon_t[n_mon] = t
+                record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - by specialize
+                work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+                mark_steps[n_mon] = step0 + steps
+                n_mon += 1
+                k_mark += 1
+                if k_mark == marks.shape[0]:
+                    break
+                target = marks[k_mark]
         else:
             rejected += 1
             h_prop = next_step(h, err, q)
@@ -201,4 +225,4 @@ def embedded_loop(force, has_e3, stop=False):
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),
                       step_end=step_epilogue(force, stop), rows=measured_rows(force),
-                      **work_kernels(force))
+                      record_row=force.recorder, **work_kernels(force))

@@ -44,17 +44,26 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
     def invalidate(self, ws):
         ws["fsal"][0] = 0
 
+    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
+    records_marks = True
+
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps):
+                   max_steps, marks=None, mark_steps=None):
+        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
+        on each and record there a row of ``mon_out`` (monitors and state),
+        its time in ``mon_t`` and its step count in ``mark_steps``."""
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
         loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None,
                         stop=stop is not None)
         fargs = _stepping.work_bound(force, fargs, ws)
-        return with_status(*loop(x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
-                    float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],
-                    ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
-                    mon_t, mon_out, _stepping.NO_STOP_ARGS if stop is None else stop,
-                    int(max_steps), float(self.config["rtol"]), float(self.config["atol"])))
+        args = (x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
+                float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],
+                ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
+                mon_t, mon_out, _stepping.NO_STOP_ARGS if stop is None else stop,
+                int(max_steps), float(self.config["rtol"]), float(self.config["atol"]))
+        if marks is not None:
+            args += (marks, mark_steps)
+        return with_status(*loop(*args))
 
 
 class Dopri5(EmbeddedRungeKutta):
