@@ -150,9 +150,9 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch)
     assert b.status == "completed" and len(b) == 41
 
 
-# -- adaptive runs: ias15 and the embedded methods land on the outputs inside their loop --
+# -- adaptive runs: ias15, the embedded methods and rk4-doubling land on the outputs in their loop
 
-ADAPTIVE = ["ias15", "dopri5", "dop853"]
+ADAPTIVE = ["ias15", "dopri5", "dop853", "rk4-doubling"]
 
 def _adaptive_pair(make, **run):
     # (outputs recorded in the loop, the same run taking each between calls)

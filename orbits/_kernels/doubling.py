@@ -60,7 +60,8 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
 
 def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
                    dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
-                   rtol, atol):
+                   rtol, atol, marks=None, mark_steps=None):
+    # marks: outputs recorded in the loop, as in orbits._kernels.embedded
     n = x.shape[0]
     every = mon[0]
     n_mon = 0
@@ -87,11 +88,17 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
     p0 = 0.0
     if HAS_WORK:  # noqa: F821 - bound by specialize
         p0 = work_rate(x, v, t, fargs)  # noqa: F821
+    target = t_end
+    k_mark = 0
+    if marks is not None:
+        target = marks[0]
     while steps < max_steps and t < t_end:
+        if marks is not None and n_mon >= mon_out.shape[0]:
+            break                                    # caller collects the rows first
         h = h_prop
         shortened = False
-        if t + 1.01 * h >= t_end:
-            h = t_end - t
+        if t + 1.01 * h >= target:
+            h = target - t
             shortened = True
         rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, False)  # noqa: F821
         pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,  # noqa: F821
@@ -121,7 +128,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                 for d in range(3):
                     x[i, d] = x2[i, d]
                     v[i, d] = v2[i, d]
-            t = t_end if shortened else t + h
+            t = target if shortened else t + h
             force(x, v, t, fargs, k0v)  # noqa: F821
             fev += 1
             for i in range(n):
@@ -141,6 +148,16 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                 info[1] = sargs[6][1]
                 status = stop
                 break
+            if marks is not None and t == target:
+                mon_t[n_mon] = t
+                record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - by specialize
+                work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+                mark_steps[n_mon] = step0 + steps
+                n_mon += 1
+                k_mark += 1
+                if k_mark == marks.shape[0]:
+                    break
+                target = marks[k_mark]
         else:
             rejected += 1
             h_prop = next_step(h, err, 4.0)
@@ -160,4 +177,4 @@ def doubling_loop(force, stop=False):
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, rk4_step=step,
                       step_end=step_epilogue(force, stop), rows=measured_rows(force),
-                      **work)
+                      record_row=force.recorder, **work)

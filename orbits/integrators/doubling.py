@@ -55,14 +55,22 @@ class RK4Doubling(AdaptiveIntegrator):
     def invalidate(self, ws):
         ws["fsal"][0] = 0
 
+    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
+    records_marks = True
+
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps):
+                   max_steps, marks=None, mark_steps=None):
+        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
+        on each and record there a row of ``mon_out`` (monitors and state),
+        its time in ``mon_t`` and its step count in ``mark_steps``."""
         loop = loop_for(_doubling.doubling_loop, force, stop=stop is not None)
         fargs = _stepping.work_bound(force, fargs, ws)
         w = ws
-        return with_status(*loop(x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"],
-                    w["kx"], w["kv"],
-                    w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
-                    w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
-                    _stepping.NO_STOP_ARGS if stop is None else stop, int(max_steps),
-                    float(self.config["rtol"]), float(self.config["atol"])))
+        args = (x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
+                w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
+                w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
+                _stepping.NO_STOP_ARGS if stop is None else stop, int(max_steps),
+                float(self.config["rtol"]), float(self.config["atol"]))
+        if marks is not None:
+            args += (marks, mark_steps)
+        return with_status(*loop(*args))
