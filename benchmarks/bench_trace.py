@@ -48,8 +48,22 @@ SCATTER_DT = 20.0             # days
 YEAR = 365.25
 
 
-def _timed_run(make, until, outputs=2, clock=time.perf_counter):
+def _timed_run(make, until, outputs=2, clock=time.perf_counter, loops=None):
     sim = make()
+    if loops is not None:
+        # the time inside the integrator's calls (the compiled loop and the
+        # arguments handed to it), apart from the run's fixed Python cost
+        integ = sim.integrator
+        name = "advance_to" if integ.adaptive else "advance"
+        inner = getattr(integ, name)
+
+        def timed(*args, **kwargs):
+            t0 = clock()
+            try:
+                return inner(*args, **kwargs)
+            finally:
+                loops.append(clock() - t0)
+        setattr(integ, name, timed)
     t0 = clock()
     res = sim.run(until=until, outputs=outputs, progress=False)
     return clock() - t0, sim, res
@@ -100,12 +114,16 @@ def encounters(repeats, clock):
             def make(integ=integ, step=step):
                 return orbits.Simulation(b, integ, dt=step)
             make().run(until=1 * u.day, outputs=2, progress=False)
-            walls = []
+            walls, inside = [], []
             for _ in range(repeats):
-                wall, sim, res = _timed_run(make, until, clock=clock)
+                loops = []
+                wall, sim, res = _timed_run(make, until, clock=clock, loops=loops)
                 walls.append(wall)
+                inside.append(sum(loops))
             row[k] = (abs(float(res.energy_error[-1])), statistics.median(walls))
+            row[k + " loop"] = statistics.median(inside)
         row["ratio"] = row["trace"][1] / row["ias15"][1]
+        row["loop ratio"] = row["trace loop"] / row["ias15 loop"]
         for name in ("trace", "ias15"):
             walls = []
             for _ in range(repeats):
@@ -121,6 +139,9 @@ def encounters(repeats, clock):
         rows.append(row)
         print(f"   {d:9.0e} " + " ".join(f"{row[k][0]:11.2e} {row[k][1]:9.5f}" for k in codes)
               + f" {row['ratio']:11.2f}")
+        print(f"   {'':9s} inside the integrators' calls: trace {row['trace loop']:.5f} s, "
+              f"ias15 {row['ias15 loop']:.5f} s, ratio {row['loop ratio']:.2f} (the rest of "
+              f"each run is its fixed Python cost)")
         print(f"   {'':9s} REBOUND: trace dE {row['REBOUND trace'][0]:9.2e} "
               f"{row['REBOUND trace'][1]:9.5f} s, ias15 dE {row['REBOUND ias15'][0]:9.2e} "
               f"{row['REBOUND ias15'][1]:9.5f} s, its trace/ias15 {row['peer ratio']:5.2f}")
