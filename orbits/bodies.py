@@ -12,6 +12,7 @@ Every value is checked where it enters; a bad one raises a
 """
 
 import copy as _copy
+import functools
 import html
 import math
 
@@ -784,7 +785,17 @@ class BodySet:
 
 
 def _describe(value):
+    # str(value), with a Quantity's unit written once per unit (astropy
+    # formats the unit anew at every str(), a third of BodySet.add's time)
+    if isinstance(value, u.Quantity):
+        unit = _unit_string(value.unit)
+        return f"{value.value} {unit}" if unit else str(value.value)
     return str(value)
+
+
+@functools.lru_cache(maxsize=64)
+def _unit_string(unit):
+    return unit.to_string()
 
 
 def _bound_elements(bodies, i):
