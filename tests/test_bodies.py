@@ -285,3 +285,16 @@ def test_history_describes_quantities_as_str_does():
     for value in (12.0 * u.au, 0.1 * u.one, 180 * u.deg, np.array([1.0, 2.0]) * u.au / u.day,
                   0 * u.kg, 0.1, 5, 1e-300 * u.au, 3.0 * u.au ** 3 / u.yr ** 2):
         assert _describe(value) == str(value)
+
+
+@pytest.mark.parametrize("n", [3, 100])
+def test_coincident_bodies_are_named_for_few_and_many(n):
+    # a few bodies are compared pair by pair, many through np.unique: the
+    # same error, naming the first of the pair and the other
+    x = np.arange(3.0 * n).reshape(n, 3)
+    x[n - 1] = x[1]
+    b = orbits.BodySet.from_arrays(np.ones(n) * u.Msun, x * u.au, np.zeros((n, 3)) * u.au / u.day,
+                                   names=[f"b{k}" for k in range(n)])
+    with pytest.raises(CoincidentBodiesError) as exc:
+        b.check()
+    assert exc.value.body == "b1" and f"'b{n - 1}'" in str(exc.value)
