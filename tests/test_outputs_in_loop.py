@@ -152,7 +152,8 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch)
 
 # -- adaptive runs: ias15, the embedded methods and rk4-doubling land on the outputs in their loop
 
-ADAPTIVE = ["ias15", "dopri5", "dop853", "rk4-doubling"]
+# dopri5 runs dop853's loop (its table without the third-order estimate)
+ADAPTIVE = ["ias15", "dop853", "rk4-doubling"]
 
 def _adaptive_pair(make, **run):
     # (outputs recorded in the loop, the same run taking each between calls)
@@ -178,7 +179,7 @@ def test_adaptive_outputs_in_the_loop_equal_those_taken_between_calls(integrator
     _same(a, b)
 
 
-@pytest.mark.parametrize("integrator", ADAPTIVE)
+@pytest.mark.parametrize("integrator", ["ias15", "dop853"])
 def test_adaptive_outputs_in_the_loop_stop_where_the_run_stops(integrator):
     # a stopping condition between two outputs: the outputs before it, then
     # the state where it stopped, as between calls
