@@ -87,10 +87,11 @@ def test_escape_distance_and_unbound():
     assert r.status == "completed"
 
 
-@pytest.mark.parametrize("integrator", ["dopri5", "dop853", "rk4-doubling", "ias15"])
+@pytest.mark.parametrize("integrator", ["dop853", "rk4-doubling", "ias15"])
 def test_adaptive_methods_name_the_body(integrator):
     # the last of three bodies leaves: the error names the body the
-    # condition found (not row 0), in every adaptive loop
+    # condition found (not row 0), in each adaptive loop (dopri5 runs
+    # dop853's)
     b = orbits.BodySet(units=orbits.UnitSystem.nbody())
     b.add("star", mass=1.0, position=[0, 0, 0], velocity=[0, 0, 0])
     b.add("planet", mass=1e-6, position=[1, 0, 0], velocity=[0, 1, 0])
