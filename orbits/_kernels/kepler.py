@@ -78,6 +78,7 @@ __all__ = [
     "elements_to_state_many",
     "state_to_elements_many",
     "stumpff",
+    "stumpff_lane",
     "kepler_drift",
     "short_step_anomaly",
     "advance_by_anomaly",
@@ -1011,6 +1012,66 @@ def stumpff(z):
         c0 = 1.0 - z * c2
         c1 = 1.0 - z * c3
     return c0, c1, c2, c3
+
+
+# quarterings of a Stumpff argument that stumpff_lane takes: |z| <= 4 (above
+# it stumpff uses the trigonometric form directly) needs at most 3, as
+# 4 / 4^3 < _STUMPFF_SERIES_Z
+_LANE_QUARTERINGS = 3
+
+
+@njit(inline="always")
+def _estrin(z):
+    # _stumpff_short's four-term series, as written there
+    z2 = z * z
+    c2 = (0.5 - z * (1.0 / 24)) + z2 * ((1.0 / 720) - z * (1.0 / 40320))
+    c3 = (1.0 / 6 - z * (1.0 / 120)) + z2 * ((1.0 / 5040) - z * (1.0 / 362880))
+    return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+
+
+@njit(inline="always")
+def stumpff_lane(z, general):
+    """:func:`_stumpff_short` without a branch, for loops that LLVM turns into
+    vector instructions (one orbit per lane), and whether ``z`` is in its
+    domain (``|z| <= 4``; beyond it the caller must take the scalar path).
+    ``general`` (the same for every lane) False: only the four-term series,
+    valid when every lane has ``|z| <= _STUMPFF_SHORT_Z``.  Bit for bit
+    :func:`_stumpff_short` inside the domain: the same operations, the
+    branches of :func:`stumpff` taken as masked selects."""
+    e0, e1, e2, e3 = _estrin(z)
+    if not general:
+        return e0, e1, e2, e3, True
+    # stumpff: quarter until |z| <= 0.1 (masked), the seven-term series
+    # there, and the quarter-argument identities back
+    zq = z
+    n = 0
+    for _ in range(_LANE_QUARTERINGS):
+        big = abs(zq) > _STUMPFF_SERIES_Z
+        zq = zq * 0.25 if big else zq
+        n += 1 if big else 0
+    c2 = (1.0 / 2 - zq * (1.0 / 24 - zq * (1.0 / 720 - zq * (1.0 / 40320 - zq * (
+        1.0 / 3628800 - zq * (1.0 / 479001600 - zq * (1.0 / 87178291200)))))))
+    c3 = (1.0 / 6 - zq * (1.0 / 120 - zq * (1.0 / 5040 - zq * (1.0 / 362880 - zq * (
+        1.0 / 39916800 - zq * (1.0 / 6227020800 - zq * (1.0 / 1307674368000)))))))
+    c0 = 1.0 - zq * c2
+    c1 = 1.0 - zq * c3
+    for k in range(_LANE_QUARTERINGS):
+        up = k < n
+        d3 = 0.25 * (c2 + c0 * c3)
+        d2 = 0.5 * c1 * c1
+        zu = zq * 4.0
+        c3 = d3 if up else c3
+        c2 = d2 if up else c2
+        zq = zu if up else zq
+        d0 = 1.0 - zq * c2
+        d1 = 1.0 - zq * c3
+        c0 = d0 if up else c0
+        c1 = d1 if up else c1
+    short = -_STUMPFF_SHORT_Z <= z <= _STUMPFF_SHORT_Z
+    ok = not (z > _STUMPFF_DIRECT_Z or z < -_STUMPFF_DIRECT_Z)
+    if short:
+        return e0, e1, e2, e3, ok
+    return c0, c1, c2, c3, ok
 
 
 @njit(inline="always")

@@ -72,9 +72,10 @@ import numpy as np
 
 from ._jit import njit
 from .coordinates import interior_gm, to_jacobi
-from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL,
-                                    _SHORT_STEP_Z, _SIXTH, _STUMPFF_DIRECT_Z,
-                                    _STUMPFF_SERIES_Z, _STUMPFF_SHORT_Z, kepler_drift)
+from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z, _SIXTH,
+                     _STUMPFF_SHORT_Z, kepler_drift)
+# the Stumpff functions without a branch (shared with orbits._kernels.wh_lanes)
+from .kepler import stumpff_lane as _stumpff_lane
 from .invariants import MONITOR_WIDTH, monitor_row
 from .status import Status
 from .wisdom_holman import synchronize
@@ -86,63 +87,6 @@ __all__ = ["CHECK_EVERY", "lanes_workspace", "kepler_drift_lanes", "interaction_
 #: scalar loops' ``check_every``): a block of this many steps is replayed for
 #: a lane that failed in it.
 CHECK_EVERY = 16
-
-# quarterings of a Stumpff argument the lanes can take: |z| <= 4 (the
-# scalar code's direct trigonometric form is used above) needs at most 3,
-# as 4 / 4^3 < _STUMPFF_SERIES_Z
-_QUARTERINGS = 3
-
-
-@njit(inline="always")
-def _estrin(z):
-    # orbits._kernels.kepler._stumpff_short's four-term series, as written there
-    z2 = z * z
-    c2 = (0.5 - z * (1.0 / 24)) + z2 * ((1.0 / 720) - z * (1.0 / 40320))
-    c3 = (1.0 / 6 - z * (1.0 / 120)) + z2 * ((1.0 / 5040) - z * (1.0 / 362880))
-    return 1.0 - z * c2, 1.0 - z * c3, c2, c3
-
-
-@njit(inline="always")
-def _stumpff_lane(z, general):
-    """``orbits._kernels.kepler._stumpff_short(z)`` without a branch, and
-    whether ``z`` is in the lanes' domain (``|z| <= 4``).  ``general``
-    (the same for every lane) False: only the four-term series, valid when
-    every lane has ``|z| <= _STUMPFF_SHORT_Z``."""
-    e0, e1, e2, e3 = _estrin(z)
-    if not general:
-        return e0, e1, e2, e3, True
-    # orbits._kernels.kepler.stumpff: quarter until |z| <= 0.1 (masked), the
-    # seven-term series there, and the quarter-argument identities back
-    zq = z
-    n = 0
-    for _ in range(_QUARTERINGS):
-        big = abs(zq) > _STUMPFF_SERIES_Z
-        zq = zq * 0.25 if big else zq
-        n += 1 if big else 0
-    c2 = (1.0 / 2 - zq * (1.0 / 24 - zq * (1.0 / 720 - zq * (1.0 / 40320 - zq * (
-        1.0 / 3628800 - zq * (1.0 / 479001600 - zq * (1.0 / 87178291200)))))))
-    c3 = (1.0 / 6 - zq * (1.0 / 120 - zq * (1.0 / 5040 - zq * (1.0 / 362880 - zq * (
-        1.0 / 39916800 - zq * (1.0 / 6227020800 - zq * (1.0 / 1307674368000)))))))
-    c0 = 1.0 - zq * c2
-    c1 = 1.0 - zq * c3
-    for k in range(_QUARTERINGS):
-        up = k < n
-        d3 = 0.25 * (c2 + c0 * c3)
-        d2 = 0.5 * c1 * c1
-        zu = zq * 4.0
-        c3 = d3 if up else c3
-        c2 = d2 if up else c2
-        zq = zu if up else zq
-        d0 = 1.0 - zq * c2
-        d1 = 1.0 - zq * c3
-        c0 = d0 if up else c0
-        c1 = d1 if up else c1
-    short = -_STUMPFF_SHORT_Z <= z <= _STUMPFF_SHORT_Z
-    ok = not (z > _STUMPFF_DIRECT_Z or z < -_STUMPFF_DIRECT_Z)
-    if short:
-        return e0, e1, e2, e3, ok
-    return c0, c1, c2, c3, ok
-
 
 def lanes_workspace(n, b):
     """The scratch arrays of :func:`advance_lanes` for ``b`` systems of ``n``

@@ -1,0 +1,261 @@
+"""The Wisdom-Holman step of one system with its planets in vector lanes.
+
+:mod:`orbits._kernels.wh_batch` puts many systems in the lanes of the
+vector registers; this module puts the planets of one system there
+(structure of arrays, as WHFast512 does, Javaheri, Rein & Tamayo 2023),
+for the compiled loop of :mod:`orbits._kernels.wisdom_holman`.  The state
+stays in that loop's arrays of shape (N, 3) (its epilogue, synchronisation
+and outputs read them); an operator copies what it needs into rows of a
+scratch array (:func:`lanes_scratch`), one row per quantity and one column
+per planet, runs its arithmetic as loops over the columns that LLVM turns
+into vector instructions (four planets in an AVX2 register), and writes the
+result back.
+
+:func:`kepler_drift_lanes` drifts every planet, bit for bit as
+:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` does, in one pass
+over the columns: the scalar drift's short-step path
+(:func:`~orbits._kernels.kepler.kepler_drift`: the third-order starter of
+the universal anomaly, one of Danby's quartic iterations, the f and g
+functions) with the four-term Stumpff series
+(:func:`~orbits._kernels.kepler.stumpff_lane`).  This is the whole drift of
+a planetary step (a few hundredths of a radian of anomaly, where the
+starter is good to 1e-6 and one iteration converges), and one pass lets the
+processor overlap the planets' long chains of dependent operations: the
+eight planets' drift took 0.19 µs against 0.39 µs for the scalar drift
+(0.27 µs as three passes, starter, iteration and f and g, each a loop).  A
+lane is taken where the scalar path would have done exactly this
+(converged after one iteration, both Stumpff arguments within the
+four-term series, a positive radius at the end).  Every other planet (a
+step long against its orbit, more than 0.045 rad of eccentric anomaly, a
+high eccentricity near pericentre, a hyperbola close in) is drifted by the
+scalar :func:`~orbits._kernels.kepler.kepler_drift` from the same start,
+which is what the scalar loop does for it too.  So no accuracy is lost, and
+the results are those of the scalar loop bit for bit: fastmath is off, so
+LLVM neither reorders nor fuses the operations, and a vector instruction
+rounds each lane as its scalar form does.
+
+A masked form of the whole short-step path in the lanes (the iteration
+repeated until every lane has converged, the general Stumpff form with a
+masked number of quarterings, as :mod:`orbits._kernels.wh_batch` does) was
+measured and dropped: where a step is long for some planets (the Sun and
+eight planets at 1 or 4 days) it was slower than the scalar drift
+(1.06-1.19 times the scalar loop's step), as the general Stumpff form then
+costs every lane; the lanes' single pass with the declined planets left to
+the scalar drift is faster there.  Where more than a quarter of the
+planets are declined the loop leaves the drift to the scalar code for
+:data:`RETRY` drifts before trying the lanes again (:data:`MEMO`;
+``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`).
+
+The interaction kick stays the scalar one.  Its pair loop and its two sums
+along the bodies are sequential in the scalar code's order, which a
+bit-for-bit vector form must keep: measured on the eight planets, the
+pairs' separations gathered in that order into columns, their inverse cubes
+in vector instructions and the sums back in order (0.34 µs), or a column of
+pairs per body with the sums in vector lanes (0.54 µs), or only the mass
+ratios and Kepler terms in lanes (0.33 µs) were all slower than the scalar
+kick (0.31 µs); a step is a chain of dependent operations, drift, kick,
+drift, and the kick's critical path is in its sums, not its arithmetic.
+
+What keeps LLVM from vectorising a loop, learnt here and in
+:mod:`orbits._kernels.wh_batch`: a branch per element (``and`` between
+comparisons is one: Python's short circuit; ``&`` of the booleans is not),
+an index numba cannot prove non-negative (unsigned indices), and indexed
+loads from an array the loop also writes (it cannot check them for
+overlap).  The columns are padded to a multiple of :data:`LANE_WIDTH` with
+copies of the first planet, so that no loop has a scalar remainder; the
+copies' results are never used.
+
+References
+----------
+Javaheri, P., Rein, H. & Tamayo, D. 2023, "WHFast512: a symplectic N-body
+integrator for planetary systems optimized with AVX512 instructions", Open
+J. Astrophys. 6 (planets in vector lanes, a Kepler solver without branches).
+Rein, H. & Tamayo, D. 2015, MNRAS 452, 376 (WHFast).  Danby, J. M. A. 1988,
+*Fundamentals of Celestial Mechanics*, 2nd ed., sect. 6.9.
+"""
+
+import math
+
+import numpy as np
+
+from ._jit import njit
+from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _SIXTH, _STUMPFF_SHORT_Z, kepler_drift,
+                     stumpff_lane)
+
+__all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "RETRY", "lane_columns", "lanes_scratch",
+           "kepler_drift_lanes"]
+
+#: doubles in a vector register of the machines this is tuned for (AVX2); the
+#: planets' columns are padded to a multiple of it
+LANE_WIDTH = 4
+
+#: rows of the drift's scratch: the start (6) and mu, the end state (6),
+#: the verdict, and a memo for the caller (:data:`MEMO`)
+DRIFT_ROWS = 15
+_X, _MU, _Y, _TAKE = 0, 6, 7, 13
+#: the scratch's row whose column 0 the loop keeps from drift to drift (see
+#: orbits._kernels.wisdom_holman._lanes_drift): the drifts left before the
+#: lanes are tried again after they declined too many planets
+MEMO = 14
+
+#: drifts that the loop leaves to the scalar drift after the lanes have
+#: declined more than a quarter of the planets (a scene whose steps are long
+#: against several orbits, where the lanes would be wasted every time),
+#: before it tries them again
+RETRY = 64
+
+
+def lane_columns(n):
+    """Columns of the scratch for ``n`` bodies: one per planet (``n - 1``),
+    padded to a multiple of :data:`LANE_WIDTH`."""
+    return LANE_WIDTH * max(1, (n - 1 + LANE_WIDTH - 1) // LANE_WIDTH)
+
+
+def lanes_scratch(n):
+    """The scratch of :func:`kepler_drift_lanes` for ``n`` bodies, shape
+    (:data:`DRIFT_ROWS`, :func:`lane_columns` ``(n)``)."""
+    return np.zeros((DRIFT_ROWS, lane_columns(n)))
+
+
+@njit(inline="always")
+def _single_pass(S, h, P):
+    # the usual planetary step in one pass over the columns: the starter,
+    # one quartic iteration and the f and g functions, all with the
+    # four-term Stumpff series; a column is right (its verdict 1) where the
+    # scalar path would have done exactly this: in the short-step domain,
+    # both Stumpff arguments within the four-term series, converged after
+    # one iteration, a positive radius at the end.  Every operation is the
+    # one kepler.short_step_anomaly and kepler._short_coefficients do, in
+    # their order, so that a right column is bit for bit the scalar drift.
+    # Returns how many columns are not right.
+    X0 = S[_X]
+    X1 = S[_X + 1]
+    X2 = S[_X + 2]
+    V0 = S[_X + 3]
+    V1 = S[_X + 4]
+    V2 = S[_X + 5]
+    MU = S[_MU]
+    Y0 = S[_Y]
+    Y1 = S[_Y + 1]
+    Y2 = S[_Y + 2]
+    U0 = S[_Y + 3]
+    U1 = S[_Y + 4]
+    U2 = S[_Y + 5]
+    tk_ = S[_TAKE]
+    rejected = 0
+    for k in range(P):
+        mu = MU[k]
+        x0 = X0[k]
+        y0 = X1[k]
+        z0 = X2[k]
+        vx0 = V0[k]
+        vy0 = V1[k]
+        vz0 = V2[k]
+        r2 = x0 * x0 + y0 * y0 + z0 * z0
+        v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
+        r0 = math.sqrt(r2)
+        ir0 = 1.0 / r0
+        et = x0 * vx0 + y0 * vy0 + z0 * vz0
+        beta = 2.0 * mu * ir0 - v2
+        zeta = mu - beta * r0
+        w = h * ir0
+        s = w * (1.0 + w * (-0.5 * et * ir0
+                            + w * ((3.0 * et * et * ir0 * ir0 - zeta * ir0) * _SIXTH)))
+        z = beta * s * s
+        good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
+                & (abs(z) <= _STUMPFF_SHORT_Z))
+        c0, c1, c2, c3, _ = stumpff_lane(z, False)
+        G1 = s * c1
+        G2 = s * s * c2
+        G3 = s * s * s * c3
+        f = r0 * s + et * G2 + zeta * G3 - h
+        ir = 1.0 / (r0 + et * G1 + zeta * G2)
+        d1 = -f * ir
+        a = 0.5 * (et * c0 + zeta * G1) * ir
+        b = (zeta * c0 - beta * et * G1) * ir * _SIXTH
+        d = d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - b)))
+        s = s + d
+        done = abs(d) <= _SHORT_STEP_TOL * abs(s)
+        z = beta * s * s
+        c0, c1, c2, c3, _ = stumpff_lane(z, False)
+        G1 = s * c1
+        G2 = s * s * c2
+        # (_advance's sigma is this et: the same expression of the start)
+        r = r0 + et * G1 + zeta * G2
+        ir = 1.0 / r
+        fm1 = -mu * G2 * ir0
+        g = r0 * G1 + et * G2
+        fdot = -mu * G1 * ir0 * ir
+        gdm1 = -mu * G2 * ir
+        Y0[k] = x0 + (fm1 * x0 + g * vx0)
+        Y1[k] = y0 + (fm1 * y0 + g * vy0)
+        Y2[k] = z0 + (fm1 * z0 + g * vz0)
+        U0[k] = vx0 + (fdot * x0 + gdm1 * vx0)
+        U1[k] = vy0 + (fdot * y0 + gdm1 * vy0)
+        U2[k] = vz0 + (fdot * z0 + gdm1 * vz0)
+        take = good & done & (abs(z) <= _STUMPFF_SHORT_Z) & (r > 0.0)
+        tk_[k] = 1.0 if take else 0.0
+        rejected += not take
+    return rejected
+
+
+@njit
+def kepler_drift_lanes(xj, vj, mu, h, S):
+    """:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` with the
+    planets in vector lanes, bit for bit.
+
+    Parameters
+    ----------
+    xj, vj : ndarray, shape (N, 3)
+        Positions and velocities: row 0 drifts in a straight line, row
+        ``i >= 1`` on its orbit about ``mu[i]``.  In place.
+    mu : ndarray, shape (N,)
+        Each row's Kepler ``G M``.
+    h : float
+        The step.
+    S : ndarray, shape (DRIFT_ROWS, P)
+        Scratch (:func:`lanes_scratch`), ``P >= N - 1`` a multiple of
+        :data:`LANE_WIDTH`.
+
+    Returns
+    -------
+    declined : int
+        The planets the lanes declined (drifted by the scalar drift).
+
+    Notes
+    -----
+    See the module notes.
+    """
+    xj[0, 0] += h * vj[0, 0]
+    xj[0, 1] += h * vj[0, 1]
+    xj[0, 2] += h * vj[0, 2]
+    n = xj.shape[0]
+    P = np.uint64(S.shape[1])
+    # the columns; the padding repeats planet 1, whose copies are never read
+    for k in range(S.shape[1]):
+        i = k + 1 if k + 1 < n else 1
+        S[_X, k] = xj[i, 0]
+        S[_X + 1, k] = xj[i, 1]
+        S[_X + 2, k] = xj[i, 2]
+        S[_X + 3, k] = vj[i, 0]
+        S[_X + 4, k] = vj[i, 1]
+        S[_X + 5, k] = vj[i, 2]
+        S[_MU, k] = mu[i]
+    _single_pass(S, h, P)
+    declined = 0
+    for i in range(1, n):
+        k = i - 1
+        if S[_TAKE, k] != 0.0:
+            xj[i, 0] = S[_Y, k]
+            xj[i, 1] = S[_Y + 1, k]
+            xj[i, 2] = S[_Y + 2, k]
+            vj[i, 0] = S[_Y + 3, k]
+            vj[i, 1] = S[_Y + 4, k]
+            vj[i, 2] = S[_Y + 5, k]
+        else:
+            # declined: the scalar drift from the same start, still in xj,
+            # vj (its short-step path first, as the scalar loop takes it,
+            # then the bracketed solver)
+            kepler_drift(mu[i], xj, vj, i, h)
+            declined += 1
+    return declined

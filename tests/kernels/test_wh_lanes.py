@@ -1,0 +1,115 @@
+"""The Kepler drift of one system with its planets in vector lanes
+(orbits._kernels.wh_lanes) against the scalar drift of the Wisdom-Holman
+loop (orbits._kernels.wisdom_holman.kepler_drift_all).
+
+Every comparison here is exact (``np.array_equal``, tolerance zero), not a
+tolerance: a column the lanes take is computed by the same floating-point
+operations in the same order as the scalar short-step path (fastmath is off,
+so LLVM neither reorders nor fuses them, and a vector instruction rounds each
+lane as its scalar form does), and a column outside the lanes' domain is
+drifted by the scalar ``kepler_drift`` itself.  So any difference, even of
+one ulp, is a bug.  Each test also checks which path its columns took, so
+that the fallbacks it means to test are exercised.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from orbits._kernels import kepler as K
+from orbits._kernels import wh_lanes as L
+from orbits._kernels import wisdom_holman as W
+
+
+def system(orbits_, mu=1.0):
+    """Jacobi arrays (N, 3) of a centre of mass (row 0, drifting) and one row
+    per ``(a, e, f)`` about ``mu``, and each row's mu."""
+    n = len(orbits_) + 1
+    xj, vj = np.zeros((n, 3)), np.zeros((n, 3))
+    xj[0], vj[0] = (0.1, -0.2, 0.05), (1e-3, 2e-3, -1e-3)
+    for i, (a, e, f) in enumerate(orbits_, start=1):
+        x, v = np.zeros(3), np.zeros(3)
+        assert K.elements_to_state(mu, a, e, 0.2 + 0.1 * i, 1.0 + i, 2.0 - 0.3 * i, f,
+                                   x, v) == 0
+        xj[i], vj[i] = x, v
+    return xj, vj, np.full(n, mu)
+
+
+def both(xj, vj, mu, h, steps=1):
+    """``steps`` drifts of ``h`` by the scalar drift and by the lanes, compared
+    after every drift; returns the lanes' scratch after the last and the
+    number of planets the lanes declined in it."""
+    a, b = xj.copy(), vj.copy()
+    c, d = xj.copy(), vj.copy()
+    w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
+    S = L.lanes_scratch(len(xj))
+    for k in range(steps):
+        W.kepler_drift_all(a, b, mu, h, w1, w2)
+        declined = L.kepler_drift_lanes(c, d, mu, h, S)
+        assert np.array_equal(a, c, equal_nan=True), k
+        assert np.array_equal(b, d, equal_nan=True), k
+    assert declined == np.sum(~lanes_took(S, len(xj)))
+    return S, declined
+
+
+def lanes_took(S, n):
+    return S[L._TAKE, :n - 1] != 0.0
+
+
+CIRCULAR = [(1.0, 0.0, 0.3), (1.6, 0.01, 2.0), (5.2, 0.05, -1.0), (9.5, 0.0, 4.0)]
+
+
+def test_circular_planets_take_the_lanes_bit_for_bit():
+    # steps of a planetary integration (1/200 of the innermost period)
+    xj, vj, mu = system(CIRCULAR)
+    S, declined = both(xj, vj, mu, 2 * math.pi / 200, steps=50)
+    assert declined == 0
+
+
+@pytest.mark.parametrize("f", [0.0, 0.05, math.pi])
+def test_eccentric_and_hyperbolic_orbits_beside_circular_ones(f):
+    # e = 0.99 at pericentre (r = 0.01, where the step is long against the
+    # orbit: the scalar drift's bracketed solver), near it and at
+    # apocentre, and two hyperbolae, in the same system as circular orbits
+    orbits_ = CIRCULAR[:2] + [(1.0, 0.99, f), (-1.0, 1.5, f / 2), (-0.5, 5.0, -f / 3)] \
+        + CIRCULAR[2:]
+    xj, vj, mu = system(orbits_)
+    both(xj, vj, mu, 2 * math.pi / 200, steps=30)
+    both(xj, vj, mu, -2 * math.pi / 200, steps=30)
+    S, _ = both(xj, vj, mu, 2 * math.pi / 200)
+    took = lanes_took(S, len(xj))
+    assert took[[0, 1, 5, 6]].all()
+    if f == 0.0:
+        # at pericentre the e = 0.99 orbit is outside the lanes' domain: it
+        # went to the scalar drift
+        assert not took[2]
+
+
+@pytest.mark.parametrize("ratio", [1 / 50, 1 / 20, 1 / 5, 1.0, 7.3])
+def test_longer_steps_are_left_to_the_scalar_drift(ratio):
+    # 1/50 and 1/20 of the innermost period: Stumpff arguments beyond the
+    # four-term series, which the lanes decline; 1/5 and beyond: outside the
+    # short-step domain (the bracketed solver, with the period reduced for
+    # the longest)
+    xj, vj, mu = system(CIRCULAR + [(0.7, 0.3, 1.0)])
+    S, declined = both(xj, vj, mu, ratio * 2 * math.pi, steps=20)
+    assert not lanes_took(S, len(xj))[0]
+    assert declined >= 1
+
+
+@pytest.mark.parametrize("planets", [1, 2, 3, 4, 5, 8, 9])
+def test_every_number_of_planets_and_the_padding(planets):
+    orbits_ = [(1.0 + 0.37 * k, 0.02 * (k % 3), 0.5 * k) for k in range(planets)]
+    xj, vj, mu = system(orbits_)
+    mu = mu * np.linspace(1.0, 1.01, len(mu))     # each row its own mu (Jacobi)
+    assert L.lanes_scratch(len(xj)).shape[1] % L.LANE_WIDTH == 0
+    both(xj, vj, mu, 0.01, steps=20)
+
+
+def test_zero_step_and_non_finite_states():
+    xj, vj, mu = system(CIRCULAR)
+    both(xj, vj, mu, 0.0)
+    xj[2, 1] = np.nan
+    vj[3, 0] = np.inf
+    both(xj, vj, mu, 0.01)
