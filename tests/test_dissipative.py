@@ -581,7 +581,9 @@ def test_terms_round_trip_through_dicts(term):
     assert back.velocity_dependent is True
 
 
-@pytest.mark.slow  # 27 s of compiling on a fresh clone; the restart test below covers it
+# 27 s of compiling on a fresh clone; test_terms_rebuilt_from_dicts_bind_the_same_floats
+# (what the runs are made of) and the restart test below (a run from a file) cover it
+@pytest.mark.slow
 def test_simulation_runs_and_terms_rebuilt_from_dicts_run_bit_identically():
     # what a restart or an ensemble rebuilds from the dictionaries binds to the same
     # floats: the two runs agree bit for bit.  Migration with its default primary
@@ -600,6 +602,32 @@ def test_simulation_runs_and_terms_rebuilt_from_dicts_run_bit_identically():
     assert np.array_equal(runs[0].velocities.value, runs[1].velocities.value)
 
 
+def _leaves(tree):
+    if isinstance(tree, tuple):
+        for branch in tree:
+            yield from _leaves(branch)
+    else:
+        yield tree
+
+
+def test_terms_rebuilt_from_dicts_bind_the_same_floats():
+    # the slow test above without its runs: the three kinds of term rebuilt from
+    # their dictionaries (through JSON, as files and ensembles store them) give
+    # the loop the same arguments, bit for bit, as the terms they were made from,
+    # so a run with them is the same floats (the compiled loop being the same)
+    terms = [forces.Migration("Planet", tau_a=1e3 * u.yr, tau_e=-1e3 * u.yr),
+             TERMS[1], TERMS[2]]
+    rebuilt = [forces.from_dict(json.loads(json.dumps(t.to_dict()))) for t in terms]
+    sims = [orbits.Simulation(_dusty(), "ias15", forces=given) for given in (terms, rebuilt)]
+    assert sims[1].forces == tuple(terms)
+    given, back = (list(_leaves(sim._fargs)) for sim in sims)
+    # the terms' own arguments are compared too, beside gravity's
+    assert len(given) == len(back) and len(list(_leaves(sims[0]._fargs[1]))) > len(terms)
+    for a, b in zip(given, back):
+        assert type(a) is type(b)
+        assert np.asarray(a).tobytes() == np.asarray(b).tobytes()
+
+
 @pytest.mark.parametrize("integrator", ["wh", "saba2"])
 @pytest.mark.parametrize("term", TERMS[:3], ids=lambda t: type(t).__name__)
 def test_wisdom_holman_refuses_them(integrator, term):
@@ -610,8 +638,12 @@ def test_wisdom_holman_refuses_them(integrator, term):
 # -- restart and ensembles -------------------------------------------------------------------
 
 def _dissipative_sim(integrator="ias15", dt=None):
+    # two terms chained, both of one kind: the resonant-migration example's loop,
+    # which the default run compiles anyway (the three kinds of TERMS chained
+    # compiled a loop for this test alone, 48 s of a fresh clone's run; their
+    # rebuilding is checked above without a run)
     terms = [forces.Migration("Planet", tau_a=1e3 * u.yr, tau_e=-1e3 * u.yr),
-             TERMS[1], TERMS[2]]
+             forces.Migration("dust", tau_e=300 * u.yr)]
     return orbits.Simulation(_dusty(), integrator, dt=dt, forces=terms)
 
 
