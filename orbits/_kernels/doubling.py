@@ -60,7 +60,7 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
 
 def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
                    dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
-                   rtol, atol, marks=None, mark_steps=None):
+                   rtol, atol, marks, mark_steps):
     # marks: outputs recorded in the loop, as in orbits._kernels.embedded
     n = x.shape[0]
     every = mon[0]
@@ -90,10 +90,12 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         p0 = work_rate(x, v, t, fargs)  # noqa: F821
     target = t_end
     k_mark = 0
-    if marks is not None:
+    # an empty marks array: none (one compiled loop for both uses)
+    has_marks = marks.shape[0] > 0
+    if has_marks:
         target = marks[0]
     while steps < max_steps and t < t_end:
-        if marks is not None and n_mon >= mon_out.shape[0]:
+        if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
         h = h_prop
         shortened = False
@@ -148,7 +150,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                 info[1] = sargs[6][1]
                 status = stop
                 break
-            if marks is not None and t == target:
+            if has_marks and t == target:
                 mon_t[n_mon] = t
                 record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - by specialize
                 work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize

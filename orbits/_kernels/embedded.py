@@ -75,13 +75,14 @@ def step_underflow(h, t, t_end):
 
 def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
                    info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps, rtol, atol,
-                   marks=None, mark_steps=None):
+                   marks, mark_steps):
     # marks (outputs recorded in the loop): the loop lands on each of these
     # times in turn, as it lands on t_end, and records there a row of
     # mon_out (monitors and state) with its time in mon_t and its step count
     # in mark_steps; t_end is then the last mark.  Landing on a mark in the
     # loop is landing on it at the end of a call: the same steps, bit for
-    # bit.  Without marks (None) this compiles to the loop without them.
+    # bit.  Empty marks: the loop lands on t_end alone (the same compiled
+    # loop for both uses).
     n = x.shape[0]
     s = b.shape[0]
     every = mon[0]
@@ -111,10 +112,12 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
         p0 = work_rate(x, v, t, fargs)  # noqa: F821
     target = t_end
     k_mark = 0
-    if marks is not None:
+    # an empty marks array: none (one compiled loop for both uses)
+    has_marks = marks.shape[0] > 0
+    if has_marks:
         target = marks[0]
     while steps < max_steps and t < t_end:
-        if marks is not None and n_mon >= mon_out.shape[0]:
+        if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
         h = h_prop
         shortened = False
@@ -198,7 +201,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
                 info[1] = sargs[6][1]
                 status = stop
                 break
-            if marks is not None and t == target:
+            if has_marks and t == target:
                 # an output: recorded as the driver would record it on return
                 mon_t[n_mon] = t
                 record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - by specialize

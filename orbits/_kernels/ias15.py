@@ -288,7 +288,7 @@ def _b6_rounding(x, xs, a0, acc, n):
 
 def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, dtp, ref,
                 tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
-                epsilon, min_dt, mode, marks=None, mark_steps=None):
+                epsilon, min_dt, mode, marks, mark_steps):
     # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
     # ref = (length of the reference step, time from its start to now).
     # tc = (time, the part of it that t + dt rounded away): the time is carried
@@ -300,8 +300,9 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     # times in turn, as it lands on t_end, and records there a row of
     # mon_out (monitors and state, orbits._kernels.stepping.record_state) with
     # its time in mon_t and its step count in mark_steps; t_end is then the
-    # last mark.  The rows count in n_mon.  Without marks (None) this compiles
-    # to the loop that lands on t_end alone.
+    # last mark.  The rows count in n_mon.  Empty marks: the loop lands on
+    # t_end alone (the same compiled loop: a loop compiled for each use cost
+    # every new force two compilations).
     n = x.shape[0]
     # the step control measures the bodies' rows (not the tangent rows of variations)
     ne = rows(x, fargs)  # noqa: F821 - bound by specialize
@@ -320,14 +321,16 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     ct = tc[1] if t == tc[0] else 0.0
     target = t_end
     k_mark = 0
-    if marks is not None:
+    # an empty marks array: none (one compiled loop for both uses)
+    has_marks = marks.shape[0] > 0
+    if has_marks:
         target = marks[0]
     eps7 = epsilon ** (1.0 / 7.0)
     prs7 = (_FACT7 * epsilon) ** (1.0 / 7.0)
     while True:
         if counts[0] >= max_steps:
             return Status.OK, t, n_mon
-        if marks is not None and n_mon >= mon_out.shape[0]:
+        if has_marks and n_mon >= mon_out.shape[0]:
             return Status.OK, t, n_mon               # caller collects the rows first
         if until_record == 1 and n_mon >= cap:
             return Status.OK, t, n_mon               # caller collects the rows first
@@ -584,7 +587,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
             info[0] = worst
             return Status.STEP_UNDERFLOW, t, n_mon
         if t == target:
-            if marks is None:
+            if not has_marks:
                 return Status.OK, t, n_mon
             # an output: recorded as the driver would record it on return
             mon_t[n_mon] = t
@@ -638,7 +641,7 @@ def ias15_loop(force, stop=False):
 
     The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
     dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs,
-    max_steps, epsilon, min_dt, mode[, marks, mark_steps])`` with the arrays of
+    max_steps, epsilon, min_dt, mode, marks, mark_steps)`` with the arrays of
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """

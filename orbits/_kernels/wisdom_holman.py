@@ -256,16 +256,24 @@ def _from_heliocentric(xh, vb, gm, mu, x, v):
     from_democratic_heliocentric(xh, vb, gm, x, v)
 
 
+#: ``_apply_corrector``'s ``inverse``: C^-1, or C
+INVERSE = 1.0
+FORWARD = 0.0
+
+
 def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs):
-    """Apply the symplectic corrector ``C`` (or ``C^-1`` if ``inverse``) for the
-    step ``h`` to the internal state ``xj``, ``vj`` in place.
+    """Apply the symplectic corrector ``C`` (or ``C^-1`` if ``inverse`` is
+    not 0) for the step ``h`` to the internal state ``xj``, ``vj`` in place.
 
     ``corr`` (shape (m, 2)) holds the stages' ``(a_i, b_i)`` in units of the
     step; ``x`` and ``acc`` (shape (N, 3)) are scratch.  See the module notes.
+    ``inverse`` is a float (:data:`INVERSE` or :data:`FORWARD`): a constant
+    True or False would be typed as a literal, and numba would compile the
+    corrector once for each (some 20 s of every loop's first compilation).
     """
     m = corr.shape[0]
     for k in range(m):
-        if inverse:
+        if inverse != 0.0:
             a = -corr[k, 0] * h
             b = corr[k, 1] * h
         else:
@@ -290,7 +298,7 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, ta
     if owed != 0.0:
         drift(xs, vs, eta, owed, x, acc, targs)  # noqa: F821 - bound by specialize
     if corr.shape[0] > 0:
-        apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, False, targs)
+        apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, FORWARD, targs)
     from_internal(xs, vs, gm, eta, x, v, targs)  # noqa: F821 - bound by specialize
 
 
@@ -310,7 +318,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         state[0] = 1
         owed_box[0] = 0.0
         if corrected:
-            apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True, targs)
+            apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
             cdt[0] = abs(dt)
     elif corrected and cdt[0] != abs(dt):
         # a new step size (a shorter last step): through the true state to the
@@ -318,8 +326,8 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         if owed_box[0] != 0.0:
             drift(xj, vj, eta, owed_box[0], xs, vs, targs)  # noqa: F821 - bound
             owed_box[0] = 0.0
-        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], False, targs)
-        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), True, targs)
+        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], FORWARD, targs)
+        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
         cdt[0] = abs(dt)
     owed = owed_box[0]
     n_ops = len(KINDS)  # noqa: F821 - bound by specialize

@@ -50,7 +50,13 @@ from .._kernels import stepping
 from ..errors import IntegratorOptionError, OrbitsWarning
 
 __all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
-           "RTOL_FLOOR"]
+           "RTOL_FLOOR", "NO_MARKS", "NO_MARK_STEPS"]
+
+#: ``advance_to``'s marks when the outputs are not recorded in the loop:
+#: empty arrays of the marks' types, so that each loop compiles once for both
+#: uses (empty: nothing is ever written to them)
+NO_MARKS = np.empty(0)
+NO_MARK_STEPS = np.empty(0, dtype=np.int64)
 
 #: The smallest relative tolerance an adaptive method is run with: 100 float64
 #: roundings (the floor scipy's ``solve_ivp`` also applies).

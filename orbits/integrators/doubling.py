@@ -6,7 +6,7 @@ from .._kernels.status import with_status
 from .._kernels import doubling as _doubling
 from .._kernels import stepping as _stepping
 from ._loops import loop_for
-from .base import AdaptiveIntegrator
+from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
 
 __all__ = ["RK4Doubling"]
 
@@ -59,7 +59,7 @@ class RK4Doubling(AdaptiveIntegrator):
     records_marks = True
 
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps, marks=None, mark_steps=None):
+                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
         """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
@@ -71,6 +71,4 @@ class RK4Doubling(AdaptiveIntegrator):
                 w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
                 _stepping.NO_STOP_ARGS if stop is None else stop, int(max_steps),
                 float(self.config["rtol"]), float(self.config["atol"]))
-        if marks is not None:
-            args += (marks, mark_steps)
-        return with_status(*loop(*args))
+        return with_status(*loop(*args, marks, mark_steps))

@@ -8,7 +8,7 @@ from .._kernels import stepping as _stepping
 from . import dop853_coefficients as _dop853
 from . import tableaux
 from ._loops import loop_for
-from .base import AdaptiveIntegrator
+from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
 
 __all__ = ["EmbeddedRungeKutta", "Dopri5", "DOP853"]
 
@@ -48,7 +48,7 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
     records_marks = True
 
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps, marks=None, mark_steps=None):
+                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
         """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
@@ -61,9 +61,7 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
                 ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
                 mon_t, mon_out, _stepping.NO_STOP_ARGS if stop is None else stop,
                 int(max_steps), float(self.config["rtol"]), float(self.config["atol"]))
-        if marks is not None:
-            args += (marks, mark_steps)
-        return with_status(*loop(*args))
+        return with_status(*loop(*args, marks, mark_steps))
 
 
 class Dopri5(EmbeddedRungeKutta):

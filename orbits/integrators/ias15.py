@@ -7,7 +7,7 @@ from .._kernels import ias15 as _k
 from .._kernels.stepping import NO_STOP_ARGS, work_bound
 from ..errors import IntegratorOptionError
 from ._loops import loop_for
-from .base import AdaptiveIntegrator
+from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
 
 __all__ = ["IAS15"]
 
@@ -139,7 +139,7 @@ class IAS15(AdaptiveIntegrator):
     records_marks = True
 
     def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out,
-                   stop, max_steps, marks=None, mark_steps=None):
+                   stop, max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
         """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
@@ -151,10 +151,7 @@ class IAS15(AdaptiveIntegrator):
                 mon, int(step0), mon_t, mon_out, NO_STOP_ARGS if stop is None else stop,
                 int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
                 ADAPTIVE_MODES[self.config["adaptive_mode"]])
-        if marks is None:
-            status, t_reached, n_mon = loop(*args)
-        else:
-            status, t_reached, n_mon = loop(*args, marks, mark_steps)
+        status, t_reached, n_mon = loop(*args, marks, mark_steps)
         c = ws["counts"]
         return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
 

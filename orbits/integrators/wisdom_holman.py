@@ -435,6 +435,10 @@ class WisdomHolman(Integrator):
                  (targs, tp))
         elif ws["state"][0]:
             terms, targs = ws.get("terms", (None, ()))
+            if terms is None and x.shape[0] >= LANES_FROM_BODIES:
+                # the loop's own arguments: the synchronisation and the
+                # corrector are then compiled once, for the loop and for this
+                targs = self._lanes_scratch(ws, x.shape[0])
             sync = _wh.synchronizer(self.config["coordinates"], terms)
             sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],
                  x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0], targs)
