@@ -264,10 +264,8 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
         w = h * ir0
         s = w * (1.0 + w * (-0.5 * et * ir0
                             + w * ((3.0 * et * et * ir0 * ir0 - zeta * ir0) * _SIXTH)))
-        # (& rather than and: the same truth without a branch per lane,
-        # which kept LLVM from vectorising this loop)
-        good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
-                & (abs(beta * s * s) <= _SHORT_STEP_Z))
+        good = (h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2 and mu > 0.0 and h != 0.0
+                and abs(beta * s * s) <= _SHORT_STEP_Z)
         s_[k] = s
         r0_[k] = r0
         ir0_[k] = ir0
