@@ -698,25 +698,21 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
         # (a Kepler drift of every body, or an inner integration in an
         # encounter, every step); else the epilogue sees the internal state
         # (the finite check)
+        seen_x, seen_v, t_seen = xh, vb, t + (k + 1) * dt
         if until_record == 1 or (STOP and k + 1 == nsteps):  # noqa: F821 - by specialize
             trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v, w1,
                               w2, inner, tabs, rtol)
             checked[1] = 0.0
-            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
-                x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every,
-                until_record, every, mon, n_mon, mon_t, mon_out, sargs, ())
+            seen_x, seen_v = x, v
         elif STOP:  # noqa: F821
             from_democratic_heliocentric(xc, vc, gm, x, v)
-            t_check = t + (k + 1) * dt - owed
-            checked[0] = t_check
+            t_seen -= owed
+            checked[0] = t_seen
             checked[1] = 1.0
-            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
-                x, v, t_check, k, nsteps, True, until_check, check_every,
-                until_record, every, mon, n_mon, mon_t, mon_out, sargs, ())
-        else:
-            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
-                xh, vb, t + (k + 1) * dt, k, nsteps, True, until_check, check_every,
-                until_record, every, mon, n_mon, mon_t, mon_out, sargs, ())
+            seen_x, seen_v = x, v
+        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+            seen_x, seen_v, t_seen, k, nsteps, True, until_check, check_every, until_record,
+            every, mon, n_mon, mon_t, mon_out, sargs, ())
         if status != GO:
             return status, done, n_mon
     return Status.OK, nsteps, n_mon

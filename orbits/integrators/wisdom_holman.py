@@ -374,12 +374,9 @@ class WisdomHolman(Integrator):
                                          mon_t, mon_out, check_every)
         if ws["state"][1] == 0:
             self._check_system(ws, force, fargs)
-        terms, targs = ws.get("terms", (None, ()))
+        terms, targs, lanes = self._loop_terms(ws, x.shape[0])
         gravity = fargs if terms is None else fargs[0]
         gm, n_active = gravity[0], gravity[1]
-        lanes = terms is None and x.shape[0] >= LANES_FROM_BODIES
-        if lanes:
-            targs = self._lanes_scratch(ws, x.shape[0])
         loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"],
                            terms, force.recorder, lanes)
         return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
@@ -387,15 +384,22 @@ class WisdomHolman(Integrator):
                     ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs))
 
     @staticmethod
-    def _lanes_scratch(ws, n):
-        # the lanes' scratch, kept in the workspace as a tuple: not an array,
-        # so neither saved nor restored (what it carries from step to step,
-        # a count of drifts left to the scalar solver, only chooses between
-        # two paths with the same results)
-        scratch = ws.get("lanes")
-        if scratch is None or scratch[0].shape != (_lanes.DRIFT_ROWS, _lanes.lane_columns(n)):
-            scratch = ws["lanes"] = (_lanes.lanes_scratch(n),)
-        return scratch
+    def _loop_terms(ws, n):
+        # (terms, the loop's targs, whether it drifts in lanes) for n rows: the
+        # added terms' kernel and arguments, or, from LANES_FROM_BODIES bodies
+        # without terms, the lanes' scratch; the loop and the synchronisation
+        # take the same targs, so that what they share compiles once.  The
+        # scratch is kept in the workspace as a tuple: not an array, so neither
+        # saved nor restored (what it carries from step to step, a count of
+        # drifts left to the scalar solver, only chooses between two paths
+        # with the same results)
+        terms, targs = ws.get("terms", (None, ()))
+        lanes = terms is None and n >= LANES_FROM_BODIES
+        if lanes:
+            targs = ws.get("lanes")
+            if targs is None or targs[0].shape != (_lanes.DRIFT_ROWS, _lanes.lane_columns(n)):
+                targs = ws["lanes"] = (_lanes.lanes_scratch(n),)
+        return terms, targs, lanes
 
     def _advance_tangent(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t,
                          mon_out, check_every):
@@ -434,11 +438,7 @@ class WisdomHolman(Integrator):
                  ws["vs"], x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0],
                  (targs, tp))
         elif ws["state"][0]:
-            terms, targs = ws.get("terms", (None, ()))
-            if terms is None and x.shape[0] >= LANES_FROM_BODIES:
-                # the loop's own arguments: the synchronisation and the
-                # corrector are then compiled once, for the loop and for this
-                targs = self._lanes_scratch(ws, x.shape[0])
+            terms, targs, _ = self._loop_terms(ws, x.shape[0])
             sync = _wh.synchronizer(self.config["coordinates"], terms)
             sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],
                  x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0], targs)
