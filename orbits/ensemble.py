@@ -895,14 +895,20 @@ def _dispatchers():
     # public ``stats`` builds a record and a cache path on every call, a
     # millisecond over the package's dispatchers, twice for every run
     counters = [getattr(d, "_cache_hits", None) for d in found]
-    _DISPATCHERS[:] = [state, [d if c is None else c for c, d in zip(counters, found)]]
+    _DISPATCHERS[:] = [state, ([c for c in counters if c is not None],
+                               [d for c, d in zip(counters, found) if c is None])]
     return _DISPATCHERS[1]
 
 
 def _cache_loads():
     """Compiled functions of the package loaded from numba's disk cache so far."""
-    return sum(sum(c.values()) if isinstance(c, dict) else sum(c.stats.cache_hits.values())
-               for c in _dispatchers())
+    counters, others = _dispatchers()
+    # a counter holds one key for each signature loaded, counted once: a
+    # dispatcher loads a signature only when it has none for it.  len() in
+    # C (0.01 ms for the package's 225 dispatchers) instead of summing the
+    # counts in Python (0.2 ms, twice a run)
+    return (sum(map(len, counters))
+            + sum(sum(d.stats.cache_hits.values()) for d in others))
 
 
 class _CompileRecorder:

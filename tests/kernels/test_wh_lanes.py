@@ -113,3 +113,103 @@ def test_zero_step_and_non_finite_states():
     xj[2, 1] = np.nan
     vj[3, 0] = np.inf
     both(xj, vj, mu, 0.01)
+
+
+# -- the drift with its tangent vectors --------------------------------------------------
+
+def with_tangents(xj, vj, k=2, seed=3):
+    """The bodies' rows followed by ``k`` random tangent vectors."""
+    n = len(xj)
+    rng = np.random.default_rng(seed)
+    x = np.concatenate([xj, rng.normal(size=(n * k, 3))])
+    v = np.concatenate([vj, rng.normal(size=(n * k, 3))])
+    return x, v
+
+
+def both_tangent(x, v, mu, h, k, dmu, steps=1):
+    """``steps`` drifts with ``k`` tangent vectors by the scalar drift
+    (wh_tangent.drift_tangent without a lanes' scratch) and by the lanes,
+    compared exactly after every drift; returns the lanes' scratch after the
+    last and the number of planets the lanes declined in it."""
+    from orbits._kernels import wh_tangent as T
+    n = len(mu)
+    deta = np.ascontiguousarray(dmu)
+    tp = (deta, deta, k, bool(np.any(dmu)), np.zeros((3 * n, 3 * n)),
+          np.zeros((3 * n, 3 * n)), np.zeros(16), np.zeros(0))
+    a, b = x.copy(), v.copy()
+    c, d = x.copy(), v.copy()
+    w1, w2 = np.zeros((n, 3)), np.zeros((n, 3))
+    S = L.tangent_lanes_scratch(n)
+    for step in range(steps):
+        T.drift_tangent(a, b, mu, h, tp, w1, w2)
+        declined = L.kepler_drift_tangent_lanes(c, d, mu, h, deta, k, S)
+        assert np.array_equal(a, c, equal_nan=True), step
+        assert np.array_equal(b, d, equal_nan=True), step
+    took = S[L._OTAKE:L._OTAKE + n - 1] != 0.0
+    assert declined == np.sum(~took)
+    return took, declined
+
+
+@pytest.mark.parametrize("ratio", [1 / 200, 1 / 40, 1 / 20, 1 / 14])
+def test_tangent_lanes_bit_for_bit_at_planetary_steps(ratio):
+    # 1/200 of the innermost period: the four-term Stumpff series and one
+    # iteration; 1/40 to 1/14 (the chaos maps' steps, 0.15 to 0.45 rad of
+    # anomaly): two iterations and the seven-term series, and for 1/14
+    # Stumpff arguments beyond it (the general form of the pass)
+    xj, vj, mu = system(CIRCULAR)
+    mu = mu * np.linspace(1.0, 1.01, len(mu))
+    x, v = with_tangents(xj, vj)
+    dmu = np.zeros((2, len(mu)))
+    took, declined = both_tangent(x, v, mu, ratio * 2 * math.pi, 2, dmu, steps=40)
+    assert declined == 0 and took.all()
+
+
+def test_tangent_lanes_with_mass_variations_and_backward_steps():
+    xj, vj, mu = system(CIRCULAR + [(2.2, 0.3, 1.0)])
+    x, v = with_tangents(xj, vj, k=3)
+    dmu = np.random.default_rng(5).normal(size=(3, len(mu))) * 1e-3
+    both_tangent(x, v, mu, 0.05, 3, dmu, steps=20)
+    both_tangent(x, v, mu, -0.05, 3, dmu, steps=20)
+    # only the first k of the K vectors carried: the others untouched
+    both_tangent(x, v, mu, 0.05, 1, dmu, steps=5)
+
+
+@pytest.mark.parametrize("f", [0.0, 0.05, math.pi])
+def test_tangent_lanes_leave_eccentric_and_hyperbolic_orbits_to_the_scalar_drift(f):
+    orbits_ = CIRCULAR[:2] + [(1.0, 0.99, f), (-1.0, 1.5, f / 2), (-0.5, 5.0, -f / 3)] \
+        + CIRCULAR[2:]
+    xj, vj, mu = system(orbits_)
+    x, v = with_tangents(xj, vj)
+    dmu = np.zeros((2, len(mu)))
+    both_tangent(x, v, mu, 2 * math.pi / 200, 2, dmu, steps=30)
+    both_tangent(x, v, mu, -2 * math.pi / 200, 2, dmu, steps=30)
+    # one step from the start: at pericentre (f = 0) the e = 0.99 orbit is
+    # outside the lanes' domain
+    took, _ = both_tangent(x, v, mu, 2 * math.pi / 200, 2, dmu)
+    assert took[[0, 1, 5, 6]].all()
+    if f == 0.0:
+        assert not took[2]
+    # a step of 7.3 periods of the inner orbits: those declined, the scalar
+    # drift's bracketed solver (with the period reduced) for each
+    took, _ = both_tangent(x, v, mu, 7.3 * 2 * math.pi, 2, dmu, steps=3)
+    assert not took[[0, 1, 2]].any()
+
+
+@pytest.mark.parametrize("planets", [1, 2, 3, 4, 5, 8, 9, 16])
+def test_tangent_lanes_every_number_of_planets(planets):
+    orbits_ = [(1.0 + 0.37 * k, 0.02 * (k % 3), 0.5 * k) for k in range(planets)]
+    xj, vj, mu = system(orbits_)
+    x, v = with_tangents(xj, vj, k=1)
+    both_tangent(x, v, mu, 0.3, 1, np.zeros((1, len(mu))), steps=20)
+
+
+def test_tangent_lanes_scratch_sizes_and_non_finite_states():
+    with pytest.raises(ValueError, match="17 planets"):
+        L.tangent_lanes_scratch(18)
+    xj, vj, mu = system(CIRCULAR)
+    x, v = with_tangents(xj, vj, k=1)
+    x[2, 1] = np.nan
+    v[3, 0] = np.inf
+    x[len(mu) + 1, 0] = np.nan      # a tangent row of a planet
+    took, _ = both_tangent(x, v, mu, 0.01, 1, np.zeros((1, len(mu))))
+    assert not took[1] and not took[2]
