@@ -1306,25 +1306,19 @@ _STUMPFF45_SERIES_Z = 1.0
 
 
 @njit(inline="always")
-def _stumpff45_series(z):
-    """``c4``, ``c5`` from their series to ``z^8``, for ``|z| < _STUMPFF45_SERIES_Z``."""
-    # c_k = sum_j (-z)^j / (k + 2j)!  (Horner)
-    c4 = (1.0 / 24 - z * (1.0 / 720 - z * (1.0 / 40320 - z * (1.0 / 3628800 - z * (
-        1.0 / 479001600 - z * (1.0 / 87178291200 - z * (1.0 / 20922789888000 - z * (
-            1.0 / 6402373705728000 - z * (1.0 / 2432902008176640000)))))))))
-    c5 = (1.0 / 120 - z * (1.0 / 5040 - z * (1.0 / 362880 - z * (1.0 / 39916800 - z * (
-        1.0 / 6227020800 - z * (1.0 / 1307674368000 - z * (1.0 / 355687428096000 - z * (
-            1.0 / 121645100408832000 - z * (1.0 / 51090942171709440000)))))))))
-    return c4, c5
-
-
-@njit(inline="always")
 def _stumpff45(z):
     """The next two Stumpff functions ``c4 = (1/2 - c2) / z``, ``c5 = (1/6 - c3) / z``
     (``1/24``, ``1/120`` at ``z = 0``), which the derivatives of ``G_2`` and
     ``G_3`` in ``beta`` need."""
     if -_STUMPFF45_SERIES_Z < z < _STUMPFF45_SERIES_Z:
-        return _stumpff45_series(z)
+        # c_k = sum_j (-z)^j / (k + 2j)!  (Horner)
+        c4 = (1.0 / 24 - z * (1.0 / 720 - z * (1.0 / 40320 - z * (1.0 / 3628800 - z * (
+            1.0 / 479001600 - z * (1.0 / 87178291200 - z * (1.0 / 20922789888000 - z * (
+                1.0 / 6402373705728000 - z * (1.0 / 2432902008176640000)))))))))
+        c5 = (1.0 / 120 - z * (1.0 / 5040 - z * (1.0 / 362880 - z * (1.0 / 39916800 - z * (
+            1.0 / 6227020800 - z * (1.0 / 1307674368000 - z * (1.0 / 355687428096000 - z * (
+                1.0 / 121645100408832000 - z * (1.0 / 51090942171709440000)))))))))
+        return c4, c5
     c0, c1, c2, c3 = stumpff(z)
     return (0.5 - c2) / z, (_SIXTH - c3) / z
 
@@ -1429,21 +1423,15 @@ def bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
 
 
 @njit(inline="always")
-def _estrin45(z):
-    # _stumpff45_short's four-term series, in Estrin's form
-    z2 = z * z
-    c4 = (1.0 / 24 - z * (1.0 / 720)) + z2 * ((1.0 / 40320) - z * (1.0 / 3628800))
-    c5 = (1.0 / 120 - z * (1.0 / 5040)) + z2 * ((1.0 / 362880) - z * (1.0 / 39916800))
-    return c4, c5
-
-
-@njit(inline="always")
 def _stumpff45_short(z):
     """:func:`_stumpff45` for the short steps of a planetary integration:
     four terms of each series for ``|z| <= _STUMPFF_SHORT_Z`` (the first
     omitted, ``z^4 / 12!``, below 1e-18 of ``c4``), in Estrin's form."""
     if -_STUMPFF_SHORT_Z <= z <= _STUMPFF_SHORT_Z:
-        return _estrin45(z)
+        z2 = z * z
+        c4 = (1.0 / 24 - z * (1.0 / 720)) + z2 * ((1.0 / 40320) - z * (1.0 / 3628800))
+        c5 = (1.0 / 120 - z * (1.0 / 5040)) + z2 * ((1.0 / 362880) - z * (1.0 / 39916800))
+        return c4, c5
     return _stumpff45(z)
 
 

@@ -49,16 +49,13 @@ body is active, which at zero mass has the same values: the tangent feels
 its pull (as the variational equations of the other integrators do).
 
 The kernels take the tangent arguments as one tuple ``tp = (dgm, deta, k,
-masses, jx, jv, box, lanes)``: ``dgm`` (shape (K, n)) the variations of ``G m``,
+masses, jx, jv, box)``: ``dgm`` (shape (K, n)) the variations of ``G m``,
 ``deta`` (shape (K, n)) those of each row's Kepler ``G M``, ``k <= K`` the
 number of tangent vectors to carry (all of them in a step; 1 to synchronise
 the chaos indicators' vector; 0 for the bodies alone), ``masses`` whether
 any ``dm`` is non-zero, ``jx``, ``jv`` (shape (3n, 3n)) scratch for the
-terms' Jacobian, ``box`` the chaos accumulators
-(:mod:`orbits._kernels.variational`) and ``lanes`` the scratch of the Kepler
-drift with the planets in vector lanes
-(:func:`~orbits._kernels.wh_lanes.tangent_lanes_scratch`; empty for the
-scalar drift).  The bound ``targs`` of the
+terms' Jacobian, and ``box`` the chaos accumulators
+(:mod:`orbits._kernels.variational`).  The bound ``targs`` of the
 Wisdom-Holman templates is then ``(the terms' args, tp)``.
 
 Chaos indicators.  With them on (a compile-time flag of the force), after
@@ -99,7 +96,6 @@ from ._jit import njit, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democratic_heliocentric,
                           to_jacobi)
 from .kepler import advance_tangent_by_anomaly, kepler_drift_tangent, short_step_anomaly
-from .wh_lanes import RETRY, TANGENT_MEMO, kepler_drift_tangent_lanes
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, heliocentric_interaction_kick,
                             interaction_kick, jump)
@@ -307,31 +303,14 @@ def drift_tangent(xj, vj, eta, h, tp, w1, w2):
     tangent vectors; ``tp[1]`` holds the variations of ``eta``; ``w1``,
     ``w2`` (at least ``n`` rows of 3) are scratch.
 
-    With a lanes' scratch in ``tp[7]``, the planets drift in vector lanes
-    (:func:`~orbits._kernels.wh_lanes.kepler_drift_tangent_lanes`, bit for
-    bit this function's scalar path); where it declined more than a quarter
-    of the planets, the scalar path takes the next
-    :data:`~orbits._kernels.wh_lanes.RETRY` drifts, as in the loop without
-    variations.  Measured on the Sun, Jupiter, Saturn and a test planet at a
-    216-day step (steps of the chaos maps, two iterations of the solver),
-    a drift and a kick with one tangent vector: 0.58 us against 0.69 to
-    0.73 scalar.
-
-    The scalar path: as in ``kepler_drift_all``, the short steps' anomalies
-    of all the bodies come first, then each body's state and tangent rows
-    from its anomaly and the same universal functions (1.6 times faster
-    than each body through
-    :func:`~orbits._kernels.kepler.kepler_drift_tangent` on the same
-    bodies); the other steps go through that function's bracketed solver."""
+    As in ``kepler_drift_all``, the short steps' anomalies of all the bodies
+    come first, then each body's state and tangent rows from its anomaly
+    and the same universal functions (1.6 times faster than each body
+    through :func:`~orbits._kernels.kepler.kepler_drift_tangent` on the
+    Sun, Jupiter, Saturn and a test planet); the other steps go through
+    that function's bracketed solver."""
     n = eta.shape[0]
-    deta, k, S = tp[1], tp[2], tp[7]
-    if S.shape[0] > 0:
-        if S[TANGENT_MEMO] > 0.0:
-            S[TANGENT_MEMO] -= 1.0
-        else:
-            if 4 * kepler_drift_tangent_lanes(xj, vj, eta, h, deta, k, S) > n - 1:
-                S[TANGENT_MEMO] = RETRY
-            return
+    deta, k = tp[1], tp[2]
     xj[0, 0] += h * vj[0, 0]
     xj[0, 1] += h * vj[0, 1]
     xj[0, 2] += h * vj[0, 2]
@@ -733,7 +712,7 @@ def _from_heliocentric(xh, vb, gm, eta, x, v, targs):
 def _carrying(targs, k):
     # targs with the tangent arguments set to carry k vectors
     tp = targs[1]
-    return (targs[0], (tp[0], tp[1], k, tp[3], tp[4], tp[5], tp[6], tp[7]))
+    return (targs[0], (tp[0], tp[1], k, tp[3], tp[4], tp[5], tp[6]))
 
 
 def _tangent_record(xj, vj, t, mon, n_mon, mon_t, mon_out):

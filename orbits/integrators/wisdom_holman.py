@@ -352,12 +352,7 @@ class WisdomHolman(Integrator):
         else:
             # every row orbits G m_0
             deta = np.repeat(dgm[:, :1], n, axis=1)
-        # the planets' drift in vector lanes where the loop without variations
-        # takes them (bit for bit the scalar drift: orbits._kernels.wh_lanes)
-        lanes = (_lanes.tangent_lanes_scratch(n) if LANES_FROM_BODIES <= n <= _lanes.TW + 1
-                 else np.zeros(0))
-        ws["tangent"] = (force, n, (dgm, np.ascontiguousarray(deta), k, masses, jx, jv, box,
-                                    lanes))
+        ws["tangent"] = (force, n, (dgm, np.ascontiguousarray(deta), k, masses, jx, jv, box))
 
     def _check_system(self, ws, force, fargs):
         gm, n_active = split_gravity(self.name, force, fargs, "'leapfrog' or 'yoshida4'")
@@ -421,7 +416,7 @@ class WisdomHolman(Integrator):
         if x.shape[0] != n * (1 + tp[2]):
             raise ValueError(f"{self.name}: {x.shape[0]} state rows for {n} bodies and "
                              f"{tp[2]} tangent vectors")
-        tp = tp[:6] + (fargs[1][4],) + tp[7:]
+        tp = tp[:6] + (fargs[1][4],)
         terms, targs = ws.get("terms", (None, ()))
         gravity = fargs[0] if terms is None else fargs[0][0]
         gm, n_active = gravity[0], gravity[1]

@@ -77,34 +77,3 @@ def test_lanes_are_chosen_by_the_number_of_bodies(monkeypatch):
         sim = orbits.Simulation(bodies, integrator="wh", dt=1 * u.day, monitors=())
         sim.run(until=10 * u.day, outputs=2, progress=False)
         assert ("lanes" in sim._ws) == lanes
-
-
-def chaos_run(monkeypatch, bodies, lanes, spec, until, dt, **options):
-    """A run with MEGNO and the Lyapunov exponent (one tangent vector): the
-    bodies, the tangent vector and the indicators at the end."""
-    monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
-    name, _, coords = spec.partition(":")
-    integ = orbits.integrators.get(name, coordinates=coords or "jacobi", **options)
-    sim = orbits.Simulation(bodies, integrator=integ, dt=dt, monitors=("megno", "lyapunov"),
-                            seed=2)
-    r = sim.run(until=until, outputs=5, progress=False)
-    tp = sim._ws["tangent"][2]
-    assert (tp[7].shape[0] > 0) == lanes
-    return (r.positions.to_value(u.au), r.velocities.to_value(u.au / u.day),
-            np.array(sim.tangent_vectors), np.asarray(r.megno),
-            r.lyapunov.to_value(1 / u.day))
-
-
-@pytest.mark.parametrize("spec, options", [("wh", {}), (f"wh:{DH}", {}),
-                                           ("wh", {"corrector": 5}), ("saba2", {})])
-def test_tangent_lanes_are_the_scalar_loop_bit_for_bit(monkeypatch, spec, options):
-    # the bodies, the tangent vector and the indicators, through the comet's
-    # pericentre (declined by the lanes) and at 5 % of Jupiter's period (two
-    # iterations of the solver, Stumpff arguments on both sides of the
-    # seven-term series)
-    bodies = with_odd_orbits()
-    for dt, until in ((10 * u.day, 20 * u.yr), (216 * u.day, 500 * u.yr)):
-        a = chaos_run(monkeypatch, bodies, False, spec, until, dt, **options)
-        b = chaos_run(monkeypatch, bodies, True, spec, until, dt, **options)
-        for p, q in zip(a, b):
-            assert np.array_equal(p, q)
