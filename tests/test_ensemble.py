@@ -254,6 +254,18 @@ def test_an_existing_cluster_by_client_or_address(serial):
             assert df.drop(columns=WHERE).equals(serial.iloc[:4].drop(columns=WHERE))
         assert client.status == "running"      # a cluster it was given, it leaves open
         assert set(client.run(numba.get_num_threads).values()) == {1}   # one per process
+        # the workers run without the statistical profiler (its sampling thread
+        # shares the run's core); a worker takes its nanny's configuration, so
+        # an environment variable alone would not do this
+        from orbits.ensemble import WORKER_DASK_CONFIG
+
+        def settings(dask_worker):
+            import dask
+            return tuple(dask.config.get(k) for k in WORKER_DASK_CONFIG)
+        assert set(client.run(settings).values()) == {tuple(WORKER_DASK_CONFIG.values())}
+        assert not any("profile" in name for name in
+                       client.run(lambda dask_worker: list(dask_worker.periodic_callbacks))
+                       .popitem()[1])
         # nothing listens beyond the loopback interface
         info = client.scheduler_info()
         assert all(a.startswith("tcp://127.0.0.1:") for a in
