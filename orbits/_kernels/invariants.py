@@ -37,15 +37,15 @@ MONITOR_WIDTH = len(MONITOR_COLUMNS)
 WORK_COLUMN = MONITOR_COLUMNS.index("work")
 
 
-@njit
+@njit(inline="always")
 def _add(s, c, term):
-    # Neumaier's variant of Kahan summation: returns the new (sum, compensation)
+    # Neumaier's variant of Kahan summation: returns the new (sum, compensation).
+    # Both roundings are computed and one is selected, without a branch that
+    # the processor would mispredict whenever the terms outgrow the sum
     t = s + term
-    if abs(s) >= abs(term):
-        c += (s - t) + term
-    else:
-        c += (term - t) + s
-    return t, c
+    big = (s - t) + term
+    small = (term - t) + s
+    return t, c + (big if abs(s) >= abs(term) else small)
 
 
 @njit

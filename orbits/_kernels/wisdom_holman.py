@@ -495,9 +495,11 @@ COORDINATE_SYSTEMS = {
 }
 
 
-def _kernels(coordinates, terms=None):
+def _kernels(coordinates, terms=None, lanes=False):
     """``terms``: a :class:`~orbits._kernels.terms.TermKernel` of position-only
-    terms added to the interaction step, or None."""
+    terms added to the interaction step, or None; ``lanes``: the
+    synchronisation's owed drift with the planets in vector lanes (the
+    loop's ``targs`` then hold the lanes' scratch)."""
     to_internal, from_internal, step, term_kick = COORDINATE_SYSTEMS[coordinates]
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
@@ -522,15 +524,19 @@ def _kernels(coordinates, terms=None):
                                   HELIOCENTRIC=coordinates != "jacobi")
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
                            drift=_plain_drift, perturbation=perturbation)
-    sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt,
-                      drift=_plain_drift, from_internal=from_internal,
-                      apply_corrector=corrector)
+    # an output's synchronisation drifts every planet by the owed half step:
+    # in lanes, bit for bit, where the loop drifts in lanes (the outer solar
+    # system with wh, an output each step: 0.60 -> 0.xx us an output)
+    sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
+                      cache=cache, nrt=nrt, drift=_lanes_drift if lanes else _plain_drift,
+                      from_internal=from_internal, apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
 
 
-def synchronizer(coordinates, terms=None):
-    """The compiled :func:`synchronize` for ``coordinates`` (and added ``terms``)."""
-    return _kernels(coordinates, terms)[3]
+def synchronizer(coordinates, terms=None, lanes=False):
+    """The compiled :func:`synchronize` for ``coordinates`` (and added ``terms``;
+    with ``lanes``, for the loop whose planets drift in vector lanes)."""
+    return _kernels(coordinates, terms, lanes)[3]
 
 
 def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record,
@@ -547,16 +553,16 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     an output)."""
     if lanes and terms is not None:
         raise ValueError("wh_loop: the lanes' loop takes no added terms")
-    to_internal, perturbation, corrector, sync = _kernels(coordinates, terms)
+    to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, lanes)
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
     nrt = not cache
-    recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, synchronize=sync,
-                          _record=record)
     drift = _plain_drift
     if lanes:
         drift = _lanes_drift
         key = f"{key}_lanes"
+    recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, synchronize=sync,
+                          _record=record)
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,

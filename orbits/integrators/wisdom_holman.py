@@ -438,8 +438,8 @@ class WisdomHolman(Integrator):
                  ws["vs"], x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0],
                  (targs, tp))
         elif ws["state"][0]:
-            terms, targs, _ = self._loop_terms(ws, x.shape[0])
-            sync = _wh.synchronizer(self.config["coordinates"], terms)
+            terms, targs, lanes = self._loop_terms(ws, x.shape[0])
+            sync = _wh.synchronizer(self.config["coordinates"], terms, lanes)
             sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],
                  x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0], targs)
 
