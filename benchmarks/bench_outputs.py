@@ -23,8 +23,9 @@ taken between calls, and streamed, beside REBOUND's IAS15 advanced to each
 output time (``exact_finish_time=1``) in the same Python loop.
 
 The cost of an output is the run's time minus the same run with two
-outputs, divided by the number of outputs; each figure is the median of
-``--repeats`` runs timed in turn, after a warm-up that excludes compilation.
+outputs, divided by the number of outputs: the median, over ``--repeats``
+pairs timed one after the other, of the pair's difference, after a warm-up
+that excludes compilation.
 Memory: the peak resident size of a process that streams 10^6 outputs to a
 file, against one that takes 10^4 (``--memory``), so that the difference is
 what the outputs keep in memory.
@@ -172,10 +173,17 @@ def main(argv=None):
             for f in (lambda: _ours(integrator, dt, 100, k),
                       lambda: _ours(integrator, dt, 100, k, path)):
                 f()                                   # compile, warm the caches
-            base = _median(lambda: _ours(integrator, dt, 1, k * n_out), repeats)
-            mem = _median(lambda: _ours(integrator, dt, n_out, k), repeats)
-            h5 = _median(lambda: _ours(integrator, dt, n_out, k, path), repeats)
-            base_path = _median(lambda: _ours(integrator, dt, 1, k * n_out, path), repeats)
+            # each run with outputs beside the same run without, in turn, and
+            # the median of the differences: at k = 10 an output is a tenth of
+            # the run, and medians taken apart let the machine's drift between
+            # them (a few per cent of the steps) pass for the outputs' cost
+            pairs = [(_ours(integrator, dt, 1, k * n_out), _ours(integrator, dt, n_out, k),
+                      _ours(integrator, dt, 1, k * n_out, path),
+                      _ours(integrator, dt, n_out, k, path)) for _ in range(repeats)]
+            base = statistics.median(p[0] for p in pairs)
+            mem = base + statistics.median(p[1] - p[0] for p in pairs)
+            base_path = statistics.median(p[2] for p in pairs)
+            h5 = base_path + statistics.median(p[3] - p[2] for p in pairs)
             try:
                 reb_base = _median(lambda: _rebound(integrator, dt, 1, k * n_out), repeats)
                 reb = _median(lambda: _rebound(integrator, dt, n_out, k), repeats)
