@@ -113,14 +113,23 @@ PROGRESS_DELAY = 3.0
 WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
                       "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
 
-#: Dask settings of :func:`local_cluster`'s workers, given to them as their
-#: configuration (a worker takes its nanny's, not its environment's): the
-#: statistical profiler sampled the running task every 10 ms from a thread of
-#: its own, and the system monitor polled the process every 0.5 s, both on
-#: the run's core.  Measured on the 512-run MEGNO map on 2 workers: the runs'
-#: summed time 17.3-17.8 s without them, 18.4-19.0 s with them.
+#: Dask settings of :func:`local_cluster`'s scheduler and workers, given to
+#: the workers as their configuration (a worker takes its nanny's, not its
+#: environment's).  Dask's defaults wake each process many times a second on
+#: the cores the runs use: the statistical profiler sampled the running task
+#: every 10 ms from a thread of its own, the event loop's latency probe ran
+#: every 20 ms (it only measures; Dask's own tests take 500 ms), the memory
+#: monitor every 0.1 s (1 s still stops a worker whose memory runs away) and
+#: the system monitor every 0.5 s.  Measured on two workers: the 512-run MEGNO
+#: map's runs took 17.3-17.8 s summed without the profiler against 18.4-19.0
+#: s with it; idle for 10 s, the workers used 0.07-0.12 s of CPU with these
+#: settings against 0.40-0.54 s with only the profiler off, and the
+#: scheduler's process 0.10-0.14 s against 0.52-0.61 (0.40-0.45 s against
+#: 0.90-1.07 s over the map).
 WORKER_DASK_CONFIG = {"distributed.worker.profile.enabled": False,
-                      "distributed.admin.system-monitor.interval": "2s"}
+                      "distributed.admin.system-monitor.interval": "2s",
+                      "distributed.admin.tick.interval": "500ms",
+                      "distributed.worker.memory.monitor-interval": "1s"}
 
 
 _GUARD_ADVICE = ('each worker process of a local cluster imports the main script again and '
