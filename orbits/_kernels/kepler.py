@@ -81,6 +81,9 @@ __all__ = [
     "stumpff_lane",
     "kepler_drift",
     "short_step_anomaly",
+    "short_start",
+    "quartic_step",
+    "f_and_g",
     "advance_by_anomaly",
     "DRIFT_MAX_ITER",
     "bracketed_anomaly",
@@ -1075,6 +1078,60 @@ def stumpff_lane(z, general):
 
 
 @njit(inline="always")
+def short_start(mu, x0, y0, z0, vx0, vy0, vz0, dt):
+    """The start's invariants and the third-order Taylor starter of the
+    universal anomaly for a step ``dt``: ``(r2, v2, r0, 1 / r0, eta = x0 . v0,
+    beta, zeta, s)``.  The one arithmetic of :func:`short_step_anomaly`, of
+    the planets' lanes (:mod:`.wh_lanes`) and of the systems' lanes
+    (:mod:`.wh_batch`), which must agree bit for bit."""
+    r2 = x0 * x0 + y0 * y0 + z0 * z0
+    v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
+    r0 = math.sqrt(r2)
+    ir0 = 1.0 / r0
+    eta = x0 * vx0 + y0 * vy0 + z0 * vz0
+    beta = 2.0 * mu * ir0 - v2
+    zeta = mu - beta * r0
+    w = dt * ir0
+    s = w * (1.0 + w * (-0.5 * eta * ir0
+                        + w * ((3.0 * eta * eta * ir0 * ir0 - zeta * ir0) * _SIXTH)))
+    return r2, v2, r0, ir0, eta, beta, zeta, s
+
+
+@njit(inline="always")
+def quartic_step(s, r0, eta, beta, zeta, c0, c1, c2, c3, dt):
+    """Danby's quartic correction of the universal anomaly ``s`` (Stumpff
+    functions ``c0 .. c3`` of ``beta s^2``), as a series in the Newton step
+    ``d1``: ``d + a d^2 + b d^3 = d1`` with ``a = f2 / (2 r)``, ``b = f3 / (6
+    r)``, ``fk`` the k-th derivative of Kepler's equation ``f``.  Shared as
+    :func:`short_start` is."""
+    G1 = s * c1
+    G2 = s * s * c2
+    G3 = s * s * s * c3
+    f = r0 * s + eta * G2 + zeta * G3 - dt
+    ir = 1.0 / (r0 + eta * G1 + zeta * G2)
+    d1 = -f * ir
+    a = 0.5 * (eta * c0 + zeta * G1) * ir
+    b = (zeta * c0 - beta * eta * G1) * ir * _SIXTH
+    return d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - b)))
+
+
+@njit(inline="always")
+def f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2):
+    """The Lagrange coefficients of a step by the anomaly ``s`` (Stumpff
+    functions ``c1``, ``c2`` of ``beta s^2``; ``sig = x0 . v0``): ``(G1, G2,
+    r, 1 / r, f - 1, g, fdot, gdot - 1)``.  Shared as :func:`short_start` is."""
+    G1 = s * c1
+    G2 = s * s * c2
+    r = r0 + sig * G1 + zeta * G2
+    ir = 1.0 / r
+    fm1 = -mu * G2 * ir0
+    g = r0 * G1 + sig * G2
+    fdot = -mu * G1 * ir0 * ir
+    gdm1 = -mu * G2 * ir
+    return G1, G2, r, ir, fm1, g, fdot, gdm1
+
+
+@njit(inline="always")
 def short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
     """The universal anomaly of a step short against the orbit, or NaN.
 
@@ -1088,35 +1145,15 @@ def short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
     non-finite input, ``r0 = 0``, ``mu <= 0`` or ``dt = 0``): then the
     bracketed solver must be used.
     """
-    r2 = x0 * x0 + y0 * y0 + z0 * z0
-    v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
-    r0 = math.sqrt(r2)
-    ir0 = 1.0 / r0
-    eta = x0 * vx0 + y0 * vy0 + z0 * vz0
-    beta = 2.0 * mu * ir0 - v2
-    zeta = mu - beta * r0
+    r2, v2, r0, ir0, eta, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, dt)
     # NaN, r0 = 0 and dt = 0 fail these tests
     if not (dt * dt * v2 < (_SHORT_STEP * _SHORT_STEP) * r2 and mu > 0.0 and dt != 0.0):
         return math.nan, r0, ir0, beta, zeta
-    w = dt * ir0
-    s = w * (1.0 + w * (-0.5 * eta * ir0
-                        + w * ((3.0 * eta * eta * ir0 * ir0 - zeta * ir0) * _SIXTH)))
     if not (abs(beta * s * s) <= _SHORT_STEP_Z):
         return math.nan, r0, ir0, beta, zeta
     for _ in range(_SHORT_STEP_ITER):
         c0, c1, c2, c3 = _stumpff_short(beta * s * s)
-        G1 = s * c1
-        G2 = s * s * c2
-        G3 = s * s * s * c3
-        f = r0 * s + eta * G2 + zeta * G3 - dt
-        ir = 1.0 / (r0 + eta * G1 + zeta * G2)
-        # Danby's quartic step as a series in the Newton step d1:
-        # d + a d^2 + b d^3 = d1 with a = f2 / (2 r), b = f3 / (6 r), fk the
-        # k-th derivative of f
-        d1 = -f * ir
-        a = 0.5 * (eta * c0 + zeta * G1) * ir
-        b = (zeta * c0 - beta * eta * G1) * ir * _SIXTH
-        d = d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - b)))
+        d = quartic_step(s, r0, eta, beta, zeta, c0, c1, c2, c3, dt)
         s += d
         if abs(d) <= _SHORT_STEP_TOL * abs(s):
             return s, r0, ir0, beta, zeta
@@ -1145,14 +1182,7 @@ def _short_coefficients(mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta):
     # where the step must go to the bracketed solver
     sig = x0 * vx0 + y0 * vy0 + z0 * vz0
     c0, c1, c2, c3 = _stumpff_short(beta * s * s)
-    G1 = s * c1
-    G2 = s * s * c2
-    r = r0 + sig * G1 + zeta * G2
-    ir = 1.0 / r
-    fm1 = -mu * G2 * ir0
-    g = r0 * G1 + sig * G2
-    fdot = -mu * G1 * ir0 * ir
-    gdm1 = -mu * G2 * ir
+    _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2)
     return c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1
 
 

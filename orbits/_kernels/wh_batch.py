@@ -72,8 +72,8 @@ import numpy as np
 
 from ._jit import njit
 from .coordinates import interior_gm, to_jacobi
-from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z, _SIXTH,
-                     _STUMPFF_SHORT_Z, kepler_drift)
+from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
+                     _STUMPFF_SHORT_Z, f_and_g, kepler_drift, quartic_step, short_start)
 # the Stumpff functions without a branch (shared with orbits._kernels.wh_lanes)
 from .kepler import stumpff_lane as _stumpff_lane
 from .invariants import MONITOR_WIDTH, monitor_row
@@ -129,15 +129,7 @@ def _iterate(s_, r0_, et_, be_, ze_, ok_, cv_, LF, h, nb, m, general):
         beta = be_[k]
         zeta = ze_[k]
         c0, c1, c2, c3, inside = _stumpff_lane(beta * s * s, general)
-        G1 = s * c1
-        G2 = s * s * c2
-        G3 = s * s * s * c3
-        f = r0 * s + et * G2 + zeta * G3 - h
-        ir = 1.0 / (r0 + et * G1 + zeta * G2)
-        d1 = -f * ir
-        a = 0.5 * (et * c0 + zeta * G1) * ir
-        bb = (zeta * c0 - beta * et * G1) * ir * _SIXTH
-        dd = d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - bb)))
+        dd = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
         sn = s + dd
         done = abs(dd) <= _SHORT_STEP_TOL * abs(sn)
         going = ok_[k] * LF[k] != 0.0 and cv_[k] == 0.0
@@ -170,14 +162,7 @@ def _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF, 
         vz0 = V2[k]
         sig = x0 * vx0 + y0 * vy0 + z0 * vz0
         c0, c1, c2, c3, inside = _stumpff_lane(beta * s * s, general)
-        G1 = s * c1
-        G2 = s * s * c2
-        r = r0 + sig * G1 + zeta * G2
-        ir = 1.0 / r
-        fm1 = -mu * G2 * ir0
-        g = r0 * G1 + sig * G2
-        fdot = -mu * G1 * ir0 * ir
-        gdm1 = -mu * G2 * ir
+        _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2)
         live = LF[k] != 0.0
         take = live and ok_[k] != 0.0 and cv_[k] != 0.0 and inside and r > 0.0
         X0[k] = x0 + (fm1 * x0 + g * vx0) if take else x0
@@ -254,16 +239,7 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
         vx0 = V0[k]
         vy0 = V1[k]
         vz0 = V2[k]
-        r2 = x0 * x0 + y0 * y0 + z0 * z0
-        v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
-        r0 = math.sqrt(r2)
-        ir0 = 1.0 / r0
-        et = x0 * vx0 + y0 * vy0 + z0 * vz0
-        beta = 2.0 * mu * ir0 - v2
-        zeta = mu - beta * r0
-        w = h * ir0
-        s = w * (1.0 + w * (-0.5 * et * ir0
-                            + w * ((3.0 * et * et * ir0 * ir0 - zeta * ir0) * _SIXTH)))
+        r2, v2, r0, ir0, et, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, h)
         good = (h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2 and mu > 0.0 and h != 0.0
                 and abs(beta * s * s) <= _SHORT_STEP_Z)
         s_[k] = s

@@ -74,13 +74,11 @@ Rein, H. & Tamayo, D. 2015, MNRAS 452, 376 (WHFast).  Danby, J. M. A. 1988,
 *Fundamentals of Celestial Mechanics*, 2nd ed., sect. 6.9.
 """
 
-import math
-
 import numpy as np
 
 from ._jit import njit
-from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _SIXTH, _STUMPFF_SHORT_Z, kepler_drift,
-                     stumpff_lane)
+from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, f_and_g, kepler_drift,
+                     quartic_step, short_start, stumpff_lane)
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "RETRY", "lane_columns", "lanes_scratch",
            "kepler_drift_lanes"]
@@ -151,42 +149,18 @@ def _single_pass(S, h, P):
         vx0 = V0[k]
         vy0 = V1[k]
         vz0 = V2[k]
-        r2 = x0 * x0 + y0 * y0 + z0 * z0
-        v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
-        r0 = math.sqrt(r2)
-        ir0 = 1.0 / r0
-        et = x0 * vx0 + y0 * vy0 + z0 * vz0
-        beta = 2.0 * mu * ir0 - v2
-        zeta = mu - beta * r0
-        w = h * ir0
-        s = w * (1.0 + w * (-0.5 * et * ir0
-                            + w * ((3.0 * et * et * ir0 * ir0 - zeta * ir0) * _SIXTH)))
+        r2, v2, r0, ir0, et, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, h)
         z = beta * s * s
         good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
                 & (abs(z) <= _STUMPFF_SHORT_Z))
         c0, c1, c2, c3, _ = stumpff_lane(z, False)
-        G1 = s * c1
-        G2 = s * s * c2
-        G3 = s * s * s * c3
-        f = r0 * s + et * G2 + zeta * G3 - h
-        ir = 1.0 / (r0 + et * G1 + zeta * G2)
-        d1 = -f * ir
-        a = 0.5 * (et * c0 + zeta * G1) * ir
-        b = (zeta * c0 - beta * et * G1) * ir * _SIXTH
-        d = d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - b)))
+        d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
         s = s + d
         done = abs(d) <= _SHORT_STEP_TOL * abs(s)
         z = beta * s * s
         c0, c1, c2, c3, _ = stumpff_lane(z, False)
-        G1 = s * c1
-        G2 = s * s * c2
         # (_advance's sigma is this et: the same expression of the start)
-        r = r0 + et * G1 + zeta * G2
-        ir = 1.0 / r
-        fm1 = -mu * G2 * ir0
-        g = r0 * G1 + et * G2
-        fdot = -mu * G1 * ir0 * ir
-        gdm1 = -mu * G2 * ir
+        _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, et, zeta, c1, c2)
         Y0[k] = x0 + (fm1 * x0 + g * vx0)
         Y1[k] = y0 + (fm1 * y0 + g * vy0)
         Y2[k] = z0 + (fm1 * z0 + g * vz0)
