@@ -265,8 +265,9 @@ class Driven:
         force = self._force
         return force.opaque or not force.jit or not force.cache
 
-    #: (k, origin): outputs are being recorded in the loop every k steps
-    #: counted from step ``origin`` (see :meth:`execute`)
+    #: (k, origin, plan): outputs are being recorded in the loop every k steps
+    #: counted from step ``origin`` (see :meth:`execute`), or, with k = -1, at
+    #: the plan's marks
     _in_loop = None
 
     def _outputs_fixed(self, plan, rec, bar, first_mark):
@@ -274,9 +275,10 @@ class Driven:
         done = self.steps - plan.start_step
         k = self._output_interval(plan, rec)
         if k:
-            last = (plan.outputs - 2) * k      # the last output before the final one
+            # the last output before the final one
+            last = (plan.outputs - 2) * k if k > 0 else next(plan.marks(plan.outputs - 3))
             if done < last:
-                self._in_loop = (k, plan.start_step)
+                self._in_loop = (k, plan.start_step, plan)
                 try:
                     done = self._advance_to(done, last, rec, bar, wall0)
                 finally:
@@ -293,7 +295,10 @@ class Driven:
 
     def _output_interval(self, plan, rec):
         # k when the plan's outputs between the first and the last fall every
-        # k steps and can be recorded in the loop (see execute), else 0
+        # k steps and can be recorded in the loop (see execute); -1 when they
+        # fall at least a step apart but not evenly, and the integrator's loop
+        # records at marks (every = -1, orbits._kernels.stepping.first_record);
+        # else 0 (recorded from here, one loop call an output)
         if (getattr(rec, "row_buffer", None) is None
                 or not getattr(rec, "records_in_loop", True) or self.monitor_every
                 or plan.outputs < 3 or self._resolves_collisions):
@@ -301,10 +306,13 @@ class Driven:
         k = int(round(plan.ratio / (plan.outputs - 1)))
         # the marks are round(i ratio / (outputs - 1)): all i k when ratio is
         # within a quarter step of (outputs - 1) k
-        if k < 1 or abs(plan.ratio - k * (plan.outputs - 1)) >= 0.25 \
-                or (plan.outputs - 2) * k > plan.n_full:
-            return 0
-        return k
+        if k >= 1 and abs(plan.ratio - k * (plan.outputs - 1)) < 0.25 \
+                and (plan.outputs - 2) * k <= plan.n_full:
+            return k
+        if plan.ratio >= plan.outputs - 1 and getattr(self.integrator, "records_step_marks",
+                                                       False):
+            return -1
+        return 0
 
     def _outputs_adaptive(self, plan, rec, bar, first_mark):
         wall0 = self._wall0
@@ -427,8 +435,11 @@ class Driven:
         while done < target:
             n = min(self._chunk, target - done)
             if cap:
-                # a recorder that streams (a file) holds at most cap outputs
-                n = min(n, cap * self._in_loop[0])
+                # a recorder that streams (a file) holds at most cap outputs:
+                # marks are at least floor(ratio / (outputs - 1)) steps apart
+                k, _, plan = self._in_loop
+                n = min(n, cap * k if k > 0
+                        else max(1, cap - 1) * int(plan.ratio / (plan.outputs - 1)))
             t0 = _time.perf_counter()
             self._advance(n, rec, wall0)
             elapsed = _time.perf_counter() - t0
@@ -496,7 +507,7 @@ class Driven:
     def _advance(self, n, rec, wall0, dt=None):
         dt = self._dt if dt is None else dt
         if self._in_loop:
-            every, origin = self._in_loop
+            every, origin, plan = self._in_loop
             width = MONITOR_WIDTH + 6 * len(self._x)
         else:
             every, origin, width = self.monitor_every or 0, 0, MONITOR_WIDTH
@@ -504,12 +515,18 @@ class Driven:
         while True:
             mon = self._mon(every)   # anew: a collision may have changed the bodies
             s0 = self.steps - origin
-            if every:
+            if every > 0:
                 first = (s0 // every + 1) * every  # next step index that records
                 size = max(0, (s0 + left - first) // every + 1)
+                mon_t = np.empty(size)
+            elif every < 0:
+                # the steps (from this call's start) after which the loop records
+                ahead = plan.marks_between(s0, s0 + left) - s0
+                size = len(ahead)
+                mon_t = ahead.astype(float)
             else:
                 size = 0
-            mon_t = np.empty(size)
+                mon_t = np.empty(0)
             # outputs are written straight where the recorder keeps them
             mon_out = (rec.row_buffer(size) if self._in_loop and size
                        else np.zeros((size, width)))
@@ -518,7 +535,10 @@ class Driven:
                 self._force, self._fargs, mon, s0, mon_t, mon_out, stop=self._stop)
             if n_mon and self._in_loop:
                 # the outputs' steps, and their times as _now() gives them there
-                ahead = (first - s0) + every * np.arange(n_mon)
+                if every > 0:
+                    ahead = (first - s0) + every * np.arange(n_mon)
+                else:
+                    ahead = ahead[:n_mon]
                 rec.output_rows(self, self.steps + ahead,
                                 self._t_base + (self._steps_since_base + ahead) * self._dt,
                                 mon_out[:n_mon])

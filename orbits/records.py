@@ -82,6 +82,32 @@ class RunPlan(NamedTuple):
         for k in range(first + 1, self.outputs - 1):
             yield min(int(round(k * self.ratio / (self.outputs - 1))), self.n_full)
 
+    def marks_between(self, lo, hi):
+        """The marks (as :meth:`marks`, the same integers) after step ``lo`` and
+        up to step ``hi``, as an int64 array, for a plan with at least one step
+        from an output to the next (``ratio >= outputs - 1``; they increase).
+
+        Examples
+        --------
+        >>> from orbits.records import RunPlan
+        >>> plan = RunPlan(until=100.0, outputs=8, ratio=100.0, n_full=100, has_partial=False,
+        ...                start_step=0)
+        >>> list(plan.marks()), plan.marks_between(14, 57).tolist()
+        ([14, 29, 43, 57, 71, 86], [29, 43, 57])
+        """
+        if self.outputs < 3 or hi <= lo:
+            return np.zeros(0, dtype=np.int64)
+        per = self.ratio / (self.outputs - 1)
+        j_lo = max(1, int(lo / per) - 1)
+        j_hi = min(self.outputs - 2, int(hi / per) + 2)
+        if j_hi < j_lo:
+            return np.zeros(0, dtype=np.int64)
+        j = np.arange(j_lo, j_hi + 1, dtype=np.int64)
+        # the same operations as marks(): (j ratio) / (outputs - 1), rounded half to even
+        s = np.minimum(np.round(j * self.ratio / (self.outputs - 1)).astype(np.int64),
+                       self.n_full)
+        return s[(s > lo) & (s <= hi)]
+
 
 class SimulationConfig(NamedTuple):
     """Everything but the bodies that makes a :class:`Simulation`: one object that

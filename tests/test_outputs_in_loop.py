@@ -1,8 +1,9 @@
 """Outputs recorded inside the compiled loop (orbits._driver.Driven.execute).
 
-A fixed-step run whose outputs fall every k steps records them inside the
-loop; one whose outputs do not, or one written to a file, takes each output
-between two calls of the loop.  Both must give the same outputs, to the bit:
+A fixed-step run records its outputs inside the loop, whether they fall
+every k steps or not (then each on the step nearest its time: the loop is
+handed those steps); with ``monitor_every`` set, it takes each output between
+two calls of the loop.  Both must give the same outputs, to the bit:
 the same state at the same steps, times computed as the clock computes them,
 and monitors from the same compiled functions.
 """
@@ -27,22 +28,46 @@ def _same(a, b):
                                   np.asarray(getattr(y, "value", y))), name
 
 
-@pytest.mark.parametrize("integrator, dt", [("leapfrog", 10 * u.day), ("wh", 30 * u.day),
-                                            ("rk4", 10 * u.day)])
-def test_outputs_in_the_loop_equal_those_taken_between_calls(integrator, dt):
+FIXED = [("leapfrog", 10 * u.day), ("wh", 30 * u.day), ("rk4", 10 * u.day),
+         ("saba2", 30 * u.day), ("implicit-midpoint", 10 * u.day), ("trace", 30 * u.day)]
+
+
+def _counting_calls(sim):
+    calls = []
+    advance = sim.integrator.advance
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return advance(*args, **kwargs)
+    sim.integrator.advance = counted
+    return calls
+
+
+@pytest.mark.parametrize("integrator, dt", FIXED)
+@pytest.mark.parametrize("k", [7, 7.37])
+def test_outputs_in_the_loop_equal_those_taken_between_calls(integrator, dt, k):
+    # k = 7.37: outputs between steps, each on the step nearest its time,
+    # 7 or 8 steps apart
     scene = orbits.scenes.outer_solar_system()
-    k = 7
-    until = 700 * k * dt    # 700 outputs every 7 steps, and the first
+    until = 700 * k * dt    # 700 outputs every k steps, and the first
     make = lambda: orbits.Simulation(scene, integrator, dt=dt,  # noqa: E731
                                      monitors=["energy", "angular_momentum", "momentum"])
-    inloop = make().run(until=until, outputs=701, progress=False)
+    sim = make()
+    calls = _counting_calls(sim)
+    inloop = sim.run(until=until, outputs=701, progress=False)
+    # recorded in the loop: a few calls of it (chunks), not one an output
+    assert 1 <= len(calls) < 20
     # the same outputs one call of the loop each: monitor_every switches the
     # recording in the loop off for outputs
     sim = make()
     sim.monitor_every = 10 ** 9
+    calls = _counting_calls(sim)
     between = sim.run(until=until, outputs=701, progress=False)
+    assert len(calls) >= 700
     assert len(inloop) == 701
     _same(inloop, between)
+    steps = np.round(inloop.times.value / dt.to_value(inloop.times.unit))
+    assert set(np.diff(steps)) == ({7} if k == 7 else {7, 8})
 
 
 def test_with_terms_work_and_chaos_monitors():
@@ -63,13 +88,14 @@ def test_with_terms_work_and_chaos_monitors():
     assert inloop.work[-1].value != 0.0 and inloop.megno[-1] > 0
 
 
-def test_uneven_outputs_and_a_shortened_last_step_keep_the_old_path():
-    # 10.5 steps a output: marks at rounded steps, between calls; the result
-    # is unchanged by the in-loop path's existence (times on step boundaries)
+def test_uneven_outputs_and_a_shortened_last_step():
+    # 10.55 steps an output: the outputs before the last on the steps nearest
+    # their times (recorded in the loop), the last after a shortened step
     sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     r = sim.run(until=105.5 * u.day, outputs=11, progress=False)
-    steps = r.times.to_value(u.day)
-    assert steps[-1] == 105.5 and np.all(np.diff(steps) > 0)
+    t = r.times.to_value(u.day)
+    assert t[-1] == 105.5 and np.all(np.diff(t) > 0)
+    assert np.array_equal(t[:-1], np.round(np.arange(10) * 105.5 / 10))
 
 
 def test_a_failure_keeps_the_outputs_before_it():
@@ -116,17 +142,19 @@ class _Crash(Exception):
     pass
 
 
-def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch):
+@pytest.mark.parametrize("outputs", [41, 37])
+def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch, outputs):
     # outputs streamed in pieces of 5 with a checkpoint between pieces; the
     # process dies after writing the rows of the fourth piece, before its
-    # checkpoint: resumed from the file, the run writes the same file, bit for bit
+    # checkpoint: resumed from the file, the run writes the same file, bit for
+    # bit (41 outputs: every 10 steps; 37: 11 or 12 steps apart)
     from orbits.io import hdf5
     monkeypatch.setattr(hdf5.FileRecorder, "max_rows", 5)
     scene = orbits.scenes.outer_solar_system()
 
     def run(path):
         sim = orbits.Simulation(scene, "leapfrog", dt=10 * u.day)
-        sim.run(until=400 * 10 * u.day, outputs=41, output=path, progress=False,
+        sim.run(until=400 * 10 * u.day, outputs=outputs, output=path, progress=False,
                 checkpoint_interval=1e-9)
     whole, cut = tmp_path / "whole.h5", tmp_path / "cut.h5"
     run(whole)
@@ -147,7 +175,7 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch)
     assert np.array_equal(a.times.value, b.times.value)
     assert np.array_equal(a.positions.value, b.positions.value)
     assert np.array_equal(a.energy_error, b.energy_error)
-    assert b.status == "completed" and len(b) == 41
+    assert b.status == "completed" and len(b) == outputs
 
 
 # -- adaptive runs: ias15, the embedded methods and rk4-doubling land on the outputs in their loop

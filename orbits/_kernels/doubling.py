@@ -19,7 +19,7 @@ import math
 from ._jit import specialize
 from .embedded import initial_step, next_step, step_underflow
 from .status import Status
-from .stepping import GO, step_epilogue, work_kernels
+from .stepping import GO, first_record, step_epilogue, work_kernels
 from .variational import measured_rows
 
 __all__ = ["doubling_loop"]
@@ -65,7 +65,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
     n = x.shape[0]
     every = mon[0]
     n_mon = 0
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     steps = 0
     rejected = 0
     fev = 0

@@ -24,7 +24,7 @@ import math
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import GO, step_epilogue, work_kernels
+from .stepping import GO, first_record, step_epilogue, work_kernels
 from .variational import measured_rows
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
@@ -87,7 +87,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     s = b.shape[0]
     every = mon[0]
     n_mon = 0
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     steps = 0
     rejected = 0
     fev = 0

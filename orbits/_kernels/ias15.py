@@ -62,7 +62,7 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import GO, step_epilogue, work_kernels
+from .stepping import GO, first_record, step_epilogue, work_kernels
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -325,7 +325,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     every = mon[0]
     cap = mon_t.shape[0]
     n_mon = 0
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     counts[0] = 0
     counts[1] = 0
     counts[2] = 0

@@ -59,7 +59,7 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import GO, state_is_finite, step_epilogue, work_kernels
+from .stepping import GO, first_record, state_is_finite, step_epilogue, work_kernels
 
 __all__ = ["implicit_loop", "gravity_jacobian", "user_jacobian",
            "finite_difference_jacobian", "jacobian_for", "lu_factor", "lu_solve",
@@ -323,7 +323,7 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
     every = mon[0]
     n_mon = 0
     until_check = check_every
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         ts = t + k * dt + th * dt
         predicted = cache[0] != 0

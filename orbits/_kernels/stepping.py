@@ -31,7 +31,10 @@ counted from the start of the simulation (``step0``), into ``mon_t`` and
 Outputs use the same mechanism: rows ``6 N`` wider than the monitors' also
 take the bodies' state (:func:`record_state`), so that a run's evenly
 spaced outputs are recorded inside the loop, ``step0`` then counting from
-the run's start (:meth:`orbits._driver.Driven.execute`).
+the run's start (:meth:`orbits._driver.Driven.execute`).  Outputs that do not
+fall a whole number of steps apart are recorded in the fixed-step loops too:
+with ``every = -1``, ``mon_t`` holds on entry the steps after which to record
+(:func:`first_record`).
 
 The work of non-conservative force terms.  A force built by :func:`with_terms`
 with non-conservative terms (``work``) carries a third item in ``fargs``, the
@@ -62,8 +65,8 @@ from .stopping import check_stop, no_stop
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
            "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms",
-           "step_epilogue", "epilogue", "GO", "work_kernels", "work_args", "work_bound",
-           "work_total"]
+           "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
+           "work_bound", "work_total"]
 
 #: the stopping arguments of a loop compiled without conditions
 NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
@@ -109,6 +112,21 @@ def _record(x, v, t, mon, n_mon, mon_t, mon_out):
 GO = -1
 
 
+@njit(inline="always")
+def first_record(every, step0, mon_t):
+    """Steps until a loop's first record (-1: none).  ``every > 0``: a record
+    every ``every`` steps counted from step 0, ``step0`` steps having been
+    done before this call.  ``every = -1`` (fixed-step loops): after the steps
+    ``mon_t`` holds on entry, counted from this call's start as floats and
+    increasing, each overwritten by its record's time (outputs that do not fall
+    a whole number of steps apart, :class:`orbits._driver.Driver`)."""
+    if every > 0:
+        return every - step0 % every
+    if every < 0 and mon_t.shape[0] > 0:
+        return int(mon_t[0])
+    return -1
+
+
 def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record, every,
               mon, n_mon, mon_t, mon_out, sargs, fargs):
     # The epilogue of every loop's step, at time t after step k (of nsteps):
@@ -129,7 +147,15 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
     renormalise = tangent_step(x, v, t, fargs)  # noqa: F821 - bound by specialize
     until_record -= 1
     if until_record == 0:
-        until_record = every
+        if every > 0:
+            until_record = every
+        elif n_mon + 1 < mon_t.shape[0]:
+            # marks (every = -1, fixed-step loops): the next record's step,
+            # counted from the call's start, before this record overwrites
+            # its own entry with its time (first_record)
+            until_record = int(mon_t[n_mon + 1]) - (k + 1)
+        else:
+            until_record = -1
         _record(x, v, t, mon, n_mon, mon_t, mon_out)
         work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
         n_mon += 1
@@ -455,7 +481,7 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
     n_mon = 0
     fresh = cache[0] != 0
     until_check = check_every
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         tx = t + k * dt
         for op in range(len(KINDS)):  # noqa: F821 - bound by specialize
@@ -558,7 +584,7 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
     every = mon[0]
     n_mon = 0
     until_check = check_every
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         tk = t + k * dt
         pw = 0.0

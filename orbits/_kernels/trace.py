@@ -65,7 +65,7 @@ from ._jit import njit, specialize
 from .coordinates import from_democratic_heliocentric, to_democratic_heliocentric
 from .gravity import pair_accelerations
 from .status import Status
-from .stepping import GO, _record, epilogue
+from .stepping import GO, _record, epilogue, first_record
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 __all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
@@ -579,7 +579,7 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
     owed = owed_box[0]
     half = 0.5 * dt
     until_check = check_every
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         seg = owed + half
         flagged = state[4] != 0

@@ -105,7 +105,7 @@ from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi
 from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
-from .stepping import DRIFT, GO, _record, epilogue
+from .stepping import DRIFT, GO, _record, epilogue, first_record
 from .wh_lanes import MEMO, RETRY, kepler_drift_lanes
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
@@ -333,7 +333,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
     n_ops = len(KINDS)  # noqa: F821 - bound by specialize
     defer = KINDS[n_ops - 1] == DRIFT  # noqa: F821
     until_check = check_every
-    until_record = every - step0 % every if every > 0 else -1
+    until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         for op in range(n_ops):
             h = COEFS[op] * dt  # noqa: F821

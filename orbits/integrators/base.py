@@ -106,6 +106,11 @@ class Integrator:
     #: whether its loop updates the chaos indicators after every step (the
     #: shared step epilogue, :mod:`orbits._kernels.variational`)
     chaos_indicators = True
+    #: whether ``advance`` records at the steps ``mon_t`` holds on entry when
+    #: ``mon[0]`` is -1 (:func:`orbits._kernels.stepping.first_record`), so that
+    #: outputs that do not fall a whole number of steps apart are recorded in
+    #: its loop; the compiled fixed-step methods do
+    records_step_marks = False
 
     @property
     def batchable(self):
@@ -330,6 +335,10 @@ class SplittingMethod(Integrator):
     1.0
     """
 
+    #: outputs that do not fall a whole number of steps apart are recorded in the
+    #: loop too (``every = -1``: the steps in ``mon_t``)
+    records_step_marks = True
+
     operators = ()
     symplectic = True
     stop_conditions = True
@@ -426,6 +435,10 @@ class ExplicitRungeKutta(Integrator):
     >>> round(float(np.sum(rk4.B)), 12), np.allclose(np.sum(rk4.A, axis=1), rk4.C)
     (1.0, True)
     """
+
+    #: outputs that do not fall a whole number of steps apart are recorded in the
+    #: loop too (``every = -1``: the steps in ``mon_t``)
+    records_step_marks = True
 
     A = None
     B = None

@@ -32,6 +32,10 @@ class ImplicitOneLeg(Integrator):
     :class:`~orbits.errors.ConvergenceFailure` at the last good step.
     """
 
+    #: outputs that do not fall a whole number of steps apart are recorded in the
+    #: loop too (``every = -1``: the steps in ``mon_t``)
+    records_step_marks = True
+
     theta = None
     stop_conditions = True
     # counted as in the loop's usual case: two Newton iterations of one force each

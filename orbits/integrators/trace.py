@@ -146,6 +146,10 @@ class Trace(Integrator):
     20
     """
 
+    #: outputs that do not fall a whole number of steps apart are recorded in the
+    #: loop too (``every = -1``: the steps in ``mon_t``)
+    records_step_marks = True
+
     name = "trace"
     order = 2
     symplectic = False

@@ -235,6 +235,10 @@ class WisdomHolman(Integrator):
     True
     """
 
+    #: outputs that do not fall a whole number of steps apart are recorded in the
+    #: loop too (``every = -1``: the steps in ``mon_t``)
+    records_step_marks = True
+
     name = "wh"
     order = 2
     symplectic = True
