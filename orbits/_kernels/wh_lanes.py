@@ -76,25 +76,31 @@ Rein, H. & Tamayo, D. 2015, MNRAS 452, 376 (WHFast).  Danby, J. M. A. 1988,
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import njit, specialize
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, f_and_g, kepler_drift,
                      quartic_step, short_start, stumpff_lane)
 
-__all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "RETRY", "lane_columns", "lanes_scratch",
-           "kepler_drift_lanes"]
+__all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
+           "lanes_scratch", "kepler_drift_lanes", "kepler_drift_lanes_twice"]
 
 #: doubles in a vector register of the machines this is tuned for (AVX2); the
 #: planets' columns are padded to a multiple of it
 LANE_WIDTH = 4
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
-#: the verdict, and a memo for the caller (:data:`MEMO`)
-DRIFT_ROWS = 15
+#: the verdict, a memo for the caller (:data:`MEMO`), each column's step, and
+#: an output the loop has yet to finish (:data:`PENDING`)
+DRIFT_ROWS = 17
 _X, _MU, _Y, _TAKE = 0, 6, 7, 13
 #: the scratch's row whose column 0 the loop keeps from drift to drift (see
 #: orbits._kernels.wisdom_holman._lanes_drift): the drifts left before the
 #: lanes are tried again after they declined too many planets
 MEMO = 14
+_H = 15
+#: the scratch's row where the loop notes an output due at the end of a step
+#: (1, its row, its time), whose synchronising drift it then makes in the same
+#: pass as the next step's first drift (:func:`kepler_drift_lanes_twice`)
+PENDING = 16
 
 #: drifts that the loop leaves to the scalar drift after the lanes have
 #: declined more than a quarter of the planets (a scene whose steps are long
@@ -103,20 +109,63 @@ MEMO = 14
 RETRY = 64
 
 
+@njit(inline="always")
 def lane_columns(n):
-    """Columns of the scratch for ``n`` bodies: one per planet (``n - 1``),
+    """Columns of one drift for ``n`` bodies: one per planet (``n - 1``),
     padded to a multiple of :data:`LANE_WIDTH`."""
     return LANE_WIDTH * max(1, (n - 1 + LANE_WIDTH - 1) // LANE_WIDTH)
 
 
 def lanes_scratch(n):
-    """The scratch of :func:`kepler_drift_lanes` for ``n`` bodies, shape
-    (:data:`DRIFT_ROWS`, :func:`lane_columns` ``(n)``)."""
-    return np.zeros((DRIFT_ROWS, lane_columns(n)))
+    """The scratch of :func:`kepler_drift_lanes` and
+    :func:`kepler_drift_lanes_twice` for ``n`` bodies, shape
+    (:data:`DRIFT_ROWS`, 2 :func:`lane_columns` ``(n)``)."""
+    return np.zeros((DRIFT_ROWS, 2 * lane_columns(n)))
 
 
 @njit(inline="always")
-def _single_pass(S, h, P):
+def _load(S, xj, vj, mu, h, off, P):
+    # columns off .. off + P - 1: the planets' start and mu, and the step h;
+    # the padding repeats planet 1, whose copies are never read
+    n = xj.shape[0]
+    for k in range(P):
+        i = k + 1 if k + 1 < n else 1
+        c = off + k
+        S[_X, c] = xj[i, 0]
+        S[_X + 1, c] = xj[i, 1]
+        S[_X + 2, c] = xj[i, 2]
+        S[_X + 3, c] = vj[i, 0]
+        S[_X + 4, c] = vj[i, 1]
+        S[_X + 5, c] = vj[i, 2]
+        S[_MU, c] = mu[i]
+        S[_H, c] = h
+
+
+@njit(inline="always")
+def _store(S, xj, vj, mu, off):
+    # the planets from columns off ..: those the lanes took, and the others
+    # drifted by the scalar drift from their start (still in xj, vj) by
+    # their column's step; returns how many the lanes declined
+    declined = 0
+    for i in range(1, xj.shape[0]):
+        k = off + i - 1
+        if S[_TAKE, k] != 0.0:
+            xj[i, 0] = S[_Y, k]
+            xj[i, 1] = S[_Y + 1, k]
+            xj[i, 2] = S[_Y + 2, k]
+            vj[i, 0] = S[_Y + 3, k]
+            vj[i, 1] = S[_Y + 4, k]
+            vj[i, 2] = S[_Y + 5, k]
+        else:
+            # declined: the scalar drift from the same start (its
+            # short-step path first, as the scalar loop takes it, then the
+            # bracketed solver)
+            kepler_drift(mu[i], xj, vj, i, S[_H, k])
+            declined += 1
+    return declined
+
+
+def _pass(S, h0, P):
     # the usual planetary step in one pass over the columns: the starter,
     # one quartic iteration and the f and g functions, all with the
     # four-term Stumpff series; a column is right (its verdict 1) where the
@@ -140,8 +189,10 @@ def _single_pass(S, h, P):
     U1 = S[_Y + 4]
     U2 = S[_Y + 5]
     tk_ = S[_TAKE]
+    H = S[_H]
     rejected = 0
     for k in range(P):
+        h = step_of(H, k, h0)  # noqa: F821 - bound by specialize
         mu = MU[k]
         x0 = X0[k]
         y0 = X1[k]
@@ -173,6 +224,22 @@ def _single_pass(S, h, P):
     return rejected
 
 
+@njit(inline="always")
+def _one_step(H, k, h):
+    # every column takes the step h
+    return h
+
+
+@njit(inline="always")
+def _column_step(H, k, h):
+    # each column takes its own step (kepler_drift_lanes_twice)
+    return H[k]
+
+
+_single_pass = specialize(_pass, "one_step", inline=True, step_of=_one_step)
+_single_pass_steps = specialize(_pass, "column_steps", inline=True, step_of=_column_step)
+
+
 @njit
 def kepler_drift_lanes(xj, vj, mu, h, S):
     """:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` with the
@@ -187,9 +254,9 @@ def kepler_drift_lanes(xj, vj, mu, h, S):
         Each row's Kepler ``G M``.
     h : float
         The step.
-    S : ndarray, shape (DRIFT_ROWS, P)
-        Scratch (:func:`lanes_scratch`), ``P >= N - 1`` a multiple of
-        :data:`LANE_WIDTH`.
+    S : ndarray, shape (DRIFT_ROWS, 2 P)
+        Scratch (:func:`lanes_scratch`), ``P`` (:func:`lane_columns`)
+        ``>= N - 1`` a multiple of :data:`LANE_WIDTH`.
 
     Returns
     -------
@@ -203,33 +270,40 @@ def kepler_drift_lanes(xj, vj, mu, h, S):
     xj[0, 0] += h * vj[0, 0]
     xj[0, 1] += h * vj[0, 1]
     xj[0, 2] += h * vj[0, 2]
+    P = lane_columns(xj.shape[0])
+    _load(S, xj, vj, mu, h, 0, P)
+    _single_pass(S, h, np.uint64(P))
+    return _store(S, xj, vj, mu, 0)
+
+
+@njit
+def kepler_drift_lanes_twice(xj, vj, mu, h, xs, vs, h2, S):
+    """Two drifts from the same start in one pass over the columns:
+    :func:`kepler_drift_lanes` of ``xj``, ``vj`` by ``h`` (in place), and a
+    copy of them drifted by ``h2`` into ``xs``, ``vs``; each bit for bit the
+    scalar drift.  The Wisdom-Holman loop's output: the copy is the state
+    synchronised by the owed drift ``h2``, made beside the next step's first
+    drift, whose long chains of dependent operations it overlaps (an
+    output's drift made on its own added its whole latency to the step).
+
+    Returns
+    -------
+    declined : int
+        The planets of ``xj`` the lanes declined (the copy's are not counted).
+    """
+    for d in range(3):
+        xs[0, d] = xj[0, d] + h2 * vj[0, d]
+        vs[0, d] = vj[0, d]
+        xj[0, d] += h * vj[0, d]
     n = xj.shape[0]
-    P = np.uint64(S.shape[1])
-    # the columns; the padding repeats planet 1, whose copies are never read
-    for k in range(S.shape[1]):
-        i = k + 1 if k + 1 < n else 1
-        S[_X, k] = xj[i, 0]
-        S[_X + 1, k] = xj[i, 1]
-        S[_X + 2, k] = xj[i, 2]
-        S[_X + 3, k] = vj[i, 0]
-        S[_X + 4, k] = vj[i, 1]
-        S[_X + 5, k] = vj[i, 2]
-        S[_MU, k] = mu[i]
-    _single_pass(S, h, P)
-    declined = 0
+    P = lane_columns(n)
+    _load(S, xj, vj, mu, h, 0, P)
+    _load(S, xj, vj, mu, h2, P, P)
+    _single_pass_steps(S, h, np.uint64(2 * P))
+    # the copy's declined planets start from xj, vj, so the copy first
     for i in range(1, n):
-        k = i - 1
-        if S[_TAKE, k] != 0.0:
-            xj[i, 0] = S[_Y, k]
-            xj[i, 1] = S[_Y + 1, k]
-            xj[i, 2] = S[_Y + 2, k]
-            vj[i, 0] = S[_Y + 3, k]
-            vj[i, 1] = S[_Y + 4, k]
-            vj[i, 2] = S[_Y + 5, k]
-        else:
-            # declined: the scalar drift from the same start, still in xj,
-            # vj (its short-step path first, as the scalar loop takes it,
-            # then the bracketed solver)
-            kepler_drift(mu[i], xj, vj, i, h)
-            declined += 1
-    return declined
+        for d in range(3):
+            xs[i, d] = xj[i, d]
+            vs[i, d] = vj[i, d]
+    _store(S, xs, vs, mu, P)
+    return _store(S, xj, vj, mu, 0)

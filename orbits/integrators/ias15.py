@@ -48,8 +48,9 @@ class IAS15(AdaptiveIntegrator):
     evaluations per iteration, two or three iterations, plus one at the start
     of the step), run to rounding; at a loose ``epsilon`` (above 1e-7) only
     until its change falls below ``1e-2 epsilon**2``, far below the step's
-    truncation error, which saves up to half the force evaluations there.  The step is accepted unless the step it implies is below
-    ``0.25 dt``; the next step is at most ``4 dt``.  Positions, velocities and
+    truncation error, which saves up to half the force evaluations there.
+    The step is accepted unless the step it implies is below ``0.25 dt``; the
+    next step is at most ``4 dt``.  Positions, velocities and
     the time are summed with compensation, and the ``b`` a step ends with are
     computed from that step's forces alone (not carried over from the
     prediction), so the rounding errors of successive steps are independent

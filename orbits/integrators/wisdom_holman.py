@@ -401,7 +401,7 @@ class WisdomHolman(Integrator):
         lanes = terms is None and n >= LANES_FROM_BODIES
         if lanes:
             targs = ws.get("lanes")
-            if targs is None or targs[0].shape != (_lanes.DRIFT_ROWS, _lanes.lane_columns(n)):
+            if targs is None or targs[0].shape != (_lanes.DRIFT_ROWS, 2 * _lanes.lane_columns(n)):
                 targs = ws["lanes"] = (_lanes.lanes_scratch(n),)
         return terms, targs, lanes
 

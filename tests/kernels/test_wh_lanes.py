@@ -113,3 +113,28 @@ def test_zero_step_and_non_finite_states():
     xj[2, 1] = np.nan
     vj[3, 0] = np.inf
     both(xj, vj, mu, 0.01)
+
+
+@pytest.mark.parametrize("f", [0.0, 0.05])
+def test_two_drifts_in_one_pass_are_each_the_scalar_drift(f):
+    # the Wisdom-Holman loop's output: the next step's drift h of the state
+    # and the owed drift h2 of a copy, in one pass over the lanes; each must
+    # be the scalar drift bit for bit, also for planets the lanes decline
+    # (e = 0.99 at pericentre, a hyperbola), whose start the copy must keep
+    orbits_ = CIRCULAR[:2] + [(1.0, 0.99, f), (-1.0, 1.5, f / 2)] + CIRCULAR[2:]
+    xj, vj, mu = system(orbits_)
+    h, h2 = 2 * math.pi / 200, math.pi / 200
+    w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
+    a, b = xj.copy(), vj.copy()
+    W.kepler_drift_all(a, b, mu, h, w1, w2)
+    c, d = xj.copy(), vj.copy()
+    W.kepler_drift_all(c, d, mu, h2, w1, w2)
+    S = L.lanes_scratch(len(xj))
+    xs, vs = np.full_like(xj, np.nan), np.full_like(xj, np.nan)
+    declined = L.kepler_drift_lanes_twice(xj, vj, mu, h, xs, vs, h2, S)
+    assert np.array_equal(xj, a) and np.array_equal(vj, b)
+    assert np.array_equal(xs, c) and np.array_equal(vs, d)
+    P = L.lane_columns(len(xj))
+    took, took2 = S[L._TAKE, :len(xj) - 1] != 0.0, S[L._TAKE, P:P + len(xj) - 1] != 0.0
+    assert declined == np.sum(~took) and 1 <= declined < len(xj) - 1
+    assert np.sum(~took2) >= 1            # the copy had declined planets too
