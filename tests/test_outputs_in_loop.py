@@ -70,6 +70,24 @@ def test_outputs_in_the_loop_equal_those_taken_between_calls(integrator, dt, k):
     assert set(np.diff(steps)) == ({7} if k == 7 else {7, 8})
 
 
+@pytest.mark.parametrize("options", [{"corrector": 11},
+                                     {"coordinates": "democratic-heliocentric"}])
+def test_wh_outputs_made_beside_the_next_drift_with_a_corrector_or_other_coordinates(
+        options):
+    # the lanes' loop (four bodies or more) makes an output's drift beside the
+    # next step's first one, then the corrector and the transform: the outputs
+    # must be those of the immediate synchronisation between calls
+    from orbits.integrators import get
+    make = lambda: orbits.Simulation(  # noqa: E731
+        orbits.scenes.solar_system(moon=False), get("wh", **options), dt=1 * u.day,
+        monitors=["energy", "angular_momentum"])
+    inloop = make().run(until=3000 * u.day, outputs=377, progress=False)
+    sim = make()
+    sim.monitor_every = 10 ** 9
+    between = sim.run(until=3000 * u.day, outputs=377, progress=False)
+    _same(inloop, between)
+
+
 def test_with_terms_work_and_chaos_monitors():
     b = orbits.BodySet()
     b.add("Star", 1 * u.Msun)
