@@ -85,6 +85,17 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     # loop for both uses).
     n = x.shape[0]
     s = b.shape[0]
+    # flat views of the (N, 3) arrays: the stages run over every component in
+    # loops that LLVM turns into vector instructions
+    m3 = 3 * n
+    xF = x.reshape(m3)
+    vF = v.reshape(m3)
+    xsF = xs.reshape(m3)
+    vsF = vs.reshape(m3)
+    x1F = x1.reshape(m3)
+    v1F = v1.reshape(m3)
+    kxF = kx.reshape((kx.shape[0], m3))
+    kvF = kv.reshape((kv.shape[0], m3))
     every = mon[0]
     n_mon = 0
     until_record = first_record(every, step0, mon_t)
@@ -127,32 +138,37 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             shortened = True
         pw = b[0] * p0
         for st in range(1, s):
-            for i in range(n):
-                for d in range(3):
-                    xi = x[i, d]
-                    vi = v[i, d]
-                    for j in range(st):
-                        a = A[st, j]
-                        if a != 0.0:
-                            xi += h * a * kx[j, i, d]
-                            vi += h * a * kv[j, i, d]
-                    xs[i, d] = xi
-                    vs[i, d] = vi
-                    kx[st, i, d] = vi
+            # a stage: passes over every component (each operation as the
+            # sum over j per component would make it, h a computed once)
+            for k in range(m3):
+                xsF[k] = xF[k]
+                vsF[k] = vF[k]
+            for j in range(st):
+                a = A[st, j]
+                if a != 0.0:
+                    ha = h * a
+                    for k in range(m3):
+                        xsF[k] += ha * kxF[j, k]
+                        vsF[k] += ha * kvF[j, k]
+            for k in range(m3):
+                kxF[st, k] = vsF[k]
             force(xs, vs, t + c[st] * h, fargs, kv[st])  # noqa: F821
             if HAS_WORK and b[st] != 0.0:  # noqa: F821
                 pw += b[st] * work_rate(xs, vs, t + c[st] * h, fargs)  # noqa: F821
         fev += s - 1
-        for i in range(n):
-            for d in range(3):
-                dx = 0.0
-                dv = 0.0
-                for j in range(s):
-                    dx += b[j] * kx[j, i, d]
-                    dv += b[j] * kv[j, i, d]
-                x1[i, d] = x[i, d] + h * dx
-                v1[i, d] = v[i, d] + h * dv
-                kx[s, i, d] = v1[i, d]
+        # the step's sums b . k, gathered in x1, v1, then the new state
+        for k in range(m3):
+            x1F[k] = 0.0
+            v1F[k] = 0.0
+        for j in range(s):
+            bj = b[j]
+            for k in range(m3):
+                x1F[k] += bj * kxF[j, k]
+                v1F[k] += bj * kvF[j, k]
+        for k in range(m3):
+            x1F[k] = xF[k] + h * x1F[k]
+            v1F[k] = vF[k] + h * v1F[k]
+            kxF[s, k] = v1F[k]
         force(x1, v1, t + h, fargs, kv[s])  # noqa: F821
         fev += 1
         err5 = 0.0
