@@ -581,6 +581,14 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
     # W' = -P(x, v, t): W += -dt sum_s b_s P(stage s).
     n = x.shape[0]
     n_stages = b.shape[0]
+    # flat views of the (N, 3) arrays, for loops LLVM turns into vector instructions
+    m3 = 3 * n
+    xF = x.reshape(m3)
+    vF = v.reshape(m3)
+    xsF = xs.reshape(m3)
+    vsF = vs.reshape(m3)
+    kxF = kx.reshape((kx.shape[0], m3))
+    kvF = kv.reshape((kv.shape[0], m3))
     every = mon[0]
     n_mon = 0
     until_check = check_every
@@ -589,30 +597,35 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
         tk = t + k * dt
         pw = 0.0
         for s in range(n_stages):
-            for i in range(n):
-                for d in range(3):
-                    xi = x[i, d]
-                    vi = v[i, d]
-                    for j in range(s):
-                        a_sj = A[s, j]
-                        if a_sj != 0.0:
-                            xi += dt * a_sj * kx[j, i, d]
-                            vi += dt * a_sj * kv[j, i, d]
-                    xs[i, d] = xi
-                    vs[i, d] = vi
-                    kx[s, i, d] = vi
+            # passes over every component (each operation as the sum over j
+            # per component would make it, dt a computed once)
+            for q in range(m3):
+                xsF[q] = xF[q]
+                vsF[q] = vF[q]
+            for j in range(s):
+                a_sj = A[s, j]
+                if a_sj != 0.0:
+                    ha = dt * a_sj
+                    for q in range(m3):
+                        xsF[q] += ha * kxF[j, q]
+                        vsF[q] += ha * kvF[j, q]
+            for q in range(m3):
+                kxF[s, q] = vsF[q]
             force(xs, vs, tk + c[s] * dt, fargs, kv[s])  # noqa: F821 - bound by specialize
             if HAS_WORK and b[s] != 0.0:  # noqa: F821
                 pw += b[s] * work_rate(xs, vs, tk + c[s] * dt, fargs)  # noqa: F821
-        for i in range(n):
-            for d in range(3):
-                dx = 0.0
-                dv = 0.0
-                for s in range(n_stages):
-                    dx += b[s] * kx[s, i, d]
-                    dv += b[s] * kv[s, i, d]
-                x[i, d] += dt * dx
-                v[i, d] += dt * dv
+        # the step's sums b . k, gathered in xs, vs (free until the next step)
+        for q in range(m3):
+            xsF[q] = 0.0
+            vsF[q] = 0.0
+        for s in range(n_stages):
+            bs = b[s]
+            for q in range(m3):
+                xsF[q] += bs * kxF[s, q]
+                vsF[q] += bs * kvF[s, q]
+        for q in range(m3):
+            xF[q] += dt * xsF[q]
+            vF[q] += dt * vsF[q]
         if HAS_WORK:  # noqa: F821
             work_add(fargs, -dt * pw)  # noqa: F821
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
