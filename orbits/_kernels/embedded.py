@@ -24,7 +24,7 @@ import math
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import GO, first_record, step_epilogue, work_kernels
+from .stepping import GO, first_record, rk_stage, rk_sums, step_epilogue, work_kernels
 from .variational import measured_rows
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
@@ -86,7 +86,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     n = x.shape[0]
     s = b.shape[0]
     # flat views of the (N, 3) arrays: the stages run over every component in
-    # loops that LLVM turns into vector instructions
+    # loops that LLVM turns into vector instructions (stepping.rk_stage)
     m3 = 3 * n
     xF = x.reshape(m3)
     vF = v.reshape(m3)
@@ -138,33 +138,13 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             shortened = True
         pw = b[0] * p0
         for st in range(1, s):
-            # a stage: passes over every component (each operation as the
-            # sum over j per component would make it, h a computed once)
-            for k in range(m3):
-                xsF[k] = xF[k]
-                vsF[k] = vF[k]
-            for j in range(st):
-                a = A[st, j]
-                if a != 0.0:
-                    ha = h * a
-                    for k in range(m3):
-                        xsF[k] += ha * kxF[j, k]
-                        vsF[k] += ha * kvF[j, k]
-            for k in range(m3):
-                kxF[st, k] = vsF[k]
+            rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, st, h)
             force(xs, vs, t + c[st] * h, fargs, kv[st])  # noqa: F821
             if HAS_WORK and b[st] != 0.0:  # noqa: F821
                 pw += b[st] * work_rate(xs, vs, t + c[st] * h, fargs)  # noqa: F821
         fev += s - 1
         # the step's sums b . k, gathered in x1, v1, then the new state
-        for k in range(m3):
-            x1F[k] = 0.0
-            v1F[k] = 0.0
-        for j in range(s):
-            bj = b[j]
-            for k in range(m3):
-                x1F[k] += bj * kxF[j, k]
-                v1F[k] += bj * kvF[j, k]
+        rk_sums(x1F, v1F, kxF, kvF, b, s)
         for k in range(m3):
             x1F[k] = xF[k] + h * x1F[k]
             v1F[k] = vF[k] + h * v1F[k]

@@ -66,7 +66,7 @@ from .stopping import check_stop, no_stop
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
            "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
-           "work_bound", "work_total"]
+           "work_bound", "work_total", "rk_stage", "rk_sums"]
 
 #: the stopping arguments of a loop compiled without conditions
 NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
@@ -573,6 +573,43 @@ def splitting_loop(force, name, kinds, coefs, stop=False):
 
 # -- explicit Runge-Kutta ---------------------------------------------------------------
 
+@njit(inline="always")
+def rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, st, h):
+    """Stage ``st`` of a Runge-Kutta step of ``h`` on flat views (length 3 N;
+    ``kxF``, ``kvF`` one row a stage): its state ``y + h sum_j A[st, j] k_j``
+    into ``xsF``, ``vsF`` and its velocity into ``kxF[st]``.  Passes over every
+    component that LLVM turns into vector instructions, each operation as the
+    sum over j per component makes it (``h A[st, j]`` computed once)."""
+    m3 = xF.shape[0]
+    for q in range(m3):
+        xsF[q] = xF[q]
+        vsF[q] = vF[q]
+    for j in range(st):
+        a = A[st, j]
+        if a != 0.0:
+            ha = h * a
+            for q in range(m3):
+                xsF[q] += ha * kxF[j, q]
+                vsF[q] += ha * kvF[j, q]
+    for q in range(m3):
+        kxF[st, q] = vsF[q]
+
+
+@njit(inline="always")
+def rk_sums(sx, sv, kxF, kvF, b, count):
+    """``sum_s b[s] k_s`` over the first ``count`` stages into ``sx``, ``sv``
+    (flat views, as :func:`rk_stage`), summed in stage order per component."""
+    m3 = sx.shape[0]
+    for q in range(m3):
+        sx[q] = 0.0
+        sv[q] = 0.0
+    for s in range(count):
+        bs = b[s]
+        for q in range(m3):
+            sx[q] += bs * kxF[s, q]
+            sv[q] += bs * kvF[s, q]
+
+
 def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, step0,
                       mon_t, mon_out, check_every, sargs):
     # y = (x, v), y' = (v, a(x, v, t)); stage s has state
@@ -597,32 +634,12 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
         tk = t + k * dt
         pw = 0.0
         for s in range(n_stages):
-            # passes over every component (each operation as the sum over j
-            # per component would make it, dt a computed once)
-            for q in range(m3):
-                xsF[q] = xF[q]
-                vsF[q] = vF[q]
-            for j in range(s):
-                a_sj = A[s, j]
-                if a_sj != 0.0:
-                    ha = dt * a_sj
-                    for q in range(m3):
-                        xsF[q] += ha * kxF[j, q]
-                        vsF[q] += ha * kvF[j, q]
-            for q in range(m3):
-                kxF[s, q] = vsF[q]
+            rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, s, dt)
             force(xs, vs, tk + c[s] * dt, fargs, kv[s])  # noqa: F821 - bound by specialize
             if HAS_WORK and b[s] != 0.0:  # noqa: F821
                 pw += b[s] * work_rate(xs, vs, tk + c[s] * dt, fargs)  # noqa: F821
         # the step's sums b . k, gathered in xs, vs (free until the next step)
-        for q in range(m3):
-            xsF[q] = 0.0
-            vsF[q] = 0.0
-        for s in range(n_stages):
-            bs = b[s]
-            for q in range(m3):
-                xsF[q] += bs * kxF[s, q]
-                vsF[q] += bs * kvF[s, q]
+        rk_sums(xsF, vsF, kxF, kvF, b, n_stages)
         for q in range(m3):
             xF[q] += dt * xsF[q]
             vF[q] += dt * vsF[q]
