@@ -326,13 +326,8 @@ def output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
 
 
 @njit(inline="always")
-def finish_output(mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active, corr, h,
-                  targs):
-    pass
-
-
-@njit(inline="always")
-def flush_output(xj, vj, mon, mon_t, mon_out, sync):
+def make_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
+                corr, h, targs):
     pass
 
 
@@ -361,26 +356,16 @@ def _lanes_output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
     _lanes_drift(xj, vj, eta, h, x, acc, targs)
 
 
-def _lanes_finish_output(mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active, corr, h,
-                         targs):
-    # the rest of the noted output's synchronisation (_synchronize after its
-    # drift), and its row
+def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
+                  corr, h, targs):
+    # the noted output, by the usual synchronisation of the state xa, va that
+    # still owes the drift owed: the loop's state when it returns, or the copy
+    # that output_drift already drifted (owed 0; xa, va are then xs, vs)
     S = targs[0]
-    if corr.shape[0] > 0:
-        apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, FORWARD, targs)
-    from_internal(xs, vs, gm, eta, x, v, targs)  # noqa: F821 - bound by specialize
+    S[PENDING, 0] = 0.0
+    synchronize(xa, va, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+                targs)
     _record(x, v, S[PENDING, 2], mon, int(S[PENDING, 1]), mon_t, mon_out)  # noqa: F821
-
-
-def _lanes_flush_output(xj, vj, mon, mon_t, mon_out, sync):
-    # a noted output made now, by the usual synchronisation (the loop returns)
-    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
-    S = targs[0]
-    if S[PENDING, 0] != 0.0:
-        S[PENDING, 0] = 0.0
-        synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
-                    targs)
-        _record(x, v, S[PENDING, 2], mon, int(S[PENDING, 1]), mon_t, mon_out)  # noqa: F821
 
 
 def _lanes_note(xj, vj, t, mon, n_mon, mon_t, mon_out):
@@ -433,8 +418,8 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                         # the output noted at the end of the last step
                         # (the lanes' loop): its drift beside this one
                         output_drift(xj, vj, eta, h + owed, xs, vs, owed, x, acc, targs)
-                        finish_output(mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
-                                      n_active, corr, cdt[0], targs)
+                        make_output(xs, vs, 0.0, mon, mon_t, mon_out, gm, eta, xs, vs, x, v,
+                                    acc, n_active, corr, cdt[0], targs)
                         owed = 0.0
                         continue
                     h += owed
@@ -454,12 +439,15 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
             xj, vj, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
             every, (mon, sync), n_mon, mon_t, mon_out, (), sync)
         if status != GO:
-            flush_output(xj, vj, mon, mon_t, mon_out, sync)
+            # an output still noted is made before the loop returns
+            if output_pending(targs):
+                make_output(xj, vj, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
+                            n_active, corr, cdt[0], targs)
             owed_box[0] = owed
             return status, done, n_mon
-    # (the loop's own sync is unset when it took no step)
-    flush_output(xj, vj, mon, mon_t, mon_out, (gm, eta, owed, xs, vs, x, v, acc, n_active,
-                                               corr, cdt[0], targs))
+    if output_pending(targs):
+        make_output(xj, vj, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
+                    corr, cdt[0], targs)
     owed_box[0] = owed
     return Status.OK, nsteps, n_mon
 
@@ -668,18 +656,12 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     if lanes:
         # outputs made beside the next step's first drift (see _lanes_note)
         recorder = specialize(_lanes_note, key, cache=cache, nrt=nrt)
-        _, from_internal, _ = COORDINATE_SYSTEMS[coordinates][:3]
         outputs = dict(
             output_pending=specialize(_lanes_pending, key, cache=cache, inline=True, nrt=nrt),
             output_drift=specialize(_lanes_output_drift, key, cache=cache, inline=True,
                                     nrt=nrt),
-            finish_output=specialize(_lanes_finish_output, key, cache=cache, nrt=nrt,
-                                     apply_corrector=corrector, _record=record,
-                                     from_internal=specialize(
-                                         _plain_convert, f"from_{coordinates}", inline=True,
-                                         convert=from_internal)),
-            flush_output=specialize(_lanes_flush_output, key, cache=cache, nrt=nrt,
-                                    synchronize=sync, _record=record))
+            make_output=specialize(_lanes_output, key, cache=cache, nrt=nrt,
+                                   synchronize=sync, _record=record))
     else:
         recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, synchronize=sync,
                               _record=record)
