@@ -199,7 +199,8 @@ class WisdomHolman(Integrator):
     AVX2 or AVX-512, :mod:`orbits._kernels.wh_lanes`), bit for bit the
     scalar drift: a planet outside the branch-free solver's domain (a high
     eccentricity near pericentre, a hyperbola, a long step) is drifted by
-    the scalar solver.
+    the scalar solver.  From seven bodies on, the interaction kick's pulls
+    are summed in the lanes too, bit for bit the scalar sums.
 
     Variational equations (a force with variations, ``force.inner`` set;
     :mod:`orbits._kernels.variational`): the tangent vectors in the rows

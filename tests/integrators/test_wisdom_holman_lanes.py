@@ -5,8 +5,11 @@ same trajectory bit for bit.
 The comparisons are exact (tolerance zero): the lanes compute each planet's
 drift by the scalar code's operations in its order, or hand it to the scalar
 drift (see tests/kernels/test_wh_lanes.py), so nothing may differ by even an
-ulp.  Which loop a run takes is chosen by the number of bodies
-(``LANES_FROM_BODIES``), set here to force one or the other.
+ulp; from seven bodies on (``PAIRS_LANES_FROM_BODIES``; the odd orbits'
+scene has eight) the kick's pulls are also summed in the lanes, in the scalar
+order (tests/kernels/test_wh_lanes.py).  Which loop a run takes is chosen by
+the number of bodies (``LANES_FROM_BODIES``), set here to force one or the
+other.
 """
 
 import astropy.units as u
