@@ -176,62 +176,69 @@ def _store(S, xj, vj, mu, off):
     return declined
 
 
-def _pass(S, h0, P):
-    # the usual planetary step in one pass over the columns: the starter,
-    # one quartic iteration and the f and g functions, all with the
-    # four-term Stumpff series; a column is right (its verdict 1) where the
-    # scalar path would have done exactly this: in the short-step domain,
-    # both Stumpff arguments within the four-term series, converged after
-    # one iteration, a positive radius at the end.  Every operation is the
-    # one kepler.short_step_anomaly and kepler._short_coefficients do, in
-    # their order, so that a right column is bit for bit the scalar drift.
-    # Returns how many columns are not right.
-    X0 = S[_X]
-    X1 = S[_X + 1]
-    X2 = S[_X + 2]
-    V0 = S[_X + 3]
-    V1 = S[_X + 4]
-    V2 = S[_X + 5]
-    MU = S[_MU]
-    Y0 = S[_Y]
-    Y1 = S[_Y + 1]
-    Y2 = S[_Y + 2]
-    U0 = S[_Y + 3]
-    U1 = S[_Y + 4]
-    U2 = S[_Y + 5]
-    tk_ = S[_TAKE]
-    H = S[_H]
+@njit(inline="always")
+def _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k, h):
+    # column k drifted by h (see _pass_rows); 1 if it is not right, else 0
+    mu = MU[k]
+    x0 = X0[k]
+    y0 = X1[k]
+    z0 = X2[k]
+    vx0 = V0[k]
+    vy0 = V1[k]
+    vz0 = V2[k]
+    r2, v2, r0, ir0, et, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, h)
+    z = beta * s * s
+    good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
+            & (abs(z) <= _STUMPFF_SHORT_Z))
+    c0, c1, c2, c3, _ = stumpff_lane(z, False)
+    d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
+    s = s + d
+    done = abs(d) <= _SHORT_STEP_TOL * abs(s)
+    z = beta * s * s
+    c0, c1, c2, c3, _ = stumpff_lane(z, False)
+    # (_advance's sigma is this et: the same expression of the start)
+    _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, et, zeta, c1, c2)
+    Y0[k] = x0 + (fm1 * x0 + g * vx0)
+    Y1[k] = y0 + (fm1 * y0 + g * vy0)
+    Y2[k] = z0 + (fm1 * z0 + g * vz0)
+    U0[k] = vx0 + (fdot * x0 + gdm1 * vx0)
+    U1[k] = vy0 + (fdot * y0 + gdm1 * vy0)
+    U2[k] = vz0 + (fdot * z0 + gdm1 * vz0)
+    take = good & done & (abs(z) <= _STUMPFF_SHORT_Z) & (r > 0.0)
+    tk_[k] = 1.0 if take else 0.0
+    return 0 if take else 1
+
+
+def _pass_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, H, h0, k0, P):
+    # the usual planetary step in one pass over the columns k0 .. P - 1 of
+    # the rows (start X, V and mu; end Y, U; verdict tk_; each column's step
+    # H where step_of reads it): the starter, one quartic iteration and the
+    # f and g functions, all with the four-term Stumpff series; a column is
+    # right (its verdict 1) where the scalar path would have done exactly
+    # this: in the short-step domain, both Stumpff arguments within the
+    # four-term series, converged after one iteration, a positive radius at
+    # the end.  Every operation is the one kepler.short_step_anomaly and
+    # kepler._short_coefficients do, in their order, so that a right column
+    # is bit for bit the scalar drift.  Returns how many columns are not
+    # right.
     rejected = 0
-    for k in range(P):
-        h = step_of(H, k, h0)  # noqa: F821 - bound by specialize
-        mu = MU[k]
-        x0 = X0[k]
-        y0 = X1[k]
-        z0 = X2[k]
-        vx0 = V0[k]
-        vy0 = V1[k]
-        vz0 = V2[k]
-        r2, v2, r0, ir0, et, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, h)
-        z = beta * s * s
-        good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
-                & (abs(z) <= _STUMPFF_SHORT_Z))
-        c0, c1, c2, c3, _ = stumpff_lane(z, False)
-        d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
-        s = s + d
-        done = abs(d) <= _SHORT_STEP_TOL * abs(s)
-        z = beta * s * s
-        c0, c1, c2, c3, _ = stumpff_lane(z, False)
-        # (_advance's sigma is this et: the same expression of the start)
-        _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, et, zeta, c1, c2)
-        Y0[k] = x0 + (fm1 * x0 + g * vx0)
-        Y1[k] = y0 + (fm1 * y0 + g * vy0)
-        Y2[k] = z0 + (fm1 * z0 + g * vz0)
-        U0[k] = vx0 + (fdot * x0 + gdm1 * vx0)
-        U1[k] = vy0 + (fdot * y0 + gdm1 * vy0)
-        U2[k] = vz0 + (fdot * z0 + gdm1 * vz0)
-        take = good & done & (abs(z) <= _STUMPFF_SHORT_Z) & (r > 0.0)
-        tk_[k] = 1.0 if take else 0.0
-        rejected += not take
+    for k in range(k0, P):
+        rejected += _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k,
+                            step_of(H, k, h0))  # noqa: F821 - bound by specialize
+    return rejected
+
+
+@njit(inline="always")
+def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, h, k0, P):
+    """The lanes' drift (see the module notes) of the columns ``k0 .. P - 1``
+    by ``h``: from the start rows ``X``, ``V`` with ``MU``, into the end rows
+    ``Y``, ``U``, and into ``tk_`` 1 for a column bit for bit the scalar
+    drift, 0 for one to leave to it; returns how many are left.  The drift
+    of :mod:`orbits._kernels.wh_batch`, whose columns are the bodies of many
+    systems."""
+    rejected = 0
+    for k in range(k0, P):
+        rejected += _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k, h)
     return rejected
 
 
@@ -247,8 +254,24 @@ def _column_step(H, k, h):
     return H[k]
 
 
-_single_pass = specialize(_pass, "one_step", inline=True, step_of=_one_step)
-_single_pass_steps = specialize(_pass, "column_steps", inline=True, step_of=_column_step)
+_pass_rows_one = specialize(_pass_rows, "one_step", inline=True, step_of=_one_step)
+_pass_rows_steps = specialize(_pass_rows, "column_steps", inline=True, step_of=_column_step)
+
+
+@njit(inline="always")
+def _single_pass(S, h0, P):
+    # every column of the scratch by the step h0
+    return _pass_rows_one(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
+                          S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
+                          S[_Y + 5], S[_TAKE], S[_H], h0, np.uint64(0), P)
+
+
+@njit(inline="always")
+def _single_pass_steps(S, h0, P):
+    # every column of the scratch by its own step (row _H)
+    return _pass_rows_steps(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
+                            S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
+                            S[_Y + 5], S[_TAKE], S[_H], h0, np.uint64(0), P)
 
 
 @njit
