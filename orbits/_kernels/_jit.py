@@ -35,11 +35,33 @@ NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True
 
 
 def njit(func=None, **overrides):
-    """``numba.njit`` with the package's options; usable bare or with overrides."""
+    """``numba.njit`` with the package's options; usable bare or with overrides.
+
+    A cached function's cache carries :data:`KERNEL_STAMP` in its name (see
+    :func:`_compile`)."""
     options = dict(NUMBA_OPTIONS, **overrides)
     if func is None:
-        return lambda f: numba.njit(**options)(f)
-    return numba.njit(**options)(func)
+        return lambda f: _compile(f, options)
+    return _compile(func, options)
+
+
+def _compile(func, options):
+    # numba keys a function's on-disk cache by the function's own source file
+    # only: a function that inlines a kernel of another file (the batch loop
+    # inlines the lanes' drift) would load its old compilation after that
+    # kernel changed.  So the cache is named, as specialize names its copies,
+    # with the hash of every kernel source: numba reads the name when the
+    # dispatcher is made, and the function keeps its own name
+    if not options.get("cache"):
+        return numba.njit(**options)(func)
+    qualname = func.__qualname__
+    func.__qualname__ = f"{qualname}__{KERNEL_STAMP}"
+    try:
+        dispatcher = numba.njit(**options)(func)
+    finally:
+        func.__qualname__ = qualname
+    dispatcher.__qualname__ = qualname
+    return dispatcher
 
 
 def njit_parallel(func=None, **overrides):
