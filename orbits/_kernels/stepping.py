@@ -463,6 +463,10 @@ def user_force(accel, jit):
 
 # -- splitting methods --------------------------------------------------------------
 
+#: bodies from which the splitting loop drifts and kicks over flat views
+FLAT_FROM_BODIES = 4
+
+
 def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_dependent, mon,
                     step0, mon_t, mon_out, check_every, sargs):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
@@ -477,6 +481,17 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
     # the kinetic energy by exactly h sum m a . (v + v') / 2: the
     # non-conservative terms' part of it is their work (HAS_WORK).
     n = x.shape[0]
+    # flat views of the (N, 3) arrays: the drifts and kicks as loops LLVM
+    # turns into vector instructions, each component's operation as before
+    # (bit for bit).  Measured (CPU time a step, paired runs): leapfrog on the
+    # Sun and eight planets 0.148-0.151 -> 0.133-0.138 us, the outer solar
+    # system unchanged; two bodies 0.031 -> 0.033 us, too few for the vector
+    # loop's set-up, so below FLAT_FROM_BODIES the nested loops stay
+    flat = n >= FLAT_FROM_BODIES
+    m3 = 3 * n
+    xF = x.reshape(m3)
+    vF = v.reshape(m3)
+    aF = acc.reshape(m3)
     every = mon[0]
     n_mon = 0
     fresh = cache[0] != 0
@@ -487,10 +502,14 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
         for op in range(len(KINDS)):  # noqa: F821 - bound by specialize
             h = COEFS[op] * dt  # noqa: F821
             if KINDS[op] == DRIFT:  # noqa: F821
-                for i in range(n):
-                    x[i, 0] += h * v[i, 0]
-                    x[i, 1] += h * v[i, 1]
-                    x[i, 2] += h * v[i, 2]
+                if flat:
+                    for q in range(m3):
+                        xF[q] += h * vF[q]
+                else:
+                    for i in range(n):
+                        x[i, 0] += h * v[i, 0]
+                        x[i, 1] += h * v[i, 1]
+                        x[i, 2] += h * v[i, 2]
                 tx += h
                 fresh = False
             elif velocity_dependent:
@@ -503,10 +522,14 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
                 if not fresh:
                     force(x, v, tx, fargs, acc)  # noqa: F821 - bound by specialize
                     fresh = True
-                for i in range(n):
-                    v[i, 0] += h * acc[i, 0]
-                    v[i, 1] += h * acc[i, 1]
-                    v[i, 2] += h * acc[i, 2]
+                if flat:
+                    for q in range(m3):
+                        vF[q] += h * aF[q]
+                else:
+                    for i in range(n):
+                        v[i, 0] += h * acc[i, 0]
+                        v[i, 1] += h * acc[i, 1]
+                        v[i, 2] += h * acc[i, 2]
                 if HAS_WORK:  # noqa: F821
                     for i in range(n):
                         for d in range(3):
