@@ -191,7 +191,7 @@ class Simulation(Driven):
         self.parallel = (n >= PARALLEL_THRESHOLD) if parallel is None else bool(parallel)
         self.rebound_arithmetic = bool(rebound_arithmetic)
         kind = ("rebound" if self.rebound_arithmetic else "parallel" if self.parallel else
-                "small" if self._n_active <= _gravity.SMALL_N else "serial")
+                _gravity.serial_kind(n, self._n_active))
         self._force = _stepping.gravity_force(kind)
         self._fargs = _gravity.gravity_args(self.units.G, self._m, self._n_active, self._eps2,
                                             self.parallel)

@@ -57,8 +57,9 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from ._jit import njit, specialize
-from .gravity import (accelerate_pairwise, accelerate_pairwise_parallel,
-                      accelerate_pairwise_rebound, accelerate_pairwise_small)
+from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
+                      accelerate_pairwise_parallel, accelerate_pairwise_rebound,
+                      accelerate_pairwise_small)
 from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, monitor_row
 from .status import Status
 from .stopping import check_stop, no_stop
@@ -282,13 +283,14 @@ class ForceKernel(NamedTuple):
 
 _PAIR_KERNELS = {
     "small": accelerate_pairwise_small,
+    "lanes": accelerate_pairwise_lanes,
     "serial": accelerate_pairwise,
     "parallel": accelerate_pairwise_parallel,
 }
 
 
 def gravity_force(kind):
-    """The pairwise-gravity force: ``kind`` is ``"small"``, ``"serial"``, ``"parallel"``
+    """The pairwise-gravity force: ``kind`` is ``"small"``, ``"lanes"``, ``"serial"``, ``"parallel"``
     or ``"rebound"`` (REBOUND's arithmetic; see :mod:`orbits._kernels.gravity`)."""
     key = f"gravity_{kind}"
     if kind == "rebound":

@@ -46,7 +46,8 @@ planets are declined the loop leaves the drift to the scalar code for
 :data:`RETRY` drifts before trying the lanes again (:data:`MEMO`;
 ``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`).
 
-The interaction kick's pulls (:func:`pair_accelerations_lanes`) go to the
+The interaction kick's pulls
+(:func:`orbits._kernels.gravity.pair_accelerations_lanes`) go to the
 lanes as well, from seven bodies on (``PAIRS_LANES_FROM_BODIES`` in
 :mod:`orbits._kernels.wisdom_holman`): one vector pass per source body over
 all the lanes, each lane's pulls summed over the sources in ascending order,
@@ -82,21 +83,19 @@ Rein, H. & Tamayo, D. 2015, MNRAS 452, 376 (WHFast).  Danby, J. M. A. 1988,
 *Fundamentals of Celestial Mechanics*, 2nd ed., sect. 6.9.
 """
 
-import math
-
 import numpy as np
 
 from ._jit import njit, specialize
+# the planets' columns, padded to a multiple of the lane width (shared with the
+# gravity kernels' lanes)
+from .gravity import LANE_WIDTH, lane_columns
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, f_and_g, kepler_drift,
                      quartic_step, short_start, stumpff_lane)
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
            "lanes_scratch", "kepler_drift_lanes", "kepler_drift_lanes_twice",
-           "pair_accelerations_lanes"]
+           "drift_columns"]
 
-#: doubles in a vector register of the machines this is tuned for (AVX2); the
-#: planets' columns are padded to a multiple of it
-LANE_WIDTH = 4
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
 #: the verdict, a memo for the caller (:data:`MEMO`), each column's step, and
@@ -118,13 +117,6 @@ PENDING = 16
 #: against several orbits, where the lanes would be wasted every time),
 #: before it tries them again
 RETRY = 64
-
-
-@njit(inline="always")
-def lane_columns(n):
-    """Columns of one drift for ``n`` bodies: one per planet (``n - 1``),
-    padded to a multiple of :data:`LANE_WIDTH`."""
-    return LANE_WIDTH * max(1, (n - 1 + LANE_WIDTH - 1) // LANE_WIDTH)
 
 
 def lanes_scratch(n):
@@ -342,87 +334,3 @@ def kepler_drift_lanes_twice(xj, vj, mu, h, xs, vs, h2, S):
     _store(S, xs, vs, mu, P)
     return _store(S, xj, vj, mu, 0)
 
-
-# The interaction kick's pairs.  Each source body's pull on every lane at
-# once: the source broadcast, the lanes its receivers, one pass over the
-# columns per source (8 sources over 8 lanes: 64 pulls, of which 28 pairs
-# are needed, but in 8 vector passes instead of 28 chains of scalar
-# operations).  A body's pulls are summed over the sources in ascending
-# order, which is pair_accelerations's order (the pulls of the bodies before
-# it, then those after), and each pull is the same expression: the scalar
-# code's ``-(G m_j / r^3) (x_i - x_j)`` is exactly ``(G m_j / r^3)
-# (x_j - x_i)``, subtraction being the addition of the negation; so the
-# accelerations are those of the scalar loop bit for bit.  A lane's own
-# source (and the pair left out in Jacobi coordinates) adds a zero that
-# leaves its sum as it is: its mass is replaced by 0 and its distance by 1
-# (a sum started at +0 is never -0, so adding +0 or -0 changes nothing).
-# The columns' rows: positions in the drift's start rows, sums in its end rows.
-
-@njit(inline="always")
-def _pull(S, P, xs, ys, zs, ms, own):
-    # the pull of a source at (xs, ys, zs) of G m = ms on every column but
-    # ``own``, added to the sums
-    X = S[_X]
-    Y = S[_X + 1]
-    Z = S[_X + 2]
-    AX = S[_Y]
-    AY = S[_Y + 1]
-    AZ = S[_Y + 2]
-    for k in range(P):
-        dx = xs - X[k]
-        dy = ys - Y[k]
-        dz = zs - Z[k]
-        skip = k == own
-        r2 = dx * dx + dy * dy + dz * dz
-        r2 = 1.0 if skip else r2
-        s = (0.0 if skip else ms) * (1.0 / (r2 * math.sqrt(r2)))
-        AX[k] = AX[k] + s * dx
-        AY[k] = AY[k] + s * dy
-        AZ[k] = AZ[k] + s * dz
-
-
-@njit(inline="always")
-def pair_accelerations_lanes(x, gm, n_active, acc, first, S):
-    """:func:`~orbits._kernels.gravity.pair_accelerations` ``(x, gm, n_active,
-    0.0, acc, first, first == 0)`` with the bodies after the first in vector
-    lanes, bit for bit: ``first`` 1 (democratic heliocentric coordinates,
-    the central body neither pulls nor is pulled) or 0 (Jacobi coordinates,
-    every pair but (0, 1)).  ``S`` is the drift's scratch
-    (:func:`lanes_scratch`)."""
-    n = x.shape[0]
-    P = lane_columns(n)
-    for k in range(P):
-        # the padding repeats body 1: its sums are never read
-        i = k + 1 if k + 1 < n else 1
-        S[_X, k] = x[i, 0]
-        S[_X + 1, k] = x[i, 1]
-        S[_X + 2, k] = x[i, 2]
-        S[_Y, k] = 0.0
-        S[_Y + 1, k] = 0.0
-        S[_Y + 2, k] = 0.0
-    Pu = np.uint64(P)
-    for j in range(first, n_active):
-        # body j's column is j - 1; the central body (j = 0) skips body 1's
-        _pull(S, Pu, x[j, 0], x[j, 1], x[j, 2], gm[j], np.uint64(j - 1 if j > 0 else 0))
-    ax = 0.0
-    ay = 0.0
-    az = 0.0
-    if first == 0:
-        # the central body's sums, pulled by bodies 2.. in order, as the
-        # scalar loop adds them
-        for i in range(2, n_active):
-            dx = x[i, 0] - x[0, 0]
-            dy = x[i, 1] - x[0, 1]
-            dz = x[i, 2] - x[0, 2]
-            r2 = dx * dx + dy * dy + dz * dz
-            s = gm[i] * (1.0 / (r2 * math.sqrt(r2)))
-            ax += s * dx
-            ay += s * dy
-            az += s * dz
-    acc[0, 0] = ax
-    acc[0, 1] = ay
-    acc[0, 2] = az
-    for i in range(1, n):
-        acc[i, 0] = S[_Y, i - 1]
-        acc[i, 1] = S[_Y + 1, i - 1]
-        acc[i, 2] = S[_Y + 2, i - 1]

@@ -102,12 +102,11 @@ import math
 from ._jit import njit, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
                           to_democratic_heliocentric, to_jacobi)
-from .gravity import pair_accelerations
+from .gravity import pair_accelerations, pair_accelerations_lanes
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
-from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, kepler_drift_lanes_twice,
-                       pair_accelerations_lanes)
+from .wh_lanes import MEMO, PENDING, RETRY, kepler_drift_lanes, kepler_drift_lanes_twice
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
@@ -581,7 +580,7 @@ def _perturbation_with_terms(xj, vj, x, acc, gm, eta, n_active, h, targs):
 
 
 #: bodies from which the lanes' loop sums the interaction kick's pulls in
-#: vector lanes (wh_lanes.pair_accelerations_lanes, bit for bit the scalar
+#: vector lanes (gravity.pair_accelerations_lanes, bit for bit the scalar
 #: sums).  It evaluates every source on every lane, twice the pairs, in one
 #: vector pass a source: a gain where the lanes are full.  Measured (CPU time
 #: a step, paired runs against the scalar pairs, AVX-512 machine, the Sun and
@@ -595,7 +594,7 @@ PAIRS_LANES_FROM_BODIES = 7
 @njit(inline="always")
 def _lanes_pairs(x, gm, n_active, acc, first, S):
     if x.shape[0] >= PAIRS_LANES_FROM_BODIES:
-        pair_accelerations_lanes(x, gm, n_active, acc, first, S)
+        pair_accelerations_lanes(x, gm, n_active, 0.0, acc, first, first == 0, S)
     else:
         pair_accelerations(x, gm, n_active, 0.0, acc, first, first == 0)
 
@@ -603,7 +602,7 @@ def _lanes_pairs(x, gm, n_active, acc, first, S):
 @njit(inline="always")
 def _lanes_interaction_kick(xj, vj, x, acc, gm, eta, n_active, h, targs):
     # interaction_kick with the pairs' pulls in vector lanes, bit for bit
-    # (wh_lanes.pair_accelerations_lanes; targs[0] the lanes' scratch)
+    # (gravity.pair_accelerations_lanes; targs[0] the lanes' scratch)
     if xj.shape[0] <= 2:
         return
     from_jacobi_one(xj, gm, eta, x)

@@ -17,6 +17,11 @@ def accelerate_pairwise_small(x, gm, n_active, eps2, acc):
                                              pair_workspace(len(x), n_active))
 
 
+def accelerate_pairwise_lanes(x, gm, n_active, eps2, acc):
+    return gravity.accelerate_pairwise_lanes(x, gm, n_active, eps2, acc,
+                                             pair_workspace(len(x), n_active))
+
+
 def accelerate_pairwise_parallel(x, gm, n_active, eps2, acc):
     return gravity.accelerate_pairwise_parallel(x, gm, n_active, eps2, acc,
                                                 pair_workspace(len(x), n_active, True))
@@ -31,7 +36,7 @@ def random_system(rng, n, n_massless=0):
 
 @pytest.mark.parametrize("n, n_massless", [(2, 0), (5, 0), (9, 3), (200, 50)])
 @pytest.mark.parametrize("kernel", [accelerate_pairwise_small, accelerate_pairwise,
-                                    accelerate_pairwise_parallel])
+                                    accelerate_pairwise_lanes, accelerate_pairwise_parallel])
 @pytest.mark.parametrize("eps2", [0.0, 0.01])
 def test_against_numpy_reference(rng, n, n_massless, kernel, eps2):
     x, gm, n_active = random_system(rng, n, n_massless)
@@ -42,15 +47,18 @@ def test_against_numpy_reference(rng, n, n_massless, kernel, eps2):
     np.testing.assert_allclose(acc, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
 
 
-def test_small_and_batched_serial_kernels_agree_bit_for_bit(rng):
-    # the same j < i pair terms in the same order: identical results
+def test_small_batched_and_lanes_serial_kernels_agree_bit_for_bit(rng):
+    # the same j < i pair terms summed in the same order: identical results
     for n, massless in ((2, 0), (8, 2), (30, 5)):
         x, gm, n_active = random_system(rng, n, massless)
         a1 = np.empty_like(x)
         a2 = np.empty_like(x)
+        a3 = np.empty_like(x)
         accelerate_pairwise_small(x, gm, n_active, 0.0, a1)
         accelerate_pairwise(x, gm, n_active, 0.0, a2)
+        accelerate_pairwise_lanes(x, gm, n_active, 0.0, a3)
         np.testing.assert_array_equal(a1, a2)
+        np.testing.assert_array_equal(a1, a3)
 
 
 def test_serial_and_parallel_agree_for_large_n(rng):
@@ -120,3 +128,43 @@ def test_parallel_result_does_not_depend_on_thread_count(rng):
     finally:
         numba.set_num_threads(before)
     np.testing.assert_array_equal(out[0], out[1])
+
+
+def scattered(n, seed, planar=False):
+    """Positions of ``n`` bodies 0.3 to 30 apart in every direction (in a
+    plane with signed zeros in z if ``planar``) and their G m over six
+    decades."""
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal((n, 3)) * 10 ** rng.uniform(-0.5, 1.5, (n, 1))
+    if planar:
+        x[:, 2] = np.where(rng.random(n) < 0.5, 0.0, -0.0)
+    return x, 10 ** rng.uniform(-9, -3, n)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5, 7, 8, 9, 12, 17])
+@pytest.mark.parametrize("first, skip", [(0, True), (1, False), (0, False)])
+@pytest.mark.parametrize("test_particles", [0, 2])
+@pytest.mark.parametrize("planar", [False, True])
+@pytest.mark.parametrize("eps2", [0.0, 1e-4])
+def test_pairs_in_lanes_are_the_scalar_sums_bit_for_bit(n, first, skip, test_particles, planar,
+                                                        eps2):
+    # each source's pull on every lane, summed over the sources in ascending
+    # order, must be pair_accelerations's sums exactly: the same pulls (the
+    # scalar -(G m / r^3) (x_i - x_j) is exactly (G m / r^3) (x_j - x_i)) in
+    # the same order; the lanes' own source and a pair left out (the
+    # Wisdom-Holman kick in Jacobi coordinates: (0, 1)) add an exact zero;
+    # padding columns (n - 1 not a multiple of the lane width) and test
+    # particles (sources of nothing) change nothing.  The three forms: the
+    # Jacobi kick, the democratic heliocentric one, and gravity
+    x, gm = scattered(n, seed=n + 100 * first + 10 * test_particles, planar=planar)
+    n_active = max(1, n - test_particles)
+    gm[n_active:] = 0.0
+    want = np.full_like(x, np.nan)
+    got = np.full_like(x, np.nan)
+    gravity.pair_accelerations(x, gm, n_active, eps2, want, first, skip)
+    gravity.pair_accelerations_lanes(x, gm, n_active, eps2, got, first, skip,
+                                     np.full((gravity.LANE_ROWS, gravity.lane_columns(n)),
+                                             np.nan))
+    assert np.array_equal(got, want)
+    assert np.all(np.isfinite(got))
+    assert np.array_equal(np.signbit(got), np.signbit(want))
