@@ -587,7 +587,8 @@ def _perturbation_with_terms(xj, vj, x, acc, gm, eta, n_active, h, targs):
 #: its first n - 1 planets at half a day, Jacobi / democratic heliocentric):
 #: n = 5 1.13 / 1.12, 6 0.96 / 0.95, 7 0.89 / 0.89, 8 0.84 / 0.83, the Sun
 #: and eight planets 0.84 / 0.80; the outer solar system (6 bodies, 10 days)
-#: 1.04 / 1.05.
+#: 1.04 / 1.05.  With the lanes padded to 8 columns (gravity.LANE_WIDTH),
+#: n = 5 still 1.05-1.10 / 1.09-1.12 (two paired runs).
 PAIRS_LANES_FROM_BODIES = 7
 
 
