@@ -2,8 +2,9 @@
 
 What is measured
 ----------------
-``orbits._kernels.gravity.accelerate_pairwise`` (one thread, each pair visited
-once, Newton's third law) against ``accelerate_pairwise_parallel`` (threads
+``orbits._kernels.gravity.accelerate_pairwise_lanes`` (one thread, the kernel
+a simulation of 7 or more massive bodies takes there: each source's pull on
+all bodies in vector lanes) against ``accelerate_pairwise_parallel`` (threads
 over rows, each pair computed from both sides) on the same positions, for N
 from 16 to 4000.  Each kernel is called ``k`` times from a small compiled
 loop, so the figure is the cost of a call inside a compiled stepping loop
@@ -39,7 +40,7 @@ import numba
 import numpy as np
 
 from orbits._kernels import gravity
-from orbits._kernels.gravity import accelerate_pairwise, accelerate_pairwise_parallel
+from orbits._kernels.gravity import accelerate_pairwise_lanes, accelerate_pairwise_parallel
 
 SIZES = (16, 32, 48, 64, 96, 128, 192, 256, 512, 1000, 2000, 4000)
 QUICK_SIZES = (16, 64, 128, 512, 1000)
@@ -48,7 +49,7 @@ QUICK_SIZES = (16, 64, 128, 512, 1000)
 @numba.njit
 def _repeat_serial_loop(x, gm, n_active, eps2, acc, work, k):
     for _ in range(k):
-        accelerate_pairwise(x, gm, n_active, eps2, acc, work)
+        accelerate_pairwise_lanes(x, gm, n_active, eps2, acc, work)
 
 
 @numba.njit

@@ -109,7 +109,7 @@ PROGRESS_DELAY = 3.0
 
 #: Set in every worker of :func:`local_cluster`.  One numba thread per worker
 #: process: the workers already use every core, and threads on top of them
-#: would only compete (the threaded gravity kernel starts at 72 bodies).
+#: would only compete (the threaded gravity kernel starts at 128 bodies).
 WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
                       "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
 

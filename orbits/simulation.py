@@ -33,10 +33,13 @@ __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescr
            "Snapshot", "RunPlan", "PARALLEL_THRESHOLD"]
 
 #: Bodies from which the threaded gravity kernel is used.  Measured with
-#: benchmarks/bench_gravity.py on the 2-core reference machine (whole leapfrog
-#: steps): break-even at N = 64 and 73 in two runs, threaded 1.25 times faster
-#: at N = 96.  Below it thread start-up (~4 us a step) outweighs the split work.
-PARALLEL_THRESHOLD = 72
+#: benchmarks/bench_gravity.py (whole leapfrog steps, two cores): against the
+#: one-thread batched kernel, break-even at N = 64 and 73 in two runs on the
+#: AVX2 machine (the threshold was 72); against the one-thread lanes kernel
+#: (orbits._kernels.gravity.LANES_FROM) on the AVX-512 machine, break-even at
+#: N = 114 (threaded 0.94 times as fast at 96, 1.05 at 128, 1.50 at 192).
+#: Below it thread start-up (~4 us a step) outweighs the split work.
+PARALLEL_THRESHOLD = 128
 
 #: Outputs of a run when none are asked for.
 DEFAULT_OUTPUTS = 500

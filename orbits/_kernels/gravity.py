@@ -25,7 +25,7 @@ __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_re
            "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
            "accelerate_pairwise_small", "accelerate_pairwise_rebound", "pair_accelerations",
            "accelerate_pairwise_lanes", "pair_accelerations_lanes", "lane_columns",
-           "LANE_WIDTH", "LANE_ROWS", "LANES_N", "serial_kind"]
+           "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind"]
 
 
 #: Up to this many massive bodies the plain double loop
@@ -35,19 +35,20 @@ __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_re
 #: 213 ns against 168 ns at N = 9).
 SMALL_N = 8
 
-#: Massive bodies from which, and bodies up to which, the pairs' pulls are
-#: summed in vector lanes (:func:`accelerate_pairwise_lanes`).  It evaluates
-#: each pair twice (once per body), one vector pass per source, so it pays
-#: where the lanes are full and the sums' chains short.  Measured (CPU time a
-#: leapfrog step, AVX-512 machine, against the plain double loop up to 8
-#: massive bodies and the batched kernel beyond): the Sun and its first
-#: n - 1 planets, n = 5 0.067 -> 0.074 us, 6 0.084-0.090 -> 0.083-0.105, 7
-#: 0.108-0.118 -> 0.090, 8 0.141-0.151 -> 0.094-0.099, 9 0.128-0.138 ->
-#: 0.107-0.108; Plummer spheres, n = 12 0.204-0.213 -> 0.189-0.204, 16 0.34
-#: -> 0.22-0.23, 32 1.16-1.19 -> 0.77-0.80, 64 4.2-4.3 -> 2.3.  From 72
-#: bodies the threaded kernel takes over (``PARALLEL_THRESHOLD`` in
-#: :mod:`orbits.simulation`).
-LANES_N = (7, 71)
+#: Massive bodies from which the pairs' pulls are summed in vector lanes
+#: (:func:`accelerate_pairwise_lanes`) on one thread.  It evaluates each pair
+#: twice (once per body), one vector pass per source, so it pays where the
+#: lanes are full.  Measured (CPU time a leapfrog step, AVX-512 machine,
+#: against the plain double loop up to 8 massive bodies and the batched
+#: kernel beyond): the Sun and its first n - 1 planets, n = 5 0.067 -> 0.074
+#: us, 6 0.084-0.090 -> 0.083-0.105, 7 0.108-0.118 -> 0.090, 8 0.141-0.151
+#: -> 0.094-0.099, 9 0.128-0.138 -> 0.107-0.108; Plummer spheres, n = 12
+#: 0.204-0.213 -> 0.189-0.204, 16 0.34 -> 0.22-0.23, 32 1.16-1.19 ->
+#: 0.77-0.80, 64 4.2-4.3 -> 2.3; whole steps of 512 and 1000 bodies on one
+#: thread 257 -> 105-113 and 988 -> 420-424 us (benchmarks/bench_gravity.py,
+#: the batched kernel's pair rate 2.2e8 a second against 1.2e9 for the
+#: lanes).  So the batched kernel is left to where it is asked for.
+LANES_FROM = 7
 
 #: Pairs handled per batch by the serial kernel: enough to fill the vector
 #: units, small enough that the batch stays in L1 cache (4 arrays x 8 bytes).
@@ -71,8 +72,8 @@ def serial_kind(n, n_active):
     massive: ``"small"`` (:func:`accelerate_pairwise_small`), ``"lanes"``
     (:func:`accelerate_pairwise_lanes`) or ``"serial"``
     (:func:`accelerate_pairwise`); all three give the same numbers bit for
-    bit.  See :data:`LANES_N`."""
-    if LANES_N[0] <= n_active and n <= LANES_N[1]:
+    bit.  See :data:`LANES_FROM`."""
+    if n_active >= LANES_FROM:
         return "lanes"
     return "small" if n_active <= SMALL_N else "serial"
 
