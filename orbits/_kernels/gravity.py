@@ -5,13 +5,21 @@ others are test particles, which feel the massive bodies but cost no pair work
 among themselves.  ``gm[i] = G * m[i]`` is precomputed by the caller.
 Softening replaces ``r**2`` by ``r**2 + eps2``.
 
-Two kernels compute the same accelerations:
+The kernels, and which one a simulation takes (:func:`serial_kind`):
 
-* :func:`accelerate_pairwise` visits each pair once (j < i) and uses Newton's
-  third law; it is the fastest for small N and is deterministic.
+* :func:`accelerate_pairwise_small`, the plain double loop: each pair once
+  (j < i), Newton's third law; up to six massive bodies.
+* :func:`accelerate_pairwise_lanes`: every body's pulls from each source in
+  one vector pass over all bodies (each pair computed from both sides),
+  summed in the double loop's order, so bit for bit its numbers; from seven
+  massive bodies on one thread (:data:`LANES_FROM`).
+* :func:`accelerate_pairwise`: each pair once, the separations gathered in
+  batches whose square roots and divisions vectorise; bit for bit the
+  double loop too, but slower than the lanes (kept for comparison).
 * :func:`accelerate_pairwise_parallel` also visits each pair once, in blocks
   of rows spread over threads, each block adding into its own accumulator so
   that threads never write the same element; its inner loops vectorise.
+  From ``orbits.simulation.PARALLEL_THRESHOLD`` bodies.
 """
 
 import math
