@@ -195,6 +195,21 @@ def _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF, 
 
 
 @njit(inline="always")
+def _scalar_drifts(X, V, MU, h, alone, nb, one_x, one_v):
+    # the elements with alone != 0 drifted one by one by the scalar
+    # kepler_drift, from their start (one_x, one_v: its scratch)
+    for k in range(np.uint64(nb), np.uint64(X.shape[1])):
+        if alone[k] != 0.0:
+            for c in range(3):
+                one_x[0, c] = X[c, k]
+                one_v[0, c] = V[c, k]
+            kepler_drift(MU[k], one_x, one_v, 0, h)
+            for c in range(3):
+                X[c, k] = one_x[0, c]
+                V[c, k] = one_v[0, c]
+
+
+@njit(inline="always")
 def _masked_drift(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     # kepler_drift's short-step path in every element with LF != 0 at once
     # (the others keep their state): Danby's iteration repeated until every
@@ -256,15 +271,7 @@ def _masked_drift(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
                            alone, nb, m, False)
     # the elements outside the domain: the scalar drift, from the same start
     if n_alone:
-        for k in range(np.uint64(nb), np.uint64(m)):
-            if alone[k] != 0.0:
-                for c in range(3):
-                    one_x[0, c] = X[c, k]
-                    one_v[0, c] = V[c, k]
-                kepler_drift(MU[k], one_x, one_v, 0, h)
-                for c in range(3):
-                    X[c, k] = one_x[0, c]
-                    V[c, k] = one_v[0, c]
+        _scalar_drifts(X, V, MU, h, alone, nb, one_x, one_v)
 
 
 @njit
@@ -348,15 +355,7 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
                 mask[k] = alone[k]
             _masked_drift(X, V, MU, h, mask, nb, d, fl, one_x, one_v)
         else:
-            for k in range(np.uint64(nb), np.uint64(m)):
-                if alone[k] != 0.0:
-                    for c in range(3):
-                        one_x[0, c] = X[c, k]
-                        one_v[0, c] = V[c, k]
-                    kepler_drift(MU[k], one_x, one_v, 0, h)
-                    for c in range(3):
-                        X[c, k] = one_x[0, c]
-                        V[c, k] = one_v[0, c]
+            _scalar_drifts(X, V, MU, h, alone, nb, one_x, one_v)
 
 
 @njit
