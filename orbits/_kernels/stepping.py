@@ -469,6 +469,21 @@ def user_force(accel, jit):
 FLAT_FROM_BODIES = 4
 
 
+@njit(inline="always")
+def add_scaled(a, aF, h, b, bF, flat):
+    """``a += h b`` for arrays of shape (N, 3), over their flat views ``aF``,
+    ``bF`` if ``flat`` (a loop LLVM vectorises), else body by body; each
+    component's operation is the same either way."""
+    if flat:
+        for q in range(aF.shape[0]):
+            aF[q] += h * bF[q]
+    else:
+        for i in range(a.shape[0]):
+            a[i, 0] += h * b[i, 0]
+            a[i, 1] += h * b[i, 1]
+            a[i, 2] += h * b[i, 2]
+
+
 def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_dependent, mon,
                     step0, mon_t, mon_out, check_every, sargs):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
@@ -504,14 +519,7 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
         for op in range(len(KINDS)):  # noqa: F821 - bound by specialize
             h = COEFS[op] * dt  # noqa: F821
             if KINDS[op] == DRIFT:  # noqa: F821
-                if flat:
-                    for q in range(m3):
-                        xF[q] += h * vF[q]
-                else:
-                    for i in range(n):
-                        x[i, 0] += h * v[i, 0]
-                        x[i, 1] += h * v[i, 1]
-                        x[i, 2] += h * v[i, 2]
+                add_scaled(x, xF, h, v, vF, flat)
                 tx += h
                 fresh = False
             elif velocity_dependent:
@@ -524,14 +532,7 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
                 if not fresh:
                     force(x, v, tx, fargs, acc)  # noqa: F821 - bound by specialize
                     fresh = True
-                if flat:
-                    for q in range(m3):
-                        vF[q] += h * aF[q]
-                else:
-                    for i in range(n):
-                        v[i, 0] += h * acc[i, 0]
-                        v[i, 1] += h * acc[i, 1]
-                        v[i, 2] += h * acc[i, 2]
+                add_scaled(v, vF, h, acc, aF, flat)
                 if HAS_WORK:  # noqa: F821
                     for i in range(n):
                         for d in range(3):
