@@ -33,7 +33,7 @@ __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_re
            "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
            "accelerate_pairwise_small", "accelerate_pairwise_rebound", "pair_accelerations",
            "accelerate_pairwise_lanes", "pair_accelerations_lanes", "lane_columns",
-           "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind"]
+           "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind", "pull_rows"]
 
 
 #: Up to this many massive bodies the plain double loop
@@ -192,26 +192,29 @@ def lane_columns(n):
 # sums (a further row written in the pass made LLVM keep the scalar form).
 
 @njit(inline="always")
-def _pull(S, P, xs, ys, zs, ms, own, eps2):
-    # the pull of a source at (xs, ys, zs) of G m = ms on every column but
-    # ``own``, added to the sums
-    X = S[0]
-    Y = S[1]
-    Z = S[2]
-    AX = S[3]
-    AY = S[4]
-    AZ = S[5]
+def pull_rows(X, Y, Z, AX, AY, AZ, P, xs, ys, zs, ms, own, eps2, real):
+    """The pull of a source at ``(xs, ys, zs)`` of ``G m = ms`` on the
+    columns ``k < P`` of the rows ``X``, ``Y``, ``Z``, added to the sums
+    ``AX``, ``AY``, ``AZ``; the column ``own`` and those from ``real`` on
+    (padding) add an exact zero (see the notes above)."""
     for k in range(P):
         dx = xs - X[k]
         dy = ys - Y[k]
         dz = zs - Z[k]
-        skip = k == own
+        skip = (k == own) | (k >= real)
         r2 = dx * dx + dy * dy + dz * dz + eps2
         r2 = 1.0 if skip else r2
         s = (0.0 if skip else ms) * (1.0 / (r2 * math.sqrt(r2)))
         AX[k] = AX[k] + s * dx
         AY[k] = AY[k] + s * dy
         AZ[k] = AZ[k] + s * dz
+
+
+@njit(inline="always")
+def _pull(S, P, xs, ys, zs, ms, own, eps2):
+    # the pull of a source on every column of the scratch's rows (positions
+    # 0 to 2, sums 3 to 5) but ``own``
+    pull_rows(S[0], S[1], S[2], S[3], S[4], S[5], P, xs, ys, zs, ms, own, eps2, P)
 
 
 @njit(inline="always")

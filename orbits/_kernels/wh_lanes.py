@@ -47,23 +47,28 @@ planets are declined the loop leaves the drift to the scalar code for
 ``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`).
 
 The interaction kick's pulls
-(:func:`orbits._kernels.gravity.pair_accelerations_lanes`) go to the
-lanes as well, from seven bodies on (``PAIRS_LANES_FROM_BODIES`` in
-:mod:`orbits._kernels.wisdom_holman`): one vector pass per source body over
-all the lanes, each lane's pulls summed over the sources in ascending order,
-which is the scalar pair loop's order, so the kick too is bit for bit the
-scalar one.  It evaluates each pair twice (once per body), so it pays only
-where the lanes are full (the Sun and eight planets: the step 0.80-0.84 of
-the scalar kick's).  Measured before, and slower than the scalar kick, on
-the AVX2 machine: the pairs' separations gathered in the scalar order into
-columns with the sums back in order (0.34 us against 0.31), a column of
-pairs per body (0.54 us), only the mass ratios and Kepler terms in lanes
+(:func:`orbits._kernels.gravity.pull_rows`) go to the lanes as well: one
+vector pass per source body over all the lanes, each lane's pulls summed
+over the sources in ascending order, which is the scalar pair loop's order,
+so the kick too is bit for bit the scalar one.  It evaluates each pair
+twice (once per body).  Measured before, and slower than the scalar kick,
+on the AVX2 machine: the pairs' separations gathered in the scalar order
+into columns with the sums back in order (0.34 us against 0.31), a column
+of pairs per body (0.54 us), only the mass ratios and Kepler terms in lanes
 (0.33 us).  Two things decide the speed of a lanes pass: its sums must not
 go through masked stores (a masked store cannot be forwarded to the next
 pass's load: 0.2 us for the eight planets' pulls instead of 0.065; the lane
 a source skips adds an exact zero instead), and the pass must store nothing
 but its sums (a further row written in the pass made LLVM keep the scalar
 form).
+
+The loop keeps its state in the lanes between outputs (see "the state kept
+in the lanes" below): with the copies in and out of the (N, 3) arrays on
+every operator, the lanes' kick paid only from seven bodies on, and the
+step of the Sun and eight planets took 1.84 times WHFast512's (Jacobi
+coordinates; 1.52 in democratic heliocentric ones); with the state kept,
+1.45 and 1.22, and the outer solar system 1.17 and 1.05 (CPU time, paired
+runs, AVX-512 machine).
 
 What keeps LLVM from vectorising a loop, learnt here and in
 :mod:`orbits._kernels.wh_batch`: a branch per element (``and`` between
@@ -83,18 +88,22 @@ Rein, H. & Tamayo, D. 2015, MNRAS 452, 376 (WHFast).  Danby, J. M. A. 1988,
 *Fundamentals of Celestial Mechanics*, 2nd ed., sect. 6.9.
 """
 
+import math
+
 import numpy as np
 
 from ._jit import njit, specialize
 # the planets' columns, padded to a multiple of the lane width (shared with the
 # gravity kernels' lanes)
-from .gravity import LANE_WIDTH, lane_columns
+from .gravity import LANE_WIDTH, lane_columns, pull_rows
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, f_and_g, kepler_drift,
                      quartic_step, short_start, stumpff_lane)
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
            "lanes_scratch", "kepler_drift_lanes", "kepler_drift_lanes_twice",
-           "drift_columns"]
+           "drift_columns", "SCRATCH_ROWS", "lanes_scratch_shape", "resident_load",
+           "resident_store", "resident_drift", "resident_finite", "resident_kick",
+           "resident_jump_kick"]
 
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
@@ -120,10 +129,11 @@ RETRY = 64
 
 
 def lanes_scratch(n):
-    """The scratch of :func:`kepler_drift_lanes` and
-    :func:`kepler_drift_lanes_twice` for ``n`` bodies, shape
-    (:data:`DRIFT_ROWS`, 2 :func:`lane_columns` ``(n)``)."""
-    return np.zeros((DRIFT_ROWS, 2 * lane_columns(n)))
+    """The scratch of :func:`kepler_drift_lanes`,
+    :func:`kepler_drift_lanes_twice` and the lanes' state (``resident_*``)
+    for ``n`` bodies, shape (:data:`SCRATCH_ROWS`, 2 :func:`lane_columns`
+    ``(n)``)."""
+    return np.zeros(lanes_scratch_shape(n))
 
 
 @njit(inline="always")
@@ -334,3 +344,285 @@ def kepler_drift_lanes_twice(xj, vj, mu, h, xs, vs, h2, S):
     _store(S, xs, vs, mu, P)
     return _store(S, xj, vj, mu, 0)
 
+
+
+# -- the state kept in the lanes ----------------------------------------------------
+#
+# The loop of orbits._kernels.wisdom_holman keeps its state in arrays of
+# shape (N, 3), which its epilogue, synchronisation and outputs read.  The
+# operators above copy the planets into the lanes and back on every drift
+# and kick; the scalar stores and vector loads of those copies cannot be
+# forwarded, and they cost a step more than its kick's arithmetic.  Between
+# the loop's outputs the state is now kept in the lanes (as WHFast512 keeps
+# it in its registers): rows of the scratch after the drift's, one column a
+# planet, loaded once when the loop starts (:func:`resident_load`) and
+# written back (:func:`resident_store`) only where the state is read: an
+# output, a non-finite state, the loop's return.  Row 0 (the centre of mass,
+# which only drifts) stays in the (N, 3) arrays.  The drift
+# (:func:`resident_drift`) and the perturbation steps (:func:`resident_kick`
+# in Jacobi coordinates, :func:`resident_jump_kick` in democratic
+# heliocentric ones) work on these rows with the operations of the scalar
+# operators in their order, so the state is theirs bit for bit; the finite
+# check (:func:`resident_finite`) is stepping.state_is_finite's sum, also
+# in its order.  A padded column (a copy of the first planet) feels no
+# pull, so it stays an orbit that the drift takes; where the drift declines
+# it after all it becomes a copy of the first planet again.
+
+#: the first row of the lanes' state in the scratch (after the drift's rows)
+_R = DRIFT_ROWS
+#: the state (x, y, z, vx, vy, vz), the drift's end state, each column's
+#: Kepler G M, the drift's verdict, the pulls' sums (3), the inertial
+#: positions (3, Jacobi), the weight m_i / eta_i (Jacobi), the Kepler terms
+#: of the Jacobi kick (3)
+_RX, _RY, _RMU, _RTAKE, _RA, _RQ, _RW, _RK = (_R, _R + 6, _R + 12, _R + 13, _R + 14, _R + 17,
+                                              _R + 20, _R + 21)
+#: rows of the scratch of a loop that keeps its state in the lanes
+SCRATCH_ROWS = _R + 24
+
+
+def lanes_scratch_shape(n):
+    """The shape of :func:`lanes_scratch` ``(n)``."""
+    return (SCRATCH_ROWS, 2 * lane_columns(n))
+
+
+@njit(inline="always")
+def resident_load(xj, vj, gm, eta, S):
+    """The planets of ``xj``, ``vj`` (rows 1 on) into the lanes' state, with
+    their Kepler ``G M`` (``eta``) and Jacobi weights ``gm / eta``; the
+    padding repeats planet 1."""
+    n = xj.shape[0]
+    for k in range(lane_columns(n)):
+        i = k + 1 if k + 1 < n else 1
+        for d in range(3):
+            S[_RX + d, k] = xj[i, d]
+            S[_RX + 3 + d, k] = vj[i, d]
+        S[_RMU, k] = eta[i]
+        S[_RW, k] = gm[i] / eta[i]
+
+
+@njit(inline="always")
+def resident_store(S, xj, vj):
+    """The lanes' state back into rows 1 on of ``xj``, ``vj``."""
+    for i in range(1, xj.shape[0]):
+        for d in range(3):
+            xj[i, d] = S[_RX + d, i - 1]
+            vj[i, d] = S[_RX + 3 + d, i - 1]
+
+
+@njit(inline="always")
+def resident_drift(xj, vj, eta, h, S):
+    """:func:`kepler_drift_lanes` of the lanes' state (row 0 of ``xj`` in a
+    straight line); a declined planet goes to the scalar drift, with its row
+    of ``xj``, ``vj`` as scratch.  Returns how many planets were declined."""
+    xj[0, 0] += h * vj[0, 0]
+    xj[0, 1] += h * vj[0, 1]
+    xj[0, 2] += h * vj[0, 2]
+    n = xj.shape[0]
+    P = lane_columns(n)
+    rejected = drift_columns(S[_RX], S[_RX + 1], S[_RX + 2], S[_RX + 3], S[_RX + 4],
+                             S[_RX + 5], S[_RMU], S[_RY], S[_RY + 1], S[_RY + 2], S[_RY + 3],
+                             S[_RY + 4], S[_RY + 5], S[_RTAKE], h, np.uint64(0), np.uint64(P))
+    declined = 0
+    if rejected:
+        for k in range(P):
+            if S[_RTAKE, k] != 0.0:
+                continue
+            if k < n - 1:
+                i = k + 1
+                for d in range(3):
+                    xj[i, d] = S[_RX + d, k]
+                    vj[i, d] = S[_RX + 3 + d, k]
+                kepler_drift(eta[i], xj, vj, i, h)
+                for d in range(3):
+                    S[_RY + d, k] = xj[i, d]
+                    S[_RY + 3 + d, k] = vj[i, d]
+                declined += 1
+            else:
+                for r in range(6):
+                    S[_RY + r, k] = S[_RY + r, 0]
+    for r in range(6):
+        X = S[_RX + r]
+        Y = S[_RY + r]
+        for k in range(P):
+            X[k] = Y[k]
+    return declined
+
+
+@njit(inline="always")
+def resident_finite(xj, vj, S):
+    """:func:`orbits._kernels.stepping.state_is_finite` of the state, row 0
+    from ``xj``, ``vj`` and the planets from the lanes: the same sum in the
+    same order (each row's six components, then the rows in order)."""
+    n = xj.shape[0]
+    P = lane_columns(n)
+    C = S[_RY]
+    for k in range(P):
+        C[k] = (S[_RX, k] + S[_RX + 1, k] + S[_RX + 2, k] + S[_RX + 3, k] + S[_RX + 4, k]
+                + S[_RX + 5, k])
+    s = xj[0, 0] + xj[0, 1] + xj[0, 2] + vj[0, 0] + vj[0, 1] + vj[0, 2]
+    for k in range(n - 1):
+        s += C[k]
+    return math.isfinite(s)
+
+
+@njit(inline="always")
+def _zero_sums(S, P):
+    for r in range(3):
+        A = S[_RA + r]
+        for k in range(P):
+            A[k] = 0.0
+
+
+@njit(inline="always")
+def _resident_jump(S, gm, n_active, h, P):
+    # wisdom_holman.jump on the lanes' state: the same sums in the same order
+    px = 0.0
+    py = 0.0
+    pz = 0.0
+    for i in range(1, n_active):
+        px += gm[i] * S[_RX + 3, i - 1]
+        py += gm[i] * S[_RX + 4, i - 1]
+        pz += gm[i] * S[_RX + 5, i - 1]
+    s = h / gm[0]
+    px *= s
+    py *= s
+    pz *= s
+    X = S[_RX]
+    Y = S[_RX + 1]
+    Z = S[_RX + 2]
+    for k in range(P):
+        X[k] += px
+        Y[k] += py
+        Z[k] += pz
+
+
+@njit(inline="always")
+def _resident_velocity_kick(S, h, P):
+    for r in range(3):
+        V = S[_RX + 3 + r]
+        A = S[_RA + r]
+        for k in range(P):
+            V[k] += h * A[k]
+
+
+@njit(inline="always")
+def resident_jump_kick(xj, vj, gm, n_active, h, S):
+    """:func:`~orbits._kernels.wisdom_holman.jump_interaction_kick` of the
+    lanes' state (democratic heliocentric), bit for bit: the half jump, the
+    planets' pulls summed over the sources in ascending order
+    (:func:`~orbits._kernels.gravity.pull_rows`, as
+    :func:`~orbits._kernels.gravity.pair_accelerations_lanes` does), the
+    kick, the half jump."""
+    n = xj.shape[0]
+    P = lane_columns(n)
+    Pu = np.uint64(P)
+    _resident_jump(S, gm, n_active, 0.5 * h, Pu)
+    _zero_sums(S, Pu)
+    X = S[_RX]
+    Y = S[_RX + 1]
+    Z = S[_RX + 2]
+    for j in range(1, n_active):
+        pull_rows(X, Y, Z, S[_RA], S[_RA + 1], S[_RA + 2], Pu, X[j - 1], Y[j - 1], Z[j - 1],
+                  gm[j], np.uint64(j - 1), 0.0, np.uint64(n - 1))
+    _resident_velocity_kick(S, h, Pu)
+    _resident_jump(S, gm, n_active, 0.5 * h, Pu)
+
+
+@njit(inline="always")
+def resident_kick(xj, vj, gm, n_active, h, S):
+    """:func:`~orbits._kernels.wisdom_holman.interaction_kick` of the lanes'
+    state (Jacobi coordinates; row 0, the centre of mass, from ``xj``), bit
+    for bit: the inertial positions
+    (:func:`~orbits._kernels.coordinates.from_jacobi_one`'s recurrence), the
+    pulls of every pair but (0, 1) summed over the sources in ascending
+    order, the central body's own sums, and the Jacobi transform of the
+    accelerations with the Kepler terms (:func:`~orbits._kernels.
+    wisdom_holman.jacobi_velocity_kick`'s recurrence)."""
+    n = xj.shape[0]
+    if n <= 2:
+        return
+    P = lane_columns(n)
+    Pu = np.uint64(P)
+    X = S[_RX]
+    Y = S[_RX + 1]
+    Z = S[_RX + 2]
+    QX = S[_RQ]
+    QY = S[_RQ + 1]
+    QZ = S[_RQ + 2]
+    W = S[_RW]
+    # the inertial positions, from the outermost body in
+    sx = xj[0, 0]
+    sy = xj[0, 1]
+    sz = xj[0, 2]
+    for i in range(n - 1, 0, -1):
+        k = i - 1
+        w = W[k]
+        sx -= w * X[k]
+        sy -= w * Y[k]
+        sz -= w * Z[k]
+        QX[k] = X[k] + sx
+        QY[k] = Y[k] + sy
+        QZ[k] = Z[k] + sz
+    # the padding: copies of body 1, which feel no pull
+    for k in range(n - 1, P):
+        QX[k] = QX[0]
+        QY[k] = QY[0]
+        QZ[k] = QZ[0]
+    # the Kepler terms G eta_i x'_i / r'_i^3 of rows i >= 2 (columns 1 on)
+    MU = S[_RMU]
+    KX = S[_RK]
+    KY = S[_RK + 1]
+    KZ = S[_RK + 2]
+    for k in range(P):
+        rx = X[k]
+        ry = Y[k]
+        rz = Z[k]
+        r2 = rx * rx + ry * ry + rz * rz
+        s = MU[k] / (r2 * math.sqrt(r2))
+        KX[k] = s * rx
+        KY[k] = s * ry
+        KZ[k] = s * rz
+    _zero_sums(S, Pu)
+    real = np.uint64(n - 1)
+    # the central body pulls every lane but body 1's (the pair (0, 1) is left out)
+    pull_rows(QX, QY, QZ, S[_RA], S[_RA + 1], S[_RA + 2], Pu, sx, sy, sz, gm[0],
+              np.uint64(0), 0.0, real)
+    for j in range(1, n_active):
+        pull_rows(QX, QY, QZ, S[_RA], S[_RA + 1], S[_RA + 2], Pu, QX[j - 1], QY[j - 1],
+                  QZ[j - 1], gm[j], np.uint64(j - 1), 0.0, real)
+    # the central body's sums, pulled by the bodies after body 1 in order
+    ax = 0.0
+    ay = 0.0
+    az = 0.0
+    for i in range(2, n_active):
+        dx = QX[i - 1] - sx
+        dy = QY[i - 1] - sy
+        dz = QZ[i - 1] - sz
+        r2 = dx * dx + dy * dy + dz * dz + 0.0
+        s = gm[i] * (1.0 / (r2 * math.sqrt(r2)))
+        ax += s * dx
+        ay += s * dy
+        az += s * dz
+    # to Jacobi components: jacobi_velocity_kick's recurrence
+    AX = S[_RA]
+    AY = S[_RA + 1]
+    AZ = S[_RA + 2]
+    VX = S[_RX + 3]
+    VY = S[_RX + 4]
+    VZ = S[_RX + 5]
+    for i in range(1, n):
+        k = i - 1
+        bx = AX[k] - ax
+        by = AY[k] - ay
+        bz = AZ[k] - az
+        w = W[k]
+        ax += w * bx
+        ay += w * by
+        az += w * bz
+        if i >= 2:
+            bx += KX[k]
+            by += KY[k]
+            bz += KZ[k]
+        VX[k] += h * bx
+        VY[k] += h * by
+        VZ[k] += h * bz

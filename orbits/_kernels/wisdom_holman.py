@@ -102,11 +102,14 @@ import math
 from ._jit import njit, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
                           to_democratic_heliocentric, to_jacobi)
-from .gravity import pair_accelerations, pair_accelerations_lanes
+from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
-from .wh_lanes import MEMO, PENDING, RETRY, kepler_drift_lanes, kepler_drift_lanes_twice
+from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, kepler_drift_lanes_twice,
+                       resident_finite, resident_jump_kick, resident_kick, resident_load,
+                       resident_store)
+from .wh_lanes import resident_drift as resident_drift_rows
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
@@ -335,6 +338,77 @@ def make_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n
     pass
 
 
+# The lanes' loop keeps its state in the lanes between outputs (see
+# orbits._kernels.wh_lanes, "the state kept in the lanes"): RESIDENT binds
+# its drift and perturbation step on the lanes' rows, which lanes_in loads
+# when the loop starts and after an output's drift, and which lanes_out
+# writes back before the loop returns; lanes_check makes the epilogue's
+# finite check on the lanes (the epilogue's own check is then off) and
+# writes the state back where the epilogue will read it (an output due).
+# The defaults below do nothing.
+RESIDENT = False
+
+
+@njit(inline="always")
+def resident_drift(xj, vj, eta, h, targs):
+    pass
+
+
+@njit(inline="always")
+def resident_perturbation(xj, vj, gm, eta, n_active, h, targs):
+    pass
+
+
+@njit(inline="always")
+def lanes_in(xj, vj, gm, eta, targs):
+    pass
+
+
+@njit(inline="always")
+def lanes_out(xj, vj, targs):
+    pass
+
+
+@njit(inline="always")
+def lanes_check(xj, vj, k, nsteps, until_check, check_every, until_record, targs):
+    return True, until_check
+
+
+def _resident_drift(xj, vj, eta, h, targs):
+    resident_drift_rows(xj, vj, eta, h, targs[0])
+
+
+def _resident_in(xj, vj, gm, eta, targs):
+    resident_load(xj, vj, gm, eta, targs[0])
+
+
+def _resident_out(xj, vj, targs):
+    resident_store(targs[0], xj, vj)
+
+
+def _resident_check(xj, vj, k, nsteps, until_check, check_every, until_record, targs):
+    # the epilogue's finite check (every check_every steps and after the
+    # last) on the lanes; the state back in xj, vj where it is not finite
+    # (the loop returns it) or where the epilogue records an output
+    S = targs[0]
+    until_check -= 1
+    ok = True
+    if until_check == 0 or k + 1 == nsteps:
+        until_check = check_every
+        ok = resident_finite(xj, vj, S)
+    if not ok or until_record == 1:
+        resident_store(S, xj, vj)
+    return ok, until_check
+
+
+def _resident_jacobi(xj, vj, gm, eta, n_active, h, targs):
+    resident_kick(xj, vj, gm, n_active, h, targs[0])
+
+
+def _resident_heliocentric(xj, vj, gm, eta, n_active, h, targs):
+    resident_jump_kick(xj, vj, gm, n_active, h, targs[0])
+
+
 def _lanes_pending(targs):
     return targs[0][PENDING, 0] != 0.0
 
@@ -409,6 +483,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
         cdt[0] = abs(dt)
     owed = owed_box[0]
+    lanes_in(xj, vj, gm, eta, targs)
     n_ops = len(KINDS)  # noqa: F821 - bound by specialize
     defer = KINDS[n_ops - 1] == DRIFT  # noqa: F821
     until_check = check_every
@@ -424,14 +499,19 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                         output_drift(xj, vj, eta, h + owed, xs, vs, owed, x, acc, targs)
                         make_output(xs, vs, 0.0, mon, mon_t, mon_out, gm, eta, xs, vs, x, v,
                                     acc, n_active, corr, cdt[0], targs)
+                        lanes_in(xj, vj, gm, eta, targs)
                         owed = 0.0
                         continue
                     h += owed
                     owed = 0.0
                 if op == n_ops - 1 and defer:
                     owed = h
+                elif RESIDENT:
+                    resident_drift(xj, vj, eta, h, targs)
                 else:
                     drift(xj, vj, eta, h, xs, vs, targs)  # noqa: F821 - bound
+            elif RESIDENT:
+                resident_perturbation(xj, vj, gm, eta, n_active, h, targs)
             else:
                 perturbation(xj, vj, xs, acc, gm, eta, n_active, h, targs)  # noqa: F821
         # the shared epilogue checks the internal state; its recorder
@@ -439,16 +519,23 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         # time; the synchronisation's arguments are also its fargs, for the
         # chaos indicators of a run with variations (orbits._kernels.wh_tangent)
         sync = (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)
-        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
-            xj, vj, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, (mon, sync), n_mon, mon_t, mon_out, (), sync)
+        finite, until_check = lanes_check(xj, vj, k, nsteps, until_check, check_every,
+                                          until_record, targs)
+        if finite:
+            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+                xj, vj, t + (k + 1) * dt, k, nsteps, not RESIDENT, until_check, check_every,
+                until_record, every, (mon, sync), n_mon, mon_t, mon_out, (), sync)
+        else:
+            status, done = Status.NON_FINITE, k
         if status != GO:
+            lanes_out(xj, vj, targs)
             # an output still noted is made before the loop returns
             if output_pending(targs):
                 make_output(xj, vj, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
                             n_active, corr, cdt[0], targs)
             owed_box[0] = owed
             return status, done, n_mon
+    lanes_out(xj, vj, targs)
     if output_pending(targs):
         make_output(xj, vj, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
                     corr, cdt[0], targs)
@@ -579,56 +666,16 @@ def _perturbation_with_terms(xj, vj, x, acc, gm, eta, n_active, h, targs):
         term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
 
 
-#: bodies from which the lanes' loop sums the interaction kick's pulls in
-#: vector lanes (gravity.pair_accelerations_lanes, bit for bit the scalar
-#: sums).  It evaluates every source on every lane, twice the pairs, in one
-#: vector pass a source: a gain where the lanes are full.  Measured (CPU time
-#: a step, paired runs against the scalar pairs, AVX-512 machine, the Sun and
-#: its first n - 1 planets at half a day, Jacobi / democratic heliocentric):
-#: n = 5 1.13 / 1.12, 6 0.96 / 0.95, 7 0.89 / 0.89, 8 0.84 / 0.83, the Sun
-#: and eight planets 0.84 / 0.80; the outer solar system (6 bodies, 10 days)
-#: 1.04 / 1.05.  With the lanes padded to 8 columns (gravity.LANE_WIDTH),
-#: n = 5 still 1.05-1.10 / 1.09-1.12 (two paired runs).
-PAIRS_LANES_FROM_BODIES = 7
-
-
-@njit(inline="always")
-def _lanes_pairs(x, gm, n_active, acc, first, S):
-    if x.shape[0] >= PAIRS_LANES_FROM_BODIES:
-        pair_accelerations_lanes(x, gm, n_active, 0.0, acc, first, first == 0, S)
-    else:
-        pair_accelerations(x, gm, n_active, 0.0, acc, first, first == 0)
-
-
-@njit(inline="always")
-def _lanes_interaction_kick(xj, vj, x, acc, gm, eta, n_active, h, targs):
-    # interaction_kick with the pairs' pulls in vector lanes, bit for bit
-    # (gravity.pair_accelerations_lanes; targs[0] the lanes' scratch)
-    if xj.shape[0] <= 2:
-        return
-    from_jacobi_one(xj, gm, eta, x)
-    _lanes_pairs(x, gm, n_active, acc, 0, targs[0])
-    jacobi_velocity_kick(xj, vj, acc, gm, eta, h, True)
-
-
-@njit(inline="always")
-def _lanes_jump_interaction_kick(xh, vb, x, acc, gm, mu, n_active, h, targs):
-    # jump_interaction_kick with the pairs' pulls in vector lanes, bit for bit
-    jump(xh, vb, gm, n_active, 0.5 * h)
-    _lanes_pairs(xh, gm, n_active, acc, 1, targs[0])
-    _kick_all_but_first(vb, acc, h)
-    jump(xh, vb, gm, n_active, 0.5 * h)
-
-
 #: coordinate system -> (to internal, from internal, perturbation step, the
-#: added terms' kick, the perturbation step of the lanes' loop); each takes
-#: ``(.., gm, eta, ..)`` with ``eta`` the rows' Kepler ``G M``
+#: added terms' kick, the perturbation step of the lanes' loop on the state
+#: kept in the lanes); each takes ``(.., gm, eta, ..)`` with ``eta`` the rows'
+#: Kepler ``G M``
 COORDINATE_SYSTEMS = {
     "jacobi": (to_jacobi, from_jacobi, interaction_kick, _jacobi_term_kick,
-               _lanes_interaction_kick),
+               _resident_jacobi),
     "democratic-heliocentric": (_to_heliocentric, _from_heliocentric,
                                 jump_interaction_kick, _heliocentric_term_kick,
-                                _lanes_jump_interaction_kick),
+                                _resident_heliocentric),
 }
 
 
@@ -696,15 +743,21 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     cache = terms is None or terms.cache
     nrt = not cache
     drift = _plain_drift
-    if lanes:
-        drift = _lanes_drift
-        perturbation = COORDINATE_SYSTEMS[coordinates][4]
-        key = f"{key}_lanes"
     outputs = {}
     if lanes:
-        # outputs made beside the next step's first drift (see _lanes_note)
+        # the state kept in the lanes between outputs, and outputs made beside
+        # the next step's first drift (see _lanes_note)
+        drift = _lanes_drift
+        key = f"{key}_lanes"
         recorder = specialize(_lanes_note, key, cache=cache, nrt=nrt)
         outputs = dict(
+            RESIDENT=True,
+            resident_drift=specialize(_resident_drift, key, cache=cache, inline=True, nrt=nrt),
+            resident_perturbation=specialize(COORDINATE_SYSTEMS[coordinates][4], key,
+                                             cache=cache, inline=True, nrt=nrt),
+            lanes_in=specialize(_resident_in, key, cache=cache, inline=True, nrt=nrt),
+            lanes_out=specialize(_resident_out, key, cache=cache, inline=True, nrt=nrt),
+            lanes_check=specialize(_resident_check, key, cache=cache, inline=True, nrt=nrt),
             output_pending=specialize(_lanes_pending, key, cache=cache, inline=True, nrt=nrt),
             output_drift=specialize(_lanes_output_drift, key, cache=cache, inline=True,
                                     nrt=nrt),

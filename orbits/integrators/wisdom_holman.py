@@ -199,8 +199,11 @@ class WisdomHolman(Integrator):
     AVX2 or AVX-512, :mod:`orbits._kernels.wh_lanes`), bit for bit the
     scalar drift: a planet outside the branch-free solver's domain (a high
     eccentricity near pericentre, a hyperbola, a long step) is drifted by
-    the scalar solver.  From seven bodies on, the interaction kick's pulls
-    are summed in the lanes too, bit for bit the scalar sums.
+    the scalar solver.  The interaction kick's pulls are summed in the
+    lanes too, bit for bit the scalar sums, and between outputs the state
+    stays in the lanes, as WHFast512 keeps it in its registers (written
+    back to the workspace for an output, a non-finite state and the end of
+    a call).
 
     Variational equations (a force with variations, ``force.inner`` set;
     :mod:`orbits._kernels.variational`): the tangent vectors in the rows
@@ -402,7 +405,7 @@ class WisdomHolman(Integrator):
         lanes = terms is None and n >= LANES_FROM_BODIES
         if lanes:
             targs = ws.get("lanes")
-            if targs is None or targs[0].shape != (_lanes.DRIFT_ROWS, 2 * _lanes.lane_columns(n)):
+            if targs is None or targs[0].shape != _lanes.lanes_scratch_shape(n):
                 targs = ws["lanes"] = (_lanes.lanes_scratch(n),)
         return terms, targs, lanes
 

@@ -5,11 +5,10 @@ same trajectory bit for bit.
 The comparisons are exact (tolerance zero): the lanes compute each planet's
 drift by the scalar code's operations in its order, or hand it to the scalar
 drift (see tests/kernels/test_wh_lanes.py), so nothing may differ by even an
-ulp; from seven bodies on (``PAIRS_LANES_FROM_BODIES``; the odd orbits'
-scene has eight) the kick's pulls are also summed in the lanes, in the scalar
-order (tests/kernels/test_wh_lanes.py).  Which loop a run takes is chosen by
-the number of bodies (``LANES_FROM_BODIES``), set here to force one or the
-other.
+ulp; the kick's pulls are summed in the lanes in the scalar order, and the
+state stays in the lanes between outputs (tests/kernels/test_wh_lanes.py).
+Which loop a run takes is chosen by the number of bodies
+(``LANES_FROM_BODIES``), set here to force one or the other.
 """
 
 import astropy.units as u
@@ -62,15 +61,85 @@ def test_lanes_are_the_scalar_loop_bit_for_bit(monkeypatch, spec, options):
 @pytest.mark.parametrize("spec", ["wh", f"wh:{DH}"])
 def test_long_steps_left_to_the_scalar_drift_bit_for_bit(monkeypatch, spec):
     # 400 days: a long step for Jupiter, Saturn and Uranus (the lanes decline
-    # them), a short one for Neptune and Pluto; with more than a quarter declined
-    # the loop drifts by the scalar code for a while and tries the lanes again
+    # them and hand them to the scalar drift), a short one for Neptune and Pluto
     bodies = orbits.scenes.outer_solar_system()
     until = 300 * 400 * u.day
     x0, v0, _ = final_state(monkeypatch, bodies, False, spec, until, dt=400 * u.day)
     x1, v1, ws = final_state(monkeypatch, bodies, True, spec, until, dt=400 * u.day)
     assert np.array_equal(x0, x1)
     assert np.array_equal(v0, v1)
-    assert ws["lanes"][0][_lanes.MEMO, 0] > 0
+    took = ws["lanes"][0][_lanes._RTAKE, :5]
+    assert np.array_equal(took, [0, 0, 0, 1, 1])
+
+
+def every_output(monkeypatch, bodies, lanes, spec, until, dt, **options):
+    monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
+    name, _, coords = spec.partition(":")
+    integ = orbits.integrators.get(name, coordinates=coords or "jacobi", **options)
+    sim = orbits.Simulation(bodies, integrator=integ, dt=dt)
+    steps = int(round((until / dt).to_value(u.one)))
+    return sim.run(until=until, outputs=steps + 1, progress=False)
+
+
+@pytest.mark.parametrize("scene, dt", [("outer", 10 * u.day), ("sun8", 0.5 * u.day),
+                                       ("twelve", 5 * u.day)])
+@pytest.mark.parametrize("spec, options", [("wh", {}), (f"wh:{DH}", {}),
+                                           ("wh", {"corrector": 5})])
+def test_an_output_every_step_with_monitors_bit_for_bit(monkeypatch, scene, dt, spec, options):
+    # the state kept in the lanes is written back for every output and its
+    # monitors, and loaded again after the output's drift; three lane
+    # layouts: padded (6 bodies), full (9), two groups of eight (12)
+    if scene == "outer":
+        bodies = with_odd_orbits()
+    elif scene == "sun8":
+        bodies = orbits.scenes.solar_system(moon=False)
+    else:
+        bodies = orbits.scenes.solar_system(moon=False)
+        for k in range(3):
+            bodies.add(f"p{k}", 1e-9 * u.Msun, primary="Sun", a=(12 + 7 * k) * u.au,
+                       e=0.05 * k, inc=k * u.deg, f=k * u.rad)
+    a = every_output(monkeypatch, bodies, False, spec, 60 * dt, dt, **options)
+    b = every_output(monkeypatch, bodies, True, spec, 60 * dt, dt, **options)
+    assert len(a.times) == 61
+    for name in ("times", "positions", "velocities"):
+        assert np.array_equal(getattr(a, name).value, getattr(b, name).value), name
+    assert a.energy is not None and a.angular_momentum is not None
+    for name in ("energy", "angular_momentum"):
+        assert np.array_equal(getattr(a, name).value, getattr(b, name).value), name
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")
+@pytest.mark.parametrize("coordinates, scale, step", [("jacobi", 1e160, 0), (DH, 1e160, 0),
+                                                      (DH, 1e100, 1)])
+def test_a_state_that_turns_non_finite_stops_as_the_scalar_loop_does(
+        monkeypatch, coordinates, scale, step):
+    # Saturn at an absurd speed: its state overflows in the first step or
+    # the second; the lanes' finite check stops the run where the scalar
+    # loop's does, with the same outputs and last state (NaN where the
+    # output's synchronisation overflowed, as it does in both)
+    from orbits.errors import NonFiniteState
+    got = []
+    for lanes in (False, True):
+        monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
+        sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
+                                integrator=orbits.integrators.get("wh", coordinates=coordinates),
+                                dt=10 * u.day)
+        state = sim.state
+        v = state.v.copy()
+        v[2] *= scale
+        sim.set_state(state._replace(v=v))
+        with pytest.raises(NonFiniteState) as info:
+            sim.run(until=100 * u.day, outputs=11, progress=False)
+        got.append((info.value, sim.state))
+    (e0, s0), (e1, s1) = got
+    assert e0.step == e1.step
+    assert e1.step == step
+    assert e0.time == e1.time
+    for name in ("times", "positions", "velocities"):
+        assert np.array_equal(getattr(e0.result, name).value, getattr(e1.result, name).value,
+                              equal_nan=True), name
+    assert np.array_equal(s0.x, s1.x, equal_nan=True)
+    assert np.array_equal(s0.v, s1.v, equal_nan=True)
 
 
 def test_lanes_are_chosen_by_the_number_of_bodies(monkeypatch):

@@ -37,18 +37,25 @@ def system(orbits_, mu=1.0):
 
 
 def both(xj, vj, mu, h, steps=1):
-    """``steps`` drifts of ``h`` by the scalar drift and by the lanes, compared
+    """``steps`` drifts of ``h`` by the scalar drift, by the lanes, and by the
+    lanes on the state kept in them (written back after each drift), compared
     after every drift; returns the lanes' scratch after the last and the
     number of planets the lanes declined in it."""
     a, b = xj.copy(), vj.copy()
     c, d = xj.copy(), vj.copy()
+    e, f = xj.copy(), vj.copy()
     w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
     S = L.lanes_scratch(len(xj))
+    R = L.lanes_scratch(len(xj))
+    L.resident_load(e, f, mu, mu, R)
     for k in range(steps):
         W.kepler_drift_all(a, b, mu, h, w1, w2)
         declined = L.kepler_drift_lanes(c, d, mu, h, S)
-        assert np.array_equal(a, c, equal_nan=True), k
-        assert np.array_equal(b, d, equal_nan=True), k
+        kept = L.resident_drift(e, f, mu, h, R)
+        L.resident_store(R, e, f)
+        for p, q in ((a, c), (b, d), (a, e), (b, f)):
+            assert np.array_equal(p, q, equal_nan=True), k
+        assert kept == declined
     assert declined == np.sum(~lanes_took(S, len(xj)))
     return S, declined
 
@@ -140,23 +147,63 @@ def test_two_drifts_in_one_pass_are_each_the_scalar_drift(f):
     assert np.sum(~took2) >= 1            # the copy had declined planets too
 
 
+@pytest.mark.parametrize("n, passive", [(5, 0), (9, 0), (9, 2), (12, 3)])
 @pytest.mark.parametrize("coordinates", ["jacobi", "democratic-heliocentric"])
-def test_the_kick_in_lanes_is_the_scalar_kick_bit_for_bit(coordinates):
-    # the lanes' loop's perturbation step (Jacobi: the interaction kick;
-    # democratic heliocentric: jump, kick, jump) against the scalar one, over
-    # repeated kicks of eight planets
-    rng = np.random.default_rng(7)
-    x = rng.standard_normal((9, 3)) * 10 ** rng.uniform(-0.5, 1.5, (9, 1))
-    gm = 10 ** rng.uniform(-9, -3, 9)
+def test_the_kick_in_lanes_is_the_scalar_kick_bit_for_bit(coordinates, n, passive):
+    # the lanes' loop's perturbation step on the state kept in the lanes
+    # (Jacobi: the interaction kick; democratic heliocentric: jump, kick,
+    # jump) against the scalar one, over repeated kicks: padded columns (5
+    # and 12 bodies), full ones (9), and massless bodies after the massive
+    # ones (n_active = n - passive), which feel the pulls but exert none
+    rng = np.random.default_rng(7 + n)
+    x = rng.standard_normal((n, 3)) * 10 ** rng.uniform(-0.5, 1.5, (n, 1))
+    gm = 10 ** rng.uniform(-9, -3, n)
     gm[0] = 1.0
-    v = np.random.default_rng(8).standard_normal((9, 3)) * 0.1
-    step, lanes_step = (W.COORDINATE_SYSTEMS[coordinates][k] for k in (2, 4))
-    eta = np.cumsum(gm) if coordinates == "jacobi" else np.full(9, gm[0])
+    gm[n - passive:] = 0.0
+    na = n - passive
+    v = np.random.default_rng(8).standard_normal((n, 3)) * 0.1
+    step = W.COORDINATE_SYSTEMS[coordinates][2]
+    eta = np.cumsum(gm) if coordinates == "jacobi" else np.full(n, gm[0])
+    kick = L.resident_kick if coordinates == "jacobi" else L.resident_jump_kick
     a, b, c, d = x.copy(), v.copy(), x.copy(), v.copy()
     w, acc = np.zeros_like(x), np.zeros_like(x)
-    targs = (L.lanes_scratch(9),)
+    S = L.lanes_scratch(n)
+    L.resident_load(c, d, gm, eta, S)
     for k in range(10):
-        step(a, b, w, acc, gm, eta, 9, 0.01)
-        lanes_step(c, d, w, acc, gm, eta, 9, 0.01, targs)
+        step(a, b, w, acc, gm, eta, na, 0.01)
+        kick(c, d, gm, na, 0.01, S)
+        L.resident_store(S, c, d)
         assert np.array_equal(a, c) and np.array_equal(b, d), k
     assert not np.array_equal(b, v)
+
+
+@pytest.mark.parametrize("n", [5, 9, 12])
+def test_the_finite_check_in_lanes_is_the_scalar_check(n):
+    # stepping.state_is_finite of the state written back, for a non-finite
+    # value in every place of a real row (row 0 stays in the arrays), and a
+    # NaN in the padding, which is not part of the state
+    from orbits._kernels.stepping import state_is_finite
+    rng = np.random.default_rng(n)
+    xj, vj = rng.standard_normal((n, 3)), rng.standard_normal((n, 3))
+    mu = np.ones(n)
+    S = L.lanes_scratch(n)
+    L.resident_load(xj, vj, mu, mu, S)
+    assert L.resident_finite(xj, vj, S) and state_is_finite(xj, vj)
+    P = L.lane_columns(n)
+    if P > n - 1:
+        S[L._RX + 1, P - 1] = np.nan
+        assert L.resident_finite(xj, vj, S)
+    for bad in (np.nan, np.inf, -np.inf):
+        for i in range(n):
+            for arr in (0, 1):
+                for dim in range(3):
+                    a, b = xj.copy(), vj.copy()
+                    (a, b)[arr][i, dim] = bad
+                    L.resident_load(a, b, mu, mu, S)
+                    assert not L.resident_finite(a, b, S)
+                    assert not state_is_finite(a, b)
+    # a sum that overflows is not finite for either
+    a, b = xj.copy(), vj.copy()
+    a[1, 0] = a[2, 0] = 1.7e308
+    L.resident_load(a, b, mu, mu, S)
+    assert L.resident_finite(a, b, S) == state_is_finite(a, b)
