@@ -42,9 +42,10 @@ eight planets at 1 or 4 days) it was slower than the scalar drift
 (1.06-1.19 times the scalar loop's step), as the general Stumpff form then
 costs every lane; the lanes' single pass with the declined planets left to
 the scalar drift is faster there.  Where more than a quarter of the
-planets are declined the loop leaves the drift to the scalar code for
-:data:`RETRY` drifts before trying the lanes again (:data:`MEMO`;
-``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`).
+planets are declined, an output's synchronising drift leaves the drift
+to the scalar code for :data:`RETRY` drifts before trying the lanes again
+(:data:`MEMO`; ``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`);
+the steps' drift of the state kept in the lanes always tries them.
 
 The interaction kick's pulls
 (:func:`orbits._kernels.gravity.pull_rows`) go to the lanes as well: one
