@@ -40,19 +40,22 @@ import numba
 import numpy as np
 
 from orbits._kernels import gravity
+# the package's compile options (numpy's error model: a padded lane's 0/0 is
+# a NaN that is never read, not an exception, and the loops vectorise)
+from orbits._kernels._jit import njit
 from orbits._kernels.gravity import accelerate_pairwise_lanes, accelerate_pairwise_parallel
 
 SIZES = (16, 32, 48, 64, 96, 128, 192, 256, 512, 1000, 2000, 4000)
 QUICK_SIZES = (16, 64, 128, 512, 1000)
 
 
-@numba.njit
+@njit(cache=False)
 def _repeat_serial_loop(x, gm, n_active, eps2, acc, work, k):
     for _ in range(k):
         accelerate_pairwise_lanes(x, gm, n_active, eps2, acc, work)
 
 
-@numba.njit
+@njit(cache=False)
 def _repeat_parallel_loop(x, gm, n_active, eps2, acc, work, k):
     for _ in range(k):
         accelerate_pairwise_parallel(x, gm, n_active, eps2, acc, work)
