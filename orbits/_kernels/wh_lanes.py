@@ -101,9 +101,10 @@ from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, f_and_g, ke
                      quartic_step, short_start, stumpff_lane)
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
-           "lanes_scratch", "kepler_drift_lanes", "kepler_drift_lanes_twice",
+           "lanes_scratch", "kepler_drift_lanes",
            "drift_columns", "SCRATCH_ROWS", "lanes_scratch_shape", "resident_load",
-           "resident_store", "resident_drift", "resident_finite", "resident_kick",
+           "resident_store", "resident_drift_twice", "resident_drift", "resident_finite",
+           "resident_kick",
            "resident_jump_kick"]
 
 
@@ -119,7 +120,7 @@ MEMO = 14
 _H = 15
 #: the scratch's row where the loop notes an output due at the end of a step
 #: (1, its row, its time), whose synchronising drift it then makes in the same
-#: pass as the next step's first drift (:func:`kepler_drift_lanes_twice`)
+#: pass as the next step's first drift (:func:`resident_drift_twice`)
 PENDING = 16
 
 #: drifts that the loop leaves to the scalar drift after the lanes have
@@ -130,8 +131,8 @@ RETRY = 64
 
 
 def lanes_scratch(n):
-    """The scratch of :func:`kepler_drift_lanes`,
-    :func:`kepler_drift_lanes_twice` and the lanes' state (``resident_*``)
+    """The scratch of :func:`kepler_drift_lanes` and of the lanes' state
+    (``resident_*``)
     for ``n`` bodies, shape (:data:`SCRATCH_ROWS`, 2 :func:`lane_columns`
     ``(n)``)."""
     return np.zeros(lanes_scratch_shape(n))
@@ -253,7 +254,7 @@ def _one_step(H, k, h):
 
 @njit(inline="always")
 def _column_step(H, k, h):
-    # each column takes its own step (kepler_drift_lanes_twice)
+    # each column takes its own step (resident_drift_twice)
     return H[k]
 
 
@@ -311,40 +312,6 @@ def kepler_drift_lanes(xj, vj, mu, h, S):
     _load(S, xj, vj, mu, h, 0, P)
     _single_pass(S, h, np.uint64(P))
     return _store(S, xj, vj, mu, 0)
-
-
-@njit
-def kepler_drift_lanes_twice(xj, vj, mu, h, xs, vs, h2, S):
-    """Two drifts from the same start in one pass over the columns:
-    :func:`kepler_drift_lanes` of ``xj``, ``vj`` by ``h`` (in place), and a
-    copy of them drifted by ``h2`` into ``xs``, ``vs``; each bit for bit the
-    scalar drift.  The Wisdom-Holman loop's output: the copy is the state
-    synchronised by the owed drift ``h2``, made beside the next step's first
-    drift, whose long chains of dependent operations it overlaps (an
-    output's drift made on its own added its whole latency to the step).
-
-    Returns
-    -------
-    declined : int
-        The planets of ``xj`` the lanes declined (the copy's are not counted).
-    """
-    for d in range(3):
-        xs[0, d] = xj[0, d] + h2 * vj[0, d]
-        vs[0, d] = vj[0, d]
-        xj[0, d] += h * vj[0, d]
-    n = xj.shape[0]
-    P = lane_columns(n)
-    _load(S, xj, vj, mu, h, 0, P)
-    _load(S, xj, vj, mu, h2, P, P)
-    _single_pass_steps(S, h, np.uint64(2 * P))
-    # the copy's declined planets start from xj, vj, so the copy first
-    for i in range(1, n):
-        for d in range(3):
-            xs[i, d] = xj[i, d]
-            vs[i, d] = vj[i, d]
-    _store(S, xs, vs, mu, P)
-    return _store(S, xj, vj, mu, 0)
-
 
 
 # -- the state kept in the lanes ----------------------------------------------------
@@ -426,27 +393,86 @@ def resident_drift(xj, vj, eta, h, S):
     declined = 0
     if rejected:
         for k in range(P):
-            if S[_RTAKE, k] != 0.0:
-                continue
-            if k < n - 1:
-                i = k + 1
-                for d in range(3):
-                    xj[i, d] = S[_RX + d, k]
-                    vj[i, d] = S[_RX + 3 + d, k]
-                kepler_drift(eta[i], xj, vj, i, h)
-                for d in range(3):
-                    S[_RY + d, k] = xj[i, d]
-                    S[_RY + 3 + d, k] = vj[i, d]
-                declined += 1
-            else:
-                for r in range(6):
-                    S[_RY + r, k] = S[_RY + r, 0]
+            S[_H, k] = h
+        declined = _resident_declined(xj, vj, eta, S, _RX, _RY, _RTAKE, P)
     for r in range(6):
         X = S[_RX + r]
         Y = S[_RY + r]
         for k in range(P):
             X[k] = Y[k]
     return declined
+
+
+@njit(inline="always")
+def _resident_declined(xj, vj, eta, S, src, dst, take, P):
+    # the columns of the lanes' state that the drift declined (its verdict in
+    # row take): the scalar drift from their start (rows src .. src + 5), by
+    # their column's step (row _H of the drift's rows, or h where src is the
+    # state's own rows), into rows dst ..; a declined padding column becomes
+    # a copy of column 0.  Returns how many planets were declined.
+    n = xj.shape[0]
+    declined = 0
+    for k in range(P):
+        if S[take, k] != 0.0:
+            continue
+        if k < n - 1:
+            i = k + 1
+            for d in range(3):
+                xj[i, d] = S[src + d, k]
+                vj[i, d] = S[src + 3 + d, k]
+            kepler_drift(eta[i], xj, vj, i, S[_H, k])
+            for d in range(3):
+                S[dst + d, k] = xj[i, d]
+                S[dst + 3 + d, k] = vj[i, d]
+            declined += 1
+        else:
+            for r in range(6):
+                S[dst + r, k] = S[dst + r, 0]
+    return declined
+
+
+@njit(inline="always")
+def resident_drift_twice(xj, vj, eta, h, xs, vs, h2, S):
+    """:func:`resident_drift` of the lanes' state by ``h``, and a copy of it
+    drifted by ``h2`` into ``xs``, ``vs`` (shape (N, 3)), in one pass over
+    twice the columns, each bit for bit the scalar drift.  The Wisdom-Holman
+    loop's output: the copy is the state synchronised by the owed drift
+    ``h2``, made beside the next step's first drift, whose long chains of
+    dependent operations it overlaps (an output's drift made on its own
+    added its whole latency to the step).  Returns how many planets of the
+    state were declined."""
+    n = xj.shape[0]
+    P = lane_columns(n)
+    for d in range(3):
+        xs[0, d] = xj[0, d] + h2 * vj[0, d]
+        vs[0, d] = vj[0, d]
+        xj[0, d] += h * vj[0, d]
+    # the start in both halves of the drift's rows, each half with its step
+    for r in range(6):
+        A = S[_RX + r]
+        B = S[_X + r]
+        for k in range(P):
+            B[k] = A[k]
+            B[P + k] = A[k]
+    for k in range(P):
+        S[_MU, k] = S[_RMU, k]
+        S[_MU, P + k] = S[_RMU, k]
+        S[_H, k] = h
+        S[_H, P + k] = h2
+    _single_pass_steps(S, h, np.uint64(2 * P))
+    # the copy (its declined planets start from the state, so the state first)
+    for i in range(1, n):
+        for d in range(3):
+            xs[i, d] = S[_RX + d, i - 1]
+            vs[i, d] = S[_RX + 3 + d, i - 1]
+    _store(S, xs, vs, eta, P)
+    # the state
+    for r in range(6):
+        A = S[_RX + r]
+        B = S[_Y + r]
+        for k in range(P):
+            A[k] = B[k]
+    return _resident_declined(xj, vj, eta, S, _X, _RX, _TAKE, P)
 
 
 @njit(inline="always")

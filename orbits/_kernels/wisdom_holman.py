@@ -106,7 +106,7 @@ from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
-from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, kepler_drift_lanes_twice,
+from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, resident_drift_twice,
                        resident_finite, resident_jump_kick, resident_kick, resident_load,
                        resident_store)
 from .wh_lanes import resident_drift as resident_drift_rows
@@ -312,7 +312,7 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, ta
 # An output of the lanes' loop (no added terms, four bodies or more) is noted
 # at the end of its step and made at the start of the next one: the copy's
 # owed drift beside that step's first drift, in one pass over the lanes
-# (wh_lanes.kepler_drift_lanes_twice), so that the processor overlaps their
+# (wh_lanes.resident_drift_twice), so that the processor overlaps their
 # chains of dependent operations; on its own, the output's drift added its
 # whole latency to the step (the outer solar system, an output every step:
 # the synchronisation cost 0.23 us in the loop against 0.08 us for its drift
@@ -341,11 +341,11 @@ def make_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n
 # The lanes' loop keeps its state in the lanes between outputs (see
 # orbits._kernels.wh_lanes, "the state kept in the lanes"): RESIDENT binds
 # its drift and perturbation step on the lanes' rows, which lanes_in loads
-# when the loop starts and after an output's drift, and which lanes_out
-# writes back before the loop returns; lanes_check makes the epilogue's
-# finite check on the lanes (the epilogue's own check is then off) and
-# writes the state back where the epilogue will read it (an output due).
-# The defaults below do nothing.
+# when the loop starts and lanes_out writes back before the loop returns;
+# lanes_check makes the epilogue's finite check on the lanes (the epilogue's
+# own check is then off) and writes the state back where it is not finite.
+# An output drifts its copy from the lanes (_resident_output_drift).  The
+# defaults below do nothing.
 RESIDENT = False
 
 
@@ -396,14 +396,15 @@ def _resident_out(xj, vj, targs):
 def _resident_check(xj, vj, k, nsteps, until_check, check_every, until_record, targs):
     # the epilogue's finite check (every check_every steps and after the
     # last) on the lanes; the state back in xj, vj where it is not finite
-    # (the loop returns it) or where the epilogue records an output
+    # (the loop returns it).  An output the epilogue records is only noted
+    # (_lanes_note), and its drift made from the lanes (_resident_output_drift).
     S = targs[0]
     until_check -= 1
     ok = True
     if until_check == 0 or k + 1 == nsteps:
         until_check = check_every
         ok = resident_finite(xj, vj, S)
-    if not ok or until_record == 1:
+    if not ok:
         resident_store(S, xj, vj)
     return ok, until_check
 
@@ -420,25 +421,21 @@ def _lanes_pending(targs):
     return targs[0][PENDING, 0] != 0.0
 
 
-def _lanes_output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
-    # the step's first drift h of xj, vj and the noted output's owed drift
-    # of a copy into xs, vs (both from the same state), as _lanes_drift and
-    # _synchronize would make them one after the other
-    # (x and acc are free for the scalar drifts' scratch: the loop's own
-    # scratch, xs and vs, takes the copy)
+def _resident_output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
+    # the step's first drift h of the state kept in the lanes and the noted
+    # output's owed drift of a copy into xs, vs (both from the same state),
+    # as the lanes' drift and _synchronize would make them one after the
+    # other, in one pass over the lanes (wh_lanes.resident_drift_twice)
     S = targs[0]
     S[PENDING, 0] = 0.0
-    if S[MEMO, 0] == 0.0 and owed != 0.0:
-        if 4 * kepler_drift_lanes_twice(xj, vj, eta, h, xs, vs, owed, S) > xj.shape[0] - 1:
-            S[MEMO, 0] = RETRY
-        return
-    for i in range(xj.shape[0]):
-        for d in range(3):
-            xs[i, d] = xj[i, d]
-            vs[i, d] = vj[i, d]
     if owed != 0.0:
-        kepler_drift_all(xs, vs, eta, owed, x, acc)
-    _lanes_drift(xj, vj, eta, h, x, acc, targs)
+        resident_drift_twice(xj, vj, eta, h, xs, vs, owed, S)
+        return
+    for d in range(3):
+        xs[0, d] = xj[0, d]
+        vs[0, d] = vj[0, d]
+    resident_store(S, xs, vs)
+    resident_drift_rows(xj, vj, eta, h, S)
 
 
 def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
@@ -506,7 +503,6 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                         output_drift(xj, vj, eta, h + owed, xs, vs, owed, x, acc, targs)
                         make_output(xs, vs, 0.0, mon, mon_t, mon_out, gm, eta, xs, vs, x, v,
                                     acc, n_active, corr, cdt[0], targs)
-                        lanes_in(xj, vj, gm, eta, targs)
                         owed = 0.0
                         continue
                     h += owed
@@ -767,7 +763,7 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
             lanes_out=specialize(_resident_out, key, cache=cache, inline=True, nrt=nrt),
             lanes_check=specialize(_resident_check, key, cache=cache, inline=True, nrt=nrt),
             output_pending=specialize(_lanes_pending, key, cache=cache, inline=True, nrt=nrt),
-            output_drift=specialize(_lanes_output_drift, key, cache=cache, inline=True,
+            output_drift=specialize(_resident_output_drift, key, cache=cache, inline=True,
                                     nrt=nrt),
             make_output=specialize(_lanes_output, key, cache=cache, nrt=nrt,
                                    synchronize=sync, _record=record))

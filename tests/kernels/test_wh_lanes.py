@@ -125,7 +125,8 @@ def test_zero_step_and_non_finite_states():
 @pytest.mark.parametrize("f", [0.0, 0.05])
 def test_two_drifts_in_one_pass_are_each_the_scalar_drift(f):
     # the Wisdom-Holman loop's output: the next step's drift h of the state
-    # and the owed drift h2 of a copy, in one pass over the lanes; each must
+    # kept in the lanes and the owed drift h2 of a copy into arrays (N, 3),
+    # in one pass over the lanes; each must
     # be the scalar drift bit for bit, also for planets the lanes decline
     # (e = 0.99 at pericentre, a hyperbola), whose start the copy must keep
     orbits_ = CIRCULAR[:2] + [(1.0, 0.99, f), (-1.0, 1.5, f / 2)] + CIRCULAR[2:]
@@ -137,8 +138,10 @@ def test_two_drifts_in_one_pass_are_each_the_scalar_drift(f):
     c, d = xj.copy(), vj.copy()
     W.kepler_drift_all(c, d, mu, h2, w1, w2)
     S = L.lanes_scratch(len(xj))
+    L.resident_load(xj, vj, mu, mu, S)
     xs, vs = np.full_like(xj, np.nan), np.full_like(xj, np.nan)
-    declined = L.kepler_drift_lanes_twice(xj, vj, mu, h, xs, vs, h2, S)
+    declined = L.resident_drift_twice(xj, vj, mu, h, xs, vs, h2, S)
+    L.resident_store(S, xj, vj)
     assert np.array_equal(xj, a) and np.array_equal(vj, b)
     assert np.array_equal(xs, c) and np.array_equal(vs, d)
     P = L.lane_columns(len(xj))
