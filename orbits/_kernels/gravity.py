@@ -33,7 +33,8 @@ __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_re
            "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
            "accelerate_pairwise_small", "accelerate_pairwise_rebound", "pair_accelerations",
            "accelerate_pairwise_lanes", "pair_accelerations_lanes", "lane_columns",
-           "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind", "pull_rows"]
+           "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind", "pull_rows",
+           "pull_factors", "pull_rows_factored"]
 
 
 #: Up to this many massive bodies the plain double loop
@@ -162,8 +163,9 @@ def accelerate_pairwise(x, gm, n_active, eps2, acc, work):
 #: leapfrog step of 12 bodies 0.28 us against 0.19-0.20 with 8)
 LANE_WIDTH = 8
 
-#: rows of the lanes' scratch: positions (0 to 2) and sums (3 to 5)
-LANE_ROWS = 6
+#: rows of the lanes' scratch: positions (0 to 2), sums (3 to 5) and the
+#: central body's factors 1 / r^3 (6)
+LANE_ROWS = 7
 
 
 @njit(inline="always")
@@ -211,6 +213,40 @@ def pull_rows(X, Y, Z, AX, AY, AZ, P, xs, ys, zs, ms, own, eps2, real):
 
 
 @njit(inline="always")
+def pull_factors(X, Y, Z, F, P, xs, ys, zs, own, eps2, real):
+    """The factors ``1 / r^3`` of :func:`pull_rows` for a source at ``(xs,
+    ys, zs)`` into ``F[k]``, ``k < P`` (1 for the column ``own`` and those
+    from ``real`` on), the same operations in the same order.  A source
+    whose own sums also need these factors (the central body, whose sums
+    the scalar loop adds pair by pair) then takes them from ``F`` instead of
+    a square root and a division a pair, and pulls the lanes with
+    :func:`pull_rows_factored`."""
+    for k in range(P):
+        dx = xs - X[k]
+        dy = ys - Y[k]
+        dz = zs - Z[k]
+        skip = (k == own) | (k >= real)
+        r2 = dx * dx + dy * dy + dz * dz + eps2
+        r2 = 1.0 if skip else r2
+        F[k] = 1.0 / (r2 * math.sqrt(r2))
+
+
+@njit(inline="always")
+def pull_rows_factored(X, Y, Z, AX, AY, AZ, P, xs, ys, zs, ms, own, F, real):
+    """:func:`pull_rows` with its factors ``1 / r^3`` from ``F``
+    (:func:`pull_factors` of the same source), bit for bit."""
+    for k in range(P):
+        dx = xs - X[k]
+        dy = ys - Y[k]
+        dz = zs - Z[k]
+        skip = (k == own) | (k >= real)
+        s = (0.0 if skip else ms) * F[k]
+        AX[k] = AX[k] + s * dx
+        AY[k] = AY[k] + s * dy
+        AZ[k] = AZ[k] + s * dz
+
+
+@njit(inline="always")
 def _pull(S, P, xs, ys, zs, ms, own, eps2):
     # the pull of a source on every column of the scratch's rows (positions
     # 0 to 2, sums 3 to 5) but ``own``
@@ -234,23 +270,30 @@ def pair_accelerations_lanes(x, gm, n_active, eps2, acc, first, skip_first_pair,
         S[4, k] = 0.0
         S[5, k] = 0.0
     Pu = np.uint64(P)
-    for j in range(first, n_active):
-        # body j's column is j - 1; the central body (j = 0) skips body 1's
-        # column where that pair is left out, else none
-        own = j - 1 if j > 0 else (0 if skip_first_pair else P)
-        _pull(S, Pu, x[j, 0], x[j, 1], x[j, 2], gm[j], np.uint64(own), eps2)
+    real = np.uint64(P)
+    if first == 0:
+        # the central body (column none; body 1's where the pair (0, 1) is left
+        # out), its factors 1 / r^3 kept in row 6 for its own sums below
+        own = np.uint64(0 if skip_first_pair else P)
+        pull_factors(S[0], S[1], S[2], S[6], Pu, x[0, 0], x[0, 1], x[0, 2], own, eps2, real)
+        pull_rows_factored(S[0], S[1], S[2], S[3], S[4], S[5], Pu, x[0, 0], x[0, 1], x[0, 2],
+                           gm[0], own, S[6], real)
+    for j in range(max(first, 1), n_active):
+        # body j's column is j - 1
+        _pull(S, Pu, x[j, 0], x[j, 1], x[j, 2], gm[j], np.uint64(j - 1), eps2)
     ax = 0.0
     ay = 0.0
     az = 0.0
     if first == 0:
         # the central body's sums, pulled by the bodies after it in order, as
-        # the scalar loop adds them
+        # the scalar loop adds them (a pair's r^2 is the same whichever body
+        # its separation starts from)
+        F = S[6]
         for i in range(2 if skip_first_pair else 1, n_active):
             dx = x[i, 0] - x[0, 0]
             dy = x[i, 1] - x[0, 1]
             dz = x[i, 2] - x[0, 2]
-            r2 = dx * dx + dy * dy + dz * dz + eps2
-            s = gm[i] * (1.0 / (r2 * math.sqrt(r2)))
+            s = gm[i] * F[i - 1]
             ax += s * dx
             ay += s * dy
             az += s * dz

@@ -96,7 +96,8 @@ import numpy as np
 from ._jit import njit, specialize
 # the planets' columns, padded to a multiple of the lane width (shared with the
 # gravity kernels' lanes)
-from .gravity import LANE_WIDTH, lane_columns, pull_rows
+from .gravity import (LANE_WIDTH, lane_columns, pull_factors, pull_rows,
+                      pull_rows_factored)
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, f_and_g, kepler_drift,
                      quartic_step, short_start, stumpff_lane)
 
@@ -344,6 +345,9 @@ _R = DRIFT_ROWS
 #: of the Jacobi kick (3)
 _RX, _RY, _RMU, _RTAKE, _RA, _RQ, _RW, _RK = (_R, _R + 6, _R + 12, _R + 13, _R + 14, _R + 17,
                                               _R + 20, _R + 21)
+#: the central body's factors 1 / r^3 in the Jacobi kick (the drift's end
+#: rows, free during the kick)
+_RF = _RY
 #: rows of the scratch of a loop that keeps its state in the lanes
 SCRATCH_ROWS = _R + 24
 
@@ -611,13 +615,17 @@ def resident_kick(xj, vj, gm, n_active, h, S):
         KZ[k] = s * rz
     _zero_sums(S, Pu)
     real = np.uint64(n - 1)
-    # the central body pulls every lane but body 1's (the pair (0, 1) is left out)
-    pull_rows(QX, QY, QZ, S[_RA], S[_RA + 1], S[_RA + 2], Pu, sx, sy, sz, gm[0],
-              np.uint64(0), 0.0, real)
+    # the central body pulls every lane but body 1's (the pair (0, 1) is left
+    # out); its factors 1 / r^3 kept for its own sums below
+    F = S[_RF]
+    pull_factors(QX, QY, QZ, F, Pu, sx, sy, sz, np.uint64(0), 0.0, real)
+    pull_rows_factored(QX, QY, QZ, S[_RA], S[_RA + 1], S[_RA + 2], Pu, sx, sy, sz, gm[0],
+                       np.uint64(0), F, real)
     for j in range(1, n_active):
         pull_rows(QX, QY, QZ, S[_RA], S[_RA + 1], S[_RA + 2], Pu, QX[j - 1], QY[j - 1],
                   QZ[j - 1], gm[j], np.uint64(j - 1), 0.0, real)
-    # the central body's sums, pulled by the bodies after body 1 in order
+    # the central body's sums, pulled by the bodies after body 1 in order (a
+    # pair's r^2 is the same whichever body its separation starts from)
     ax = 0.0
     ay = 0.0
     az = 0.0
@@ -625,8 +633,7 @@ def resident_kick(xj, vj, gm, n_active, h, S):
         dx = QX[i - 1] - sx
         dy = QY[i - 1] - sy
         dz = QZ[i - 1] - sz
-        r2 = dx * dx + dy * dy + dz * dz + 0.0
-        s = gm[i] * (1.0 / (r2 * math.sqrt(r2)))
+        s = gm[i] * F[i - 1]
         ax += s * dx
         ay += s * dy
         az += s * dz
