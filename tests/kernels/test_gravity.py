@@ -168,3 +168,33 @@ def test_pairs_in_lanes_are_the_scalar_sums_bit_for_bit(n, first, skip, test_par
     assert np.array_equal(got, want)
     assert np.all(np.isfinite(got))
     assert np.array_equal(np.signbit(got), np.signbit(want))
+
+
+@pytest.mark.parametrize("own, real", [(3, 8), (0, 5), (8, 8), (2, 3)])
+@pytest.mark.parametrize("eps2", [0.0, 1e-4])
+def test_a_pass_with_kept_factors_is_the_plain_pass_bit_for_bit(own, real, eps2):
+    # pull_factors then pull_rows_factored (the central body's pass, whose
+    # factors 1 / r^3 its own sums read back) must add exactly what
+    # pull_rows adds, the skipped columns (own, padding from real on) an
+    # exact zero; the factors must be the scalar pair loop's 1 / (r2 sqrt(r2))
+    x, gm = scattered(9, seed=own + 10 * real, planar=own == 0)
+    P = np.uint64(8)
+    X, Y, Z = (np.ascontiguousarray(x[1:, d]) for d in range(3))
+    start = np.random.default_rng(own).standard_normal((3, 8))
+    want = start.copy()
+    got = start.copy()
+    F = np.full(8, np.nan)
+    xs, ys, zs = x[0]
+    gravity.pull_rows(X, Y, Z, want[0], want[1], want[2], P, xs, ys, zs, gm[0],
+                      np.uint64(own), eps2, np.uint64(real))
+    gravity.pull_factors(X, Y, Z, F, P, xs, ys, zs, np.uint64(own), eps2, np.uint64(real))
+    gravity.pull_rows_factored(X, Y, Z, got[0], got[1], got[2], P, xs, ys, zs, gm[0],
+                               np.uint64(own), F, np.uint64(real))
+    assert np.array_equal(got, want)
+    for k in range(8):
+        if k == own or k >= real:
+            assert F[k] == 1.0
+        else:
+            d = x[k + 1] - x[0]
+            r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2
+            assert F[k] == 1.0 / (r2 * np.sqrt(r2))
