@@ -254,22 +254,34 @@ def _pull(S, P, xs, ys, zs, ms, own, eps2):
 
 
 @njit(inline="always")
+def _columns_from(R, x, d, n):
+    # component d of bodies 1 .. n - 1 into R[0 .. n - 2], the padding after
+    # them a copy of body 1 (its sums are never read)
+    for k in range(np.uint64(n - 1)):
+        R[k] = x[k + 1, d]
+    for k in range(np.uint64(n - 1), np.uint64(lane_columns(n))):
+        R[k] = x[1, d]
+
+
+@njit(inline="always")
 def pair_accelerations_lanes(x, gm, n_active, eps2, acc, first, skip_first_pair, S):
     """:func:`pair_accelerations` with the bodies after the first in vector
     lanes, bit for bit, for ``first`` 0 or 1.  ``S`` is scratch of at least
     :data:`LANE_ROWS` rows and :func:`lane_columns` ``(N)`` columns."""
     n = x.shape[0]
     P = lane_columns(n)
-    for k in range(P):
-        # the padding repeats body 1: its sums are never read
-        i = k + 1 if k + 1 < n else 1
-        S[0, k] = x[i, 0]
-        S[1, k] = x[i, 1]
-        S[2, k] = x[i, 2]
-        S[3, k] = 0.0
-        S[4, k] = 0.0
-        S[5, k] = 0.0
     Pu = np.uint64(P)
+    # the positions and the zeroed sums, each in a loop of its own without a
+    # select on the index, so that LLVM stores them as vectors: the passes'
+    # vector loads then take them from the store buffer, where scalar stores
+    # would make each wait until they reach the cache
+    _columns_from(S[0], x, 0, n)
+    _columns_from(S[1], x, 1, n)
+    _columns_from(S[2], x, 2, n)
+    for r in range(3, 6):
+        A = S[r]
+        for k in range(Pu):
+            A[k] = 0.0
     real = np.uint64(P)
     if first == 0:
         # the central body (column none; body 1's where the pair (0, 1) is left
