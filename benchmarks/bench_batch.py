@@ -49,7 +49,8 @@ DT = 10 * u.day
 
 
 def lanes(bodies, b, scale=1e-10, seed=1):
-    """The arrays of ``advance_lanes`` for ``b`` displaced copies of ``bodies``."""
+    """The arrays of ``advance_lanes`` for ``b`` displaced copies of ``bodies``, and
+    the loop (:func:`orbits._kernels.wh_batch.advance_loop`)."""
     sim = orbits.Simulation(bodies, "wh", dt=DT, monitors=())
     st = sim.state
     m = sim.description().masses[st.order]
@@ -60,6 +61,7 @@ def lanes(bodies, b, scale=1e-10, seed=1):
     xj, vj, eta = wh_batch.to_lanes(x, v, gm)
     n_active = int(np.count_nonzero(m > 0))
     return dict(xj=xj, vj=vj, gm=gm, eta=eta, n_active=n_active, owed=np.zeros(b),
+                loop=wh_batch.advance_loop(len(m), n_active, b),
                 live=np.ones(b), status=np.zeros(b, dtype=np.int64),
                 good=np.zeros(b, dtype=np.int64), ws=wh_batch.lanes_workspace(len(m), b),
                 dt=sim.dt.to_value(bodies.units.unit("time")))
@@ -67,8 +69,10 @@ def lanes(bodies, b, scale=1e-10, seed=1):
 
 def advance(state, n):
     s = state
-    wh_batch.advance_lanes(s["xj"], s["vj"], s["gm"], s["eta"], s["n_active"], s["dt"], n,
-                           s["owed"], s["live"], s["status"], s["good"], *s["ws"])
+    # the loop an ensemble runs: the kick written out for the systems' size
+    # (wh_batch.advance_loop)
+    s["loop"](s["xj"], s["vj"], s["gm"], s["eta"], s["n_active"], s["dt"], n, s["owed"],
+              s["live"], s["status"], s["good"], *s["ws"])
 
 
 def main(argv=None):

@@ -172,10 +172,13 @@ def _run_lanes(lanes, spec):
         ssb0 = int(states[0].steps_since_base)
         steps0 = int(states[0].steps)
 
+        # the kick written out for this size of system where it is small
+        # enough (wh_batch.advance_loop), the same steps bit for bit
+        loop = _lanes.advance_loop(n, n_active, nb)
+
         def advance(k, h):
             if k > 0:
-                _lanes.advance_lanes(xj, vj, gm, eta, n_active, h, k, owed, live, status, good,
-                                     *ws)
+                loop(xj, vj, gm, eta, n_active, h, k, owed, live, status, good, *ws)
 
         def flush():
             k = len(marks)

@@ -190,22 +190,56 @@ def lanes_of(sims):
     return xj, vj, gm, eta
 
 
-def advance(xj, vj, gm, eta, n_active, dt, steps, owed=None):
-    nb = xj.shape[2]
+def advance(xj, vj, gm, eta, n_active, dt, steps, owed=None, unrolled=False):
+    # unrolled: the loop of advance_loop, whose kick is written out for the
+    # systems' size (the same steps bit for bit), else advance_lanes
+    n, _, nb = xj.shape
     owed = np.zeros(nb) if owed is None else owed
     live = np.ones(nb)
     status, good = np.zeros(nb, dtype=np.int64), np.zeros(nb, dtype=np.int64)
-    failed = W.advance_lanes(xj, vj, gm, eta, n_active, dt, steps, owed, live, status, good,
-                             *W.lanes_workspace(xj.shape[0], nb))
+    loop = W.advance_loop(n, n_active, nb) if unrolled else W.advance_lanes
+    failed = loop(xj, vj, gm, eta, n_active, dt, steps, owed, live, status, good,
+                  *W.lanes_workspace(n, nb))
     return failed, owed, live, status, good
 
 
+def test_the_unrolled_kick_is_the_loops_kick_bit_for_bit():
+    # interaction_kick_lanes and the kick written out for one size, on
+    # systems spread over many orders of magnitude, some lanes frozen, with
+    # test particles: the same velocities, signs of zeros included
+    rng = np.random.default_rng(5)
+    for n, n_active, nb in [(3, 3, 4), (6, 6, 16), (7, 5, 9), (10, 10, 8)]:
+        m = n * nb
+        X = rng.standard_normal((3, m)) * 10 ** rng.uniform(-1, 1.5, m)
+        V = rng.standard_normal((3, m))
+        GM = 10 ** rng.uniform(-9, -3, m)
+        GM[:nb] = 1.0
+        GM[n_active * nb:] = 0.0
+        MU = np.cumsum(GM.reshape(n, nb), axis=0).reshape(-1)
+        LF = (rng.random(m) < 0.8).astype(float)
+        LF = np.tile(LF[:nb], n)
+        d = np.zeros((8, m))
+        d[6] = GM / MU
+        want, got = V.copy(), V.copy()
+        W.interaction_kick_lanes(X, want, np.zeros((3, m)), np.zeros((3, m)), GM, MU, d[6],
+                                 n_active, 0.7, LF, nb, np.zeros((3, nb)), np.zeros((3, nb)),
+                                 np.zeros((4, nb)))
+        K = d.copy()
+        K[0:3] = X
+        K[3], K[4], K[5] = GM, MU, LF
+        W.unrolled_kick(n, n_active, nb)(K.reshape(-1), got.reshape(-1), 0.7)
+        assert np.array_equal(got, want) and np.array_equal(np.signbit(got), np.signbit(want))
+        assert not np.array_equal(got[:, nb:], V[:, nb:])
+
+
+@pytest.mark.parametrize("unrolled", [False, True])
 @pytest.mark.parametrize("nb", [1, 3, 5])
-def test_advance_lanes_is_wh_bit_for_bit(nb):
+def test_advance_lanes_is_wh_bit_for_bit(nb, unrolled):
     sims = systems(nb)
     xj, vj, gm, eta = lanes_of(sims)
     n = xj.shape[0]
-    failed, owed, live, status, good = advance(xj, vj, gm, eta, n, 10.0, 500)
+    failed, owed, live, status, good = advance(xj, vj, gm, eta, n, 10.0, 500,
+                                               unrolled=unrolled)
     assert failed == 0 and live.all() and (good == 500).all()
     for b, sim in enumerate(sims):
         sim.run(until=5000 * u.day, outputs=2, progress=False)
@@ -217,7 +251,8 @@ def test_advance_lanes_is_wh_bit_for_bit(nb):
         assert np.array_equal(x, sim.state.x) and np.array_equal(v, sim.state.v)
 
 
-def test_test_particles_and_a_short_last_step_bit_for_bit():
+@pytest.mark.parametrize("unrolled", [False, True])
+def test_test_particles_and_a_short_last_step_bit_for_bit(unrolled):
     sims = []
     for k in range(3):
         bodies = orbits.scenes.outer_solar_system()
@@ -226,8 +261,8 @@ def test_test_particles_and_a_short_last_step_bit_for_bit():
         sims.append(orbits.Simulation(bodies, "wh", dt=10 * u.day, monitors=()))
     xj, vj, gm, eta = lanes_of(sims)
     n_active = len(sims[0].state.order) - 1
-    _, owed, *_ = advance(xj, vj, gm, eta, n_active, 10.0, 300)
-    advance(xj, vj, gm, eta, n_active, 3.5, 1, owed)
+    _, owed, *_ = advance(xj, vj, gm, eta, n_active, 10.0, 300, unrolled=unrolled)
+    advance(xj, vj, gm, eta, n_active, 3.5, 1, owed, unrolled=unrolled)
     for b, sim in enumerate(sims):
         sim.run(until=3003.5 * u.day, outputs=2, progress=False)
         ws = sim.state.workspace
