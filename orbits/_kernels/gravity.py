@@ -194,19 +194,30 @@ def lane_columns(n):
 # sums (a further row written in the pass made LLVM keep the scalar form).
 
 @njit(inline="always")
+def _separation(X, Y, Z, k, xs, ys, zs, own, real):
+    # a source's separation from column k, and whether the column adds an
+    # exact zero (its own, or padding from real on)
+    return xs - X[k], ys - Y[k], zs - Z[k], (k == own) | (k >= real)
+
+
+@njit(inline="always")
+def _factor(dx, dy, dz, skip, eps2):
+    # 1 / r^3 of a separation, as the scalar pair loop computes it; 1 where
+    # the column is skipped
+    r2 = dx * dx + dy * dy + dz * dz + eps2
+    r2 = 1.0 if skip else r2
+    return 1.0 / (r2 * math.sqrt(r2))
+
+
+@njit(inline="always")
 def pull_rows(X, Y, Z, AX, AY, AZ, P, xs, ys, zs, ms, own, eps2, real):
     """The pull of a source at ``(xs, ys, zs)`` of ``G m = ms`` on the
     columns ``k < P`` of the rows ``X``, ``Y``, ``Z``, added to the sums
     ``AX``, ``AY``, ``AZ``; the column ``own`` and those from ``real`` on
     (padding) add an exact zero (see the notes above)."""
     for k in range(P):
-        dx = xs - X[k]
-        dy = ys - Y[k]
-        dz = zs - Z[k]
-        skip = (k == own) | (k >= real)
-        r2 = dx * dx + dy * dy + dz * dz + eps2
-        r2 = 1.0 if skip else r2
-        s = (0.0 if skip else ms) * (1.0 / (r2 * math.sqrt(r2)))
+        dx, dy, dz, skip = _separation(X, Y, Z, k, xs, ys, zs, own, real)
+        s = (0.0 if skip else ms) * _factor(dx, dy, dz, skip, eps2)
         AX[k] = AX[k] + s * dx
         AY[k] = AY[k] + s * dy
         AZ[k] = AZ[k] + s * dz
@@ -222,13 +233,8 @@ def pull_factors(X, Y, Z, F, P, xs, ys, zs, own, eps2, real):
     a square root and a division a pair, and pulls the lanes with
     :func:`pull_rows_factored`."""
     for k in range(P):
-        dx = xs - X[k]
-        dy = ys - Y[k]
-        dz = zs - Z[k]
-        skip = (k == own) | (k >= real)
-        r2 = dx * dx + dy * dy + dz * dz + eps2
-        r2 = 1.0 if skip else r2
-        F[k] = 1.0 / (r2 * math.sqrt(r2))
+        dx, dy, dz, skip = _separation(X, Y, Z, k, xs, ys, zs, own, real)
+        F[k] = _factor(dx, dy, dz, skip, eps2)
 
 
 @njit(inline="always")
@@ -236,10 +242,7 @@ def pull_rows_factored(X, Y, Z, AX, AY, AZ, P, xs, ys, zs, ms, own, F, real):
     """:func:`pull_rows` with its factors ``1 / r^3`` from ``F``
     (:func:`pull_factors` of the same source), bit for bit."""
     for k in range(P):
-        dx = xs - X[k]
-        dy = ys - Y[k]
-        dz = zs - Z[k]
-        skip = (k == own) | (k >= real)
+        dx, dy, dz, skip = _separation(X, Y, Z, k, xs, ys, zs, own, real)
         s = (0.0 if skip else ms) * F[k]
         AX[k] = AX[k] + s * dx
         AY[k] = AY[k] + s * dy

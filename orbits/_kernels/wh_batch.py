@@ -10,7 +10,10 @@ axis: Jacobi positions and velocities of shape (N, 3, B), masses of shape
 ``X[c, i B + b]``: the Kepler drifts, independent of each other, are then
 loops over all ``(N - 1) B`` rows of all systems at once, and the
 interaction kick is a few loops over the B systems per body and per pair
-(its sums over bodies run in the scalar kernel's order).  Every such loop
+(its sums over bodies run in the scalar kernel's order), or, for systems of
+3 to :data:`UNROLLED_KICK_BODIES` bodies, one loop over the systems with
+every pair written out for that size (:func:`advance_loop`; see "the kick
+unrolled for one size of system" below).  Every such loop
 does the same operations for each element, so that LLVM turns it into
 vector instructions (four systems in an AVX2 register, eight with AVX-512)
 without a line of hand-written vector code.  Two things keep LLVM from doing
