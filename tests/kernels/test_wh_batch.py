@@ -322,3 +322,19 @@ def test_record_lanes_gives_the_rows_an_output_records():
         assert np.array_equal(rows[b, :4], snap.monitors[:4])
         assert np.array_equal(rows[b, MONITOR_WIDTH:MONITOR_WIDTH + 3 * n], snap.x.ravel())
         assert np.array_equal(rows[b, MONITOR_WIDTH + 3 * n:], snap.v.ravel())
+
+
+def test_the_generated_kick_goes_to_its_folder_or_the_loops_run(tmp_path, monkeypatch):
+    # the kick's source lands in ORBITS_KERNEL_DIR (named for the kernels'
+    # sources); where that folder cannot be made, advance_loop falls back to
+    # advance_lanes instead of failing, and the steps are the same
+    monkeypatch.setenv("ORBITS_KERNEL_DIR", str(tmp_path))
+    W.unrolled_kick(4, 3, 3)
+    files = list(tmp_path.glob("orbits-kernels-*/wh_batch_kick_4_3_3.py"))
+    assert len(files) == 1 and "def kick(K, OUT, h):" in files[0].read_text()
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    monkeypatch.setenv("ORBITS_KERNEL_DIR", str(blocker))
+    assert W.advance_loop(4, 4, 7) is W.advance_lanes
+    assert W.advance_loop(2, 2, 16) is W.advance_lanes
+    assert W.advance_loop(W.UNROLLED_KICK_BODIES + 1, 3, 16) is W.advance_lanes
