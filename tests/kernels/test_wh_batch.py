@@ -227,7 +227,7 @@ def test_the_unrolled_kick_is_the_loops_kick_bit_for_bit():
         K = d.copy()
         K[0:3] = X
         K[3], K[4], K[5] = GM, MU, LF
-        W.unrolled_kick(n, n_active, nb)(K.reshape(-1), got.reshape(-1), 0.7)
+        W.unrolled_kick(n, n_active, nb)(K.reshape(-1), got.reshape(-1), 0.7, nb)
         assert np.array_equal(got, want) and np.array_equal(np.signbit(got), np.signbit(want))
         assert not np.array_equal(got[:, nb:], V[:, nb:])
 
@@ -331,10 +331,21 @@ def test_the_generated_kick_goes_to_its_folder_or_the_loops_run(tmp_path, monkey
     monkeypatch.setenv("ORBITS_KERNEL_DIR", str(tmp_path))
     W.unrolled_kick(4, 3, 3)
     files = list(tmp_path.glob("orbits-kernels-*/wh_batch_kick_4_3_3.py"))
-    assert len(files) == 1 and "def kick(K, OUT, h):" in files[0].read_text()
+    assert len(files) == 1 and "def kick(K, OUT, h, nb):" in files[0].read_text()
     blocker = tmp_path / "a-file"
     blocker.write_text("")
     monkeypatch.setenv("ORBITS_KERNEL_DIR", str(blocker))
     assert W.advance_loop(4, 4, 7) is W.advance_lanes
     assert W.advance_loop(2, 2, 16) is W.advance_lanes
     assert W.advance_loop(W.UNROLLED_KICK_BODIES + 1, 3, 16) is W.advance_lanes
+
+
+def test_a_loop_of_advance_loop_refuses_another_number_of_systems():
+    # its kick's offsets are those of the systems it was made for
+    sims = systems(3)
+    xj, vj, gm, eta = lanes_of(sims)
+    n = xj.shape[0]
+    loop = W.advance_loop(n, n, 4)
+    with pytest.raises(ValueError, match="number of systems"):
+        loop(xj, vj, gm, eta, n, 10.0, 5, np.zeros(3), np.ones(3), np.zeros(3, dtype=np.int64),
+             np.zeros(3, dtype=np.int64), *W.lanes_workspace(n, 3))
