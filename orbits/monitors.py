@@ -127,7 +127,14 @@ def vector_relative_error(values, reference, scale):
     ref = np.asarray(reference)
     norm = np.linalg.norm(ref)
     denom = norm if norm > 1e-14 * scale else scale
-    return np.linalg.norm(np.asarray(values) - ref, axis=-1) / denom
+    # the norm of each row summed component by component, as np.linalg.norm
+    # sums a row of three (the same floats), over whole columns: a norm along
+    # an axis of three took 5 ms for 10^5 rows, the columns 1 ms
+    values = np.asarray(values)
+    dx = values[..., 0] - ref[0]
+    dy = values[..., 1] - ref[1]
+    dz = values[..., 2] - ref[2]
+    return np.sqrt(dx * dx + dy * dy + dz * dz) / denom
 
 
 def growth_exponent(t, err):
