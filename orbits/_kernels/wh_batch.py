@@ -99,7 +99,8 @@ from .wh_lanes import drift_columns
 from .wisdom_holman import synchronize
 
 __all__ = ["CHECK_EVERY", "lanes_workspace", "kepler_drift_lanes", "interaction_kick_lanes",
-           "advance_lanes", "advance_loop", "unrolled_kick", "UNROLLED_KICK_BODIES", "record_lanes", "to_lanes", "from_lanes", "lane_inertial"]
+           "advance_lanes", "advance_loop", "unrolled_kick", "UNROLLED_KICK_BODIES",
+           "record_lanes", "to_lanes", "from_lanes", "lane_inertial"]
 
 #: Steps between the tests of the lanes' states for NaN and inf (as the
 #: scalar loops' ``check_every``): a block of this many steps is replayed for
@@ -124,7 +125,7 @@ def lanes_workspace(n, b):
     """
     m = n * b
     return (np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)),
-            np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((8, m)), np.zeros((3, m)),
+            np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((10, m)), np.zeros((3, m)),
             np.zeros((3, b)), np.zeros((3, b)), np.zeros((4, b)), np.zeros((3, m)),
             np.zeros((3, m)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((1, 3)),
             np.zeros((1, 3)), np.zeros(m))
@@ -302,7 +303,7 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
         1.0 for the elements of the lanes to drift, 0.0 for frozen ones.
     nb : int
         B, the systems.
-    d, fl : ndarray, shapes (8, N B) and (3, N B)
+    d, fl : ndarray, shapes (10, N B) and (3, N B)
         Scratch (the drift uses rows 0 to 5 of ``d``).
     one_x, one_v : ndarray, shape (1, 3)
         Scratch for the scalar drift of an element outside the lanes' domain.
@@ -614,8 +615,11 @@ def advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, goo
                 V[c, k] = vj[i, c, b]
             GM[k] = gm[i, b]
             MU[k] = eta[i, b]
-            # the kick's mass ratios, once a call rather than twice a step
+            # the kick's mass ratios, once a call rather than twice a step,
+            # and the masses where the unrolled kick reads them
             d[6, k] = gm[i, b] / eta[i, b]
+            d[8, k] = gm[i, b]
+            d[9, k] = eta[i, b]
             LF[k] = live[b]
     # every live lane owes the same: that of the first live one
     ow = 0.0
@@ -633,8 +637,8 @@ def advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, goo
                 ckv[c, k] = V[c, k]
         ow0 = ow
         for _ in range(blk):
-            ow = lane_step(X, V, GM, MU, n_active, dt, ow, LF, nb, XI, ACC, d, fl, s3, a3, t4,
-                       one_x, one_v)
+            ow = lane_step(X, V, GM, MU, n_active, dt, ow, LF, nb, XI, ACC, d, fl, s3, a3,
+                           t4, one_x, one_v)
         for b in range(nb):
             if live[b] == 0.0 or _lane_finite(X, V, nb, b):
                 continue
@@ -656,8 +660,8 @@ def advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, goo
                     for c in range(3):
                         px[i, c] = X[c, k]
                         pv[i, c] = V[c, k]
-                nxt = lane_step(X, V, GM, MU, n_active, dt, owr, lf1, nb, XI, ACC, d, fl, s3, a3,
-                            t4, one_x, one_v)
+                nxt = lane_step(X, V, GM, MU, n_active, dt, owr, lf1, nb, XI, ACC, d, fl, s3,
+                                a3, t4, one_x, one_v)
                 if not _lane_finite(X, V, nb, b):
                     for i in range(n):
                         k = i * nb + b
@@ -716,9 +720,10 @@ def advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, goo
 UNROLLED_KICK_BODIES = 10
 
 #: rows of the flat array the unrolled kick reads (rows of d, each B N long):
-#: the Jacobi positions, G m, G times the interior masses, the live flags
-#: (copied each step: the drift's scratch) and the Jacobi weights (row 6)
-_KX, _KGM, _KMU, _KLF, _KWQ = 0, 3, 4, 5, 6
+#: the Jacobi positions and the live flags (copied each step into rows of
+#: the drift's scratch), the Jacobi weights, G m and G times the interior
+#: masses (rows 6, 8 and 9, filled once a call by advance_lanes)
+_KX, _KLF, _KWQ, _KGM, _KMU = 0, 3, 6, 8, 9
 
 
 def _kick_source(n, n_active, nb):
@@ -832,20 +837,17 @@ def unrolled_kick(n, n_active, nb):
 
 
 def _unrolled_step_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4):
-    # the rows the unrolled kick reads, into d (rows 0 to 5 are the drift's
-    # scratch, free until the next drift; row 6 holds the Jacobi weights)
+    # the rows the unrolled kick reads that change from step to step (the
+    # positions; the live flags, which are lf1 when a lane is replayed) into
+    # rows of d that are the drift's scratch, free until the next drift
     m = X.shape[1]
     for r in range(3):
         A = X[r]
         B = d[_KX + r]
         for k in range(np.uint64(m)):
             B[k] = A[k]
-    G = d[_KGM]
-    U = d[_KMU]
     F = d[_KLF]
     for k in range(np.uint64(m)):
-        G[k] = GM[k]
-        U[k] = MU[k]
         F[k] = LF[k]
     if nb != KICK_SYSTEMS:  # noqa: F821 - bound by specialize
         raise ValueError("wh_batch: a loop of advance_loop takes the number of systems "

@@ -396,9 +396,7 @@ def resident_drift(xj, vj, eta, h, S):
                              S[_RY + 4], S[_RY + 5], S[_RTAKE], h, np.uint64(0), np.uint64(P))
     declined = 0
     if rejected:
-        for k in range(P):
-            S[_H, k] = h
-        declined = _resident_declined(xj, vj, eta, S, _RX, _RY, _RTAKE, P)
+        declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)
     for r in range(6):
         X = S[_RX + r]
         Y = S[_RY + r]
@@ -408,12 +406,11 @@ def resident_drift(xj, vj, eta, h, S):
 
 
 @njit(inline="always")
-def _resident_declined(xj, vj, eta, S, src, dst, take, P):
-    # the columns of the lanes' state that the drift declined (its verdict in
-    # row take): the scalar drift from their start (rows src .. src + 5), by
-    # their column's step (row _H of the drift's rows, or h where src is the
-    # state's own rows), into rows dst ..; a declined padding column becomes
-    # a copy of column 0.  Returns how many planets were declined.
+def _resident_declined(xj, vj, eta, h, S, src, dst, take, P):
+    # the columns of the lanes' state that the drift by h declined (its
+    # verdict in row take): the scalar drift from their start (rows src ..
+    # src + 5) into rows dst ..; a declined padding column becomes a copy of
+    # column 0.  Returns how many planets were declined.
     n = xj.shape[0]
     declined = 0
     for k in range(P):
@@ -424,7 +421,7 @@ def _resident_declined(xj, vj, eta, S, src, dst, take, P):
             for d in range(3):
                 xj[i, d] = S[src + d, k]
                 vj[i, d] = S[src + 3 + d, k]
-            kepler_drift(eta[i], xj, vj, i, S[_H, k])
+            kepler_drift(eta[i], xj, vj, i, h)
             for d in range(3):
                 S[dst + d, k] = xj[i, d]
                 S[dst + 3 + d, k] = vj[i, d]
@@ -476,7 +473,7 @@ def resident_drift_twice(xj, vj, eta, h, xs, vs, h2, S):
         B = S[_Y + r]
         for k in range(P):
             A[k] = B[k]
-    return _resident_declined(xj, vj, eta, S, _X, _RX, _TAKE, P)
+    return _resident_declined(xj, vj, eta, h, S, _X, _RX, _TAKE, P)
 
 
 @njit(inline="always")

@@ -218,7 +218,7 @@ def test_the_unrolled_kick_is_the_loops_kick_bit_for_bit():
         MU = np.cumsum(GM.reshape(n, nb), axis=0).reshape(-1)
         LF = (rng.random(m) < 0.8).astype(float)
         LF = np.tile(LF[:nb], n)
-        d = np.zeros((8, m))
+        d = np.zeros((10, m))
         d[6] = GM / MU
         want, got = V.copy(), V.copy()
         W.interaction_kick_lanes(X, want, np.zeros((3, m)), np.zeros((3, m)), GM, MU, d[6],
@@ -226,7 +226,7 @@ def test_the_unrolled_kick_is_the_loops_kick_bit_for_bit():
                                  np.zeros((4, nb)))
         K = d.copy()
         K[0:3] = X
-        K[3], K[4], K[5] = GM, MU, LF
+        K[3], K[8], K[9] = LF, GM, MU
         W.unrolled_kick(n, n_active, nb)(K.reshape(-1), got.reshape(-1), 0.7, nb)
         assert np.array_equal(got, want) and np.array_equal(np.signbit(got), np.signbit(want))
         assert not np.array_equal(got[:, nb:], V[:, nb:])
