@@ -26,7 +26,10 @@ output time (``exact_finish_time=1``) in the same Python loop.
 The cost of an output is the run's time minus the same run with two
 outputs, divided by the number of outputs: the median, over ``--repeats``
 pairs timed one after the other, of the pair's difference, after a warm-up
-that excludes compilation.
+that excludes compilation.  The ``+-`` column is half the interquartile
+range of the pairs' figures in memory: on a shared machine a few per cent
+of drift in the steps' speed moves an output's figure by a tenth of a
+microsecond at k = 10, where the outputs are a tenth of the run.
 Memory: the peak resident size of a process that streams 10^6 outputs to a
 file, against one that takes 10^4 (``--memory``), so that the difference is
 what the outputs keep in memory.
@@ -137,6 +140,16 @@ def _rebound(integrator, dt, n_out, k):
     return time.perf_counter() - t0
 
 
+def _spread(costs):
+    # half the interquartile range of the pairs' costs: how far the machine's
+    # noise moves one pair's figure (at k = 10 a 3 % drift of the steps is
+    # 0.1 us an output)
+    if len(costs) < 2:
+        return float("nan")
+    q1, _, q3 = statistics.quantiles(costs, n=4)
+    return (q3 - q1) / 2
+
+
 def _median(f, repeats):
     return statistics.median(f() for _ in range(repeats))
 
@@ -166,8 +179,8 @@ def main(argv=None):
     path = os.path.join(tempfile.mkdtemp(), "bench.h5")
     print(f"outer solar system, {n_out} outputs, median of {repeats}; "
           f"us per output beyond its steps")
-    print(f"{'integrator':10s} {'k':>4s} {'steps us':>9s} {'memory':>8s} {'hdf5':>8s} "
-          f"{'REBOUND loop':>13s} {'REB/memory':>11s}")
+    print(f"{'integrator':10s} {'k':>4s} {'steps us':>9s} {'memory':>8s} {'+-':>7s} "
+          f"{'hdf5':>8s} {'REBOUND loop':>13s} {'REB/memory':>11s}")
     worst = {"memory": 0.0, "hdf5": 0.0}
     for integrator, dt in SCENES:
         for k in (1, 10, 10.4):
@@ -197,6 +210,7 @@ def main(argv=None):
             worst["memory"] = max(worst["memory"], mem_cost)
             worst["hdf5"] = max(worst["hdf5"], h5_cost)
             print(f"{integrator:10s} {k:4g} {base / (k * n_out) * 1e6:9.3f} {mem_cost:8.3f} "
+                  f"{_spread([(p[1] - p[0]) / n_out * 1e6 for p in pairs]):7.3f} "
                   f"{h5_cost:8.3f} {reb_cost:13.3f} {reb_cost / mem_cost:11.1f}")
 
     ok = lambda c: "PASS" if c else "MISS"  # noqa: E731
