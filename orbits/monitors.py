@@ -142,7 +142,7 @@ def vector_relative_error(values, reference, scale):
         dz = values[..., 2] - ref[2]
         return np.sqrt(dx * dx + dy * dy + dz * dz) / denom
     out = np.empty(values.shape[0])
-    _inv.vector_errors(values, ref, float(denom), out)
+    _inv.error_kernels()[1](values, ref, float(denom), out)
     return out
 
 
@@ -311,8 +311,8 @@ def monitor_fields(rows, monitors, reference, scales, units, work=False):
         if rows.shape[1] > _inv.WORK_COLUMN:
             # relative_error of E + W in one pass over the rows
             err = np.empty(rows.shape[0])
-            _inv.relative_errors(rows[:, 0], w, float(ref),
-                                 float(_denominator(ref, scales[0])), err)
+            _inv.error_kernels()[0](rows[:, 0], w, float(ref),
+                                    float(_denominator(ref, scales[0])), err)
             out["energy_error"] = err
         else:
             out["energy_error"] = relative_error(rows[:, 0] + w, ref, scale=scales[0])

@@ -13,7 +13,7 @@ from ._jit import njit
 __all__ = ["energy", "angular_momentum", "momentum", "center_of_mass",
            "monitor_row", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
            "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS", "relative_errors",
-           "vector_errors"]
+           "vector_errors", "error_kernels"]
 
 # Bits of the ``which`` mask of monitor_row, and the columns they fill.
 ENERGY = 1
@@ -155,3 +155,22 @@ def vector_errors(values, reference, denom, out):
         dy = values[i, 1] - reference[1]
         dz = values[i, 2] - reference[2]
         out[i] = math.sqrt(dx * dx + dy * dy + dz * dz) / denom
+
+
+_ERROR_SIGNATURES = (
+    (relative_errors, "void(float64[:], float64[:], float64, float64, float64[:])"),
+    (vector_errors, "void(float64[:, :], float64[:], float64, float64[:])"))
+
+
+def error_kernels():
+    """:func:`relative_errors` and :func:`vector_errors`, each compiled (or
+    loaded from the disk cache) once for arrays of any layout and then
+    closed to new compilations, so that a contiguous array (a run's single
+    row, a file's monitor rows) converts to that one compilation instead of
+    making another: an ensemble's worker loads its kernels in its first
+    task only."""
+    for kernel, signature in _ERROR_SIGNATURES:
+        if not kernel.signatures:
+            kernel.compile(signature)
+            kernel.disable_compile()
+    return relative_errors, vector_errors
