@@ -33,7 +33,7 @@ __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_re
            "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
            "accelerate_pairwise_small", "accelerate_pairwise_rebound", "pair_accelerations",
            "accelerate_pairwise_lanes", "pair_accelerations_lanes", "lane_columns",
-           "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind", "pull_rows",
+           "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind", "pull_rows", "vector_doubles",
            "pull_factors", "pull_rows_factored"]
 
 
@@ -155,13 +155,80 @@ def accelerate_pairwise(x, gm, n_active, eps2, acc, work):
     return 0
 
 
-#: doubles in a 512-bit vector register (two AVX2 registers): the lanes'
-#: columns (:func:`pair_accelerations_lanes`, and the planets of
-#: :mod:`orbits._kernels.wh_lanes`) are padded to a multiple of it, so that
-#: no loop over them has a scalar remainder (with 4, the loops over 4 or 12
-#: columns ran partly or wholly in scalar code on an AVX-512 machine: a
-#: leapfrog step of 12 bodies 0.28 us against 0.19-0.20 with 8)
-LANE_WIDTH = 8
+# A loop that LLVM vectorises over the lanes' columns runs its vector body
+# over whole registers and the rest in scalar code, so the columns are
+# padded to a multiple of the register's doubles.  How wide a register LLVM
+# fills depends on the processor it compiles for: 512 bits (8 doubles) on
+# AMD's Zen 4 with AVX-512, but 256 bits (4) on Intel's AVX-512 processors,
+# where LLVM prefers them, and on AVX2 machines.  Padded to 4 on the Zen 4
+# machine, the loops over 4 or 12 columns ran partly or wholly in scalar
+# code (a leapfrog step of 12 bodies 0.28 us against 0.19-0.20 with 8);
+# padded to 8 on the Intel AVX-512 machine, a third of the work of 3 or 9 to
+# 12 columns went to padding (CPU time a step, two alternating runs: wh
+# with the Sun and three planets 0.21-0.26 us with 4 against 0.35 with 8,
+# four planets 0.24-0.26 against 0.36-0.38; leapfrog of 12 bodies 0.33-0.40
+# against 0.49, 13 bodies 0.36-0.43 against 0.52-0.58).  So the width is
+# asked of LLVM itself, for the processor and features numba compiles for:
+# a one-line loop vectorised as numba would (10 ms at import).  The
+# results do not depend on it: each lane's arithmetic is its own, and the
+# padding's is never read.
+
+_PROBE = """
+define void @probe({p} noalias nocapture %a, {p} noalias nocapture readonly %b, i64 %n) {{
+entry:
+  %c = icmp sgt i64 %n, 0
+  br i1 %c, label %loop, label %exit
+loop:
+  %i = phi i64 [ 0, %entry ], [ %next, %loop ]
+  %pa = getelementptr inbounds double, {p} %a, i64 %i
+  %pb = getelementptr inbounds double, {p} %b, i64 %i
+  %va = load double, {p} %pa
+  %vb = load double, {p} %pb
+  %m = fmul double %vb, 2.0
+  %s = fadd double %va, %m
+  store double %s, {p} %pa
+  %next = add nuw nsw i64 %i, 1
+  %done = icmp eq i64 %next, %n
+  br i1 %done, label %exit, label %loop
+exit:
+  ret void
+}}
+"""
+
+
+def vector_doubles():
+    """Doubles in the vector registers that LLVM fills when it vectorises a
+    loop of doubles for the processor numba compiles for: 8 or 4 (4 also
+    where the registers are narrower; 8 if LLVM cannot be asked)."""
+    try:
+        import llvmlite.binding as llvm
+        from numba.core import config
+        from numba.core.codegen import get_host_cpu_features
+        llvm.initialize_native_target()
+        llvm.initialize_native_asmprinter()
+        target = llvm.Target.from_default_triple()
+        cpu = config.CPU_NAME or llvm.get_host_cpu_name()
+        features = (config.CPU_FEATURES if config.CPU_FEATURES is not None
+                    else get_host_cpu_features())
+        machine = target.create_target_machine(cpu=cpu, features=features, opt=3)
+        try:
+            module = llvm.parse_assembly(_PROBE.format(p="ptr"))
+        except RuntimeError:                  # an LLVM with typed pointers
+            module = llvm.parse_assembly(_PROBE.format(p="double*"))
+        options = llvm.create_pipeline_tuning_options(speed_level=3)
+        options.loop_vectorization = True
+        passes = llvm.create_pass_builder(machine, options)
+        passes.getModulePassManager().run(module, passes)
+        return 8 if "<8 x double>" in str(module) else 4
+    except Exception:      # noqa: BLE001 - any failure: the wider padding, safe everywhere
+        return 8
+
+
+#: the lanes' columns (:func:`pair_accelerations_lanes`, and the planets of
+#: :mod:`orbits._kernels.wh_lanes`) are padded to a multiple of it: the
+#: doubles of the vector registers LLVM fills on this machine
+#: (:func:`vector_doubles`)
+LANE_WIDTH = vector_doubles()
 
 #: rows of the lanes' scratch: positions (0 to 2), sums (3 to 5) and the
 #: central body's factors 1 / r^3 (6)

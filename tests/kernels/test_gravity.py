@@ -198,3 +198,20 @@ def test_a_pass_with_kept_factors_is_the_plain_pass_bit_for_bit(own, real, eps2)
             d = x[k + 1] - x[0]
             r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2
             assert F[k] == 1.0 / (r2 * np.sqrt(r2))
+
+
+def test_the_lane_width_is_the_vector_width_llvm_fills_for_the_processor(monkeypatch):
+    # the lanes' padding (gravity.LANE_WIDTH) is the doubles of the vector
+    # registers LLVM fills for the processor numba compiles for: 512-bit
+    # registers on AMD's Zen 4, 256-bit ones on Intel's AVX-512 processors
+    # (where LLVM prefers them) and on AVX2-only ones (LLVM's processor tables)
+    from numba.core import config
+
+    from orbits._kernels import gravity as G
+    assert G.LANE_WIDTH == G.vector_doubles() and G.LANE_WIDTH in (4, 8)
+    avx512 = "+avx,+avx2,+fma,+avx512f,+avx512dq,+avx512vl,+avx512bw,+avx512cd"
+    for cpu, features, width in [("znver4", avx512, 8), ("sapphirerapids", avx512, 4),
+                                 ("haswell", "+avx,+avx2,+fma", 4)]:
+        monkeypatch.setattr(config, "CPU_NAME", cpu)
+        monkeypatch.setattr(config, "CPU_FEATURES", features)
+        assert G.vector_doubles() == width, cpu
