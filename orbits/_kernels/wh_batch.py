@@ -37,14 +37,17 @@ select, never a branch per lane:
   :func:`~orbits._kernels.kepler.kepler_drift`'s short-step path.  It first
   runs as the single system's lanes do
   (:func:`orbits._kernels.wh_lanes.drift_columns`: the starter, one
-  iteration and the f and g functions in one pass over every body of every
-  system), which takes the usual planetary step; the elements that pass
-  declines go to the scalar drift where they are few (at most one in
+  iteration and the f and g functions in passes over every body of every
+  system), which takes the usual planetary step; the elements those passes
+  decline go to the scalar drift where they are few (at most one in
   :data:`FEW`), else to the masked form below, which takes them all with
   their iterations (the Sun and eight planets at a day: Mercury in every
-  system).  The one pass took the outer solar system's drift from 0.055 to
+  system).  The passes took the outer solar system's drift from 0.055 to
   0.044-0.046 us a system and the batch of 16 from 1.31-1.41 to 1.20-1.24
-  times WHFast512's step (the batch of 8: 2.01 to 1.60).  The masked form:
+  times WHFast512's step (the batch of 8: 2.01 to 1.60; AMD machine); split
+  in two after the starter (see ``wh_lanes``), the 80 columns of 16 outer
+  solar systems take 9.3-10.3 ns each instead of 12.3 (Intel AVX-512
+  machine).  The masked form:
   the third-order Taylor starter of the universal anomaly and Danby's quartic
   iteration, repeated until every lane has converged (at most
   ``_SHORT_STEP_ITER`` times; a lane that has converged keeps its anomaly
@@ -98,7 +101,7 @@ from .status import Status
 from .wh_lanes import drift_columns
 from .wisdom_holman import synchronize
 
-__all__ = ["CHECK_EVERY", "lanes_workspace", "kepler_drift_lanes", "interaction_kick_lanes",
+__all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "lanes_workspace", "kepler_drift_lanes", "interaction_kick_lanes",
            "advance_lanes", "advance_loop", "unrolled_kick", "UNROLLED_KICK_BODIES",
            "record_lanes", "to_lanes", "from_lanes", "lane_inertial"]
 
@@ -107,11 +110,19 @@ __all__ = ["CHECK_EVERY", "lanes_workspace", "kepler_drift_lanes", "interaction_
 #: a lane that failed in it.
 CHECK_EVERY = 16
 
-#: The drift's one pass (:func:`orbits._kernels.wh_lanes.drift_columns`)
+#: The drift's passes (:func:`orbits._kernels.wh_lanes.drift_columns`)
 #: leaves the elements it declines to the scalar drift while they are at
 #: most one in FEW of all, and to the masked short-step path with its
 #: iterations (:func:`_masked_drift`) when there are more.
 FEW = 8
+
+#: rows of the scratch ``d``: the drift's end state (0-5), the kick's
+#: weights (6), the masked drift's lanes (7), the written-out kick's masses
+#: (8-9; its positions and live flags in 0-3 between drifts), and the rows
+#: the drift's first pass keeps for its second (_DT on, seven)
+_DT = 10
+SCRATCH_ROWS = _DT + 7
+
 
 def lanes_workspace(n, b):
     """The scratch arrays of :func:`advance_lanes` for ``b`` systems of ``n``
@@ -125,7 +136,7 @@ def lanes_workspace(n, b):
     """
     m = n * b
     return (np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)),
-            np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((10, m)), np.zeros((3, m)),
+            np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((SCRATCH_ROWS, m)), np.zeros((3, m)),
             np.zeros((3, b)), np.zeros((3, b)), np.zeros((4, b)), np.zeros((3, m)),
             np.zeros((3, m)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((1, 3)),
             np.zeros((1, 3)), np.zeros(m))
@@ -303,8 +314,8 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
         1.0 for the elements of the lanes to drift, 0.0 for frozen ones.
     nb : int
         B, the systems.
-    d, fl : ndarray, shapes (10, N B) and (3, N B)
-        Scratch (the drift uses rows 0 to 5 of ``d``).
+    d, fl : ndarray, shapes (:data:`SCRATCH_ROWS`, N B) and (3, N B)
+        Scratch (the drift uses rows 0 to 5 and 10 to 16 of ``d``).
     one_x, one_v : ndarray, shape (1, 3)
         Scratch for the scalar drift of an element outside the lanes' domain.
 
@@ -326,10 +337,11 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
             X0[k] += h * V0[k]
             X1[k] += h * V1[k]
             X2[k] += h * V2[k]
-    # the usual planetary step of every body of every system in one pass
+    # the usual planetary step of every body of every system in two passes
     # (orbits._kernels.wh_lanes.drift_columns, the scalar short-step path's
     # operations in its order), into rows 0 to 5 of d with the verdicts in
-    # fl[0]; the others, and frozen lanes, keep their start
+    # fl[0] (the first pass's results in rows _DT on); the others, and frozen
+    # lanes, keep their start
     Y0 = d[0]
     Y1 = d[1]
     Y2 = d[2]
@@ -338,8 +350,8 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     U2 = d[5]
     take = fl[0]
     alone = fl[2]
-    declined = drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, take, h,
-                             np.uint64(nb), np.uint64(m))
+    declined = drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, take, d, _DT,
+                             h, np.uint64(nb), np.uint64(m))
     for k in range(np.uint64(nb), np.uint64(m)):
         keep = take[k] * LF[k] != 0.0
         X0[k] = Y0[k] if keep else X0[k]

@@ -12,17 +12,18 @@ into vector instructions (four planets in an AVX2 register), and writes the
 result back.
 
 :func:`kepler_drift_lanes` drifts every planet, bit for bit as
-:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` does, in one pass
-over the columns: the scalar drift's short-step path
-(:func:`~orbits._kernels.kepler.kepler_drift`: the third-order starter of
-the universal anomaly, one of Danby's quartic iterations, the f and g
-functions) with the four-term Stumpff series
+:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` does, in two
+passes over the columns (:func:`drift_columns`): the scalar drift's
+short-step path (:func:`~orbits._kernels.kepler.kepler_drift`: the
+third-order starter of the universal anomaly, one of Danby's quartic
+iterations, the f and g functions) with the four-term Stumpff series
 (:func:`~orbits._kernels.kepler.stumpff_lane`).  This is the whole drift of
 a planetary step (a few hundredths of a radian of anomaly, where the
-starter is good to 1e-6 and one iteration converges), and one pass lets the
-processor overlap the planets' long chains of dependent operations: the
-eight planets' drift took 0.19 µs against 0.39 µs for the scalar drift
-(0.27 µs as three passes, starter, iteration and f and g, each a loop).  A
+starter is good to 1e-6 and one iteration converges), and passes over all
+the planets let the processor overlap their long chains of dependent
+operations: the eight planets' drift took 0.19 µs in one pass against 0.39
+µs for the scalar drift (0.27 µs as three passes, starter, iteration and f
+and g, each a loop; see "two passes" below for the split kept).  A
 lane is taken where the scalar path would have done exactly this
 (converged after one iteration, both Stumpff arguments within the
 four-term series, a positive radius at the end).  Every other planet (a
@@ -182,8 +183,11 @@ def _store(S, xj, vj, mu, off):
 
 
 @njit(inline="always")
-def _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k, h):
-    # column k drifted by h (see _pass_rows); 1 if it is not right, else 0
+def _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h):
+    # the first pass of column k's drift by h (see _pass_rows): the start's
+    # invariants and the starter of the anomaly, into rows t .. t + 6 of T
+    # (s, r0, 1 / r0, eta, beta, zeta, and 1.0 where the column is in the
+    # short-step domain with its starter in the four-term series)
     mu = MU[k]
     x0 = X0[k]
     y0 = X1[k]
@@ -195,6 +199,35 @@ def _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k, h):
     z = beta * s * s
     good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
             & (abs(z) <= _STUMPFF_SHORT_Z))
+    T[t, k] = s
+    T[t + 1, k] = r0
+    T[t + 2, k] = ir0
+    T[t + 3, k] = et
+    T[t + 4, k] = beta
+    T[t + 5, k] = zeta
+    T[t + 6, k] = 1.0 if good else 0.0
+
+
+@njit(inline="always")
+def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k, h):
+    # the second pass of column k's drift by h (see _pass_rows): from the
+    # first pass's rows of T, one quartic iteration and the f and g
+    # functions; 1 if it is not right, else 0
+    mu = MU[k]
+    x0 = X0[k]
+    y0 = X1[k]
+    z0 = X2[k]
+    vx0 = V0[k]
+    vy0 = V1[k]
+    vz0 = V2[k]
+    s = T[t, k]
+    r0 = T[t + 1, k]
+    ir0 = T[t + 2, k]
+    et = T[t + 3, k]
+    beta = T[t + 4, k]
+    zeta = T[t + 5, k]
+    good = T[t + 6, k] != 0.0
+    z = beta * s * s
     c0, c1, c2, c3, _ = stumpff_lane(z, False)
     d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
     s = s + d
@@ -214,36 +247,61 @@ def _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k, h):
     return 0 if take else 1
 
 
-def _pass_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, H, h0, k0, P):
-    # the usual planetary step in one pass over the columns k0 .. P - 1 of
-    # the rows (start X, V and mu; end Y, U; verdict tk_; each column's step
-    # H where step_of reads it): the starter, one quartic iteration and the
-    # f and g functions, all with the four-term Stumpff series; a column is
-    # right (its verdict 1) where the scalar path would have done exactly
-    # this: in the short-step domain, both Stumpff arguments within the
-    # four-term series, converged after one iteration, a positive radius at
-    # the end.  Every operation is the one kepler.short_step_anomaly and
+# Two passes.  The drift of one column is some 250 vector operations whose
+# chain of dependent ones (a square root, three divisions, the polynomials
+# between them) is several hundred cycles long.  In one loop the processor
+# holds about two columns' vectors in flight, so that a pass over many
+# columns runs at about the chain's length per two vectors: 12.2 ns a column
+# on the Intel AVX-512 machine (4 columns a vector).  Split after the
+# starter, each loop's body is half as long and more of them overlap: 9.3-9.7
+# ns a column from 16 columns on, 11.1 against 12.3 at 8 (repeated passes,
+# paired in one process).  The split after the iteration too (three passes)
+# took 15-16 ns.  In the Wisdom-Holman loop (a drift and a kick, paired in one
+# process, CPU time): the outer solar system 0.253-0.255 -> 0.235-0.238 us,
+# the Sun and eight planets 0.310-0.315 -> 0.294-0.297 us.  The first pass
+# keeps seven rows (the anomaly's start s, r0, 1 / r0, eta, beta, zeta and
+# its verdict), the same floats the one pass kept in registers, so the
+# drift is the same bit for bit.
+
+
+def _pass_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, H, h0, k0, P):
+    # the usual planetary step over the columns k0 .. P - 1 of the rows
+    # (start X, V and mu; end Y, U; verdict tk_; each column's step H where
+    # step_of reads it): the starter, one quartic iteration and the f and g
+    # functions, all with the four-term Stumpff series; a column is right
+    # (its verdict 1) where the scalar path would have done exactly this: in
+    # the short-step domain, both Stumpff arguments within the four-term
+    # series, converged after one iteration, a positive radius at the end.
+    # Every operation is the one kepler.short_step_anomaly and
     # kepler._short_coefficients do, in their order, so that a right column
-    # is bit for bit the scalar drift.  Returns how many columns are not
-    # right.
+    # is bit for bit the scalar drift.  Two passes, the starter's results
+    # kept in rows t .. t + 6 of T between them (see "two passes" below).
+    # Returns how many columns are not right.
+    for k in range(k0, P):
+        _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k,
+                      step_of(H, k, h0))  # noqa: F821 - bound by specialize
     rejected = 0
     for k in range(k0, P):
-        rejected += _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k,
-                            step_of(H, k, h0))  # noqa: F821 - bound by specialize
+        rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,
+                                   t, k, step_of(H, k, h0))  # noqa: F821
     return rejected
 
 
 @njit(inline="always")
-def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, h, k0, P):
+def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, h, k0, P):
     """The lanes' drift (see the module notes) of the columns ``k0 .. P - 1``
     by ``h``: from the start rows ``X``, ``V`` with ``MU``, into the end rows
     ``Y``, ``U``, and into ``tk_`` 1 for a column bit for bit the scalar
-    drift, 0 for one to leave to it; returns how many are left.  The drift
-    of :mod:`orbits._kernels.wh_batch`, whose columns are the bodies of many
-    systems."""
+    drift, 0 for one to leave to it; returns how many are left.  Rows ``t
+    .. t + 6`` of ``T`` (none of the others) keep the first pass's results.
+    The drift of :mod:`orbits._kernels.wh_batch`, whose columns are the
+    bodies of many systems."""
+    for k in range(k0, P):
+        _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h)
     rejected = 0
     for k in range(k0, P):
-        rejected += _column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, k, h)
+        rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,
+                                   t, k, h)
     return rejected
 
 
@@ -268,7 +326,7 @@ def _single_pass(S, h0, P):
     # every column of the scratch by the step h0
     return _pass_rows_one(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
                           S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
-                          S[_Y + 5], S[_TAKE], S[_H], h0, np.uint64(0), P)
+                          S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
 
 
 @njit(inline="always")
@@ -276,7 +334,7 @@ def _single_pass_steps(S, h0, P):
     # every column of the scratch by its own step (row _H)
     return _pass_rows_steps(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
                             S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
-                            S[_Y + 5], S[_TAKE], S[_H], h0, np.uint64(0), P)
+                            S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
 
 
 @njit
@@ -293,7 +351,7 @@ def kepler_drift_lanes(xj, vj, mu, h, S):
         Each row's Kepler ``G M``.
     h : float
         The step.
-    S : ndarray, shape (DRIFT_ROWS, 2 P)
+    S : ndarray, shape (SCRATCH_ROWS, 2 P)
         Scratch (:func:`lanes_scratch`), ``P`` (:func:`lane_columns`)
         ``>= N - 1`` a multiple of :data:`LANE_WIDTH`.
 
@@ -348,8 +406,10 @@ _RX, _RY, _RMU, _RTAKE, _RA, _RQ, _RW, _RK = (_R, _R + 6, _R + 12, _R + 13, _R +
 #: the central body's factors 1 / r^3 in the Jacobi kick (the drift's end
 #: rows, free during the kick)
 _RF = _RY
+#: the drift's first pass's results (seven rows, see _pass_rows)
+_T = _R + 24
 #: rows of the scratch of a loop that keeps its state in the lanes
-SCRATCH_ROWS = _R + 24
+SCRATCH_ROWS = _R + 31
 
 
 def lanes_scratch_shape(n):
@@ -393,7 +453,8 @@ def resident_drift(xj, vj, eta, h, S):
     P = lane_columns(n)
     rejected = drift_columns(S[_RX], S[_RX + 1], S[_RX + 2], S[_RX + 3], S[_RX + 4],
                              S[_RX + 5], S[_RMU], S[_RY], S[_RY + 1], S[_RY + 2], S[_RY + 3],
-                             S[_RY + 4], S[_RY + 5], S[_RTAKE], h, np.uint64(0), np.uint64(P))
+                             S[_RY + 4], S[_RY + 5], S[_RTAKE], S, _T, h, np.uint64(0),
+                             np.uint64(P))
     declined = 0
     if rejected:
         declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)
