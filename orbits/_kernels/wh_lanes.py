@@ -209,10 +209,28 @@ def _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h):
 
 
 @njit(inline="always")
-def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k, h):
-    # the second pass of column k's drift by h (see _pass_rows): from the
-    # first pass's rows of T, one quartic iteration and the f and g
-    # functions; 1 if it is not right, else 0
+def _iterate_column(T, t, k, h):
+    # the second pass of column k's drift by h: one quartic iteration from
+    # the first pass's rows, the new anomaly into row t + 7 of T and 1.0 where
+    # it has converged into row t + 8
+    s = T[t, k]
+    r0 = T[t + 1, k]
+    et = T[t + 3, k]
+    beta = T[t + 4, k]
+    zeta = T[t + 5, k]
+    z = beta * s * s
+    c0, c1, c2, c3, _ = stumpff_lane(z, False)
+    d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
+    s = s + d
+    done = abs(d) <= _SHORT_STEP_TOL * abs(s)
+    T[t + 7, k] = s
+    T[t + 8, k] = 1.0 if done else 0.0
+
+
+@njit(inline="always")
+def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k):
+    # the third pass of column k's drift: the f and g functions of the
+    # iterated anomaly; 1 if the column is not right, else 0
     mu = MU[k]
     x0 = X0[k]
     y0 = X1[k]
@@ -220,18 +238,12 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
     vx0 = V0[k]
     vy0 = V1[k]
     vz0 = V2[k]
-    s = T[t, k]
+    s = T[t + 7, k]
     r0 = T[t + 1, k]
     ir0 = T[t + 2, k]
     et = T[t + 3, k]
     beta = T[t + 4, k]
     zeta = T[t + 5, k]
-    good = T[t + 6, k] != 0.0
-    z = beta * s * s
-    c0, c1, c2, c3, _ = stumpff_lane(z, False)
-    d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
-    s = s + d
-    done = abs(d) <= _SHORT_STEP_TOL * abs(s)
     z = beta * s * s
     c0, c1, c2, c3, _ = stumpff_lane(z, False)
     # (_advance's sigma is this et: the same expression of the start)
@@ -242,7 +254,8 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
     U0[k] = vx0 + (fdot * x0 + gdm1 * vx0)
     U1[k] = vy0 + (fdot * y0 + gdm1 * vy0)
     U2[k] = vz0 + (fdot * z0 + gdm1 * vz0)
-    take = good & done & (abs(z) <= _STUMPFF_SHORT_Z) & (r > 0.0)
+    take = ((T[t + 6, k] != 0.0) & (T[t + 8, k] != 0.0) & (abs(z) <= _STUMPFF_SHORT_Z)
+            & (r > 0.0))
     tk_[k] = 1.0 if take else 0.0
     return 0 if take else 1
 
@@ -280,10 +293,12 @@ def _pass_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, H,
     for k in range(k0, P):
         _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k,
                       step_of(H, k, h0))  # noqa: F821 - bound by specialize
+    for k in range(k0, P):
+        _iterate_column(T, t, k, step_of(H, k, h0))  # noqa: F821
     rejected = 0
     for k in range(k0, P):
         rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,
-                                   t, k, step_of(H, k, h0))  # noqa: F821
+                                   t, k)
     return rejected
 
 
@@ -298,10 +313,12 @@ def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t,
     bodies of many systems."""
     for k in range(k0, P):
         _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h)
+    for k in range(k0, P):
+        _iterate_column(T, t, k, h)
     rejected = 0
     for k in range(k0, P):
         rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,
-                                   t, k, h)
+                                   t, k)
     return rejected
 
 
@@ -406,10 +423,10 @@ _RX, _RY, _RMU, _RTAKE, _RA, _RQ, _RW, _RK = (_R, _R + 6, _R + 12, _R + 13, _R +
 #: the central body's factors 1 / r^3 in the Jacobi kick (the drift's end
 #: rows, free during the kick)
 _RF = _RY
-#: the drift's first pass's results (seven rows, see _pass_rows)
+#: the drift's passes' results (nine rows, see _pass_rows)
 _T = _R + 24
 #: rows of the scratch of a loop that keeps its state in the lanes
-SCRATCH_ROWS = _R + 31
+SCRATCH_ROWS = _R + 33
 
 
 def lanes_scratch_shape(n):
