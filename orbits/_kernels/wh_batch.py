@@ -45,9 +45,10 @@ select, never a branch per lane:
   system).  The passes took the outer solar system's drift from 0.055 to
   0.044-0.046 us a system and the batch of 16 from 1.31-1.41 to 1.20-1.24
   times WHFast512's step (the batch of 8: 2.01 to 1.60; AMD machine); split
-  in two after the starter (see ``wh_lanes``), the 80 columns of 16 outer
-  solar systems take 9.3-10.3 ns each instead of 12.3 (Intel AVX-512
-  machine).  The masked form:
+  in three loops (starter, iteration, f and g; see ``wh_lanes``), the 80
+  columns of 16 outer solar systems take 7.7-8.1 ns each instead of 12.2,
+  and the batch of 16 0.53 instead of 0.67 times WHFast512's step (the
+  drift inlined into the step too; Intel AVX-512 machine).  The masked form:
   the third-order Taylor starter of the universal anomaly and Danby's quartic
   iteration, repeated until every lane has converged (at most
   ``_SHORT_STEP_ITER`` times; a lane that has converged keeps its anomaly
@@ -345,7 +346,7 @@ def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
             X0[k] += h * V0[k]
             X1[k] += h * V1[k]
             X2[k] += h * V2[k]
-    # the usual planetary step of every body of every system in two passes
+    # the usual planetary step of every body of every system in three passes
     # (orbits._kernels.wh_lanes.drift_columns, the scalar short-step path's
     # operations in its order), into rows 0 to 5 of d with the verdicts in
     # fl[0] (the passes' results in rows _DT on); the others, and frozen

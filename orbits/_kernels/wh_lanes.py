@@ -23,7 +23,7 @@ starter is good to 1e-6 and one iteration converges), and passes over all
 the planets let the processor overlap their long chains of dependent
 operations: the eight planets' drift took 0.19 µs in one pass against 0.39
 µs for the scalar drift (0.27 µs as three passes, starter, iteration and f
-and g, each a loop; see "two passes" below for the split kept).  A
+and g, each a loop; see "three passes" below for the split kept).  A
 lane is taken where the scalar path would have done exactly this
 (converged after one iteration, both Stumpff arguments within the
 four-term series, a positive radius at the end).  Every other planet (a
@@ -260,20 +260,22 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
     return 0 if take else 1
 
 
-# Two passes.  The drift of one column is some 250 vector operations whose
+# Three passes.  The drift of one column is some 250 vector operations whose
 # chain of dependent ones (a square root, three divisions, the polynomials
 # between them) is several hundred cycles long.  In one loop the processor
 # holds about two columns' vectors in flight, so that a pass over many
 # columns runs at about the chain's length per two vectors: 12.2 ns a column
-# on the Intel AVX-512 machine (4 columns a vector).  Split after the
-# starter, each loop's body is half as long and more of them overlap: 9.3-9.7
-# ns a column from 16 columns on, 11.1 against 12.3 at 8 (repeated passes,
-# paired in one process).  The split after the iteration too (three passes)
-# took 15-16 ns.  In the Wisdom-Holman loop (a drift and a kick, paired in one
-# process, CPU time): the outer solar system 0.253-0.255 -> 0.235-0.238 us,
-# the Sun and eight planets 0.310-0.315 -> 0.294-0.297 us.  The first pass
-# keeps seven rows (the anomaly's start s, r0, 1 / r0, eta, beta, zeta and
-# its verdict), the same floats the one pass kept in registers, so the
+# on the Intel AVX-512 machine (4 columns a vector).  Split into loops with
+# shorter bodies, more of them overlap (repeated passes, paired in one
+# process): after the starter (two passes) 9.3-9.7 ns a column from 16
+# columns on; after the iteration too (three) 7.7-8.1 ns, and 11.0 against
+# 12.5 at 8 columns; the f and g functions apart from the new state (four)
+# 7.2-7.7 ns, but 14 at 8 columns.  So three: in the Wisdom-Holman loop (a
+# drift and a kick, paired in one process, CPU time) the outer solar system
+# took 0.907 and the Sun and eight planets 0.917 of the one pass's time
+# (0.228 against 0.252 us, 0.285 against 0.314).  The passes keep nine rows
+# (the start's s, r0, 1 / r0, eta, beta, zeta and verdict, the iterated s
+# and its verdict), the same floats the one pass kept in registers, so the
 # drift is the same bit for bit.
 
 
@@ -287,8 +289,8 @@ def _pass_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, H,
     # series, converged after one iteration, a positive radius at the end.
     # Every operation is the one kepler.short_step_anomaly and
     # kepler._short_coefficients do, in their order, so that a right column
-    # is bit for bit the scalar drift.  Two passes, the starter's results
-    # kept in rows t .. t + 6 of T between them (see "two passes" below).
+    # is bit for bit the scalar drift.  Three passes, their results kept in
+    # rows t .. t + 8 of T between them (see "three passes" above).
     # Returns how many columns are not right.
     for k in range(k0, P):
         _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k,
@@ -308,7 +310,7 @@ def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t,
     by ``h``: from the start rows ``X``, ``V`` with ``MU``, into the end rows
     ``Y``, ``U``, and into ``tk_`` 1 for a column bit for bit the scalar
     drift, 0 for one to leave to it; returns how many are left.  Rows ``t
-    .. t + 6`` of ``T`` (none of the others) keep the first pass's results.
+    .. t + 8`` of ``T`` (none of the others) keep the passes' results.
     The drift of :mod:`orbits._kernels.wh_batch`, whose columns are the
     bodies of many systems."""
     for k in range(k0, P):
