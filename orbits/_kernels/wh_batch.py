@@ -331,9 +331,10 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
 
 @njit(inline="always")
 def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
-    # kepler_drift_lanes, inlined into the loops that step (as a call of its
-    # own it cost the batch of 4 outer solar systems 27 ns a column against
-    # 10 inlined)
+    # kepler_drift_lanes, inlined into the loops that step: as a call of its
+    # own its passes took 27 ns a column for the batch of 4 outer solar
+    # systems, against 10 inlined (12 against 10 at 8 systems, 11 against 10
+    # at 16; the cause not found)
     m = X.shape[1]
     X0 = X[0]
     X1 = X[1]
@@ -370,21 +371,32 @@ def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
         V1[k] = U1[k] if keep else V1[k]
         V2[k] = U2[k] if keep else V2[k]
         alone[k] = 1.0 if (LF[k] != 0.0) & (take[k] == 0.0) else 0.0
-    # the live elements the pass declined (a step long against an orbit, more
-    # than one iteration): few, the scalar drift, from the same start; more
-    # than one in FEW, the masked short-step path in every element with its
-    # iterations (the Sun and eight planets at a day: Mercury in every system)
+    # the live elements the passes declined (a step long against an orbit,
+    # more than one iteration), in a function of its own (inlined at both of
+    # the loop's steps, with the scalar drift's solver inlined in it twice,
+    # they took the batch loop's compilation from 19 to 104 s)
     if declined:
-        n_alone = 0
+        _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v)
+
+
+@njit
+def _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
+    # the elements of fl[2] that the passes declined: few, the scalar drift,
+    # from the same start; more than one in FEW, the masked short-step path
+    # in every element with its iterations (the Sun and eight planets at a
+    # day: Mercury in every system)
+    m = X.shape[1]
+    alone = fl[2]
+    n_alone = 0
+    for k in range(np.uint64(nb), np.uint64(m)):
+        n_alone += 1 if alone[k] != 0.0 else 0
+    if FEW * n_alone > m - nb:
+        mask = d[7]
         for k in range(np.uint64(nb), np.uint64(m)):
-            n_alone += 1 if alone[k] != 0.0 else 0
-        if FEW * n_alone > m - nb:
-            mask = d[7]
-            for k in range(np.uint64(nb), np.uint64(m)):
-                mask[k] = alone[k]
-            _masked_drift(X, V, MU, h, mask, nb, d, fl, one_x, one_v)
-        else:
-            _scalar_drifts(X, V, MU, h, alone, nb, one_x, one_v)
+            mask[k] = alone[k]
+        _masked_drift(X, V, MU, h, mask, nb, d, fl, one_x, one_v)
+    else:
+        _scalar_drifts(X, V, MU, h, alone, nb, one_x, one_v)
 
 
 @njit
