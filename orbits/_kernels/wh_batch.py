@@ -99,7 +99,7 @@ from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP
 from .kepler import stumpff_lane as _stumpff_lane
 from .invariants import MONITOR_WIDTH, monitor_row
 from .status import Status
-from .wh_lanes import drift_columns
+from .wh_lanes import column_start, drift_columns
 from .wisdom_holman import synchronize
 
 __all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "lanes_workspace", "kepler_drift_lanes", "interaction_kick_lanes",
@@ -254,13 +254,7 @@ def _masked_drift(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     alone = fl[2]
     # the starter (orbits._kernels.kepler.short_step_anomaly)
     for k in range(np.uint64(nb), np.uint64(m)):
-        mu = MU[k]
-        x0 = X0[k]
-        y0 = X1[k]
-        z0 = X2[k]
-        vx0 = V0[k]
-        vy0 = V1[k]
-        vz0 = V2[k]
+        mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
         r2, v2, r0, ir0, et, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, h)
         good = (h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2 and mu > 0.0 and h != 0.0
                 and abs(beta * s * s) <= _SHORT_STEP_Z)

@@ -104,7 +104,7 @@ from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, f_and_g, ke
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
            "lanes_scratch", "kepler_drift_lanes",
-           "drift_columns", "SCRATCH_ROWS", "lanes_scratch_shape", "resident_load",
+           "drift_columns", "column_start", "SCRATCH_ROWS", "lanes_scratch_shape", "resident_load",
            "resident_store", "resident_drift_twice", "resident_drift", "resident_finite",
            "resident_kick",
            "resident_jump_kick"]
@@ -183,18 +183,19 @@ def _store(S, xj, vj, mu, off):
 
 
 @njit(inline="always")
+def column_start(X0, X1, X2, V0, V1, V2, MU, k):
+    """Column ``k``'s Kepler ``G M`` and start ``(x, y, z, vx, vy, vz)``, from
+    rows laid out as :func:`drift_columns` reads them."""
+    return MU[k], X0[k], X1[k], X2[k], V0[k], V1[k], V2[k]
+
+
+@njit(inline="always")
 def _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h):
     # the first pass of column k's drift by h (see _pass_rows): the start's
     # invariants and the starter of the anomaly, into rows t .. t + 6 of T
     # (s, r0, 1 / r0, eta, beta, zeta, and 1.0 where the column is in the
     # short-step domain with its starter in the four-term series)
-    mu = MU[k]
-    x0 = X0[k]
-    y0 = X1[k]
-    z0 = X2[k]
-    vx0 = V0[k]
-    vy0 = V1[k]
-    vz0 = V2[k]
+    mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
     r2, v2, r0, ir0, et, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, h)
     z = beta * s * s
     good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
@@ -231,13 +232,7 @@ def _iterate_column(T, t, k, h):
 def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k):
     # the third pass of column k's drift: the f and g functions of the
     # iterated anomaly; 1 if the column is not right, else 0
-    mu = MU[k]
-    x0 = X0[k]
-    y0 = X1[k]
-    z0 = X2[k]
-    vx0 = V0[k]
-    vy0 = V1[k]
-    vz0 = V2[k]
+    mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
     s = T[t + 7, k]
     r0 = T[t + 1, k]
     ir0 = T[t + 2, k]
