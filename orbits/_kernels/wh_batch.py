@@ -103,8 +103,8 @@ from .wh_lanes import column_start, drift_columns
 from .wisdom_holman import synchronize
 
 __all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "lanes_workspace", "kepler_drift_lanes",
-           "interaction_kick_lanes", "advance_lanes", "advance_loop", "unrolled_kick", "UNROLLED_KICK_BODIES",
-           "record_lanes", "to_lanes", "from_lanes", "lane_inertial"]
+           "interaction_kick_lanes", "advance_lanes", "advance_loop", "unrolled_kick",
+           "UNROLLED_KICK_BODIES", "record_lanes", "to_lanes", "from_lanes", "lane_inertial"]
 
 #: Steps between the tests of the lanes' states for NaN and inf (as the
 #: scalar loops' ``check_every``): a block of this many steps is replayed for
