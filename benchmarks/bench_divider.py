@@ -117,7 +117,7 @@ def main(argv=None):
     if not ok512:
         print(f"WHFast512 not timed: {why}")
     scenes = [s for s in bench_wh.scenes() if len(s[1]) > 2]
-    print(f"{"scene":36s} {'factors':>8s} {'drifts':>7s} {'floor us':>9s} "
+    print(f"{'scene':36s} {'factors':>8s} {'drifts':>7s} {'floor us':>9s} "
           f"{'whfast512 us':>13s} {'floor/512':>10s}")
     for name, bodies, dt in scenes:
         sim = orbits.Simulation(bodies, "wh", dt=dt, monitors=())
