@@ -12,7 +12,7 @@ into vector instructions (four planets in an AVX2 register), and writes the
 result back.
 
 :func:`kepler_drift_lanes` drifts every planet, bit for bit as
-:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` does, in two
+:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` does, in three
 passes over the columns (:func:`drift_columns`): the scalar drift's
 short-step path (:func:`~orbits._kernels.kepler.kepler_drift`: the
 third-order starter of the universal anomaly, one of Danby's quartic
@@ -22,8 +22,9 @@ a planetary step (a few hundredths of a radian of anomaly, where the
 starter is good to 1e-6 and one iteration converges), and passes over all
 the planets let the processor overlap their long chains of dependent
 operations: the eight planets' drift took 0.19 µs in one pass against 0.39
-µs for the scalar drift (0.27 µs as three passes, starter, iteration and f
-and g, each a loop; see "three passes" below for the split kept).  A
+µs for the scalar drift (0.27 µs in an earlier split into three loops; the
+split now kept, and why it pays on the Intel AVX-512 machine, under "three
+passes" below).  A
 lane is taken where the scalar path would have done exactly this
 (converged after one iteration, both Stumpff arguments within the
 four-term series, a positive radius at the end).  Every other planet (a
@@ -308,15 +309,9 @@ def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t,
     .. t + 8`` of ``T`` (none of the others) keep the passes' results.
     The drift of :mod:`orbits._kernels.wh_batch`, whose columns are the
     bodies of many systems."""
-    for k in range(k0, P):
-        _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h)
-    for k in range(k0, P):
-        _iterate_column(T, t, k, h)
-    rejected = 0
-    for k in range(k0, P):
-        rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,
-                                   t, k)
-    return rejected
+    # every column by h (_pass_rows with _one_step reads no row of steps)
+    return _pass_rows_one(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, MU, h,
+                          k0, P)
 
 
 @njit(inline="always")

@@ -65,8 +65,9 @@ def drift_lanes(xj, vj, h):
     X = np.ascontiguousarray(xj.transpose(1, 0, 2).reshape(3, n * nb))
     V = np.ascontiguousarray(vj.transpose(1, 0, 2).reshape(3, n * nb))
     fl = np.zeros((3, n * nb))
-    W.kepler_drift_lanes(X, V, np.ones(n * nb), h, np.ones(n * nb), nb, np.zeros((W.SCRATCH_ROWS, n * nb)),
-                         fl, np.zeros((1, 3)), np.zeros((1, 3)))
+    W.kepler_drift_lanes(X, V, np.ones(n * nb), h, np.ones(n * nb), nb,
+                         np.zeros((W.SCRATCH_ROWS, n * nb)), fl, np.zeros((1, 3)),
+                         np.zeros((1, 3)))
     xj[...] = X.reshape(3, n, nb).transpose(1, 0, 2)
     vj[...] = V.reshape(3, n, nb).transpose(1, 0, 2)
     return fl[2, nb:2 * nb].copy()
