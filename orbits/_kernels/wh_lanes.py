@@ -309,9 +309,19 @@ def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t,
     .. t + 8`` of ``T`` (none of the others) keep the passes' results.
     The drift of :mod:`orbits._kernels.wh_batch`, whose columns are the
     bodies of many systems."""
-    # every column by h (_pass_rows with _one_step reads no row of steps)
-    return _pass_rows_one(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, MU, h,
-                          k0, P)
+    # _pass_rows's loops with the one step h, written out again: as a call
+    # of _pass_rows_one (specialised with _one_step) the batch's step took
+    # 0.13 instead of 0.104-0.109 us a system at 16 systems, and 0.28
+    # instead of 0.165 at 4 (paired runs)
+    for k in range(k0, P):
+        _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h)
+    for k in range(k0, P):
+        _iterate_column(T, t, k, h)
+    rejected = 0
+    for k in range(k0, P):
+        rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,
+                                   t, k)
+    return rejected
 
 
 @njit(inline="always")
