@@ -12,6 +12,12 @@ compilation options are the same everywhere and can be changed once.
 * ``fastmath`` is off: results must be reproducible and comparable bit for bit.
   The one exception is the parallel gravity kernel, which allows
   re-association of its inner sums so that they vectorise (see there).
+* :func:`fma` is a fused multiply-add, ``a * b + c`` with one rounding
+  (LLVM's ``llvm.fma``): correctly rounded by IEEE 754 on every machine, so
+  the Kepler drift that uses it gives the same bits everywhere, where
+  fastmath's contraction would fuse whatever the target allows.  Processors
+  with AVX2 have it in hardware; elsewhere LLVM calls the C library's
+  ``fma``, which is slower but gives the same result.
 * ``nrt=False`` in :func:`specialize` (numba's ``_nrt`` option) compiles a loop
   without reference counting, for loops that allocate nothing.  Every array
   that a kernel inlined with ``inline="always"`` receives is a new reference
@@ -28,8 +34,10 @@ import pathlib
 import types
 
 import numba
+from numba.core import types as nbtypes
+from numba.extending import intrinsic
 
-__all__ = ["njit", "njit_parallel", "specialize", "KERNEL_STAMP", "NUMBA_OPTIONS"]
+__all__ = ["njit", "njit_parallel", "specialize", "fma", "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -62,6 +70,18 @@ def _compile(func, options):
         func.__qualname__ = qualname
     dispatcher.__qualname__ = qualname
     return dispatcher
+
+
+@intrinsic
+def fma(typingctx, a, b, c):
+    """``a * b + c`` rounded once (see the module notes); float64 arguments,
+    in compiled code only."""
+    sig = nbtypes.float64(nbtypes.float64, nbtypes.float64, nbtypes.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.fma(*args)
+
+    return sig, codegen
 
 
 def njit_parallel(func=None, **overrides):

@@ -51,7 +51,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import fma, njit
 
 __all__ = [
     "STATUS_OK",
@@ -84,6 +84,9 @@ __all__ = [
     "short_start",
     "quartic_step",
     "f_and_g",
+    "dot3",
+    "radius",
+    "advanced",
     "advance_by_anomaly",
     "DRIFT_MAX_ITER",
     "bracketed_anomaly",
@@ -955,10 +958,7 @@ def _stumpff_short(z):
     ``|z| <= _STUMPFF_SHORT_Z`` four terms of each series, in Estrin's form
     (two independent halves, for a shorter chain of dependent operations)."""
     if -_STUMPFF_SHORT_Z <= z <= _STUMPFF_SHORT_Z:
-        z2 = z * z
-        c2 = (0.5 - z * (1.0 / 24)) + z2 * ((1.0 / 720) - z * (1.0 / 40320))
-        c3 = (1.0 / 6 - z * (1.0 / 120)) + z2 * ((1.0 / 5040) - z * (1.0 / 362880))
-        return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+        return _estrin(z)
     return _stumpff_inline(z)
 
 
@@ -1025,11 +1025,13 @@ _LANE_QUARTERINGS = 3
 
 @njit(inline="always")
 def _estrin(z):
-    # _stumpff_short's four-term series, as written there
+    # _stumpff_short's four terms of each series, in Estrin's form with fused
+    # multiply-adds: c2 = (1/2 - z/4!) + z^2 (1/6! - z/8!), c3 = (1/3! -
+    # z/5!) + z^2 (1/7! - z/9!), c0 = 1 - z c2, c1 = 1 - z c3
     z2 = z * z
-    c2 = (0.5 - z * (1.0 / 24)) + z2 * ((1.0 / 720) - z * (1.0 / 40320))
-    c3 = (1.0 / 6 - z * (1.0 / 120)) + z2 * ((1.0 / 5040) - z * (1.0 / 362880))
-    return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+    c2 = fma(z2, fma(-z, 1.0 / 40320, 1.0 / 720), fma(-z, 1.0 / 24, 0.5))
+    c3 = fma(z2, fma(-z, 1.0 / 362880, 1.0 / 5040), fma(-z, 1.0 / 120, 1.0 / 6))
+    return fma(-z, c2, 1.0), fma(-z, c3, 1.0), c2, c3
 
 
 @njit(inline="always")
@@ -1078,22 +1080,49 @@ def stumpff_lane(z, general):
 
 
 @njit(inline="always")
+def dot3(a0, a1, a2, b0, b1, b2):
+    """``a . b`` as the short-step drift computes it, with fused
+    multiply-adds: ``((a0 b0) + a1 b1) + a2 b2``, each sum rounded once with
+    its product."""
+    return fma(a2, b2, fma(a1, b1, a0 * b0))
+
+
+@njit(inline="always")
+def radius(r0, sig, zeta, G1, G2):
+    """``r = r0 + sigma G1 + zeta G2``, the radius after a step by the
+    anomaly whose ``G1 = s c1``, ``G2 = s^2 c2`` (``sigma = x0 . v0``), with
+    fused multiply-adds; the quartic iteration's derivative and the f and g
+    functions share it."""
+    return fma(zeta, G2, fma(sig, G1, r0))
+
+
+@njit(inline="always")
+def advanced(a, b, p, q):
+    """One component after a short step, as an increment of its start ``a``
+    so that no digit of it is lost: ``a + (p a + q b)`` with ``q b`` the
+    larger term (``g v0`` for a position, ``fdot x0`` for a velocity; ``p``
+    is ``f - 1`` or ``gdot - 1``), rounded once with ``p a``."""
+    return a + fma(q, b, p * a)
+
+
+@njit(inline="always")
 def short_start(mu, x0, y0, z0, vx0, vy0, vz0, dt):
     """The start's invariants and the third-order Taylor starter of the
     universal anomaly for a step ``dt``: ``(r2, v2, r0, 1 / r0, eta = x0 . v0,
     beta, zeta, s)``.  The one arithmetic of :func:`short_step_anomaly`, of
     the planets' lanes (:mod:`.wh_lanes`) and of the systems' lanes
     (:mod:`.wh_batch`), which must agree bit for bit."""
-    r2 = x0 * x0 + y0 * y0 + z0 * z0
-    v2 = vx0 * vx0 + vy0 * vy0 + vz0 * vz0
+    r2 = dot3(x0, y0, z0, x0, y0, z0)
+    v2 = dot3(vx0, vy0, vz0, vx0, vy0, vz0)
     r0 = math.sqrt(r2)
     ir0 = 1.0 / r0
-    eta = x0 * vx0 + y0 * vy0 + z0 * vz0
-    beta = 2.0 * mu * ir0 - v2
-    zeta = mu - beta * r0
+    eta = dot3(x0, y0, z0, vx0, vy0, vz0)
+    beta = fma(2.0 * mu, ir0, -v2)
+    zeta = fma(-beta, r0, mu)
     w = dt * ir0
-    s = w * (1.0 + w * (-0.5 * eta * ir0
-                        + w * ((3.0 * eta * eta * ir0 * ir0 - zeta * ir0) * _SIXTH)))
+    e = eta * ir0
+    # s = w (1 + w (-e / 2 + w (3 e^2 - zeta / r0) / 6))
+    s = w * fma(w, fma(w, fma(3.0 * e, e, -zeta * ir0) * _SIXTH, -0.5 * e), 1.0)
     return r2, v2, r0, ir0, eta, beta, zeta, s
 
 
@@ -1105,14 +1134,17 @@ def quartic_step(s, r0, eta, beta, zeta, c0, c1, c2, c3, dt):
     r)``, ``fk`` the k-th derivative of Kepler's equation ``f``.  Shared as
     :func:`short_start` is."""
     G1 = s * c1
-    G2 = s * s * c2
-    G3 = s * s * s * c3
-    f = r0 * s + eta * G2 + zeta * G3 - dt
-    ir = 1.0 / (r0 + eta * G1 + zeta * G2)
+    ss = s * s
+    G2 = ss * c2
+    G3 = ss * s * c3
+    # f = r0 s + eta G2 + zeta G3 - dt, from the difference r0 s - dt rounded once
+    f = fma(zeta, G3, fma(eta, G2, fma(r0, s, -dt)))
+    ir = 1.0 / radius(r0, eta, zeta, G1, G2)
     d1 = -f * ir
-    a = 0.5 * (eta * c0 + zeta * G1) * ir
-    b = (zeta * c0 - beta * eta * G1) * ir * _SIXTH
-    return d1 * (1.0 + d1 * (-a + d1 * (2.0 * a * a - b)))
+    a = 0.5 * fma(eta, c0, zeta * G1) * ir
+    b = fma(zeta, c0, -(beta * eta) * G1) * ir * _SIXTH
+    # d1 (1 + d1 (-a + d1 (2 a^2 - b)))
+    return d1 * fma(d1, fma(d1, fma(2.0 * a, a, -b), -a), 1.0)
 
 
 @njit(inline="always")
@@ -1122,10 +1154,10 @@ def f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2):
     r, 1 / r, f - 1, g, fdot, gdot - 1)``.  Shared as :func:`short_start` is."""
     G1 = s * c1
     G2 = s * s * c2
-    r = r0 + sig * G1 + zeta * G2
+    r = radius(r0, sig, zeta, G1, G2)
     ir = 1.0 / r
     fm1 = -mu * G2 * ir0
-    g = r0 * G1 + sig * G2
+    g = fma(sig, G2, r0 * G1)
     fdot = -mu * G1 * ir0 * ir
     gdm1 = -mu * G2 * ir
     return G1, G2, r, ir, fm1, g, fdot, gdm1
@@ -1166,12 +1198,12 @@ def _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1):
     coefficients, written as increments (``f - 1``, ``g dot - 1``) so that a
     short step loses no digits of the start: ``x = x0 + ((f - 1) x0 + g v0)``,
     ``v = v0 + (f dot x0 + (g dot - 1) v0)``."""
-    x[i, 0] = x0 + (fm1 * x0 + g * vx0)
-    x[i, 1] = y0 + (fm1 * y0 + g * vy0)
-    x[i, 2] = z0 + (fm1 * z0 + g * vz0)
-    v[i, 0] = vx0 + (fdot * x0 + gdm1 * vx0)
-    v[i, 1] = vy0 + (fdot * y0 + gdm1 * vy0)
-    v[i, 2] = vz0 + (fdot * z0 + gdm1 * vz0)
+    x[i, 0] = advanced(x0, vx0, fm1, g)
+    x[i, 1] = advanced(y0, vy0, fm1, g)
+    x[i, 2] = advanced(z0, vz0, fm1, g)
+    v[i, 0] = advanced(vx0, x0, gdm1, fdot)
+    v[i, 1] = advanced(vy0, y0, gdm1, fdot)
+    v[i, 2] = advanced(vz0, z0, gdm1, fdot)
 
 
 @njit(inline="always")
@@ -1180,7 +1212,7 @@ def _short_coefficients(mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta):
     # advance_by_anomaly), with what the drift's tangent reuses: (c0 .. c3,
     # sigma = x0 . v0, r, 1 / r, f - 1, g, fdot, gdot - 1); r <= 0 (or NaN)
     # where the step must go to the bracketed solver
-    sig = x0 * vx0 + y0 * vy0 + z0 * vz0
+    sig = dot3(x0, y0, z0, vx0, vy0, vz0)
     c0, c1, c2, c3 = _stumpff_short(beta * s * s)
     _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2)
     return c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1

@@ -28,8 +28,10 @@ and a batch of one is several times slower than ``wh`` on its own.
 
 Each system gets, bit for bit, the arithmetic of the scalar kernels of
 :mod:`orbits._kernels.wisdom_holman`: the same operations in the same order
-(fastmath is off, so LLVM neither reassociates nor fuses them, and a vector
-instruction rounds each element as its scalar form does).  Where the
+(fastmath is off, so LLVM neither reassociates nor fuses them; the Kepler
+helpers' fused multiply-adds are explicit, :func:`orbits._kernels._jit.fma`,
+in the scalar code too; and a vector instruction rounds each element as its
+scalar form does).  Where the
 scalar code branches, the lanes compute both sides and keep one with a
 select, never a branch per lane:
 
@@ -94,7 +96,8 @@ import numpy as np
 from ._jit import KERNEL_STAMP, njit, specialize
 from .coordinates import interior_gm, to_jacobi
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
-                     _STUMPFF_SHORT_Z, f_and_g, kepler_drift, quartic_step, short_start)
+                     _STUMPFF_SHORT_Z, advanced, dot3, f_and_g, kepler_drift, quartic_step,
+                     short_start)
 # the Stumpff functions without a branch (shared with orbits._kernels.wh_lanes)
 from .kepler import stumpff_lane as _stumpff_lane
 from .invariants import MONITOR_WIDTH, monitor_row
@@ -197,17 +200,17 @@ def _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF, 
         vx0 = V0[k]
         vy0 = V1[k]
         vz0 = V2[k]
-        sig = x0 * vx0 + y0 * vy0 + z0 * vz0
+        sig = dot3(x0, y0, z0, vx0, vy0, vz0)
         c0, c1, c2, c3, inside = _stumpff_lane(beta * s * s, general)
         _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2)
         live = LF[k] != 0.0
         take = live and ok_[k] != 0.0 and cv_[k] != 0.0 and inside and r > 0.0
-        X0[k] = x0 + (fm1 * x0 + g * vx0) if take else x0
-        X1[k] = y0 + (fm1 * y0 + g * vy0) if take else y0
-        X2[k] = z0 + (fm1 * z0 + g * vz0) if take else z0
-        V0[k] = vx0 + (fdot * x0 + gdm1 * vx0) if take else vx0
-        V1[k] = vy0 + (fdot * y0 + gdm1 * vy0) if take else vy0
-        V2[k] = vz0 + (fdot * z0 + gdm1 * vz0) if take else vz0
+        X0[k] = advanced(x0, vx0, fm1, g) if take else x0
+        X1[k] = advanced(y0, vy0, fm1, g) if take else y0
+        X2[k] = advanced(z0, vz0, fm1, g) if take else z0
+        V0[k] = advanced(vx0, x0, gdm1, fdot) if take else vx0
+        V1[k] = advanced(vy0, y0, gdm1, fdot) if take else vy0
+        V2[k] = advanced(vz0, z0, gdm1, fdot) if take else vz0
         leave = live and not take
         alone[k] = 1.0 if leave else 0.0
         n_alone += 1 if leave else 0
