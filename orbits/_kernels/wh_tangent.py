@@ -759,7 +759,7 @@ def _kernels(coordinates, terms, key, cache):
     """The bound tangent kernels: (to internal, perturbation, corrector,
     synchronize)."""
     to_internal, from_internal, pert, term_kick, term_tangent = _CONVERSIONS[coordinates]
-    nrt = not cache
+    nrt = _runtime(terms, cache)
     # the tangent kernels are calls, not inlined: a step's tangent costs far
     # more than a call, and inlining them all into every loop and corrector
     # took minutes to compile
@@ -779,6 +779,14 @@ def _kernels(coordinates, terms, key, cache):
     sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt, drift=_drift,
                       from_internal=from_internal, apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
+
+
+def _runtime(terms, cache):
+    # numba's runtime (reference counts, allocation) for a loop that a user's
+    # function joins (not cached), or whose force terms' Jacobians build their
+    # small work arrays (orbits._kernels.terms); without it numba refuses to
+    # compile them
+    return not cache or terms is not None
 
 
 def _key(coordinates, force):
@@ -806,7 +814,7 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
     from .variational import chaos_update, renormalise
     key = _key(coordinates, force)
     cache = force.cache
-    nrt = not cache
+    nrt = _runtime(terms, cache)
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, key, cache)
     recorder = specialize(_tangent_record, key, cache=cache, nrt=nrt, synchronize=sync,
                           _record=force.recorder)
