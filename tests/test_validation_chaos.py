@@ -149,12 +149,18 @@ def test_quick_section_against_rebound(tmp_path):
         ours, same = r["ours"], r["rebound_same"]
         if max(ours["megno"], same["megno"]) < chaos.REGULAR_BELOW:
             # From the same floats and tangent the two codes integrate the same
-            # tangent map: ln|delta| agrees to rounding (measured 1e-11 relative
-            # on regular orbits), and <Y> by what the two quadratures of its
-            # integral leave, about 2 ln|delta| / steps = 3.5e-3 (measured
-            # 3.5e-3 at every regular point); the 0.05 bounds it
+            # tangent map.  Ours reads the tangent at the step's internal
+            # point, before the half drift it defers to the next step, where
+            # REBOUND's is synchronised: half a step of 216 days, 0.5-1 % of
+            # the test planet's revolution, by which the tangent's periodic
+            # part moves.  So ln|delta| differs by a small offset of either
+            # sign (measured 0.0023-0.0091 at the quick regular points, after
+            # 8023 steps), and <Y> by that and what the two quadratures of its
+            # integral leave (measured +0.009 at every quick regular point,
+            # +0.0023 over the full run); the 0.05 bounds both
             assert abs(ours["megno"] - same["megno"]) < chaos.MEGNO_GOAL
-            assert ours["lyapunov"] == pytest.approx(same["lyapunov"], rel=1e-8)
+            t = r["ours"]["steps"] * chaos.DT_DAYS
+            assert abs(ours["lyapunov"] - same["lyapunov"]) * t < chaos.MEGNO_GOAL
     m = rows[-1]
     st = chaos.map_statistics(m)
     assert st["failed"] == 0
