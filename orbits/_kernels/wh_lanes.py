@@ -487,7 +487,7 @@ def resident_drift(xj, vj, eta, h, S):
     for r in range(6):
         X = S[_RX + r]
         Y = S[_RY + r]
-        for k in range(P):
+        for k in range(np.uint64(P)):
             X[k] = Y[k]
     return declined
 
