@@ -95,6 +95,7 @@ import numpy as np
 
 from ._jit import KERNEL_STAMP, njit, specialize
 from .coordinates import interior_gm, to_jacobi
+from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
                      _STUMPFF_SHORT_Z, advanced, dot3, f_and_g, kepler_drift, quartic_step,
                      short_start)
@@ -139,11 +140,10 @@ def lanes_workspace(n, b):
     [(3, 12), (3, 12)]
     """
     m = n * b
-    return (np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)), np.zeros((3, m)),
-            np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((SCRATCH_ROWS, m)), np.zeros((3, m)),
-            np.zeros((3, b)), np.zeros((3, b)), np.zeros((4, b)), np.zeros((3, m)),
-            np.zeros((3, m)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((1, 3)),
-            np.zeros((1, 3)), np.zeros(m))
+    z = aligned_zeros   # each array from a cache line on, as the planets' lanes'
+    return (z((3, m)), z((3, m)), z((3, m)), z((3, m)), z(m), z(m), z(m), z((SCRATCH_ROWS, m)),
+            z((3, m)), z((3, b)), z((3, b)), z((4, b)), z((3, m)), z((3, m)), z((n, 3)),
+            z((n, 3)), z((1, 3)), z((1, 3)), z(m))
 
 
 @njit(inline="always")

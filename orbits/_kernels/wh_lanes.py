@@ -105,7 +105,7 @@ import numpy as np
 from ._jit import njit, specialize
 # the planets' columns, padded to a multiple of the lane width (shared with the
 # gravity kernels' lanes)
-from .gravity import (LANE_WIDTH, lane_columns, pull_factors, pull_rows,
+from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pull_rows,
                       pull_rows_factored)
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, advanced, f_and_g,
                      kepler_drift, quartic_step, short_start, stumpff_lane)
@@ -145,7 +145,7 @@ def lanes_scratch(n):
     (``resident_*``)
     for ``n`` bodies, shape (:data:`SCRATCH_ROWS`, 2 :func:`lane_columns`
     ``(n)``)."""
-    return np.zeros(lanes_scratch_shape(n))
+    return aligned_zeros(lanes_scratch_shape(n))
 
 
 @njit(inline="always")
