@@ -87,6 +87,7 @@ __all__ = [
     "dot3",
     "radius",
     "advanced",
+    "advanced_state",
     "advance_by_anomaly",
     "DRIFT_MAX_ITER",
     "bracketed_anomaly",
@@ -1106,6 +1107,18 @@ def advanced(a, b, p, q):
 
 
 @njit(inline="always")
+def advanced_state(x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1):
+    """The state after a short step from ``(x0, v0)`` with the Lagrange
+    coefficients ``f - 1``, ``g``, ``fdot``, ``gdot - 1``: each component
+    :func:`advanced`, ``x = x0 + ((f - 1) x0 + g v0)``, ``v = v0 + (fdot x0 +
+    (gdot - 1) v0)``.  The scalar drift, the planets' lanes and the systems'
+    lanes all write their end state from it."""
+    return (advanced(x0, vx0, fm1, g), advanced(y0, vy0, fm1, g), advanced(z0, vz0, fm1, g),
+            advanced(vx0, x0, gdm1, fdot), advanced(vy0, y0, gdm1, fdot),
+            advanced(vz0, z0, gdm1, fdot))
+
+
+@njit(inline="always")
 def short_start(mu, x0, y0, z0, vx0, vy0, vz0, dt):
     """The start's invariants and the third-order Taylor starter of the
     universal anomaly for a step ``dt``: ``(r2, v2, r0, 1 / r0, eta = x0 . v0,
@@ -1198,12 +1211,8 @@ def _apply_f_and_g(x, v, i, x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1):
     coefficients, written as increments (``f - 1``, ``g dot - 1``) so that a
     short step loses no digits of the start: ``x = x0 + ((f - 1) x0 + g v0)``,
     ``v = v0 + (f dot x0 + (g dot - 1) v0)``."""
-    x[i, 0] = advanced(x0, vx0, fm1, g)
-    x[i, 1] = advanced(y0, vy0, fm1, g)
-    x[i, 2] = advanced(z0, vz0, fm1, g)
-    v[i, 0] = advanced(vx0, x0, gdm1, fdot)
-    v[i, 1] = advanced(vy0, y0, gdm1, fdot)
-    v[i, 2] = advanced(vz0, z0, gdm1, fdot)
+    (x[i, 0], x[i, 1], x[i, 2], v[i, 0], v[i, 1], v[i, 2]) = advanced_state(
+        x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot, gdm1)
 
 
 @njit(inline="always")

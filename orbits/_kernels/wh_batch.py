@@ -97,7 +97,7 @@ from ._jit import KERNEL_STAMP, njit, specialize
 from .coordinates import interior_gm, to_jacobi
 from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
-                     _STUMPFF_SHORT_Z, advanced, dot3, f_and_g, kepler_drift, quartic_step,
+                     _STUMPFF_SHORT_Z, advanced_state, dot3, f_and_g, kepler_drift, quartic_step,
                      short_start)
 # the Stumpff functions without a branch (shared with orbits._kernels.wh_lanes)
 from .kepler import stumpff_lane as _stumpff_lane
@@ -205,12 +205,14 @@ def _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF, 
         _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2)
         live = LF[k] != 0.0
         take = live and ok_[k] != 0.0 and cv_[k] != 0.0 and inside and r > 0.0
-        X0[k] = advanced(x0, vx0, fm1, g) if take else x0
-        X1[k] = advanced(y0, vy0, fm1, g) if take else y0
-        X2[k] = advanced(z0, vz0, fm1, g) if take else z0
-        V0[k] = advanced(vx0, x0, gdm1, fdot) if take else vx0
-        V1[k] = advanced(vy0, y0, gdm1, fdot) if take else vy0
-        V2[k] = advanced(vz0, z0, gdm1, fdot) if take else vz0
+        x1, y1, z1, vx1, vy1, vz1 = advanced_state(x0, y0, z0, vx0, vy0, vz0, fm1, g, fdot,
+                                                   gdm1)
+        X0[k] = x1 if take else x0
+        X1[k] = y1 if take else y0
+        X2[k] = z1 if take else z0
+        V0[k] = vx1 if take else vx0
+        V1[k] = vy1 if take else vy0
+        V2[k] = vz1 if take else vz0
         leave = live and not take
         alone[k] = 1.0 if leave else 0.0
         n_alone += 1 if leave else 0

@@ -107,7 +107,7 @@ from ._jit import njit, specialize
 # gravity kernels' lanes)
 from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pull_rows,
                       pull_rows_factored)
-from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, advanced, f_and_g,
+from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, advanced_state, f_and_g,
                      kepler_drift, quartic_step, short_start, stumpff_lane)
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
@@ -251,12 +251,8 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
     c0, c1, c2, c3, _ = stumpff_lane(z, False)
     # (_advance's sigma is this et: the same expression of the start)
     _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, et, zeta, c1, c2)
-    Y0[k] = advanced(x0, vx0, fm1, g)
-    Y1[k] = advanced(y0, vy0, fm1, g)
-    Y2[k] = advanced(z0, vz0, fm1, g)
-    U0[k] = advanced(vx0, x0, gdm1, fdot)
-    U1[k] = advanced(vy0, y0, gdm1, fdot)
-    U2[k] = advanced(vz0, z0, gdm1, fdot)
+    Y0[k], Y1[k], Y2[k], U0[k], U1[k], U2[k] = advanced_state(x0, y0, z0, vx0, vy0, vz0, fm1,
+                                                              g, fdot, gdm1)
     take = ((T[t + 6, k] != 0.0) & (T[t + 8, k] != 0.0) & (abs(z) <= _STUMPFF_SHORT_Z)
             & (r > 0.0))
     tk_[k] = 1.0 if take else 0.0
