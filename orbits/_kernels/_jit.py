@@ -27,6 +27,9 @@ compilation options are the same everywhere and can be changed once.
   problem) and 40 ns for the democratic heliocentric one.  Without the
   runtime the loop cannot create arrays: numba refuses to compile one that
   tries.
+* :mod:`._inlining` makes numba's ``inline="always"`` quicker to compile
+  (each inlined function's front end once, and one copy of its scope per
+  copy of its IR): the same code, in half the time for the largest loops.
 """
 
 import hashlib
@@ -36,6 +39,8 @@ import types
 import numba
 from numba.core import types as nbtypes
 from numba.extending import intrinsic
+
+from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "fma", "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
