@@ -1421,7 +1421,8 @@ class Simulation(Driven):
             outputs = total + 1
             while outputs > 2 and not _marks_ok(plan._replace(outputs=outputs), total):
                 outputs -= 1
-            warnings.warn(f"the run has only {total} steps: taking {outputs} outputs "
+            steps = f"{total} step" + ("" if total == 1 else "s")
+            warnings.warn(f"the run has only {steps}: taking {outputs} outputs "
                           f"instead of the default {DEFAULT_OUTPUTS}", OrbitsWarning,
                           stacklevel=4)
             plan = plan._replace(outputs=outputs)
