@@ -37,18 +37,13 @@ import contextlib
 import copy
 import inspect
 
-__all__ = ["ACTIVE", "disabled", "cached_front_ends"]
+__all__ = ["ACTIVE", "disabled"]
 
 #: whether numba's inliner is patched here (False where its shape differs)
 ACTIVE = False
 
 _enabled = True
 _front_ends = {}
-
-
-def cached_front_ends():
-    """How many inlined functions' front ends are kept (for the tests)."""
-    return len(_front_ends)
 
 
 @contextlib.contextmanager
@@ -67,7 +62,8 @@ class _SharedMemo:
     """Stands for the :mod:`copy` module inside numba's inliner: while
     ``active``, the deep copies of blocks of one scope share a memo."""
 
-    def __init__(self):
+    def __init__(self, block_type):
+        self._block_type = block_type
         self.active = False
         self._scope = None
         self._memo = None
@@ -78,7 +74,7 @@ class _SharedMemo:
         self._memo = None
 
     def deepcopy(self, obj, memo=None):
-        if self.active and memo is None and isinstance(obj, _Block):
+        if self.active and memo is None and isinstance(obj, self._block_type):
             if obj.scope is not self._scope:
                 # the first block of another IR (the inliner copies the
                 # callee, then copies that copy, whose scope is new)
@@ -89,10 +85,6 @@ class _SharedMemo:
 
     def __getattr__(self, name):
         return getattr(copy, name)
-
-
-_Block = None
-_shared = _SharedMemo()
 
 
 def _compatible(icc):
@@ -112,7 +104,7 @@ def _compatible(icc):
 
 
 def _install():
-    global ACTIVE, _Block
+    global ACTIVE
     try:
         import numba.core.inline_closurecall as icc
         from numba.core import ir
@@ -120,7 +112,7 @@ def _install():
         return
     if not _compatible(icc):  # pragma: no cover - another numba version
         return
-    _Block = ir.Block
+    shared = _SharedMemo(ir.Block)
     own = icc.InlineWorker.inline_function
 
     def inline_function(self, caller_ir, block, i, function, arg_typs=None):
@@ -133,15 +125,15 @@ def _install():
         callee_ir = _front_ends.get(key)
         if callee_ir is None:
             callee_ir = _front_ends[key] = self.run_untyped_passes(function)
-        _shared.reset(True)
+        shared.reset(True)
         try:
             return self.inline_ir(caller_ir, block, i, callee_ir,
                                   function.__code__.co_freevars, arg_typs=arg_typs)
         finally:
-            _shared.reset(False)
+            shared.reset(False)
 
     icc.InlineWorker.inline_function = inline_function
-    icc.copy = _shared
+    icc.copy = shared
     ACTIVE = True
 
 

@@ -103,7 +103,7 @@ def test_the_blocks_of_one_copy_share_one_copy_of_their_scope():
         var = s.redefine("x", loc)
         block.append(ir.Assign(ir.Const(1.0, loc), var, loc))
         blocks.append(block)
-    shim = _inlining._SharedMemo()
+    shim = _inlining._SharedMemo(ir.Block)
     shim.reset(True)
     c0, c1, c2 = (shim.deepcopy(b) for b in blocks)
     # copies, their variables' scope copied once for the first two blocks
