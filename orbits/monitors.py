@@ -330,6 +330,21 @@ def monitor_fields(rows, monitors, reference, scales, units, work=False):
     return out
 
 
+def monitor_field_names(monitors, columns, work=False):
+    """The keys :func:`monitor_fields` returns for ``monitors``, rows of
+    ``columns`` columns and ``work``, without computing them (a run's result
+    computes its fields when they are first read)."""
+    names = []
+    if "energy" in monitors:
+        names += ["energy", "energy_error"] + (["work"] if work else [])
+    if "angular_momentum" in monitors:
+        names += ["angular_momentum", "angular_momentum_error"]
+    names += [k for k in ("momentum", "center_of_mass") if k in monitors]
+    if columns > _inv.MONITOR_COLUMNS.index("megno"):
+        names += [k for k in ("megno", "lyapunov", "fli") if k in monitors]
+    return tuple(names)
+
+
 def _work_column(rows):
     """The work column of monitor rows (or of one row); 0.0 where the rows have
     none (written before it was kept)."""

@@ -148,7 +148,7 @@ class Result:
     (<Quantity 10. yr>, (11, 2, 3), Unit("AU"))
     """
 
-    def __init__(self, **fields):
+    def __init__(self, _deferred=(), **fields):
         self.monitor = None
         self.energy = self.energy_error = self.work = None
         self.angular_momentum = self.angular_momentum_error = None
@@ -166,6 +166,37 @@ class Result:
         self.frame = None
         for k, v in fields.items():
             setattr(self, k, v)
+        # fields made when first read: ``_deferred`` holds (names, make)
+        # pairs, ``make()`` returning a dict of those names (a run's arrays
+        # with their units, its monitor series); reading any of them makes
+        # the group.  A run called many times for a few steps each then does
+        # not pay for the Quantities it never reads.
+        self._deferred = {}
+        for names, make in _deferred:
+            for name in names:
+                self.__dict__.pop(name, None)
+                self._deferred[name] = (names, make)
+
+    def __getattr__(self, name):
+        # only for names not set: a deferred field, made now
+        deferred = self.__dict__.get("_deferred")
+        if deferred and name in deferred:
+            self._make(name)
+            return self.__dict__[name]
+        raise AttributeError(f"'Result' object has no attribute '{name}'")
+
+    def _make(self, name):
+        names, make = self._deferred[name]
+        values = make()
+        for k in names:
+            self._deferred.pop(k, None)
+            self.__dict__.setdefault(k, values[k])
+
+    def __getstate__(self):
+        # a copy or pickle carries the fields themselves
+        while self.__dict__.get("_deferred"):
+            self._make(next(iter(self._deferred)))
+        return self.__dict__
 
     def __len__(self):
         return len(self.times)

@@ -24,7 +24,7 @@ from .bodies import BodySet
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
                      Escape, IntegratorOptionError, NonFiniteState, OrbitsWarning,
                      SimulationOptionError, StepSizeUnderflow)
-from .monitors import DEFAULT_MONITORS, monitor_fields, monitor_mask
+from .monitors import DEFAULT_MONITORS, monitor_field_names, monitor_fields, monitor_mask
 from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDescription,
                       SimulationState, Snapshot, _function_name)
 from .result import Result
@@ -1688,40 +1688,57 @@ class _Recorder:
     def result(self, sim, wall, status="completed"):
         U = sim.units
         q = U.quantity
+        n_out = self.count
         fields = dict(
-            times=q(self.t[:self.count], "time"), names=list(self.names0),
-            masses=q(self.m0, "mass"), radii=q(self.r0, "length"),
+            names=list(self.names0),
             steps=sim.steps - self.steps0,
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
-            integrator=sim.integrator.info(), units=U.to_dict(), dt=sim.dt, status=status,
+            integrator=sim.integrator.info(), units=U.to_dict(), status=status,
             monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
-            forces=tuple(map(repr, sim.forces)), start_time=q(self.t0, "time"))
+            forces=tuple(map(repr, sim.forces)))
         if sim._n_tangent:
             fields["jacobian"] = sim.jacobian
             fields["tangent_vectors"] = sim.tangent_vectors
             fields["seed"] = sim._seed
+        # the arrays with units and the monitor series are made when first
+        # read (Result's deferred fields), from what is here now
         w, n = _inv.MONITOR_WIDTH, self.n
-        rows = self.rows[:self.count]
-        x = rows[:, w:w + 3 * n].reshape(-1, n, 3)
-        v = rows[:, w + 3 * n:w + 6 * n].reshape(-1, n, 3)
-        if not np.array_equal(self.inv, np.arange(n)):
-            x, v = x[:, self.inv], v[:, self.inv]
-        fields.update(positions=q(x, "length"), velocities=q(v, "velocity"))
+        t, rows = self.t[:n_out], self.rows[:n_out]
+        inv, m0, r0, t0, dt = self.inv, self.m0, self.r0, self.t0, sim._dt
+
+        def outputs():
+            x = rows[:, w:w + 3 * n].reshape(-1, n, 3)
+            v = rows[:, w + 3 * n:w + 6 * n].reshape(-1, n, 3)
+            if not np.array_equal(inv, np.arange(n)):
+                x, v = x[:, inv], v[:, inv]
+            return dict(times=q(t, "time"), masses=q(m0, "mass"), radii=q(r0, "length"),
+                        start_time=q(t0, "time"), dt=q(dt, "time"), positions=q(x, "length"),
+                        velocities=q(v, "velocity"))
+
+        deferred = [(("times", "masses", "radii", "start_time", "dt", "positions",
+                      "velocities"), outputs)]
         if self.mass_rows is not None:
-            fields["masses_at_outputs"] = q(np.array(self.mass_rows).reshape(-1, n), "mass")
-        ref = sim._reference
+            masses = np.array(self.mass_rows).reshape(-1, n)
+            deferred.append((("masses_at_outputs",),
+                             lambda: {"masses_at_outputs": q(masses, "mass")}))
+        ref = sim._reference.copy()
+        series = (sim.monitors, (sim._E_scale, sim._L_scale), U, sim._has_work)
         if sim._mask:
-            fields.update(_monitor_fields(rows[:, :w], sim, ref))
+            block = rows[:, :w]
+            deferred.append((monitor_field_names(series[0], w, series[3]),
+                             lambda: monitor_fields(block, series[0], ref, *series[1:3],
+                                                    work=series[3])))
         if self.mon_t:
-            mon = _monitor_fields(np.concatenate(self.mon_rows), sim, ref)
-            mon["times"] = q(np.concatenate(self.mon_t), "time")
-            fields["monitor"] = mon
-        return Result(**fields)
+            mon_rows = np.concatenate(self.mon_rows)
+            mon_t = np.concatenate(self.mon_t)
 
+            def monitor():
+                mon = monitor_fields(mon_rows, series[0], ref, *series[1:3], work=series[3])
+                mon["times"] = q(mon_t, "time")
+                return {"monitor": mon}
 
-def _monitor_fields(rows, sim, ref):
-    return monitor_fields(rows, sim.monitors, ref, (sim._E_scale, sim._L_scale), sim.units,
-                          work=sim._has_work)
+            deferred.append((("monitor",), monitor))
+        return Result(_deferred=deferred, **fields)
 
 
 def _positive_number(value):
