@@ -70,7 +70,13 @@ go through masked stores (a masked store cannot be forwarded to the next
 pass's load: 0.2 us for the eight planets' pulls instead of 0.065; the lane
 a source skips adds an exact zero instead), and the pass must store nothing
 but its sums (a further row written in the pass made LLVM keep the scalar
-form).
+form).  Each pair's factor computed once (by diagonals of rotated lanes, as
+WHFast512 does, built as LLVM vector operations; the sums then in this order
+or in the diagonals') was measured on the Intel AVX-512 machine and dropped:
+0.005-0.02 µs quicker a step for the Sun and eight planets, 0.01 µs slower
+for the outer solar system in democratic heliocentric coordinates, as the
+step's chains of dependent sums, not the divider alone, set its pace
+(``benchmarks/RESULTS.md``, bench_wh, 2026-11-27 23:10).
 
 The loop keeps its state in the lanes between outputs (see "the state kept
 in the lanes" below): with the copies in and out of the (N, 3) arrays on
