@@ -141,9 +141,8 @@ class Result:
     A run hands its arrays to the result as they are; the Quantities (times,
     states, masses, step) and the monitor series are made the first time one
     of them is read.  A script that calls ``run`` many times for a few steps
-    each then does not pay for what it never reads (a one-step run of two
-    bodies: 0.87 of the time with the monitors off, 0.61 with the default
-    monitors).  Copies and pickles carry the values themselves.
+    each then does not pay for what it never reads.  Copies and pickles
+    carry the values themselves.
 
     Examples
     --------
