@@ -581,25 +581,12 @@ def _implicit_kick(x, v, t, h, fargs, acc, vm):
             v[i, d] += h * acc[i, d]
 
 
-#: splitting_loop's loops by what names their copy (see specialize): its
-#: bindings then are the same, and a run call skips building them (7 us)
-_SPLITTING_LOOPS = {}
-
-
 def splitting_loop(force, name, kinds, coefs, stop=False):
     """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
 
     ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method;
     ``stop`` compiles in the stopping conditions of :mod:`.stopping`.
     """
-    key = (name, force.key, stop, force.jit, force.cache, force.runtime)
-    loop = _SPLITTING_LOOPS.get(key)
-    if loop is None:
-        loop = _SPLITTING_LOOPS[key] = _splitting_loop_for(force, name, kinds, coefs, stop)
-    return loop
-
-
-def _splitting_loop_for(force, name, kinds, coefs, stop):
     return specialize(_splitting_loop, f"{name}_{force.key}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force, stop),
