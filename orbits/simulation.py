@@ -5,6 +5,7 @@ float64 arrays in the body set's unit system and attaches units again only
 to what it returns.
 """
 
+import functools
 import math
 import numbers
 import time as _time
@@ -1721,19 +1722,21 @@ class _Recorder:
             masses = np.array(self.mass_rows).reshape(-1, n)
             deferred.append((("masses_at_outputs",),
                              lambda: {"masses_at_outputs": q(masses, "mass")}))
-        ref = sim._reference.copy()
-        series = (sim.monitors, (sim._E_scale, sim._L_scale), U, sim._has_work)
+        # the monitor series of rows, against the reference row of now
+        series = functools.partial(monitor_fields, monitors=sim.monitors,
+                                   reference=sim._reference.copy(),
+                                   scales=(sim._E_scale, sim._L_scale), units=U,
+                                   work=sim._has_work)
         if sim._mask:
             block = rows[:, :w]
-            deferred.append((monitor_field_names(series[0], w, series[3]),
-                             lambda: monitor_fields(block, series[0], ref, *series[1:3],
-                                                    work=series[3])))
+            deferred.append((monitor_field_names(sim.monitors, w, sim._has_work),
+                             lambda: series(block)))
         if self.mon_t:
             mon_rows = np.concatenate(self.mon_rows)
             mon_t = np.concatenate(self.mon_t)
 
             def monitor():
-                mon = monitor_fields(mon_rows, series[0], ref, *series[1:3], work=series[3])
+                mon = series(mon_rows)
                 mon["times"] = q(mon_t, "time")
                 return {"monitor": mon}
 
