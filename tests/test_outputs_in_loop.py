@@ -225,7 +225,7 @@ def test_adaptive_outputs_in_the_loop_equal_those_taken_between_calls(integrator
     _same(a, b)
 
 
-@pytest.mark.parametrize("integrator", ["ias15", "dop853"])
+@pytest.mark.parametrize("integrator", ["ias15", "dop853", "taylor"])
 def test_adaptive_outputs_in_the_loop_stop_where_the_run_stops(integrator):
     # a stopping condition between two outputs: the outputs before it, then
     # the state where it stopped, as between calls

@@ -20,6 +20,7 @@ from .implicit import ImplicitEuler, ImplicitMidpoint
 from .leapfrog import Leapfrog, Verlet
 from .runge_kutta import RK2, RK4
 from .scipy_ivp import LSODA, Radau
+from .taylor import Taylor
 from .trace import Trace
 from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
@@ -83,7 +84,7 @@ def register(cls):
 
 for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
              Yoshida8, WisdomHolman, SABA2, SABA3, SABA4, Dopri5, DOP853,
-             RK4Doubling, Radau, LSODA, IAS15, ImplicitEuler, ImplicitMidpoint, Trace):
+             RK4Doubling, Radau, LSODA, IAS15, Taylor, ImplicitEuler, ImplicitMidpoint, Trace):
     register(_cls)
 
 

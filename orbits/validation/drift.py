@@ -56,6 +56,7 @@ RUNS = (
     ("dop853", False, "dop853", {"rtol": 1e-12, "atol": 1e-15}, None),
     ("ias15", False, "ias15", {}, None),
     ("ias15, prs24", False, "ias15", {"adaptive_mode": "prs24"}, None),
+    ("taylor", False, "taylor", {}, None),
     ("REBOUND leapfrog", True, "leapfrog", {}, DT),
     ("REBOUND whfast", True, "whfast", {}, DT_WH),
     ("REBOUND whfast, corrector 17", True, "whfast", {"corrector": 17}, DT_WH),

@@ -247,9 +247,13 @@ SPRING_OUTPUTS = 100                  # adaptive samples over the run
 
 def _tolerance_options(name, tol):
     """An adaptive method's options for tolerance ``tol``: rtol = tol and
-    atol = 1e-3 tol (their default ratio), IAS15's epsilon = tol."""
-    if "epsilon" in _integrators.get(name).options:
+    atol = 1e-3 tol (their default ratio), IAS15's epsilon = tol, the Taylor
+    method's tol = tol."""
+    options = _integrators.get(name).options
+    if "epsilon" in options:
         return {"epsilon": tol}
+    if "tol" in options:
+        return {"tol": tol}
     return {"rtol": tol, "atol": 1e-3 * tol}
 
 
