@@ -1,5 +1,5 @@
-"""IAS15 speed against REBOUND's IAS15 (per step) and heyoka.py's Taylor method
-(at matched final error).
+"""IAS15 speed against REBOUND's IAS15 (per step), and IAS15 and our Taylor method
+against heyoka.py's (at matched final error).
 
 What is measured: against REBOUND
 ---------------------------------
@@ -25,9 +25,12 @@ IAS15 and a Taylor method reach a given error with different knobs
 outer solar system (HLW's six bodies, the same floats and G) over 10^4 years
 (10^3 with ``--quick``), our ``ias15`` at each of ``PEER_EPSILONS`` with
 each step criterion of ``PEER_MODES`` (the default, ``"global"``, then
-``"prs24"``) and heyoka.py's ``taylor_adaptive`` on ``heyoka.model.nbody`` at each of
-``HEYOKA_TOLS`` (its defaults otherwise: double precision, order chosen from
-``tol``, ``high_accuracy`` off).  The error is the largest final position
+``"prs24"``), our ``taylor`` at each of ``HEYOKA_TOLS``, and heyoka.py's
+``taylor_adaptive`` on ``heyoka.model.nbody`` at each of ``HEYOKA_TOLS`` (its
+defaults otherwise: double precision, order chosen from ``tol``,
+``high_accuracy`` off).  Our ``taylor`` chooses its order and steps by the
+same rule (Jorba & Zou 2005), so the two take the same steps at each
+``tol`` and the comparison is of the cost of a step.  The error is the largest final position
 coordinate error in au, as in the validation report, against a reference:
 heyoka.py in extended precision (x87 ``long double``, ``tol`` its machine
 epsilon, ``high_accuracy`` on), which neither double-precision run can
@@ -52,7 +55,8 @@ we reach, the row is a MISS.  The ratio is the median over repetitions of
 Goal (the issue "Speed"), printed with PASS/MISS: ``ias15`` at most
 ``PEER_RATIO_GOAL`` (1.0) times heyoka.py's run time at the same final error,
 at every heyoka.py tolerance, with the default step criterion (``prs24``'s
-ratios are printed beside, for information).
+ratios are printed beside, for information); the same for ``taylor``, a goal
+line of its own.
 
 heyoka.py is optional, a dependency of this benchmark only (``pip install
 heyoka``; the package's extras do not name it).  Without it the script says

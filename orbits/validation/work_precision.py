@@ -2,10 +2,11 @@
 
 Fixed-step methods sweep ``dt`` (factors of two about the problem's step),
 adaptive ones their tolerance (``rtol``, with ``atol = rtol / 1000``; the
-Taylor method its ``tol``) and the IAS15s their ``epsilon``; REBOUND's integrators are swept the same way on
-the same axes: its defaults (leapfrog, WHFast without a corrector, IAS15) and
-its best fixed-step methods (WHFast with the 11th-order symplectic corrector,
-WHCKL, SABA(10,6,4), and WHFast512 where the CPU has AVX-512), so that the
+Taylor method its ``tol``) and the IAS15s their ``epsilon``; REBOUND's
+integrators are swept the same way on the same axes: its defaults
+(leapfrog, WHFast without a corrector, IAS15) and its best fixed-step
+methods (WHFast with the 11th-order symplectic corrector, WHCKL,
+SABA(10,6,4), and WHFast512 where the CPU has AVX-512), so that the
 cheapest way to an accuracy is named against REBOUND's best, not its
 defaults.  The error is the final position error against REBOUND's IAS15 at
 its default epsilon, and the largest relative energy error at the outputs.
@@ -428,7 +429,8 @@ def section(rows, out_dir, quick):
              "Fixed-step methods sweep dt by factors of two around the problem's step "
              f"({', '.join(f'{f:g}' for f in DT_FACTORS[1 if quick else 0])} times it); "
              "the embedded and step-doubling methods sweep rtol (atol = rtol / 1000); "
-             "taylor sweeps tol (which sets its order); the IAS15s sweep epsilon. REBOUND's integrators are on the same axes (grey, "
+             "taylor sweeps tol (which sets its order); the IAS15s sweep epsilon. "
+             "REBOUND's integrators are on the same axes (grey, "
              "dashed or dotted): its defaults, leapfrog, WHFast (no corrector) and IAS15, "
              "and its best fixed-step methods, WHFast with the 11th-order symplectic "
              "corrector, WHCKL (lazy implementer's kernel, 17th-order corrector) and "
