@@ -77,6 +77,7 @@ def test_rtol_reaches_the_integrator(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv, shown", [
     (["-i", "ias15", "--epsilon", "1e-7"], "epsilon=1e-07"),
+    (["-i", "taylor", "--tol", "1e-12"], "tol=1e-12"),
     (["-i", "wh", "--dt", "50d", "--corrector", "17", "--coordinates",
       "democratic-heliocentric"], "coordinates='democratic-heliocentric', corrector=17"),
 ])
@@ -95,6 +96,7 @@ def test_options_reach_other_integrators(argv, shown, capsys):
     (["-i", "wh", "--dt", "10d", "--coordinates", "helio"], ["unknown coordinates 'helio'"]),
     (["-i", "saba2", "--dt", "10d", "--corrector", "5"], ["corrector"]),
     (["-i", "dop853", "--rtol", "-1e-6"], ["'rtol' must be a positive"]),
+    (["-i", "taylor", "--tol", "0"], ["'tol' must be a positive"]),
     (["-i", "verlet", "--dt", "10d", "--escape-distance", "-3au"], ["escape_distance"]),
 ])
 def test_option_errors_are_clear(argv, words, capsys):
@@ -114,7 +116,7 @@ def test_distances_need_lengths(capsys):
 def test_option_help_names_the_integrators_that_take_each_option():
     # the help lists them from OPTION_TAKEN_BY without importing the integrators:
     # every integrator listed takes a non-default value, every other one refuses it
-    values = {"epsilon": 1e-8, "rtol": 1e-6, "atol": 1e-10, "corrector": 17,
+    values = {"epsilon": 1e-8, "tol": 1e-12, "rtol": 1e-6, "atol": 1e-10, "corrector": 17,
               "coordinates": "democratic-heliocentric"}
     assert set(values) == set(cli.INTEGRATOR_OPTIONS) == set(cli.OPTION_TAKEN_BY)
     for option, value in values.items():

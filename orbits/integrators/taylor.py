@@ -163,7 +163,11 @@ class Taylor(AdaptiveIntegrator):
         """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
-        if "series" not in ws:
+        series = ws.get("series")
+        if (series is None or series[0].shape != (self.order_used + 1, 3, x.shape[0])
+                or series[8].shape[0] < _k.pair_count(x.shape[0], int(fargs[1]))):
+            # a workspace not bound yet, or bound for other bodies (the kernel
+            # writes as many pairs as the massive bodies make)
             self.bind(ws, force, fargs)
         loop = loop_for(_k.taylor_loop, force, stop=stop is not None)
         status, t_reached, n_mon = loop(
