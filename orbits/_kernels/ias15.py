@@ -62,7 +62,8 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import GO, first_record, step_epilogue, work_kernels
+from .stepping import (GO, adaptive_start, clock_step, first_record, must_return,
+                       step_epilogue, work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -340,31 +341,17 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     cap = mon_t.shape[0]
     n_mon = 0
     until_record = first_record(every, step0, mon_t)
-    counts[0] = 0
-    counts[1] = 0
-    counts[2] = 0
-    info[0] = -1
-    info[1] = -1
+    # an empty marks array: none (one compiled loop for both uses)
+    direction, ct, target, has_marks = adaptive_start(t, t_end, tc, marks, counts, info)
     if t == t_end:
         return Status.OK, t, n_mon
-    direction = 1.0 if t_end > t else -1.0
-    ct = tc[1] if t == tc[0] else 0.0
-    target = t_end
     k_mark = 0
-    # an empty marks array: none (one compiled loop for both uses)
-    has_marks = marks.shape[0] > 0
-    if has_marks:
-        target = marks[0]
     eps7 = epsilon ** (1.0 / 7.0)
     pc_tol = max(PC_TOLERANCE, PC_EPSILON_SQUARED * epsilon * epsilon)
     prs7 = (_FACT7 * epsilon) ** (1.0 / 7.0)
     while True:
-        if counts[0] >= max_steps:
+        if must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap):
             return Status.OK, t, n_mon
-        if has_marks and n_mon >= mon_out.shape[0]:
-            return Status.OK, t, n_mon               # caller collects the rows first
-        if until_record == 1 and n_mon >= cap:
-            return Status.OK, t, n_mon               # caller collects the rows first
         if flags[0] == 0:
             force(x, v, t, fargs, a0)  # noqa: F821 - bound by specialize
             counts[2] += 1
@@ -583,17 +570,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         flags[0] = 0
         if HAS_WORK:  # noqa: F821
             work_add(fargs, -dt * pw)  # noqa: F821
-        if trimmed:
-            t = target
-            ct = 0.0
-        else:
-            # t + (dt + ct) and what its rounding lost, exactly (Knuth's two-sum:
-            # t may be smaller than the step at the start)
-            y = dt + ct
-            tn = t + y
-            yb = tn - t
-            ct = (t - (tn - yb)) + (y - yb)
-            t = tn
+        t, ct = clock_step(t, ct, dt, trimmed, target)
         tc[0] = t
         tc[1] = ct
         counts[0] += 1

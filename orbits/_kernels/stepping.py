@@ -67,7 +67,8 @@ from .stopping import check_stop, no_stop
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
            "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
-           "work_bound", "work_total", "rk_stage", "rk_sums"]
+           "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
+           "clock_step"]
 
 #: the stopping arguments of a loop compiled without conditions
 NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
@@ -111,6 +112,49 @@ def _record(x, v, t, mon, n_mon, mon_t, mon_out):
 
 #: the status of a step epilogue (:func:`step_epilogue`) that lets a loop carry on
 GO = -1
+
+
+# -- the bookkeeping of the adaptive loops (orbits._kernels.ias15, .taylor) ---------
+
+@njit(inline="always")
+def adaptive_start(t, t_end, tc, marks, counts, info):
+    """The counts and stop info of an adaptive loop's call reset, and its
+    ``(direction, ct, target, has_marks)``: ``ct`` the time's compensation
+    (``tc = (time reached, what t + dt rounded away)``, used only when the
+    call starts at the time the last one reached), ``target`` the first
+    time to land on (the first mark, else ``t_end``)."""
+    counts[0] = 0
+    counts[1] = 0
+    counts[2] = 0
+    info[0] = -1
+    info[1] = -1
+    direction = 1.0 if t_end > t else -1.0
+    ct = tc[1] if t == tc[0] else 0.0
+    has_marks = marks.shape[0] > 0
+    target = marks[0] if has_marks else t_end
+    return direction, ct, target, has_marks
+
+
+@njit(inline="always")
+def must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap):
+    """Whether an adaptive loop returns before its next step: its steps for
+    this call taken, or its rows full (the caller collects them first)."""
+    return (counts[0] >= max_steps or (has_marks and n_mon >= mon_out.shape[0])
+            or (until_record == 1 and n_mon >= cap))
+
+
+@njit(inline="always")
+def clock_step(t, ct, dt, trimmed, target):
+    """The time and its compensation after a step ``dt``: ``target`` exactly
+    for a step shortened to land on it, else ``t + (dt + ct)`` and what its
+    rounding lost, exactly (Knuth's two-sum: ``t`` may be smaller than the
+    step at the start)."""
+    if trimmed:
+        return target, 0.0
+    y = dt + ct
+    tn = t + y
+    yb = tn - t
+    return tn, (t - (tn - yb)) + (y - yb)
 
 
 @njit(inline="always")

@@ -49,7 +49,8 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import GO, first_record, step_epilogue, work_kernels
+from .stepping import (GO, adaptive_start, clock_step, first_record, must_return,
+                       step_epilogue, work_kernels)
 
 __all__ = ["order_for", "pair_count", "padded_pairs", "taylor_loop", "expand", "PAD"]
 
@@ -235,27 +236,13 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
     cap = mon_t.shape[0]
     n_mon = 0
     until_record = first_record(every, step0, mon_t)
-    counts[0] = 0
-    counts[1] = 0
-    counts[2] = 0
-    info[0] = -1
-    info[1] = -1
+    direction, ct, target, has_marks = adaptive_start(t, t_end, tc, marks, counts, info)
     if t == t_end:
         return Status.OK, t, n_mon
-    direction = 1.0 if t_end > t else -1.0
-    ct = tc[1] if t == tc[0] else 0.0
-    target = t_end
     k_mark = 0
-    has_marks = marks.shape[0] > 0
-    if has_marks:
-        target = marks[0]
     while True:
-        if counts[0] >= max_steps:
+        if must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap):
             return Status.OK, t, n_mon
-        if has_marks and n_mon >= mon_out.shape[0]:
-            return Status.OK, t, n_mon               # caller collects the rows first
-        if until_record == 1 and n_mon >= cap:
-            return Status.OK, t, n_mon               # caller collects the rows first
         finite = expand(x, v, X, V, D, R2, S, W, IR, A, PI, PJ, npair, gm, eps2, order)
         counts[2] += order
         if not finite:
@@ -297,16 +284,7 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
                 vn = v[i, c] + y
                 csv[i, c] = y - (vn - v[i, c])
                 v[i, c] = vn
-        if trimmed:
-            t = target
-            ct = 0.0
-        else:
-            # Knuth's two-sum of t and dt + ct, as in the IAS15 loop
-            y = dt + ct
-            tn = t + y
-            yb = tn - t
-            ct = (t - (tn - yb)) + (y - yb)
-            t = tn
+        t, ct = clock_step(t, ct, dt, trimmed, target)
         tc[0] = t
         tc[1] = ct
         counts[0] += 1

@@ -542,6 +542,19 @@ class AdaptiveIntegrator(Integrator):
                                                 else ""))
             self.config[name] = float(value)
 
+    def _min_dt(self):
+        """Check the ``min_dt`` option: a finite number >= 0, kept as a float."""
+        min_dt = self.config["min_dt"]
+        try:
+            ok = 0 <= float(min_dt) < float("inf")
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise IntegratorOptionError(
+                f"integrator {self.name!r}: option 'min_dt' must be a finite number >= 0, "
+                f"got {min_dt!r}")
+        self.config["min_dt"] = float(min_dt)
+
     def _relative_tolerance(self, name):
         """Raise ``name`` to :data:`RTOL_FLOOR` if asked for less, with a warning.
 

@@ -102,15 +102,7 @@ class IAS15(AdaptiveIntegrator):
 
     def _check_options(self):
         self._positive("epsilon")
-        min_dt = self.config["min_dt"]
-        try:
-            ok = float(min_dt) >= 0 and float(min_dt) < float("inf")
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise IntegratorOptionError(
-                f"integrator {self.name!r}: option 'min_dt' must be a finite number >= 0, "
-                f"got {min_dt!r}")
+        self._min_dt()
         mode = self.config["adaptive_mode"]
         if mode not in ADAPTIVE_MODES:
             raise IntegratorOptionError(

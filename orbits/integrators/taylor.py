@@ -86,7 +86,6 @@ class Taylor(AdaptiveIntegrator):
     order = 20
     options = {"tol": TOLERANCE, "order": 0, "min_dt": 0.0}
     summary = "Taylor series by automatic differentiation, order from tol (Jorba & Zou 2005)"
-    forces_per_step = 20
     chaos_indicators = False
     #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
     records_marks = True
@@ -100,21 +99,17 @@ class Taylor(AdaptiveIntegrator):
                 f"integrator {self.name!r}: option 'order' must be a whole number >= 2 "
                 f"(or 0: from tol), got {order!r}")
         self.config["order"] = int(order)
-        min_dt = self.config["min_dt"]
-        try:
-            ok = 0 <= float(min_dt) < float("inf")
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise IntegratorOptionError(
-                f"integrator {self.name!r}: option 'min_dt' must be a finite number >= 0, "
-                f"got {min_dt!r}")
-        self.config["min_dt"] = float(min_dt)
+        self._min_dt()
 
     @property
     def order_used(self):
         """The order of the series: the ``order`` option, else the one ``tol`` sets."""
         return self.config["order"] or _k.order_for(self.config["tol"])
+
+    @property
+    def forces_per_step(self):
+        """One pass of the recurrences per order, counted as a force evaluation."""
+        return self.order_used
 
     def info(self):
         """As every integrator's, with ``order`` the order used."""
