@@ -62,8 +62,8 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import (GO, adaptive_start, clock_step, first_record, must_return,
-                       step_epilogue, work_kernels)
+from .stepping import (GO, adaptive_start, add_compensated, clock_step, first_record,
+                       must_return, step_epilogue, stop_info, work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -557,16 +557,8 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 s += dx + dv
         if not math.isfinite(s):
             return Status.NON_FINITE, t, n_mon
-        for i in range(n):
-            for d in range(3):
-                y = xs[i, d] + csx[i, d]
-                xn = x[i, d] + y
-                csx[i, d] = y - (xn - x[i, d])
-                x[i, d] = xn
-                y = vs[i, d] + csv[i, d]
-                vn = v[i, d] + y
-                csv[i, d] = y - (vn - v[i, d])
-                v[i, d] = vn
+        add_compensated(x, xs, csx)
+        add_compensated(v, vs, csv)
         flags[0] = 0
         if HAS_WORK:  # noqa: F821
             work_add(fargs, -dt * pw)  # noqa: F821
@@ -597,9 +589,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
             x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out, sargs,
             fargs)
         if stop != GO:
-            sinfo = sargs[6]
-            info[0] = sinfo[0]
-            info[1] = sinfo[1]
+            stop_info(sargs, info)
             return stop, t, n_mon
         if abs(proposed) < min_dt:
             info[0] = worst

@@ -68,7 +68,7 @@ __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force
            "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
-           "clock_step"]
+           "clock_step", "add_compensated", "stop_info"]
 
 #: the stopping arguments of a loop compiled without conditions
 NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
@@ -141,6 +141,28 @@ def must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap)
     this call taken, or its rows full (the caller collects them first)."""
     return (counts[0] >= max_steps or (has_marks and n_mon >= mon_out.shape[0])
             or (until_record == 1 and n_mon >= cap))
+
+
+@njit(inline="always")
+def add_compensated(x, dx, cs):
+    """``x += dx`` element by element with Kahan's compensation ``cs`` (what
+    the last additions rounded away, carried into the next), as the
+    adaptive loops add their steps' increments."""
+    for i in range(x.shape[0]):
+        for d in range(3):
+            y = dx[i, d] + cs[i, d]
+            xn = x[i, d] + y
+            cs[i, d] = y - (xn - x[i, d])
+            x[i, d] = xn
+
+
+@njit(inline="always")
+def stop_info(sargs, info):
+    """The bodies behind a stopping condition (the stop arguments' last
+    entry) into an adaptive loop's ``info``."""
+    sinfo = sargs[6]
+    info[0] = sinfo[0]
+    info[1] = sinfo[1]
 
 
 @njit(inline="always")

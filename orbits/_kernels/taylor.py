@@ -49,8 +49,8 @@ import numpy as np
 
 from ._jit import njit, specialize
 from .status import Status
-from .stepping import (GO, adaptive_start, clock_step, first_record, must_return,
-                       step_epilogue, work_kernels)
+from .stepping import (GO, adaptive_start, add_compensated, clock_step, first_record,
+                       must_return, step_epilogue, stop_info, work_kernels)
 
 __all__ = ["order_for", "pair_count", "padded_pairs", "taylor_loop", "expand", "PAD"]
 
@@ -109,7 +109,7 @@ def expand(x, v, X, V, D, R2, S, W, IR, A, PI, PJ, npair, gm, eps2, order):
     """The series of positions ``X[k, c, i]`` and velocities ``V[k, c, i]``
     (``k = 0 .. order``) of the state ``(x, v)``; returns whether every
     coefficient is finite.  ``D``, ``R2``, ``S`` (the pairs' series), ``W``,
-    ``IR`` and ``A[0]`` are scratch (see the module notes)."""
+    ``IR`` and ``A[0]`` (shape (N, 3)) are scratch (see the module notes)."""
     n = x.shape[0]
     P = np.uint64(R2.shape[1])
     Ak = A[0]
@@ -174,7 +174,7 @@ def expand(x, v, X, V, D, R2, S, W, IR, A, PI, PJ, npair, gm, eps2, order):
         # the accelerations' coefficient of order k, pair by pair
         for c in range(3):
             for i in range(n):
-                Ak[c, i] = 0.0
+                Ak[i, c] = 0.0
         for q in range(npair):
             i = PI[q]
             j = PJ[q]
@@ -182,12 +182,12 @@ def expand(x, v, X, V, D, R2, S, W, IR, A, PI, PJ, npair, gm, eps2, order):
             gj = gm[j]
             for c in range(3):
                 w = W[c, q]
-                Ak[c, i] += gj * w
-                Ak[c, j] -= gi * w
+                Ak[i, c] += gj * w
+                Ak[j, c] -= gi * w
         f = 1.0 / (k + 1)
         for c in range(3):
             for i in range(n):
-                V[k + 1, c, i] = Ak[c, i] * f
+                V[k + 1, c, i] = Ak[i, c] * f
                 X[k + 1, c, i] = V[k, c, i] * f
     s = 0.0
     for c in range(3):
@@ -269,21 +269,13 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
                     dv = V[k, c, i] + dt * dv
                 dx *= dt
                 dv *= dt
-                A[1, c, i] = dx
-                A[0, c, i] = dv
+                A[1, i, c] = dx
+                A[2, i, c] = dv
                 s += dx + dv
         if not math.isfinite(s):
             return Status.NON_FINITE, t, n_mon
-        for i in range(n):
-            for c in range(3):
-                y = A[1, c, i] + csx[i, c]
-                xn = x[i, c] + y
-                csx[i, c] = y - (xn - x[i, c])
-                x[i, c] = xn
-                y = A[0, c, i] + csv[i, c]
-                vn = v[i, c] + y
-                csv[i, c] = y - (vn - v[i, c])
-                v[i, c] = vn
+        add_compensated(x, A[1], csx)
+        add_compensated(v, A[2], csv)
         t, ct = clock_step(t, ct, dt, trimmed, target)
         tc[0] = t
         tc[1] = ct
@@ -293,9 +285,7 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
             x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out, sargs,
             fargs)
         if stop != GO:
-            sinfo = sargs[6]
-            info[0] = sinfo[0]
-            info[1] = sinfo[1]
+            stop_info(sargs, info)
             return stop, t, n_mon
         if t == target:
             if not has_marks:

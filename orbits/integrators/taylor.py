@@ -139,7 +139,7 @@ class Taylor(AdaptiveIntegrator):
         ws["series"] = (np.zeros((p + 1, 3, n)), np.zeros((p + 1, 3, n)),
                         np.zeros((p + 1, 3, pairs)), np.zeros((p + 1, pairs)),
                         np.zeros((p + 1, pairs)), np.zeros((3, pairs)), np.zeros(pairs),
-                        np.zeros((2, 3, n)), np.zeros(pairs, dtype=np.int64),
+                        np.zeros((3, n, 3)), np.zeros(pairs, dtype=np.int64),
                         np.zeros(pairs, dtype=np.int64))
 
     def workspace(self, n, initial_step=0.0):
