@@ -149,6 +149,18 @@ def applies(prob, name, quick=False, body_set=None, length=None):
     return None
 
 
+def tolerance_options(name, tol):
+    """Adaptive method ``name``'s options for tolerance ``tol``: rtol = tol and
+    atol = 1e-3 tol (their default ratio), IAS15's epsilon = tol, the Taylor
+    method's tol = tol (which sets its order)."""
+    options = _integrators.get(name).options
+    if "epsilon" in options:
+        return {"epsilon": tol}
+    if "tol" in options:
+        return {"tol": tol}
+    return {"rtol": tol, "atol": 1e-3 * tol}
+
+
 def integrator_names():
     """Every registered integrator, in registry order."""
     return [info.name for info in _integrators.available()]

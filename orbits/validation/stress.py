@@ -245,18 +245,6 @@ SPRING_STEPS = 1000
 SPRING_SEGMENTS = 10                  # wall-time checks per run
 SPRING_OUTPUTS = 100                  # adaptive samples over the run
 
-def _tolerance_options(name, tol):
-    """An adaptive method's options for tolerance ``tol``: rtol = tol and
-    atol = 1e-3 tol (their default ratio), IAS15's epsilon = tol, the Taylor
-    method's tol = tol."""
-    options = _integrators.get(name).options
-    if "epsilon" in options:
-        return {"epsilon": tol}
-    if "tol" in options:
-        return {"tol": tol}
-    return {"rtol": tol, "atol": 1e-3 * tol}
-
-
 def _adaptive(name):
     return _integrators.get(name).adaptive
 
@@ -491,7 +479,7 @@ def _step_cell(name, options, value, quick):
     bodies = _scenes.outer_solar_system(com=True)
     until = STEP_ORBITS[quick] * _P_JUPITER
     if _adaptive(name):
-        row = _measure.run_orbits(bodies, name, {**options, **_tolerance_options(name, value)},
+        row = _measure.run_orbits(bodies, name, {**options, **cases.tolerance_options(name, value)},
                                   until=until,
                                   outputs=2, wall_limit=_wall(quick))
     else:
@@ -512,7 +500,7 @@ def _pythagorean_cell(name, options, value, quick):
     bodies = _scenes.pythagorean()
     until = PYTHAGOREAN_UNTIL[quick]
     if _adaptive(name):
-        row = _measure.run_orbits(bodies, name, {**options, **_tolerance_options(name, value)},
+        row = _measure.run_orbits(bodies, name, {**options, **cases.tolerance_options(name, value)},
                                   until=until,
                                   outputs=PYTHAGOREAN_OUTPUTS, wall_limit=_wall(quick))
     else:

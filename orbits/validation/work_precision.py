@@ -313,16 +313,12 @@ def tasks(quick):
             if name == "ias15":
                 for eps in EPSILONS[k]:
                     add(name, steps * 1e-6, options={"epsilon": eps})
-            elif "tol" in integ.options:
-                # taylor: its tolerance sets its order (and no absolute part)
-                for tol in TOLERANCES[k]:
-                    add(name, steps * 1e-6, options={"tol": tol})
             elif integ.adaptive:
                 for tol in TOLERANCES[k]:
                     if name in cases.PYTHON_FORCE and tol < PYTHON_FORCE_TIGHTEST:
                         continue
                     cost = steps * 1e-6 * (300 if name in cases.PYTHON_FORCE else 1)
-                    add(name, cost, options={"rtol": tol, "atol": tol * 1e-3})
+                    add(name, cost, options=cases.tolerance_options(name, tol))
             else:
                 for f in DT_FACTORS[k]:
                     add(name, steps / f * integ.forces_per_step * 1e-7, dt=prob.dt * f)
