@@ -44,6 +44,7 @@ rule and order; the pairwise N-body recurrences).
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -52,7 +53,8 @@ from .status import Status
 from .stepping import (GO, adaptive_start, add_compensated, clock_step, first_record,
                        must_return, step_epilogue, stop_info, work_kernels)
 
-__all__ = ["order_for", "pair_count", "padded_pairs", "taylor_loop", "expand", "PAD"]
+__all__ = ["order_for", "pair_count", "padded_pairs", "Series", "series_arrays", "taylor_loop",
+           "expand", "PAD"]
 
 #: the pairs' arrays are padded to a multiple of this many pairs
 PAD = 8
@@ -82,6 +84,31 @@ def padded_pairs(n, n_active):
     multiple)."""
     p = pair_count(n, n_active)
     return max(PAD, -(-p // PAD) * PAD)
+
+
+class Series(NamedTuple):
+    """The arrays the loop expands the series in, in the order of its
+    arguments (``P``: the pairs, padded; ``p``: the order)."""
+
+    X: np.ndarray    # (p + 1, 3, N): the positions' coefficients
+    V: np.ndarray    # (p + 1, 3, N): the velocities'
+    D: np.ndarray    # (p + 1, 3, P): the pairs' separations'
+    R2: np.ndarray   # (p + 1, P): their squared distances'
+    S: np.ndarray    # (p + 1, P): r2^(-3/2)'s
+    W: np.ndarray    # (3, P): the pulls' coefficient of the order at hand
+    IR: np.ndarray   # (P,): 1 / r2
+    A: np.ndarray    # (3, N, 3): the accelerations' coefficient, a step's increments
+    PI: np.ndarray   # (P,) int64: each pair's massive body
+    PJ: np.ndarray   # (P,) int64: its other body
+
+
+def series_arrays(order, n, n_active):
+    """:class:`Series` for ``n`` bodies (the first ``n_active`` massive) to ``order``."""
+    pairs = padded_pairs(n, n_active)
+    z = np.zeros
+    return Series(z((order + 1, 3, n)), z((order + 1, 3, n)), z((order + 1, 3, pairs)),
+                  z((order + 1, pairs)), z((order + 1, pairs)), z((3, pairs)), z(pairs),
+                  z((3, n, 3)), z(pairs, dtype=np.int64), z(pairs, dtype=np.int64))
 
 
 @njit

@@ -118,9 +118,9 @@ class Taylor(AdaptiveIntegrator):
     def check_terms(self, terms):
         """Every added term is refused: the recurrences are those of Newtonian
         gravity alone."""
-        for term in terms:
+        if terms:
             raise IntegratorOptionError(
-                f"{self.name} cannot take the force term {term!r}: its series are "
+                f"{self.name} cannot take the force term {terms[0]!r}: its series are "
                 "computed by recurrences written for Newtonian gravity alone. Use 'ias15' "
                 "(adaptive, as accurate) or an embedded method such as 'dop853'.")
 
@@ -133,14 +133,7 @@ class Taylor(AdaptiveIntegrator):
             raise IntegratorOptionError(
                 f"{self.name} computes the series of Newtonian gravity only and cannot "
                 f"integrate {what}; use 'ias15' or 'dop853'")
-        n = ws["csx"].shape[0]
-        p = self.order_used
-        pairs = _k.padded_pairs(n, int(fargs[1]))
-        ws["series"] = (np.zeros((p + 1, 3, n)), np.zeros((p + 1, 3, n)),
-                        np.zeros((p + 1, 3, pairs)), np.zeros((p + 1, pairs)),
-                        np.zeros((p + 1, pairs)), np.zeros((3, pairs)), np.zeros(pairs),
-                        np.zeros((3, n, 3)), np.zeros(pairs, dtype=np.int64),
-                        np.zeros(pairs, dtype=np.int64))
+        ws["series"] = _k.series_arrays(self.order_used, ws["csx"].shape[0], int(fargs[1]))
 
     def workspace(self, n, initial_step=0.0):
         """The state of a run of ``n`` bodies.  ``initial_step`` is kept as the
@@ -159,8 +152,8 @@ class Taylor(AdaptiveIntegrator):
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
         series = ws.get("series")
-        if (series is None or series[0].shape != (self.order_used + 1, 3, x.shape[0])
-                or series[8].shape[0] < _k.pair_count(x.shape[0], int(fargs[1]))):
+        if (series is None or series.X.shape != (self.order_used + 1, 3, x.shape[0])
+                or series.PI.shape[0] < _k.pair_count(x.shape[0], int(fargs[1]))):
             # a workspace not bound yet, or bound for other bodies (the kernel
             # writes as many pairs as the massive bodies make)
             self.bind(ws, force, fargs)
