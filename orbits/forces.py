@@ -320,7 +320,7 @@ class Gravity(ForceTerm):
 class _SourceTerm(ForceTerm):
     """A GR term about one dominant body, the ``source``."""
 
-    def __init__(self, source, c=None):
+    def __init__(self, source, *, c=None):
         if not isinstance(source, str):
             raise ForceTermError(f"source must be a body's name, got {source!r}",
                                  term=type(self).__name__, field="source")
@@ -516,7 +516,7 @@ class GRFull(ForceTerm):
     velocity_dependent = True
     why_not_wisdom_holman = "it depends on velocities"
 
-    def __init__(self, c=None):
+    def __init__(self, *, c=None):
         self.c = c
 
     def to_dict(self):
@@ -1201,7 +1201,7 @@ class RadiationPressure(ForceTerm):
     conservative = False
     why_not_wisdom_holman = "it is dissipative and depends on velocities"
 
-    def __init__(self, source, beta, c=None):
+    def __init__(self, source, beta, *, c=None):
         name = f"RadiationPressure({source!r})"
         if not isinstance(source, str):
             raise ForceTermError(f"source must be a body's name, got {source!r}", term=name,

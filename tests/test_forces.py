@@ -9,6 +9,7 @@ first-order theory; parity with REBOUND + REBOUNDx on the same floats, G and c
 the run without it; bad input gets named errors.
 """
 
+import inspect
 import math
 
 import astropy.constants as const
@@ -545,6 +546,25 @@ def test_user_force_wrong_shape():
     with pytest.raises(ForceTermError, match=r"shape \(3,\).*expected.*\(2, 3\)"):
         orbits.Simulation(sun_mercury(), "leapfrog", dt=1 * u.day,
                           forces=[forces.UserForce(_wrong_shape)])
+
+
+def test_the_speed_of_light_is_keyword_only():
+    # GRFull("Star") used to be taken, the name landing in c
+    with pytest.raises(TypeError, match="positional"):
+        forces.GRFull("Star")
+    with pytest.raises(TypeError, match="positional"):
+        forces.GR("Sun", 1e5 * u.km / u.s)
+    with pytest.raises(TypeError, match="positional"):
+        forces.RadiationPressure("Sun", 0.1, 1e5 * u.km / u.s)
+    # every term that takes c, found by its signature
+    takes_c = [cls for cls in vars(forces).values()
+               if isinstance(cls, type) and issubclass(cls, forces.ForceTerm)
+               and "c" in inspect.signature(cls.__init__).parameters]
+    assert {c.__name__ for c in takes_c} >= {"GR", "GRPotential", "GRFull",
+                                             "RadiationPressure"}
+    for cls in takes_c:
+        kind = inspect.signature(cls.__init__).parameters["c"].kind
+        assert kind is inspect.Parameter.KEYWORD_ONLY, cls.__name__
 
 
 def test_forces_must_be_terms():
