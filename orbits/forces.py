@@ -366,19 +366,34 @@ class GR(_SourceTerm):
 
     REBOUNDx's ``gr`` works in Jacobi coordinates and puts each body's whole
     acceleration into its correction, so a moon's term there also carries its
-    planet's pull; here every body is a test body about the source.  The two
-    agree to 2e-9 au on the planets over 10 years and differ by 1.6e-7 au on
-    the Moon (the validation report's section *Against JPL DE421*).
+    planet's pull; here each body's orbit about the source is corrected as a
+    two-body orbit.  The two agree to 2e-9 au on the planets over 10 years and
+    differ by 1.6e-7 au on the Moon (the validation report's section *Against
+    JPL DE421*).
 
-    Every other body, test particles included, feels ::
+    Every other body ``i``, test particles included, feels ::
 
-        a = mu / (c^2 r^3) [ (4 mu / r - v^2) r + 4 (r . v) v ]
+        a_i = mu / (c^2 r^3) [ (4 mu_i / r - v^2) r + 4 (r . v) v ]
 
-    with ``r``, ``v`` relative to the source and ``mu = G m_source``; the
-    source takes the reaction, so momentum is conserved.  Cost O(N).
-    Velocity-dependent: not for the Wisdom-Holman family (use
-    :class:`GRPotential` there).  Its energy is the 1PN energy of each body
-    about the source, ``m (3/8 v^4 + 3/2 mu v^2 / r + 1/2 mu^2 / r^2) / c^2``.
+    with ``r``, ``v`` relative to the source, ``mu = G m_source`` and
+    ``mu_i = G (m_source + m_i)``; the source takes the reaction
+    ``-(m_i / m_source) a_i``, so momentum is conserved.  The relative motion
+    of body and source then feels Schwarzschild's test-body correction about
+    ``mu_i``: the periapsis advances by ``6 pi G (m_source + m_i) / (c^2 a
+    (1 - e^2))`` a period at any mass ratio.  Cost O(N).  Velocity-dependent:
+    not for the Wisdom-Holman family (use :class:`GRPotential` there).
+
+    Its energy is that correction's 1PN energy times the reduced mass
+    ``m_r = m_i m_source / (m_source + m_i)`` of each body,
+    ``m_r (3/8 v^4 + 3/2 mu_i v^2 / r + 1/2 mu_i^2 / r^2) / c^2``, from the
+    Lagrangian whose equations the accelerations are: with a source and one
+    massive body the energy monitor measures the integration (the energy is
+    conserved to O(1/c^4)).  With several massive bodies their pulls on one
+    another's orbits about the source, left out of the correction, leave an
+    energy change of their mass ratio to the source times the 1PN energy's
+    variation (1.4e-10 of the energy for two planets of a thousandth of the
+    star's mass at a = 1 and 1.6, with G = 1 and c = 1e4); :class:`GRFull`
+    conserves its energy there.
 
     Parameters
     ----------

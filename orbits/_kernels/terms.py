@@ -75,12 +75,17 @@ def _pull(acc, i, src, w, ax, ay, az):
 
 @njit(inline="always")  # called every substep: a call costs ~15 % of it
 def gr_accel(x, v, t, args, acc):
-    """The 1PN correction of a test body orbiting ``src`` (harmonic gauge)::
+    """The 1PN correction of each body about ``src`` (harmonic gauge)::
 
-        a = mu / (c^2 r^3) [ (4 mu / r - v^2) r + 4 (r . v) v ]
+        a_i = mu / (c^2 r^3) [ (4 mu_i / r - v^2) r + 4 (r . v) v ]
 
-    with ``r``, ``v`` relative to the source and ``mu = G m_src``; the source
-    takes the reaction ``-(m_i / m_src) a_i`` so momentum is conserved.
+    with ``r``, ``v`` relative to the source, ``mu = G m_src`` and
+    ``mu_i = G (m_src + m_i)``; the source takes the reaction
+    ``-(m_i / m_src) a_i`` so momentum is conserved.  The relative
+    acceleration ``(1 + m_i / m_src) a_i`` is then Schwarzschild's test-body
+    correction about ``mu_i``, whose periapsis advances by
+    ``6 pi mu_i / (c^2 a (1 - e^2))`` a period; a test particle (``mu_i = mu``)
+    feels exactly that correction.
     ``args = (src, gm, inv_c2)``; O(N), test particles included.
     """
     src, gm, inv_c2 = args
@@ -108,7 +113,7 @@ def gr_accel(x, v, t, args, acc):
         u2 = ux * ux + uy * uy + uz * uz
         rv = rx * ux + ry * uy + rz * uz
         f = k * inv_r * inv_r * inv_r
-        a = f * (4.0 * mu * inv_r - u2)
+        a = f * (4.0 * (mu + gm[i]) * inv_r - u2)
         b = 4.0 * f * rv
         ax = a * rx + b * ux
         ay = a * ry + b * uy
@@ -127,10 +132,20 @@ def gr_accel(x, v, t, args, acc):
 
 @njit
 def gr_energy(x, v, args):
-    """The 1PN energy of each body about the source, whose Lagrangian gives
-    :func:`gr_accel`: ``m_i (3/8 v^4 + 3/2 mu v^2 / r + 1/2 mu^2 / r^2) / c^2``,
-    with ``m_i = gm_i / G`` carried as ``gm_i`` over ``G = gm / m`` (``args`` as
-    :func:`gr_accel`, plus the masses)."""
+    """The 1PN energy of each body's orbit about the source, from the
+    Lagrangian whose equations :func:`gr_accel` are: Schwarzschild's test-body
+    energy about ``mu_i = G (m_src + m_i)`` in the relative coordinates, times
+    the reduced mass ``m_i m_src / (m_src + m_i) = m_i mu / mu_i``::
+
+        m_i (mu / mu_i) (3/8 v^4 + 3/2 mu_i v^2 / r + 1/2 mu_i^2 / r^2) / c^2
+
+    (``args`` as :func:`gr_accel`, plus the masses).  The Newtonian energy's
+    rate of change under the term is ``sum_i m_i v_i . a_i`` (relative
+    velocities), minus this energy's along the Keplerian motion about
+    ``mu_i``: for two bodies the sum is conserved to O(1/c^4); with more,
+    the others' pull on a body's relative orbit leaves terms of order their
+    mass ratio to the source times the 1PN energy.
+    """
     src, gm, inv_c2, m = args
     mu = gm[src]
     s = 0.0
@@ -144,8 +159,9 @@ def gr_energy(x, v, args):
         u2 = ((v[i, 0] - v[src, 0]) ** 2 + (v[i, 1] - v[src, 1]) ** 2
               + (v[i, 2] - v[src, 2]) ** 2)
         r = math.sqrt(rx * rx + ry * ry + rz * rz)
-        s, c = _add(s, c, m[i] * inv_c2 * (0.375 * u2 * u2 + 1.5 * mu * u2 / r
-                                           + 0.5 * mu * mu / (r * r)))
+        mu_i = mu + gm[i]
+        s, c = _add(s, c, m[i] * (mu / mu_i) * inv_c2
+                    * (0.375 * u2 * u2 + 1.5 * mu_i * u2 / r + 0.5 * mu_i * mu_i / (r * r)))
     return s + c
 
 
@@ -170,11 +186,12 @@ def gr_jacobian(x, v, t, args, jx, jv):
         rr = math.sqrt(r2)
         u2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
         rv = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
-        # a = k [A(r, u) r + B(r, u) u] with A = (4 mu / r - u^2) / r^3, B = 4 rv / r^3
-        A = (4.0 * mu / rr - u2) / (r2 * rr)
+        # a = k [A(r, u) r + B(r, u) u] with A = (4 mu_i / r - u^2) / r^3, B = 4 rv / r^3
+        mu_i = mu + gm[i]
+        A = (4.0 * mu_i / rr - u2) / (r2 * rr)
         B = 4.0 * rv / (r2 * rr)
         # dA/dr_b = dA_dr r_b, dB/dr_b = dB_dr r_b + 4 u_b / r^3
-        dA_dr = -4.0 * mu / (r2 * r2 * r2) - 3.0 * A / r2
+        dA_dr = -4.0 * mu_i / (r2 * r2 * r2) - 3.0 * A / r2
         dB_dr = -3.0 * B / r2
         for a in range(3):
             for b in range(3):
