@@ -9,9 +9,10 @@ import numpy as np
 
 from ._kernels import invariants as _inv
 
-__all__ = ["MONITORS", "CHAOS_MONITORS", "DEFAULT_MONITORS", "monitor_mask", "relative_error",
-           "vector_relative_error", "growth_exponent", "ensemble_growth_exponent",
-           "monitor_fields"]
+__all__ = ["MONITORS", "CHAOS_MONITORS", "DEFAULT_MONITORS", "CIRCULAR_E", "monitor_mask",
+           "relative_error", "vector_relative_error", "growth_exponent",
+           "ensemble_growth_exponent", "monitor_fields", "massless_energies",
+           "massless_energy_errors"]
 
 #: monitor name -> bit of the kernel mask
 MONITORS = {
@@ -28,6 +29,11 @@ MONITORS = {
 CHAOS_MONITORS = ("megno", "lyapunov", "fli")
 
 DEFAULT_MONITORS = ("energy", "angular_momentum")
+
+#: eccentricity below which two massive bodies count as a circular binary, so
+#: that their test particles keep the Jacobi integral (the circular restricted
+#: three-body problem); a binary of eccentricity e changes it by O(e)
+CIRCULAR_E = 1e-8
 
 
 def monitor_mask(names):
@@ -352,3 +358,142 @@ def _work_column(rows):
     if rows.shape[-1] > _inv.WORK_COLUMN:
         return rows[..., _inv.WORK_COLUMN]
     return 0.0 if rows.ndim == 1 else np.zeros(rows.shape[0])
+
+
+def massless_energies(x, v, m, G, masses=None):
+    """Each test particle's specific energy at every output, in the form its
+    motion keeps.
+
+    The energy monitor sums ``m E`` and cannot see a massless body; this is
+    its measure for them, computed from output states.  With two massive
+    bodies on a circular orbit (eccentricity below :data:`CIRCULAR_E` at the
+    first output) it is the Jacobi integral of the circular restricted
+    three-body problem, ::
+
+        E_J = |v'|^2 / 2 - sum_j G m_j / |x - x_j| - Omega . (x' x v')
+
+    with ``x'``, ``v'`` relative to the pair's barycentre and ``Omega = r x u
+    / |r|^2`` the pair's angular velocity (``r``, ``u`` its relative
+    position and velocity), a constant of the motion.  Otherwise it is the
+    Kepler energy about the primary, the most massive body, ::
+
+        E = |v - v_p|^2 / 2 - G m_p / |x - x_p|
+
+    a constant of the motion with one massive body; with more, the others'
+    pull changes it by about their mass ratio to the primary.  Newtonian
+    gravity only: force terms that act on test particles change either.
+
+    Parameters
+    ----------
+    x, v : numpy.ndarray, shape (n, N, 3)
+        Positions and velocities at n outputs, in one unit system.
+    m : numpy.ndarray, shape (N,)
+        Masses at the start: the test particles are the bodies of mass 0.
+    G : float
+        The gravitational constant in that unit system.
+    masses : numpy.ndarray, shape (n, N), optional
+        Masses at each output where collisions changed them (NaN for a body
+        merged away, whose positions are NaN too).
+
+    Returns
+    -------
+    kind : str or None
+        ``"jacobi"`` or ``"kepler"``; None, and the rest empty, without test
+        particles or without a massive body.
+    primary : int or None
+        Index of the primary (``"kepler"``); None for ``"jacobi"``.
+    index : numpy.ndarray, shape (k,)
+        Indices of the test particles.
+    energy : numpy.ndarray, shape (n, k)
+        Their specific energies (energy per mass in the unit system).
+    scale : numpy.ndarray, shape (k,)
+        The sum of the magnitudes of its terms at the first output: what the
+        energy is relative to where it is 0 there.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits.monitors import massless_energies
+    >>> x = np.array([[[0.0, 0, 0], [1.0, 0, 0]]])      # a star and, at r = 1,
+    >>> v = np.array([[[0.0, 0, 0], [0.0, 1, 0]]])      # a particle at v = 1
+    >>> kind, primary, index, energy, scale = massless_energies(x, v, [1.0, 0.0], 1.0)
+    >>> kind, primary, index.tolist(), energy.tolist(), scale.tolist()
+    ('kepler', 0, [1], [[-0.5]], [1.5])
+    """
+    m = np.asarray(m, dtype=float)
+    index = np.flatnonzero(m == 0)
+    massive = np.flatnonzero(m > 0)
+    n = x.shape[0]
+    if index.size == 0 or massive.size == 0:
+        return None, None, index, np.empty((n, 0)), np.empty(0)
+    mt = np.broadcast_to(m, (n, m.size)) if masses is None else np.nan_to_num(masses)
+    gm = G * mt[:, massive]                                    # (n, j)
+    xt, vt = x[:, index], v[:, index]                          # (n, k, 3)
+    # (n, k) distances to every massive body and the Newtonian potential
+    d = np.linalg.norm(xt[:, :, None] - x[:, None, massive], axis=-1)
+    if massive.size == 2 and _eccentricity(x[0], v[0], gm[0], massive) < CIRCULAR_E:
+        a, b = massive
+        w = gm / gm.sum(axis=1, keepdims=True)
+        X = w[:, 0, None] * x[:, a] + w[:, 1, None] * x[:, b]
+        V = w[:, 0, None] * v[:, a] + w[:, 1, None] * v[:, b]
+        r, u = x[:, b] - x[:, a], v[:, b] - v[:, a]
+        omega = np.cross(r, u) / np.sum(r * r, axis=1)[:, None]
+        xp, vp = xt - X[:, None], vt - V[:, None]
+        kinetic = 0.5 * np.sum(vp * vp, axis=-1)
+        potential = np.sum(gm[:, None, :] / d, axis=-1)
+        spin = np.einsum("nd,nkd->nk", omega, np.cross(xp, vp))
+        energy = kinetic - potential - spin
+        scale = (kinetic + potential + np.abs(spin))[0]
+        return "jacobi", None, index, energy, scale
+    p = int(massive[np.argmax(m[massive])])
+    j = int(np.flatnonzero(massive == p)[0])
+    u = vt - v[:, p, None]
+    kinetic = 0.5 * np.sum(u * u, axis=-1)
+    potential = gm[:, j, None] / d[:, :, j]
+    return "kepler", p, index, kinetic - potential, (kinetic + potential)[0]
+
+
+def massless_energy_errors(x, v, m, G, masses=None):
+    """The relative change of each test particle's energy (as
+    :func:`massless_energies` defines it) since the first output,
+    ``|E - E_0| / |E_0|`` (``E_0 = 0``: over the scale of its terms).
+
+    Parameters
+    ----------
+    x, v, m, G, masses
+        As for :func:`massless_energies`.
+
+    Returns
+    -------
+    kind, primary, index
+        As :func:`massless_energies` returns them.
+    errors : numpy.ndarray, shape (n, k)
+        Dimensionless; NaN after a collision merged the particle away.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits.monitors import massless_energy_errors
+    >>> x = np.array([[[0.0, 0, 0], [1.0, 0, 0]], [[0.0, 0, 0], [0.0, 1, 0]]])
+    >>> v = np.array([[[0.0, 0, 0], [0.0, 1, 0]], [[0.0, 0, 0], [-1.1, 0, 0]]])
+    >>> kind, primary, index, errors = massless_energy_errors(x, v, [1.0, 0.0], 1.0)
+    >>> kind, errors[:, 0].round(6).tolist()
+    ('kepler', [0.0, 0.21])
+    """
+    kind, primary, index, energy, scale = massless_energies(x, v, m, G, masses)
+    if kind is None:
+        return kind, primary, index, energy
+    e0 = energy[0]
+    with np.errstate(invalid="ignore"):
+        errors = np.abs(energy - e0) / np.where(e0 != 0, np.abs(e0), scale)
+    return kind, primary, index, errors
+
+
+def _eccentricity(x, v, gm, pair):
+    """Eccentricity of the relative orbit of the two bodies ``pair`` (one
+    state, ``gm`` their ``G m``)."""
+    a, b = pair
+    r, u = x[b] - x[a], v[b] - v[a]
+    mu = gm[0] + gm[1]
+    e = np.cross(u, np.cross(r, u)) / mu - r / np.linalg.norm(r)
+    return float(np.linalg.norm(e))

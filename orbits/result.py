@@ -17,6 +17,7 @@ import numpy as np
 
 from ._kernels import kepler as _kepler
 from .errors import BodyError, ElementsError, NoMassiveBodyError, UnknownBodyError
+from .monitors import massless_energy_errors
 from .units import UnitSystem
 
 __all__ = ["Result", "FRAMES", "DOMINANT_MASS_FRACTION"]
@@ -35,7 +36,7 @@ _ELEMENT_KEYS = ("a", "e", "inc", "Omega", "omega", "f", "M")
 #: Monitor series that :meth:`Result.to_pandas` and :meth:`Result.to_xarray`
 #: export: (attribute, is a 3-vector).
 _MONITOR_SERIES = (("energy", False), ("work", False), ("energy_error", False),
-                   ("angular_momentum", True), ("angular_momentum_error", False),
+                   ("test_particle_energy_error", False), ("angular_momentum", True), ("angular_momentum_error", False),
                    ("momentum", True), ("center_of_mass", True), ("megno", False),
                    ("lyapunov", False), ("fli", False))
 
@@ -84,7 +85,26 @@ class Result:
     energy_error : ndarray, shape (n,) or None
         ``|E + W - E0| / |E0|`` against the energy when the simulation was
         made: the integration's error, the work ``W`` of non-conservative terms
-        (zero without them) accounted for.
+        (zero without them) accounted for.  Massless bodies add nothing to
+        ``E``; ``test_particle_energy_error`` watches them.
+    test_particle_energy_error : ndarray, shape (n,) or None
+        With the energy monitor and massless bodies: at each output, the
+        largest over the massless bodies of ``|e - e0| / |e0|``, the relative
+        change of the specific energy each keeps since the first output
+        (:func:`orbits.monitors.massless_energies`): the Jacobi integral when
+        two massive bodies are on a circular orbit (the circular restricted
+        three-body problem), else the Kepler energy about the most massive
+        body.  Both are constants of the motion with one massive body or a
+        circular binary, so the figure measures the integration there; with
+        more massive bodies their pull changes the Kepler energy by about
+        their mass ratio to the primary, so it tells an orbit kept from one
+        destroyed (a change of order one), not round-off.  Newtonian: force
+        terms acting on test particles change it too.  Computed from the
+        outputs when first read (no cost per step); its reference is the first
+        output, where ``energy_error``'s is the simulation's start.  None
+        without massless bodies or the energy monitor, and for a run written
+        to a file, whose result holds the last output only (:func:`orbits.load`
+        the file for the series).  :meth:`summary` names the body.
     angular_momentum : Quantity, shape (n, 3) or None
     angular_momentum_error : ndarray, shape (n,) or None
         ``|L - L0| / |L0|`` (see :func:`orbits.monitors.vector_relative_error`).
@@ -227,7 +247,10 @@ class Result:
         else:
             span = "no outputs"
         names = ", ".join(self.names[:6]) + (", ..." if len(self.names) > 6 else "")
+        tp = self.test_particle_energy_error
         errors = (("largest energy error", self.max_energy_error()),
+                  ("largest test-particle energy error",
+                   None if tp is None or not np.isfinite(tp).any() else float(np.nanmax(tp))),
                   ("largest ang. momentum error", self.max_angular_momentum_error()))
         rows = [("outputs", str(len(self))), ("bodies", f"{len(self.names)}: {names}"),
                 ("time", span),
@@ -284,6 +307,52 @@ class Result:
         value = (self.largest_errors or {}).get(name)
         return None if value is None else np.array([value])
 
+    @property
+    def test_particle_energy_error(self):
+        """The massless bodies' largest relative energy change at each output
+        (see the class's attributes), or None.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> b = orbits.scenes.kepler()
+        >>> b.add("comet", mass=0 * u.Msun, primary="Star", a=3 * u.au, e=0.9)
+        >>> sim = orbits.Simulation(b, "ias15")
+        >>> result = sim.run(until=10 * u.yr, outputs=11, progress=False)
+        >>> err = result.test_particle_energy_error
+        >>> err.shape, bool(err.max() < 1e-13)
+        ((11,), True)
+        >>> line = result.summary().splitlines()[7]      # the planet's orbit is circular
+        >>> line[:45], line.split("(")[1]
+        ('test particles  largest relative energy error', 'comet; Jacobi integral)')
+        """
+        found = self._massless_errors()
+        return None if found is None else np.fmax.reduce(found[3], axis=1)
+
+    def _massless_errors(self):
+        """(kind, primary's name, the massless bodies' names, errors (n, k)) of
+        :func:`orbits.monitors.massless_energy_errors` on the outputs, made once;
+        None where ``test_particle_energy_error`` is."""
+        if "_massless" not in self.__dict__:
+            self.__dict__["_massless"] = self._make_massless_errors()
+        return self.__dict__["_massless"]
+
+    def _make_massless_errors(self):
+        if "energy" not in (getattr(self, "monitors", None) or ()):
+            return None
+        m0 = self.masses.value
+        if not np.any(m0 == 0) or not np.any(m0 > 0) or not len(self.times):
+            return None
+        if self.start_time is not None and self.start_time != self.times[0]:
+            return None             # the last output of a run written to a file
+        U, x, v, m = self._internal()
+        masses = (None if self.masses_at_outputs is None
+                  else self.masses_at_outputs.to_value(U.unit("mass")))
+        kind, primary, index, errors = massless_energy_errors(x, v, m, U.G, masses)
+        return (kind, None if primary is None else self.names[primary],
+                [self.names[i] for i in index], errors)
+
     def summary(self):
         """A few lines for a person: what ran, how long, and how well it kept the invariants.
 
@@ -337,6 +406,14 @@ class Result:
         if e is not None:
             lines.append(f"energy          largest relative error {e:.3e}"
                          + _final(self.energy_error))
+        found = self._massless_errors()
+        if found is not None:
+            kind, primary, names, errors = found
+            worst = np.fmax.reduce(errors, axis=0)
+            k = int(np.nanargmax(worst)) if np.isfinite(worst).any() else 0
+            what = "Jacobi integral" if kind == "jacobi" else f"Kepler energy about {primary}"
+            lines.append(f"test particles  largest relative energy error {worst[k]:.3e} "
+                         f"({names[k]}; {what})")
         lerr = self.max_angular_momentum_error()
         if lerr is not None:
             lines.append(f"ang. momentum   largest relative error {lerr:.3e}"
@@ -655,6 +732,7 @@ class Result:
             ``.z``, ``.vx [AU / d]``, ``.vy``, ``.vz`` (in the units of
             ``positions``, ``velocities`` and ``times``); then the monitors that
             were recorded: ``"energy [...]"``, ``"energy_error"``,
+            ``"test_particle_energy_error"`` (with massless bodies),
             ``"angular_momentum.x [...]"`` ..., ``"angular_momentum_error"``,
             ``"momentum.x [...]"`` ..., ``"center_of_mass.x [...]"`` ....
             Dimensionless quantities have no bracket.  ``DataFrame.attrs``
