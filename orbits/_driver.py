@@ -15,7 +15,7 @@ from ._kernels.stepping import USER_FORCE_SIZE
 from .errors import ForceTermError, RunInterrupted, WallTimeExceeded
 
 __all__ = ["advance_checked", "restored_on_error", "Signals", "CHECK_EVERY", "Driven",
-           "CHUNK_SECONDS", "PROGRESS_DELAY"]
+           "CHUNK_SECONDS", "FIRST_CHUNK", "next_chunk", "PROGRESS_DELAY"]
 
 #: The compiled loops test the state for NaN and inf every this many steps
 #: (a test is a dependent chain of 6N additions, as dear as the force for a few
@@ -148,8 +148,69 @@ class Signals:
 
 
 #: A run's compiled loop returns to Python about this often, so that progress
-#: bars move; the chunk length in steps adapts to keep to it.
+#: bars move and Ctrl-C, SIGTERM, ``wall_limit`` and checkpoints are acted on;
+#: each chunk's length in steps is sized from the time a step took in the
+#: chunk before (:func:`next_chunk`).
 CHUNK_SECONDS = 0.25
+
+#: Steps in a simulation's first call of its compiled loop.  What a step costs
+#: is not known before one is taken (0.2 us for the outer solar system on
+#: ``leapfrog``, 40 ms for 2000 bodies on ``ias15``), so the first call takes
+#: one and its time sizes the next (a call's fixed cost, some 20 us, makes
+#: the next chunk of a cheap step about 1e4 steps, and the one after it
+#: ``CHUNK_SECONDS`` long).
+FIRST_CHUNK = 1
+
+#: The shortest time :func:`next_chunk` takes a call to have lasted: below a
+#: call's fixed cost, so only a clock that did not advance is raised to it.
+_CLOCK_FLOOR = 1e-6
+
+
+def next_chunk(chunk, steps, elapsed):
+    """The length in steps of the chunk after one of ``chunk`` steps that took
+    ``steps`` steps in ``elapsed`` seconds.
+
+    A chunk that ran to its end sets the next to last ``CHUNK_SECONDS`` at its
+    time a step, ``CHUNK_SECONDS steps / elapsed`` (at least one step); that
+    time includes the call's fixed cost, so a short sample overestimates what
+    a step costs and the next chunk errs short.  A call that ended before its
+    chunk (at an output, the end of the run) says only that its steps took
+    ``elapsed``: it shortens the chunk if it took longer than
+    ``CHUNK_SECONDS``, and otherwise leaves it.
+
+    Parameters
+    ----------
+    chunk : int
+        Steps the call was allowed.
+    steps : int
+        Steps it took (accepted steps, for an adaptive method).
+    elapsed : float
+        Wall-clock seconds the call took.
+
+    Returns
+    -------
+    int
+        The next chunk's length in steps, at least 1.
+
+    Examples
+    --------
+    A first step that took 40 ms (2000 bodies on ``ias15``) sizes the next
+    chunk to six steps:
+
+    >>> from orbits._driver import next_chunk
+    >>> next_chunk(1, 1, 0.04)
+    6
+    >>> next_chunk(1, 1, 25e-6)        # a step of a few bodies, with the call's cost
+    10000
+    >>> next_chunk(1000, 10, 1e-4)     # ended at an output: no longer
+    1000
+    """
+    if steps <= 0:
+        return chunk
+    want = max(1, int(CHUNK_SECONDS * steps / max(elapsed, _CLOCK_FLOOR)))
+    if steps < chunk:
+        return min(chunk, want) if elapsed > CHUNK_SECONDS else chunk
+    return want
 
 #: A progress bar appears once a run has gone on this long, so short runs stay quiet.
 PROGRESS_DELAY = 3.0
@@ -374,10 +435,7 @@ class Driven:
             if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
                 self._stop_info[:] = self._ws["info"]
             self._fail(status, rec, wall0)
-        if acc == self._chunk and elapsed < CHUNK_SECONDS / 4:
-            self._chunk *= 4
-        elif elapsed > CHUNK_SECONDS:
-            self._chunk = max(16, self._chunk // 2)
+        self._chunk = next_chunk(self._chunk, int(acc), elapsed)
         self._between_chunks(rec, wall0)
         return first + n_mon
 
@@ -422,15 +480,13 @@ class Driven:
                 if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
                     self._stop_info[:] = self._ws["info"]
                 self._fail(status, rec, wall0)
-            if acc == n and elapsed < CHUNK_SECONDS / 4:
-                self._chunk *= 4
-            elif elapsed > CHUNK_SECONDS:
-                self._chunk = max(16, self._chunk // 2)
+            self._chunk = next_chunk(n, int(acc), elapsed)
             self._between_chunks(rec, wall0)
 
     def _advance_to(self, done, target, rec, bar, wall0):
-        # the loop returns to Python about every CHUNK_SECONDS (progress bar);
-        # the chunk length adapts and is kept from one call to the next
+        # the loop returns to Python about every CHUNK_SECONDS (progress bar,
+        # signals, wall_limit); the chunk length adapts (next_chunk) and is
+        # kept from one call to the next
         cap = getattr(rec, "max_rows", None) if self._in_loop else None
         while done < target:
             n = min(self._chunk, target - done)
@@ -445,11 +501,7 @@ class Driven:
             elapsed = _time.perf_counter() - t0
             done += n
             bar.update(n)
-            if n == self._chunk:
-                if elapsed < CHUNK_SECONDS / 4:
-                    self._chunk *= 4
-                elif elapsed > CHUNK_SECONDS:
-                    self._chunk = max(1, self._chunk // 2)
+            self._chunk = next_chunk(self._chunk, n, elapsed)
             self._between_chunks(rec, wall0)
         return done
 

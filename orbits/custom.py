@@ -14,7 +14,7 @@ import numba
 import numpy as np
 
 from . import integrators as _integrators
-from ._driver import Driven
+from ._driver import FIRST_CHUNK, Driven
 from ._kernels import implicit as _implicit
 from ._kernels import stepping as _stepping
 from ._kernels.status import Status
@@ -274,7 +274,7 @@ class _UserRun(Driven):
         self._t_base, self._steps_since_base = float(t0), 0
         self._dt = 0.0 if dt is None else float(dt)
         self.steps = self.steps_rejected = self.force_evaluations = 0
-        self._chunk = 1024
+        self._chunk = FIRST_CHUNK
         self._stop_info = np.full(2, -1, dtype=np.int64)
         self._no_monitors = (0, 0, np.zeros(x.shape[0]), 0.0, 0, 0.0)
 

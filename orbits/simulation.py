@@ -18,7 +18,8 @@ from . import collisions as _collisions
 from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
-from ._driver import CHUNK_SECONDS, PROGRESS_DELAY, Driven  # noqa: F401 - documented here
+from ._driver import (CHUNK_SECONDS, FIRST_CHUNK, PROGRESS_DELAY,  # noqa: F401 - documented here
+                      Driven)
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
@@ -250,7 +251,7 @@ class Simulation(Driven):
         self._steps_since_base = 0
         self.steps = 0              # steps since the simulation was made
         self.force_evaluations = 0
-        self._chunk = 1024          # steps per compiled call; adapts in run()
+        self._chunk = FIRST_CHUNK   # steps per compiled call; adapts in run()
         #: the HDF5 file this simulation writes to (set by ``run(output=...)``
         #: and :meth:`from_file`): a later ``run`` with the same ``output``
         #: appends to it
@@ -1341,8 +1342,10 @@ class Simulation(Driven):
         wall_limit : float, optional
             Seconds of wall-clock time after which the run stops with
             :class:`~orbits.errors.WallTimeExceeded` (checked about every
-            ``CHUNK_SECONDS``), for sweeps in which some runs may need far more
-            steps than expected.  Default: no limit.
+            ``CHUNK_SECONDS`` from the first step on: the first call of the
+            compiled loop takes one step and its time sizes the next), for
+            sweeps in which some runs may need far more steps than expected.
+            Default: no limit.
 
         Returns
         -------

@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 
 import orbits
+from orbits import _driver
 from orbits.errors import (ForceTermError, IntegratorOptionError, OrbitsWarning,
-                           RunInterrupted, StepSizeUnderflow)
+                           RunInterrupted, StepSizeUnderflow, WallTimeExceeded)
 from orbits.cli import main
 
 from helpers import kepler_bodies
@@ -56,13 +57,17 @@ def test_ctrl_c_during_the_compiled_loop_leaves_a_consistent_simulation():
     np.testing.assert_array_equal(sim.bodies.positions.value, ref.bodies.positions.value)
 
 
-def _signal_at_chunk(sim, k, signum):
-    """Send ``signum`` to this process as the run reaches its ``k``-th chunk boundary."""
+def _signal_at_chunk(sim, k, signum, chunk=64):
+    """Send ``signum`` to this process as the run reaches its ``k``-th chunk
+    boundary, the chunks held at ``chunk`` steps (many boundaries, so that the
+    signal comes mid-run)."""
     calls = [0]
     original = sim._between_chunks
+    sim._chunk = chunk
 
     def between(rec, wall0):
         calls[0] += 1
+        sim._chunk = chunk
         if calls[0] == k:
             os.kill(os.getpid(), signum)
         return original(rec, wall0)
@@ -76,7 +81,6 @@ def test_ctrl_c_with_a_file_writes_a_checkpoint_that_resumes_bit_identically(tmp
     until, outputs = 2000 * u.yr, 40
     path = tmp_path / "run.h5"
     sim = outer(integrator)
-    sim._chunk = 64           # many chunk boundaries, so the signal comes mid-run
     _signal_at_chunk(sim, 5, signal.SIGINT)
     with pytest.raises(RunInterrupted, match="checkpoint"):
         sim.run(until=until, outputs=outputs, progress=False, output=path)
@@ -99,7 +103,6 @@ def test_a_callers_own_signal_handler_is_called_at_a_consistent_state():
     previous = signal.signal(signal.SIGTERM, handler)
     try:
         sim = outer()
-        sim._chunk = 64
         _signal_at_chunk(sim, 3, signal.SIGTERM)
         sim.run(until=20 * u.yr, outputs=2, progress=False)
         assert seen == [signal.SIGTERM]
@@ -130,6 +133,89 @@ def test_sigterm_stops_the_command_line_run_with_a_checkpoint(tmp_path):
     sim = orbits.Simulation.from_file(path)
     assert sim.steps > 0 and not sim.resume_point.finished
     assert sim.time.to_value(u.d) == sim.steps * 10.0
+
+
+# -- how soon a run of expensive steps reacts --------------------------------------------
+
+class _Clock:
+    """The run driver's wall clock, advanced only by what the steps cost."""
+
+    def __init__(self):
+        self.now = 0.0
+
+    def perf_counter(self):
+        return self.now
+
+
+def _expensive_steps(monkeypatch, sim, cost, at=None, signum=None):
+    """Make every step of ``sim`` cost ``cost`` seconds of the clock that the run
+    driver reads, and send ``signum`` to this process from the call of the
+    compiled loop during which that clock passes ``at``.  The steps themselves
+    are the real ones, of a loop compiled for other tests too."""
+    clock = _Clock()
+    monkeypatch.setattr(_driver, "_time", clock)
+    integ = sim.integrator
+    name = "advance_to" if integ.adaptive else "advance"
+    real = getattr(integ, name)
+
+    def timed(*args, **kw):
+        out = real(*args, **kw)
+        before = clock.now
+        clock.now += cost * int(out[2] if integ.adaptive else out[1])
+        if signum is not None and before < at <= clock.now:
+            os.kill(os.getpid(), signum)
+        return out
+
+    setattr(integ, name, timed)
+    return clock
+
+
+# 40 ms a step: 2000 bodies on ias15, whose first chunk of 1024 steps took 39 s
+# to react to Ctrl-C and passed a wall_limit of 5 s by 54 s
+_STEP = 0.04
+
+
+@pytest.mark.parametrize("integrator", ["leapfrog", "ias15"])
+@pytest.mark.parametrize("at", [0.5 * _STEP, 3.0])
+def test_ctrl_c_is_acted_on_within_a_chunk_of_expensive_steps(monkeypatch, integrator, at):
+    sim = outer(integrator)
+    clock = _expensive_steps(monkeypatch, sim, _STEP, at=at, signum=signal.SIGINT)
+    with pytest.raises(RunInterrupted) as info:
+        sim.run(until=1e4 * u.yr, outputs=5, progress=False)
+    assert info.value.step == sim.steps
+    # a chunk is sized from its predecessor's time a step to last at most
+    # CHUNK_SECONDS; the first is one step (a signal during it stops there)
+    assert at <= clock.now <= at + _driver.CHUNK_SECONDS
+    if at < _STEP:
+        assert sim.steps == _driver.FIRST_CHUNK == 1
+
+
+@pytest.mark.parametrize("integrator", ["leapfrog", "ias15"])
+def test_wall_limit_is_acted_on_within_a_chunk_of_expensive_steps(monkeypatch, integrator):
+    limit = 5.0
+    sim = outer(integrator)
+    clock = _expensive_steps(monkeypatch, sim, _STEP)
+    with pytest.raises(WallTimeExceeded) as info:
+        sim.run(until=1e4 * u.yr, outputs=2, progress=False, wall_limit=limit)
+    assert info.value.step == sim.steps
+    assert limit < clock.now <= limit + _driver.CHUNK_SECONDS
+
+
+@pytest.mark.parametrize("cost", [1e-7, 2e-5, 0.04, 0.3, 10.0])
+def test_a_chunk_is_sized_from_the_time_a_step_took(cost):
+    # after a first step of `cost` seconds, and then after chunks that ran
+    # to their end at that cost, a chunk lasts at most CHUNK_SECONDS (or is
+    # one step); by the third, at least half of it where a step is cheaper
+    target = _driver.CHUNK_SECONDS
+    chunk = _driver.FIRST_CHUNK
+    for _ in range(3):
+        chunk = _driver.next_chunk(chunk, chunk, cost * chunk)
+        assert chunk == 1 or chunk * cost <= target
+    assert chunk * cost >= target / 2 or cost > target / 2
+    # a call that ended early (at an output) shortens the chunk only if it
+    # took longer than CHUNK_SECONDS
+    assert _driver.next_chunk(1000, 10, 10 * cost) == (
+        1000 if 10 * cost <= target else max(1, int(target / cost)))
 
 
 # -- user forces of the wrong shape -------------------------------------------------------
@@ -180,6 +266,7 @@ def _shrinking(x, v, t, m):
     "leapfrog", pytest.param("dopri5", marks=pytest.mark.slow)])  # ~7 s each: a new loop
 def test_a_user_force_term_that_changes_shape_leaves_the_simulation_whole(integrator):
     sim = outer(integrator, forces=[orbits.forces.UserForce(_shrinking)])
+    sim._chunk = 1024           # the step that fails (t > 100 d) falls in the first chunk
     start = sim.bodies.positions.value.copy()
     with pytest.raises(ForceTermError, match="another shape"):
         sim.run(until=1000 * u.d, outputs=2, progress=False)
