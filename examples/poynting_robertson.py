@@ -77,10 +77,10 @@ def semi_major_axis(result, name, beta):
     """Osculating semi-major axis (Quantity, one per output) about the Sun with
     the grain's reduced gravity ``(1 - beta) G M``."""
     i, s = result.names.index(name), result.names.index("Sun")
-    # plain floats in the run's own units, in which result.units["G"] is given
+    # plain floats in the run's own units, in which result.units.G is given
     r = (result.positions[:, i] - result.positions[:, s]).value
     v = (result.velocities[:, i] - result.velocities[:, s]).value
-    mu = (1 - beta) * result.units["G"] * result.masses[s].value
+    mu = (1 - beta) * result.units.G * result.masses[s].value
     a = 1 / (2 / np.linalg.norm(r, axis=1) - np.sum(v * v, axis=1) / mu)
     return a << result.positions.unit
 

@@ -803,11 +803,16 @@ def _plain(q, name):
 
 
 def _spacing(t, hint=""):
-    """The sampling interval of evenly spaced ``t``; a ValueError otherwise."""
+    """The sampling interval of evenly spaced ``t``; a ValueError otherwise
+    (``hint``, on how to space them evenly, ends the message of uneven ones)."""
     d = np.diff(t.astype(float))
     mean = (t[-1] - t[0]) / (len(t) - 1)
-    if not mean > 0 or np.any(d <= 0):
-        raise ValueError("times: expected increasing times" + hint)
+    if np.any(d <= 0):
+        k = int(np.argmax(d <= 0))
+        raise ValueError(f"times: expected increasing times; times[{k + 1}] = {t[k + 1]:.10g} "
+                         f"is not after times[{k}] = {t[k]:.10g}")
+    if not mean > 0:
+        raise ValueError("times: expected increasing times")
     spread = float(np.max(np.abs(d - mean))) / mean
     if spread > SPACING_RTOL:
         k = int(np.argmax(np.abs(d - mean)))

@@ -1,19 +1,58 @@
 """Command line: ``orbits run | resume | info | plot | elements | validate | scenes | integrators``.
 
 ``main(argv=None)`` only parses arguments and calls the library; the tests
-call it with a list.
+call it with a list.  It returns the exit status: one of
+:data:`EXIT_STATUSES`, or 128 + the signal number for a run stopped by
+SIGINT or SIGTERM.
 """
 
 import argparse
 import re
 import signal
 import sys
+import textwrap
 import threading
+import traceback
 
 import astropy.units as u
 import numpy as np
 
-__all__ = ["main", "parse_quantity"]
+__all__ = ["main", "parse_quantity", "EXIT_STATUSES", "EXIT_COMPLETED", "EXIT_STOPPED",
+           "EXIT_USAGE", "EXIT_INPUT", "EXIT_FILE", "EXIT_RUN_FAILED", "EXIT_INTERNAL"]
+
+EXIT_COMPLETED = 0
+EXIT_STOPPED = 1
+EXIT_USAGE = 2          # argparse's own
+EXIT_INPUT = 3
+EXIT_FILE = 4
+EXIT_RUN_FAILED = 5
+EXIT_INTERNAL = 70      # EX_SOFTWARE of sysexits.h
+
+#: what each exit status of ``orbits`` means; ``orbits --help`` and the command
+#: line's guide (docs/guides/cli.rst) list this table
+EXIT_STATUSES = {
+    EXIT_COMPLETED: "completed",
+    EXIT_STOPPED: "the run was stopped by a stopping condition (an encounter, an escape, "
+                  "a collision); its summary is printed, and --out holds it",
+    EXIT_USAGE: "the command line cannot be parsed: an unknown option, a missing argument",
+    EXIT_INPUT: "bad input: a scene, body-set file, integrator, option or value that "
+                "cannot be used",
+    EXIT_FILE: "a file that cannot be read or written: missing, damaged, written by "
+               "another run, a symbolic link, or a full disk",
+    EXIT_RUN_FAILED: "the run failed: the state became non-finite, the step size "
+                     "collapsed, or a Newton iteration did not converge",
+    EXIT_INTERNAL: "an error inside orbits itself (a bug): the traceback is printed",
+}
+_SIGNAL_STATUS = ("stopped by the signal N (130: SIGINT, Ctrl-C; 143: SIGTERM); with "
+                  "--out, after a checkpoint from which 'orbits resume' finishes the run")
+
+
+def _exit_help():
+    """The exit statuses, as ``--help`` shows them."""
+    rows = [*EXIT_STATUSES.items(), ("128+N", _SIGNAL_STATUS)]
+    return "exit status:\n" + "\n".join(
+        textwrap.fill(text, width=79, initial_indent=f"  {code:>5}  ",
+                      subsequent_indent=" " * 9) for code, text in rows) + "\n"
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z_]\w*(?:\s*\S*)?)?\s*$")
 
@@ -100,7 +139,6 @@ then:
 
 A .csv file works too: a header 'name,mass [Msun],x [au],...,vz [km/s]' (or element
 columns 'primary,a [au],e,inc [deg]'), a row per body; see orbits.systemfile.
-Exit status: 0 done, 1 stopped by a stopping condition, 2 an error.
 """
 
 
@@ -122,14 +160,16 @@ def _forces():
 
 
 def _parser():
-    p = argparse.ArgumentParser(prog="orbits", description="N-body orbital mechanics.")
+    p = argparse.ArgumentParser(prog="orbits", description="N-body orbital mechanics.",
+                                epilog=_exit_help(),
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
 
     run = sub.add_parser("run", help="integrate a built-in scene or your own body set "
                                      "and print a summary",
                          description="Integrate a built-in scene or a body set from a "
                                      "TOML or CSV file, and print a summary.",
-                         epilog=RUN_EXAMPLES,
+                         epilog=RUN_EXAMPLES + "\n" + _exit_help(),
                          formatter_class=argparse.RawDescriptionHelpFormatter)
     run.add_argument("scene", help="scene name (see 'orbits scenes') or a body-set file "
                                    "ending in .toml or .csv")
@@ -155,7 +195,8 @@ def _parser():
         opts.add_argument(f"--{option}", type=kind, default=None,
                           help=f"{text}; taken by {', '.join(OPTION_TAKEN_BY[option])}")
     stops = run.add_argument_group("stopping conditions", "checked after every step; the "
-                                   "run stops with exit status 1 and prints what it has")
+                                   f"run stops with exit status {EXIT_STOPPED} and prints "
+                                   f"what it has")
     stops.add_argument("--encounter-distance", type=_length, default=None,
                        help="stop when two bodies come closer than this (0.01au, 1e5km)")
     stops.add_argument("--encounter-hill", type=float, default=None,
@@ -268,11 +309,12 @@ def _terminated(signum, frame):
 
 
 def main(argv=None):
-    """Entry point of the ``orbits`` command; returns the exit status."""
+    """Entry point of the ``orbits`` command; returns the exit status
+    (:data:`EXIT_STATUSES`; argparse exits with :data:`EXIT_USAGE` itself)."""
     argv = _negative_values(sys.argv[1:] if argv is None else list(argv))
     args = _parser().parse_args(argv)
     import orbits
-    from orbits.errors import OrbitsError, RunInterrupted
+    from orbits.errors import OrbitsError, RunError, RunInterrupted, SimulationStopped
 
     path = getattr(args, "out", None) or (args.file if args.command == "resume" else None)
     previous = None
@@ -290,9 +332,31 @@ def main(argv=None):
               + (f"; a checkpoint is in {path}: 'orbits resume {path}' finishes the run"
                  if path else "; nothing was written (no --out)"), file=sys.stderr)
         return 128 + int(exc.signal or signal.SIGINT)
+    except SimulationStopped as exc:
+        if exc.result is not None:
+            print(exc.result.summary())
+        print(f"stopped         {exc}")
+        if path:
+            print(f"written         {path}")
+        return EXIT_STOPPED
+    except RunError as exc:
+        if exc.result is not None:
+            print(exc.result.summary())
+        if path:
+            print(f"written         {path}")
+        print(f"orbits: the run failed: {exc}", file=sys.stderr)
+        return EXIT_RUN_FAILED
+    except OSError as exc:          # OrbitsFileError, and the system's own
+        print(f"orbits: error: {exc}", file=sys.stderr)
+        return EXIT_FILE
     except (OrbitsError, ValueError, u.UnitsError) as exc:
         print(f"orbits: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_INPUT
+    except Exception:
+        traceback.print_exc()
+        print(f"orbits: internal error (exit status {EXIT_INTERNAL}): the traceback above is "
+              f"of a bug in orbits; please report it", file=sys.stderr)
+        return EXIT_INTERNAL
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
@@ -397,18 +461,10 @@ def _run(args, orbits):
                             dt=_in_scene_units(dt, bodies), forces=forces,
                             **{k: v for k, v in stops.items() if v is not None})
     print(f"scene           {args.scene}")
-    try:
-        result = sim.run(until=_in_scene_units(until, bodies), outputs=given("outputs"),
-                         progress=False if args.no_progress else None,
-                         output=args.out, overwrite=args.force,
-                         checkpoint_interval=args.checkpoint_interval)
-    except orbits.errors.SimulationStopped as exc:
-        if exc.result is not None:
-            print(exc.result.summary())
-        print(f"stopped         {exc}")
-        if args.out:
-            print(f"written         {args.out}")
-        return 1
+    result = sim.run(until=_in_scene_units(until, bodies), outputs=given("outputs"),
+                     progress=False if args.no_progress else None,
+                     output=args.out, overwrite=args.force,
+                     checkpoint_interval=args.checkpoint_interval)
     print(result.summary())
     if args.out:
         print(f"written         {args.out}")
@@ -442,7 +498,7 @@ def _validate(args):
                                    sections=args.only or validation.SECTIONS)
     except validation.ValidationError as exc:
         print(f"orbits: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_INPUT
     finally:
         if client is not None:
             client.close()

@@ -144,8 +144,11 @@ class Result:
         written to a file); :meth:`max_energy_error` takes them into account.
     integrator : dict
         Name and options of the integrator.
-    units : dict
-        The unit system, with G and where it came from.
+    units : UnitSystem
+        The run's unit system, G and where it came from included, as
+        :func:`orbits.load` reads it back from a file: a body set made from
+        the result's arrays takes it (``BodySet.from_arrays(...,
+        units=result.units)``) and keeps the run's G.
     status : str
         ``"completed"`` or the reason the run stopped.
     forces : tuple of str
@@ -194,6 +197,8 @@ class Result:
         self.frame = None
         for k, v in fields.items():
             setattr(self, k, v)
+        if isinstance(self.__dict__.get("units"), dict):   # as UnitSystem.to_dict() gives it
+            self.units = UnitSystem.from_dict(self.units)
         # fields made when first read: ``_deferred`` holds (names, make)
         # pairs, ``make()`` returning a dict of those names (a run's arrays
         # with their units, its monitor series); reading any of them makes
@@ -398,8 +403,8 @@ class Result:
             f"steps           {self.steps} "
             + (f"(+{self.steps_rejected} rejected) " if self.integrator.get("adaptive") else "")
             + f"({forces}), {wall_text}",
-            f"units           {self.units['name']}, G = {self.units['G']!r} "
-            f"({self.units['G_source']})",
+            f"units           {self.units.name}, G = {self.units.G!r} "
+            f"({self.units.G_source})",
             f"forces          {' + '.join(['Newtonian gravity', *self.forces])}",
         ]
         e = self.max_energy_error()
@@ -737,7 +742,8 @@ class Result:
             ``"momentum.x [...]"`` ..., ``"center_of_mass.x [...]"`` ....
             Dimensionless quantities have no bracket.  ``DataFrame.attrs``
             holds ``frame``, ``names``, ``masses`` (a list of floats),
-            ``mass_unit`` and ``units`` (the unit system).
+            ``mass_unit`` and ``units`` (the unit system, as
+            :meth:`~orbits.UnitSystem.to_dict` gives it).
 
         Raises
         ------
@@ -777,7 +783,7 @@ class Result:
         df = pd.DataFrame(np.concatenate(data, axis=1), columns=columns)
         df.attrs.update(frame=self.frame, names=list(self.names),
                         masses=self.masses.value.tolist(),
-                        mass_unit=self.masses.unit.to_string(), units=dict(self.units))
+                        mass_unit=self.masses.unit.to_string(), units=self.units.to_dict())
         return df
 
     def to_xarray(self):
@@ -830,7 +836,7 @@ class Result:
         attrs = {"frame": "as integrated" if self.frame is None else self.frame,
                  "integrator": str(self.integrator.get("name", "")),
                  "status": str(self.status)}
-        attrs.update({f"units_{k}": str(val) for k, val in self.units.items()})
+        attrs.update({f"units_{k}": str(val) for k, val in self.units.to_dict().items()})
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     # -- plots --------------------------------------------------------------------
@@ -911,7 +917,7 @@ class Result:
 
     def _internal(self):
         """The unit system and plain arrays of positions, velocities and masses in it."""
-        U = UnitSystem.from_dict(self.units)
+        U = self.units
         return (U, self.positions.to_value(U.unit("length")),
                 self.velocities.to_value(U.unit("velocity")),
                 self.masses.to_value(U.unit("mass")))

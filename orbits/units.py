@@ -282,6 +282,22 @@ class UnitSystem:
                 "G": self.G, "G_source": self.G_source}
         return dict(d)
 
+    def __getitem__(self, key):
+        """A field of :meth:`to_dict` by its name (``U["G"]`` is ``U.G``), as a
+        result's ``units`` gave them when it was that dictionary.
+
+        Examples
+        --------
+        >>> from orbits import UnitSystem
+        >>> U = UnitSystem.default()
+        >>> U["name"], U["G"] == U.G
+        ('au-Msun-day', True)
+        """
+        d = self.to_dict()
+        if key not in d:
+            raise KeyError(f"{key!r}; a UnitSystem's fields are {', '.join(map(repr, d))}")
+        return d[key]
+
     @classmethod
     def from_dict(cls, d):
         """Inverse of :meth:`to_dict`.

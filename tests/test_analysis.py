@@ -298,8 +298,8 @@ def test_cli_elements(oss, oss_file, tmp_path, capsys):
     assert rows[0] == columns
     np.testing.assert_array_equal(np.array(rows[1:], dtype=float), table)  # full precision
 
-    assert main(["elements", str(oss_file), "--body", "Vulcan"]) == 2
+    assert main(["elements", str(oss_file), "--body", "Vulcan"]) == 3
     err = capsys.readouterr().err
     assert "'Vulcan'" in err and "known: Sun, Jupiter" in err
-    assert main(["elements", str(oss_file), "--body", "Jupiter", "--primary", "Vulcan"]) == 2
+    assert main(["elements", str(oss_file), "--body", "Jupiter", "--primary", "Vulcan"]) == 3
     assert "unknown primary 'Vulcan'" in capsys.readouterr().err

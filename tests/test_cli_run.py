@@ -101,7 +101,7 @@ def test_options_reach_other_integrators(argv, shown, capsys):
 ])
 def test_option_errors_are_clear(argv, words, capsys):
     assert main(["run", "outer-solar-system", *argv, "--until", "100d",
-                 "--no-progress"]) == 2
+                 "--no-progress"]) == 3
     err = capsys.readouterr().err
     for word in words:
         assert word in err
@@ -185,13 +185,13 @@ def test_stopping_conditions_stop_with_status_1(argv, words, capsys):
 
 
 def test_file_and_scene_errors(tmp_path, capsys):
-    assert main(["run", str(tmp_path / "none.toml"), "--until", "1yr"]) == 2
+    assert main(["run", str(tmp_path / "none.toml"), "--until", "1yr"]) == 3
     assert "no such file" in capsys.readouterr().err
     bad = tmp_path / "bad.toml"
     bad.write_text(SYSTEM.replace('"1.3 deg"', "1.3"))
-    assert main(["run", str(bad), "--until", "1yr"]) == 2
+    assert main(["run", str(bad), "--until", "1yr"]) == 3
     assert f"{bad}, line 11: body 'Jupiter', field 'inc'" in capsys.readouterr().err
-    assert main(["run", "no-such-scene", "--until", "1yr"]) == 2
+    assert main(["run", "no-such-scene", "--until", "1yr"]) == 3
     assert ".toml or .csv" in capsys.readouterr().err
-    assert main(["run", "kepler", "-i", "ias15"]) == 2
+    assert main(["run", "kepler", "-i", "ias15"]) == 3
     assert "--until is needed" in capsys.readouterr().err

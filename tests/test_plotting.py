@@ -113,7 +113,7 @@ def test_cli_plot_frame(long_file, tmp_path, capsys):
     png = tmp_path / "bary.png"
     assert main(["plot", str(long_file), "-o", str(png), "--frame", "barycentric"]) == 0
     assert png.read_bytes()[:8] == PNG and f"wrote {png}" in capsys.readouterr().out
-    assert main(["plot", str(long_file), "-o", str(png), "--frame", "Vulcan"]) == 2
+    assert main(["plot", str(long_file), "-o", str(png), "--frame", "Vulcan"]) == 3
     err = capsys.readouterr().err
     assert "'Vulcan'" in err and "barycentric, heliocentric or a body's name" in err
 

@@ -370,7 +370,7 @@ def test_an_adaptive_progress_bar_counts_outputs(capsys):
 
 def test_command_line_time_options(capsys):
     # a negative step reaches the library's check instead of argparse's
-    assert main(["run", "kepler", "--dt", "-10d", "--until", "1yr"]) == 2
+    assert main(["run", "kepler", "--dt", "-10d", "--until", "1yr"]) == 3
     assert "dt must be a positive" in capsys.readouterr().err
     # plain numbers are read in the scene's units, as the help says
     assert main(["run", "kepler", "--dt", "10", "--until", "100", "--no-progress",
@@ -379,10 +379,10 @@ def test_command_line_time_options(capsys):
     # an adaptive integrator needs no --dt; a fixed-step one says it does
     assert main(["run", "kepler", "-i", "ias15", "--until", "1yr", "--no-progress"]) == 0
     capsys.readouterr()
-    assert main(["run", "kepler", "--until", "1yr"]) == 2
+    assert main(["run", "kepler", "--until", "1yr"]) == 3
     assert "--dt is needed" in capsys.readouterr().err
     # beyond float64's range
-    assert main(["run", "kepler", "--dt", "10d", "--until", "1e400yr"]) == 2
+    assert main(["run", "kepler", "--dt", "10d", "--until", "1e400yr"]) == 3
     assert "finite" in capsys.readouterr().err
 
 

@@ -200,7 +200,7 @@ def test_guide_section_by_command(tmp_path):
 
 
 def test_unknown_section(capsys):
-    assert cli.main(["validate", "--only", "nope", "--workers", "1"]) == 2
+    assert cli.main(["validate", "--only", "nope", "--workers", "1"]) == 3
     assert "valid: accuracy" in capsys.readouterr().err
 
 

@@ -100,6 +100,16 @@ written, so even a run stopped before its first periodic checkpoint resumes;
 :meth:`FileRecorder.checkpoint` may be called at any point between two
 compiled chunks (a signal handler does).
 
+A full disk stops a run between two writes: before each write the disk is
+asked (``posix_fallocate``) for the space it may take, and where there is
+none the run stops with an :class:`OrbitsFileError` that says the disk is
+full, the file closed whole, ending at or after its last checkpoint, and the
+space reserved past its end given back.  While it is being written a file
+may therefore be larger than the end its superblock records.  Temporary
+files (``<file>.creating``, ``<file>.resume``) are made exclusively, never
+through a link that has their name, and a destination that is a link is
+refused unless asked to be replaced.
+
 Damaged files
 -------------
 HDF5 reading a file in SWMR mode retries a metadata block whose checksum
@@ -114,6 +124,22 @@ with the tries bounded (:data:`SWMR_READ_ATTEMPTS`).  The groups and
 datasets the layout needs are then checked, and a missing one is named in
 words.
 
+What a reader trusts
+--------------------
+A file carries data, never code.  Nothing it names is imported (the
+functions of a run are named in ``/parameters`` and come back from the
+caller of :meth:`orbits.Simulation.from_file`), and nothing outside it is
+read: external and user-defined links, datasets stored in external files or
+as virtual views, and filters that HDF5 would load as plugins are refused
+(:func:`_inventory`).  Declared shapes are checked against the bodies' count
+and against the bytes the file stores before anything is read, and of a time
+series only the rows stored are read (:func:`_covered`), so that a small file
+cannot make a reader allocate for data it does not hold.  Every control
+value (the checkpoints' count, clock, plan, progress, the bodies' order, the
+units and the recorded configuration) is checked for type, shape and range
+(:func:`_check_values`); what fails is an :class:`OrbitsFileError` naming the
+dataset or attribute and what was expected.
+
 Writers' lock
 -------------
 A writer holds ``<file>.lock`` (made atomically; it names the host, process
@@ -125,8 +151,10 @@ this host) is taken over.
 
 import ctypes
 import datetime
+import errno
 import functools
 import json
+import math
 import os
 import pathlib
 import re
@@ -138,6 +166,11 @@ from typing import NamedTuple
 
 import h5py
 import numpy as np
+
+try:
+    import resource     # the file-size limit (ulimit -f); POSIX only
+except ImportError:     # pragma: no cover - not POSIX
+    resource = None
 
 from .._kernels import invariants as _inv
 from ..errors import OrbitsError
@@ -468,8 +501,9 @@ _PARAMETERS = ("orbits_version", "written", "integrator", "integrator_options",
                "integrator_info", "dt", "dt_unit", "units", "monitors", "bodies_history")
 
 
-def _check_layout(f, path):
-    """Raise an OrbitsFileError naming, in words, what the layout misses."""
+def _check_layout(f, path, contents):
+    """Raise an OrbitsFileError naming, in words, what the layout misses
+    (``contents``: the file's :func:`_inventory`)."""
     missing = []
     absent = set()
 
@@ -479,7 +513,7 @@ def _check_layout(f, path):
         parent, _, _ = name.rpartition("/")
         if parent and not exists(parent, h5py.Group):
             return False
-        if isinstance(f.get(name), kind):
+        if name in (contents.groups if kind is h5py.Group else contents.datasets):
             return True
         absent.add(name)
         what = _GROUPS.get(name) or _DATASETS.get(name, "")
@@ -492,14 +526,12 @@ def _check_layout(f, path):
     exists("observables/in_loop", h5py.Group)
     exists("restart/ws", h5py.Group)
     monitors = ()
-    if isinstance(f.get("parameters"), h5py.Group):
+    if "parameters" in contents.groups:
         par = f["parameters"].attrs
         missing += [f"the attribute {k!r} of /parameters (the run's metadata)"
                     for k in _PARAMETERS if k not in par]
-        try:
-            monitors = tuple(json.loads(par["monitors"])) if "monitors" in par else ()
-        except ValueError:
-            missing.append("a readable 'monitors' attribute of /parameters")
+        if "monitors" in par:
+            monitors = _monitors_attr(f["parameters"], path)
     for name in monitors:
         for part in ("step", "time", "value"):
             exists(f"observables/{name}/{part}", h5py.Dataset)
@@ -524,14 +556,17 @@ def _open_read(path):
     f = _open_hdf5(path)
     try:
         fmt = f.attrs.get("orbits_format")
-        if fmt != FORMAT:
+        if not isinstance(fmt, str) or fmt != FORMAT:
             raise OrbitsFileError(f"{path}: not an orbits output file (no "
                                   f"orbits_format = {FORMAT!r} attribute)")
-        version = int(f.attrs.get("orbits_format_version", -1))
-        if version != FORMAT_VERSION:
-            raise OrbitsFileError(f"{path}: layout version {version}, but this orbits reads "
-                                  f"version {FORMAT_VERSION}")
-        _check_layout(f, path)
+        version = f.attrs.get("orbits_format_version", -1)
+        if not _is_int(version) or version != FORMAT_VERSION:
+            shown = int(version) if _is_int(version) else repr(version)
+            raise OrbitsFileError(f"{path}: layout version {shown}, but this orbits "
+                                  f"reads version {FORMAT_VERSION}")
+        # nothing is opened by name before the links are known to stay in the file
+        contents = _inventory(f, path)
+        _check_values(f, contents.datasets, path, _check_layout(f, path, contents))
     except BaseException as exc:
         f.close()
         if isinstance(exc, (OSError, RuntimeError)) and not isinstance(exc, OrbitsFileError):
@@ -542,6 +577,497 @@ def _open_read(path):
 
 def _decode(a):
     return [s.decode() if isinstance(s, bytes) else str(s) for s in a]
+
+
+# -- what a reader trusts --------------------------------------------------------------
+#
+# A file carries data, never code, and its declared shapes are claims: nothing
+# it names is imported, nothing outside it is read, and every shape, type and
+# control value is checked against the file's own counts and size before a
+# reader allocates for it or acts on it.
+
+#: HDF5 filters that the library and h5py provide; any other is found and
+#: loaded as a plugin, code that a file would choose
+_KNOWN_FILTERS = {h5py.h5z.FILTER_DEFLATE: "gzip", h5py.h5z.FILTER_SHUFFLE: "shuffle",
+                  h5py.h5z.FILTER_FLETCHER32: "fletcher32", h5py.h5z.FILTER_LZF: "lzf"}
+#: the most bytes of data a filtered byte of storage gives back: deflate's
+#: limit (a 258-byte match in a 2-bit code, 1032 : 1; RFC 1951), which LZF
+#: (at most 264 bytes from 2) stays below
+_FILTER_EXPANSION = 1032
+#: links a file may hold; an orbits file holds about fifty
+_MAX_LINKS = 10_000
+#: bytes a file keeps for each variable-length string (its global heap id)
+_VLEN_BYTES = 16
+
+
+class _Contents(NamedTuple):
+    """A file's datasets (name -> :class:`_Stored`) and groups (names), as hard
+    links reach them."""
+
+    datasets: dict
+    groups: set
+
+
+class _Stored(NamedTuple):
+    """What the file says of one dataset, read without reading its data."""
+
+    shape: tuple        # None for a dataset without a dataspace
+    dtype: np.dtype     # None for a type numpy has no match for
+    stored: int         # the most bytes of data its storage gives back
+
+
+def _inventory(f, path):
+    """The file's :class:`_Contents`: every group, and every dataset with what
+    the file says of it (:class:`_Stored`); an OrbitsFileError
+    for anything that reaches outside the file or loads code: external and
+    user-defined links, datasets whose storage is external files or a virtual
+    mapping of other datasets, and filters other than those h5py provides.
+    Taken before anything in the file is opened by name, since opening an
+    external link opens the file it names."""
+    names = []
+    seen = []
+
+    def visit(name, info):
+        seen.append(None)
+        if len(seen) > _MAX_LINKS:
+            return f"it holds more than {_MAX_LINKS} links (an orbits file holds about fifty)"
+        if info.type == h5py.h5l.TYPE_HARD:
+            names.append(name)
+        elif info.type != h5py.h5l.TYPE_SOFT:       # soft links stay inside the file
+            what = ("an external link" if info.type == h5py.h5l.TYPE_EXTERNAL
+                    else f"a user-defined link (type {info.type})")
+            return f"/{name.decode(errors='replace')} is {what}, which leaves the file"
+        return None
+
+    refused = f.id.links.visit(visit, info=True)
+    out, groups = {}, set()
+    for name in names if refused is None else ():
+        obj = h5py.h5o.open(f.id, name)
+        shown = name.decode(errors="replace")
+        if isinstance(obj, h5py.h5g.GroupID):
+            groups.add(shown)
+        if not isinstance(obj, h5py.h5d.DatasetID):
+            continue
+        dcpl = obj.get_create_plist()
+        codes = [dcpl.get_filter(k)[0] for k in range(dcpl.get_nfilters())]
+        unknown = [code for code in codes if code not in _KNOWN_FILTERS]
+        if dcpl.get_layout() == h5py.h5d.VIRTUAL:
+            refused = f"/{shown} is a virtual dataset (a view of other datasets or files)"
+        elif dcpl.get_external_count():
+            refused = f"/{shown} keeps its data in external files"
+        elif unknown:
+            refused = (f"/{shown} is stored through HDF5 filter {unknown[0]}, which would be "
+                       f"loaded as a plugin (known filters: "
+                       f"{', '.join(_KNOWN_FILTERS.values())})")
+        if refused:
+            break
+        try:
+            dtype = obj.dtype
+        except (TypeError, ValueError):     # a type numpy has no match for: never read
+            dtype = None
+        stored = obj.get_storage_size() * (_FILTER_EXPANSION if codes else 1)
+        out[shown] = _Stored(obj.shape, dtype, stored)
+    if refused:
+        raise OrbitsFileError(f"{path}: refused: {refused}; an orbits file keeps all of its "
+                              f"data inside itself")
+    return _Contents(out, groups)
+
+
+def _covered(ds):
+    """The rows of a time series ``ds`` (axis 0) that its storage holds: its
+    declared length, but no more than the bytes the file keeps for it.  Rows
+    declared beyond them (a writer killed between extending a series and
+    flushing its data, or a crafted file) hold no data and are not read."""
+    element = _VLEN_BYTES if ds.dtype.kind == "O" else ds.dtype.itemsize
+    row = element * int(np.prod(ds.shape[1:], dtype=np.int64))
+    stored = ds.id.get_storage_size()
+    if ds.id.get_create_plist().get_nfilters():
+        stored *= _FILTER_EXPANSION
+    return min(ds.shape[0], stored // max(row, 1))
+
+
+_KINDS = {"float": "f", "int": "iu", "str": "OS", "number": "fiub"}
+
+
+def _checked(stored, name, path, shape, kind, backed=True):
+    """The :class:`_Stored` of the dataset ``name``, checked before anything is
+    read from it: its ``shape`` (None for an axis of any length), its type,
+    and (``backed``) that the file stores all the data that shape declares."""
+    ds = stored.get(name)
+    if ds is None:
+        raise OrbitsFileError(f"{path}: damaged or incomplete orbits file: /{name} is not "
+                              f"a dataset")
+    if ds.shape is None or len(ds.shape) != len(shape) or any(
+            want is not None and have != want for have, want in zip(ds.shape, shape)):
+        want = "(" + ", ".join("any" if k is None else str(k) for k in shape) + \
+            ("," if len(shape) == 1 else "") + ")"
+        raise OrbitsFileError(f"{path}: /{name} has shape {ds.shape}; expected {want}")
+    ok = ds.dtype is not None and ds.dtype.kind in _KINDS[kind]
+    if ok and ds.dtype.kind == "O":
+        ok = kind == "str" and h5py.check_string_dtype(ds.dtype) is not None
+    if not ok:
+        raise OrbitsFileError(f"{path}: /{name} holds values of type {ds.dtype}; expected "
+                              f"{'strings' if kind == 'str' else kind + 's'}")
+    element = _VLEN_BYTES if ds.dtype.kind == "O" else ds.dtype.itemsize
+    declared = int(np.prod(ds.shape, dtype=np.int64)) * element
+    if backed and declared > ds.stored:
+        raise OrbitsFileError(
+            f"{path}: /{name} declares shape {ds.shape} ({declared} bytes), but the file "
+            f"stores less of it; refused before reading")
+    return ds
+
+
+@functools.lru_cache(maxsize=256)
+def _parsed_unit(text, like):
+    """``(unit, of the kind of like)`` for a unit's name; None if it names none
+    (parsed once: astropy takes about a millisecond for ``"AU / d"``)."""
+    import astropy.units as u
+    try:
+        unit = u.Unit(text)
+    except (ValueError, TypeError):
+        return None
+    return unit, like is None or unit.is_equivalent(u.Unit(like))
+
+
+#: the physical type that a unit's name in _unit's ``like`` stands for
+_KIND_OF = {"m": "length", "kg": "mass", "s": "time", "m / s": "speed"}
+
+
+def _unit(f, name, path, like=None):
+    """The ``unit`` attribute of the dataset ``name``, parsed, and (``like``, a
+    unit's name) of the physical type of that unit."""
+    text = f[name].attrs.get("unit")
+    parsed = _parsed_unit(text, like) if isinstance(text, str) else None
+    if parsed is None:
+        raise OrbitsFileError(f"{path}: /{name} has the unit {text!r}; expected a unit's "
+                              f"name")
+    if not parsed[1]:
+        raise OrbitsFileError(f"{path}: /{name} has the unit {text!r}; expected a unit of "
+                              f"{_KIND_OF[like]}")
+    return parsed[0]
+
+
+def _json_attr(par, key, path, kind):
+    """The /parameters attribute ``key``, a JSON text, parsed and of type ``kind``."""
+    text = par.attrs[key]
+    try:
+        value = json.loads(text)
+    except (TypeError, ValueError, RecursionError):
+        raise OrbitsFileError(f"{path}: the {key!r} attribute of /parameters is not "
+                              f"readable JSON") from None
+    if not isinstance(value, kind):
+        raise OrbitsFileError(f"{path}: the {key!r} attribute of /parameters is "
+                              f"{type(value).__name__}; expected a JSON "
+                              f"{'object' if kind is dict else 'array'}")
+    return value
+
+
+def _monitors_attr(par, path):
+    """The monitors a file records: a list of distinct known names."""
+    monitors = _json_attr(par, "monitors", path, list)
+    known = [name for name in _MONITOR_KIND if name != "work"]
+    for name in monitors:
+        if not isinstance(name, str) or name not in known:
+            raise OrbitsFileError(f"{path}: the 'monitors' attribute of /parameters names "
+                                  f"{name!r}; expected monitors among {', '.join(known)}")
+    if len(set(monitors)) != len(monitors):
+        raise OrbitsFileError(f"{path}: the 'monitors' attribute of /parameters names a "
+                              f"monitor twice: {monitors}")
+    return tuple(monitors)
+
+
+def _is_int(value):
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_number(value):
+    return isinstance(value, (int, float, np.integer, np.floating)) and \
+        not isinstance(value, (bool, np.bool_)) and math.isfinite(value)
+
+
+def _attr(par, key, path, check, expected):
+    value = par.attrs[key]
+    if not check(value):
+        raise OrbitsFileError(f"{path}: the {key!r} attribute of /parameters is {value!r}; "
+                              f"expected {expected}")
+    return value
+
+
+def _check_units_record(units, path):
+    """Raise an OrbitsFileError where the unit system a file records (a
+    UnitSystem.to_dict()) does not have the fields and kinds of units it needs."""
+    for key, like in (("length", "m"), ("mass", "kg"), ("time", "s")):
+        text = units.get(key)
+        parsed = _parsed_unit(text, like) if isinstance(text, str) else None
+        if parsed is None or not parsed[1]:
+            raise OrbitsFileError(f"{path}: the unit system in /parameters has {key} "
+                                  f"{text!r}; expected a unit of {_KIND_OF[like]}")
+    if not (_is_number(units.get("G")) and units["G"] > 0):
+        raise OrbitsFileError(f"{path}: the unit system in /parameters has G = "
+                              f"{units.get('G')!r}; expected a number > 0")
+    for key in ("name", "G_source"):
+        if not isinstance(units.get(key), str):
+            raise OrbitsFileError(f"{path}: the unit system in /parameters has {key} "
+                                  f"{units.get(key)!r}; expected a string")
+
+
+def _unit_system(par, path):
+    """The UnitSystem of a file's /parameters (checked by :func:`_check_values`)."""
+    import astropy.units as u
+    from ..units import UnitSystem
+    try:
+        return UnitSystem.from_dict(json.loads(par.attrs["units"]))
+    except (OrbitsError, ValueError, TypeError, u.UnitsError) as exc:
+        raise OrbitsFileError(f"{path}: the unit system in /parameters does not rebuild: "
+                              f"{exc}") from None
+
+
+def _check_config(config, path, monitors):
+    """Raise an OrbitsFileError where the configuration record (a
+    SimulationConfig.to_dict()) a file keeps is not of the types that record has."""
+    def bad(field, value, expected):
+        return OrbitsFileError(f"{path}: the configuration in /parameters has {field} = "
+                               f"{value!r}; expected {expected}")
+
+    def quantity(value):
+        return (isinstance(value, list) and len(value) == 2 and isinstance(value[1], str)
+                and (_is_number(value[0]) or isinstance(value[0], list)))
+
+    for key in ("integrator", "integrator_options", "dt", "forces", "monitors",
+                "monitor_every", "stop_conditions"):
+        if key not in config:
+            raise OrbitsFileError(f"{path}: the configuration in /parameters lacks "
+                                  f"{key!r}")
+    if not isinstance(config["integrator"], str):
+        raise bad("integrator", config["integrator"], "an integrator's name")
+    if not isinstance(config["integrator_options"], dict):
+        raise bad("integrator_options", config["integrator_options"], "a JSON object")
+    if config["dt"] is not None and not quantity(config["dt"]):
+        raise bad("dt", config["dt"], "null or [value, unit]")
+    forces = config["forces"]
+    if not isinstance(forces, list) or not forces or not all(
+            isinstance(d, dict) and isinstance(d.get("type"), str) for d in forces):
+        raise bad("forces", forces, "a list of force terms' records, gravity's first")
+    if config["monitors"] != list(monitors):
+        raise bad("monitors", config["monitors"],
+                  f"the monitors the file keeps, {list(monitors)}")
+    every = config["monitor_every"]
+    if every is not None and not (_is_int(every) and every >= 1):
+        raise bad("monitor_every", every, "null or a whole number >= 1")
+    stops = config["stop_conditions"]
+    if not isinstance(stops, dict) or not all(
+            v is None or isinstance(v, (bool, str)) or _is_number(v) or quantity(v)
+            for v in stops.values()):
+        raise bad("stop_conditions", stops, "an object of numbers, names and [value, unit]")
+    variations = config.get("variations")
+    if not (variations is None or variations in ("state", "all")
+            or (_is_int(variations) and variations >= 1)):
+        raise bad("variations", variations, 'null, "state", "all" or a whole number >= 1')
+    seed = config.get("seed")
+    if seed is not None and not (_is_int(seed) and seed >= 0):
+        raise bad("seed", seed, "null or a whole number >= 0")
+
+
+def _check_values(f, stored, path, monitors):
+    """Raise an OrbitsFileError for a value a reader would use that is not of the
+    type, shape or range the layout gives it; called by :func:`_open_read`
+    once the layout is complete, with the file's :func:`_inventory`.
+
+    Shapes are checked against the bodies' count and the file's own size
+    before anything is read, so that a small file cannot make a reader
+    allocate for data it does not hold; the control values (the checkpoints'
+    count, clock, plan and progress) are read and checked.
+    """
+    par = f["parameters"]
+    for key in ("orbits_version", "written", "integrator", "dt_unit"):
+        _attr(par, key, path, lambda v: isinstance(v, str), "a string")
+    _attr(par, "dt", path, lambda v: _is_number(v) and v >= 0, "a number >= 0")
+    parsed = _parsed_unit(par.attrs["dt_unit"], "s")
+    if parsed is None or not parsed[1]:
+        raise OrbitsFileError(f"{path}: the 'dt_unit' attribute of /parameters is "
+                              f"{par.attrs['dt_unit']!r}; expected a unit of time")
+    _json_attr(par, "integrator_options", path, dict)
+    info = _json_attr(par, "integrator_info", path, dict)
+    if not (isinstance(info.get("name"), str) and _is_int(info.get("order"))
+            and isinstance(info.get("symplectic"), bool)
+            and isinstance(info.get("adaptive", False), bool)):
+        raise OrbitsFileError(f"{path}: the 'integrator_info' attribute of /parameters is "
+                              f"{info!r}; expected the integrator's name, order and kind")
+    _json_attr(par, "bodies_history", path, list)
+    _check_units_record(_json_attr(par, "units", path, dict), path)
+    if "forces" in par.attrs:
+        records = _json_attr(par, "forces", path, list)
+        if not all(isinstance(d, dict) and isinstance(d.get("type"), str) for d in records):
+            raise OrbitsFileError(f"{path}: the 'forces' attribute of /parameters is "
+                                  f"{records!r}; expected force terms' records")
+    if "config" in par.attrs:
+        _check_config(_json_attr(par, "config", path, dict), path, monitors)
+
+    # the bodies: their count N is the length of every per-body axis
+    b = "particles/bodies"
+    n = _checked(stored, f"{b}/names", path, (None,), "str").shape[0]
+    if n < 1:
+        raise OrbitsFileError(f"{path}: /{b}/names is empty; expected one name a body")
+    _checked(stored, f"{b}/mass", path, (n,), "float")
+    _unit(f, f"{b}/mass", path, "kg")
+    if f"{b}/radius" in stored:
+        _checked(stored, f"{b}/radius", path, (n,), "float")
+        _unit(f, f"{b}/radius", path, "m")
+    # the time series: any number of rows, of which only those stored are read
+    series = {f"{b}/position": ((n, 3), "m"), f"{b}/velocity": ((n, 3), "m / s")}
+    if f"{b}/masses_at_outputs/value" in stored:
+        series[f"{b}/masses_at_outputs"] = ((n,), "kg")
+    kept = list(monitors) + (["work"] if "observables/work/value" in stored else [])
+    for name in kept:
+        shape = () if name in _SCALAR_SERIES else (3,)
+        series[f"observables/{name}"] = (shape, None)
+        if f"observables/in_loop/{name}/value" in stored:
+            series[f"observables/in_loop/{name}"] = (shape, None)
+    for group, (shape, like) in series.items():
+        _checked(stored, f"{group}/step", path, (None,), "int", backed=False)
+        _checked(stored, f"{group}/time", path, (None,), "float", backed=False)
+        _checked(stored, f"{group}/value", path, (None,) + shape, "float", backed=False)
+        _unit(f, f"{group}/time", path, "s")
+        _unit(f, f"{group}/value", path, like)
+    # the parameters' arrays
+    width = len(_inv.MONITOR_COLUMNS)
+    ref = _checked(stored, "parameters/reference", path, (None,), "float")
+    if not 10 <= ref.shape[0] <= width:
+        raise OrbitsFileError(f"{path}: /parameters/reference has {ref.shape[0]} values; "
+                              f"expected 10 to {width}")
+    _checked(stored, "parameters/scales", path, (2,), "float")
+    if "parameters/start_clock" in stored:
+        _checked(stored, "parameters/start_clock", path, (3,), "int")
+        start = par["start_clock"][()]
+        if (start < 0).any():
+            raise OrbitsFileError(f"{path}: /parameters/start_clock is {start.tolist()}; "
+                                  f"expected counts >= 0")
+    _check_restart(f, stored, path, n)
+    # the logs, one row per event
+    for group, columns in (("collisions", _COLLISION_COLUMNS),
+                           ("encounters", _ENCOUNTER_COLUMNS)):
+        if group in f:
+            _check_log(f, stored, group, columns, path)
+
+
+def _check_restart(f, stored, path, n):
+    r = "restart"
+    _checked(stored, f"{r}/count", path, (), "int")
+    count = f[r]["count"][()]
+    if count < 0:
+        raise OrbitsFileError(f"{path}: /{r}/count is {count}; expected the number of "
+                              f"checkpoints written, >= 0")
+    written = count > 0          # the slots hold data only once one was written
+    _checked(stored, f"{r}/order", path, (n,), "int")
+    order = f[r]["order"][()]
+    if not np.array_equal(np.sort(order), np.arange(n)):
+        raise OrbitsFileError(f"{path}: /{r}/order is not an order of the {n} bodies (a "
+                              f"permutation of 0 .. {n - 1})")
+    arrays = {"x": ((_SLOTS, n, 3), "float"), "v": ((_SLOTS, n, 3), "float"),
+              "clock": ((_SLOTS, 5), "int"), "t_base": ((_SLOTS,), "float"),
+              "plan": ((_SLOTS, 7), "float"), "progress": ((_SLOTS, 3), "int"),
+              "wall": ((_SLOTS,), "float"), "masses": ((_SLOTS, n), "float"),
+              "radii": ((_SLOTS, n), "float"), "orders": ((_SLOTS, n), "int")}
+    varying = [name in stored for name in (f"{r}/masses", f"{r}/radii", f"{r}/orders")]
+    if any(varying) and not all(varying):
+        raise OrbitsFileError(f"{path}: /{r} holds some of masses, radii and orders but "
+                              f"not all three")
+    for name, (shape, kind) in arrays.items():
+        if f"{r}/{name}" in stored:
+            _checked(stored, f"{r}/{name}", path, shape, kind, backed=written)
+    g = f[r]
+    # tangent vectors of a shape other than the configuration's are named by
+    # TangentShapeError where they would be read (_check_tangent_rows,
+    # _derivatives), before anything is read from them
+    k = sum(_config_layout(_config(f), n))
+    tangent_shapes = {"tangent": (_SLOTS, 2, n * k, 3), "tangent_vectors": (_SLOTS, k, n, 6)}
+    for name, ds in g["ws"].items():
+        shape = stored[f"{r}/ws/{name}"].shape or ()
+        d = _checked(stored, f"{r}/ws/{name}", path, (_SLOTS,) + (None,) * (
+            max(1, len(shape)) - 1), "number",
+            backed=written and tangent_shapes.get(name, shape) == shape)
+        if "body_axes" in ds.attrs:
+            axes = ds.attrs["body_axes"]
+            if not (isinstance(axes, np.ndarray) and axes.ndim == 1
+                    and (axes.dtype.kind in "iu" or axes.size == 0)
+                    and all(0 <= k < len(d.shape) - 1 for k in axes.tolist())):
+                raise OrbitsFileError(f"{path}: /{r}/ws/{name} has body_axes {axes!r}; "
+                                      f"expected axes of its slot's shape {d.shape[1:]}")
+    if f"{r}/tangent_vectors" in stored:
+        _checked(stored, f"{r}/tangent_vectors", path, (_SLOTS, None, n, 6), "float",
+                 backed=written and tangent_shapes["tangent_vectors"]
+                 == stored[f"{r}/tangent_vectors"].shape)
+        layout = g["tangent_vectors"].attrs.get("layout")
+        if layout is not None and not (isinstance(layout, np.ndarray)
+                                       and layout.shape == (4,) and layout.dtype.kind in "iu"
+                                       and (layout >= 0).all()):
+            raise OrbitsFileError(f"{path}: /{r}/tangent_vectors has the layout {layout!r}; "
+                                  f"expected four counts (chaos, random, state, mass)")
+    if written:
+        _check_slot(g, path, (count - 1) % _SLOTS)
+
+
+def _check_slot(g, path, slot):
+    # the control values of the checkpoint in ``slot`` of the group /restart ``g``
+    def bad(name, value, expected):
+        return OrbitsFileError(f"{path}: /restart/{name} at the last checkpoint (slot "
+                               f"{slot}) is {value}; expected {expected}")
+
+    clock = g["clock"][slot]
+    if (clock < 0).any():
+        raise bad("clock", clock.tolist(), "counts of steps, force evaluations, rows and "
+                                           "rejected steps, each >= 0")
+    t_base = float(g["t_base"][slot])
+    if not math.isfinite(t_base):
+        raise bad("t_base", t_base, "a finite time")
+    plan = g["plan"][slot]
+    until, outputs, ratio, n_full, partial, start_step, start_time = plan.tolist()
+    whole = lambda x: x == int(x) and x >= 0  # noqa: E731
+    if not (np.isfinite(plan).all() and whole(outputs) and outputs >= 1 and whole(n_full)
+            and partial in (0.0, 1.0) and whole(start_step) and ratio >= 0):
+        raise bad("plan", plan.tolist(), "a run's plan: finite times, a whole number of "
+                                         "outputs >= 1, whole step counts >= 0")
+    done, finished, code = g["progress"][slot].tolist()
+    if not (0 <= done <= outputs and finished in (0, 1) and code >= 0):
+        raise bad("progress", [done, finished, code],
+                  f"(outputs written, 0 .. {int(outputs)}; finished, 0 or 1; status >= 0)")
+    if "wall" in g:
+        wall = float(g["wall"][slot])
+        if not (math.isfinite(wall) and wall >= 0):
+            raise bad("wall", wall, "seconds >= 0")
+    if "masses" in g:
+        m = g["masses"][slot]
+        alive = np.isfinite(m)
+        left = int(alive.sum())
+        orders = g["orders"][slot]
+        if (m[alive] < 0).any() or left < 1 or not np.array_equal(
+                np.sort(orders[:left]), np.arange(left)) or (orders[left:] != -1).any():
+            raise bad("masses and orders", f"{m.tolist()} and {orders.tolist()}",
+                      "masses >= 0 (NaN for a body merged away) and the order of the "
+                      "bodies left, then -1")
+
+
+#: the columns of the logs and the type of each
+_COLLISION_COLUMNS = {"time": "float", "step_time": "float", "body_1": "str", "body_2": "str",
+                      "resolution": "str", "survivor": "str", "distance": "float",
+                      "speed": "float", "energy_change": "float"}
+_ENCOUNTER_COLUMNS = {"time": "float", "body_1": "str", "body_2": "str", "distance": "float",
+                      "speed": "float"}
+
+
+def _check_log(f, stored, group, columns, path):
+    # columns of any length (a live writer extends one before the next): the
+    # readers take the rows all of them store (_log_rows)
+    for name, kind in columns.items():
+        _checked(stored, f"{group}/{name}", path, (None,), kind, backed=False)
+        if kind == "float":
+            _unit(f, f"{group}/{name}", path)
+
+
+def _log_rows(g, columns):
+    """The rows of a log (group ``collisions`` or ``encounters``) that every one
+    of its columns stores."""
+    return min(_covered(g[name]) for name in columns)
 
 
 # -- the writers' lock ---------------------------------------------------------------------
@@ -624,7 +1150,15 @@ def _acquire(path):
           "start": stat[1] if stat else None, "token": token,
           "since": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
     tmp = lock.with_name(f"{lock.name}.{token}")
-    tmp.write_text(json.dumps(me))
+    made = False
+    try:
+        with open(tmp, "x") as fh:              # a new file, never one a link names
+            made = True
+            fh.write(json.dumps(me))
+    except OSError as exc:
+        if made:
+            tmp.unlink(missing_ok=True)
+        raise _write_error(path, exc, f"when making its writers' lock {lock}") from None
     try:
         for _ in range(5):
             if _link(tmp, lock):
@@ -647,6 +1181,10 @@ def _acquire(path):
             raise _in_use(path, lock, rec)
         raise FileInUse(f"{path}: could not take its lock {lock} (other writers keep "
                         f"taking it)")
+    except OrbitsFileError:
+        raise
+    except OSError as exc:
+        raise _write_error(path, exc, f"when taking its writers' lock {lock}") from None
     finally:
         tmp.unlink(missing_ok=True)
 
@@ -704,7 +1242,194 @@ def _release(path):
         lock.unlink(missing_ok=True)
 
 
+# -- writing safely --------------------------------------------------------------------
+#
+# HDF5 closing a dataset or a file flushes it first.  Where that flush fails (a
+# full disk), HDF5 frees the object but keeps its identifier, and closes it
+# again when the library shuts down at exit: a use after free, and the
+# interpreter's segmentation fault after a full disk.  So space is reserved on
+# disk ahead of what a write takes (_reserve), which makes a full disk show as
+# a failed reservation between two writes, with nothing pending that cannot be
+# written; and a file whose writes failed anyway (a file system that cannot
+# reserve) is closed with what HDF5 still holds for it sent to /dev/null
+# (_abandon).  Temporary files are made exclusively (_new_file).
+
+#: errno values of a full disk: no space left, a file larger than allowed (the
+#: file system's limit, or ``ulimit -f``), the user's quota used up
+_DISK_FULL = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
+#: bytes reserved beyond what the next write needs, so that the disk is asked
+#: for space about once per this much output rather than at every write
+_RESERVE_BYTES = 4 << 20
+#: bytes of HDF5's own bookkeeping a write may add besides the data and the
+#: chunks it starts (chunk indexes, object headers, heaps): a new file of a few
+#: bodies holds about 0.2 MB of it in all
+_METADATA_BYTES = 1 << 19
+#: bytes reserved for a row of the collision or encounter log (a few floats,
+#: and names kept in HDF5's global heap)
+_LOG_ROW_BYTES = 1024
+
+
+class _NoRoom(OSError):
+    """The disk has no room for what the next write may take (see _reserve)."""
+
+
+def _error_number(exc):
+    """The errno of an error of writing: an OSError's own, or the one HDF5 names in
+    the message h5py passes on (``..., errno = 28, error message = ...``)."""
+    code = getattr(exc, "errno", None)
+    if code is None:
+        found = re.search(r"errno = (\d+)", str(exc))
+        code = int(found.group(1)) if found else None
+    return code
+
+
+def _write_error(path, exc, then=""):
+    """The OrbitsFileError of ``exc``, an error of writing ``path``: one that says the
+    disk is full where the file system said so, with the errno on ``.errno``;
+    ``then`` follows the first clause."""
+    code = _error_number(exc)
+    if code in _DISK_FULL:
+        what = f"the disk is full ({os.strerror(code)})"
+    else:
+        what = f"cannot be written ({os.strerror(code) if code else exc})"
+    err = OrbitsFileError(f"{path}: {what}{then}")
+    err.errno = code
+    return err
+
+
+def _reserve(fd, end, need):
+    """Have the disk hold ``need`` bytes for the file open on ``fd`` beyond ``end``
+    (where HDF5 allocates next), and :data:`_RESERVE_BYTES` more if it can.
+
+    ``posix_fallocate`` allocates the blocks, so that the writes after it
+    cannot fail for space; the file grows past its end meanwhile, and
+    :func:`_trim` gives that back when it closes.  Returns False where the
+    file system cannot reserve space (the writes then go on unreserved);
+    raises :class:`_NoRoom` where there is no room for ``need``.
+    """
+    want = end + need
+    size = os.fstat(fd).st_size
+    if size >= want:
+        return True
+    limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0] if resource else None
+    failed = None
+    for target in (want + _RESERVE_BYTES, want):
+        if limit is not None and limit != resource.RLIM_INFINITY and target > limit:
+            # past ulimit -f the kernel would end the process (SIGXFSZ)
+            failed = errno.EFBIG
+            continue
+        try:
+            os.posix_fallocate(fd, size, target - size)
+            return True
+        except OSError as exc:
+            if exc.errno not in _DISK_FULL:
+                return False
+            failed = exc.errno
+    raise _NoRoom(failed, os.strerror(failed))
+
+
+def _descriptor(f):
+    """The descriptor HDF5 writes the open file ``f`` through (its sec2 driver), or None."""
+    try:
+        return f.id.get_vfd_handle()
+    except (NotImplementedError, ValueError, RuntimeError, OSError):
+        return None
+
+
+def _abandon(f):
+    """Close ``f``, whose writes fail, without writing to it again.
+
+    What HDF5 still holds to write is sent to /dev/null: its descriptor is
+    pointed there, so that every close succeeds and HDF5 keeps no freed
+    object for its shutdown at exit.  The file on disk keeps what was
+    written before, and stays marked as being written, as a killed writer
+    leaves it.
+    """
+    fd = _descriptor(f)
+    if fd is not None:
+        null = os.open(os.devnull, os.O_RDWR)
+        try:
+            os.dup2(null, fd)
+        finally:
+            os.close(null)
+    try:
+        f.close()
+    except (OSError, RuntimeError):
+        pass
+
+
+def _close_written(f):
+    """Close ``f``, open for writing, flushing it first; where the flush fails,
+    abandon it (:func:`_abandon`).  Returns the flush's error, or None."""
+    try:
+        f.flush()
+    except (OSError, RuntimeError) as exc:
+        _abandon(f)
+        return exc
+    f.close()
+    return None
+
+
+def _trim(path):
+    """Give back the space reserved past the end of a file closed cleanly: the end
+    its superblock records (a file still marked as being written is left as it is)."""
+    try:
+        sb = _superblock(pathlib.Path(path))
+        if sb is not None and sb.eof > 0 and not sb.flags and sb.size > sb.eof:
+            os.truncate(path, sb.eof)
+    except OSError:
+        pass
+
+
+def _new_file(path):
+    """A new HDF5 file at ``path`` (a temporary beside an output file whose writers'
+    lock this process holds), opened for writing.
+
+    Made exclusively (``O_CREAT | O_EXCL``), so that it is never a file a
+    link there names.  What had its name is left over from a writer that
+    died, or was put there to be written through: it is removed first (a link
+    is removed, not what it names).
+    """
+    try:
+        os.unlink(path)
+    except FileNotFoundError:
+        pass
+    except OSError as exc:
+        raise OrbitsFileError(f"{path}: in the way of the temporary file orbits makes "
+                              f"there, and cannot be removed ({exc.strerror})") from None
+    try:
+        return h5py.File(path, "x", libver="latest")
+    except FileExistsError:
+        raise OrbitsFileError(f"{path}: made again by another process while orbits was "
+                              f"making it; nothing is written through it") from None
+    except OSError as exc:
+        raise _write_error(path, exc, " when making it") from None
+
+
 # -- writing ---------------------------------------------------------------------------
+
+def _writes(method):
+    """A method of :class:`FileRecorder` that writes to its file: an error of
+    the file system becomes an :class:`OrbitsFileError` (one saying the disk is
+    full where it is), raised once; after it the recorder writes nothing more
+    (its methods that write return at once, as the run's cleanup calls them),
+    and its :meth:`~FileRecorder.close` only closes the file."""
+    @functools.wraps(method)
+    def writing(self, *args, **kwargs):
+        if self._failed is not None:
+            return None
+        try:
+            return method(self, *args, **kwargs)
+        except OrbitsFileError as exc:
+            self._failed = exc
+            raise
+        except OrbitsError:
+            raise
+        except (OSError, RuntimeError) as exc:
+            self._failed = self._stopped_by(exc)
+            raise self._failed from None
+    return writing
+
 
 class FileRecorder:
     """Streams one run's outputs into an HDF5 file (used by ``Simulation.run``).
@@ -771,8 +1496,18 @@ class FileRecorder:
         self.end_status = 0          # a Status code when a run ends early
         self.largest = {}            # monitor -> largest relative error seen in this plan
         self.checkpoints = 0         # written by this recorder
+        self._failed = None          # the OrbitsFileError of a write that failed
+        self._fd = None              # the file's descriptor, to reserve space on
+        self._unflushed = 0          # bytes written since the last flush
+        self._checkpoint_step = None  # the step of the file's last checkpoint
         mine = sim.output_path
         mine = mine is not None and os.path.abspath(mine) == os.path.abspath(self.path)
+        if self.path.is_symlink() and not overwrite:
+            raise OrbitsFileError(f"{self.path}: a symbolic link (to "
+                                  f"{os.readlink(self.path)}), which orbits does not write "
+                                  f"through; write to the file itself, or pass "
+                                  f"overwrite=True (--force) to replace the link with a "
+                                  f"new file")
         if self.path.exists() and not overwrite and not mine:
             raise OrbitsFileError(f"{self.path}: exists; pass overwrite=True (or --force) "
                                   f"to replace it")
@@ -802,6 +1537,11 @@ class FileRecorder:
             self._restart = {name: r[name] for name in r if isinstance(r[name], h5py.Dataset)}
             self._ws = {name: r["ws"][name] for name in r["ws"]}
             self.rows = self.f["particles/bodies/position/value"].shape[0]
+            self._fd = _descriptor(self.f)
+            self._headroom, self._row_bytes, self._inloop_bytes = self._sizes()
+            count = int(r["count"][()])
+            if count:
+                self._checkpoint_step = int(r["clock"][(count - 1) % _SLOTS][0])
             # the columns: the bodies when the file was made
             b = self.f["particles/bodies"]
             self.columns = _decode(b["names"][()])
@@ -812,16 +1552,87 @@ class FileRecorder:
                 self.outputs_written = resume_rows
                 self._largest_so_far()
             else:
-                if plan.outputs > 1:
+                if plan.outputs > 1 and self._ends_with(sim):
+                    # a run continued into its file: its first output is the
+                    # file's last row, kept once
+                    self.last = self._columns_of(sim.snapshot())
+                    self._note_rows(self.last[4][None])
+                    self.outputs_written = 1
+                elif plan.outputs > 1:
                     self.output(sim)
                 if not self.checkpoints:
                     self.checkpoint()       # a run stopped at once still resumes
-        except BaseException:
-            if self.f is not None:
-                self.f.close()
+        except BaseException as exc:
             self.closed = True
-            _release(self.path)
+            self._shut()
+            if isinstance(exc, (OSError, RuntimeError)) and not isinstance(exc, OrbitsError):
+                raise _write_error(self.path, exc) from None
             raise
+
+    def _ends_with(self, sim):
+        """Whether the file's last output row is the simulation's present state."""
+        if not self.rows:
+            return False
+        g = self.f["particles/bodies/position"]
+        return (int(g["step"][self.rows - 1]) == sim.steps
+                and float(g["time"][self.rows - 1]) == sim.time_value)
+
+    def _sizes(self):
+        """``(headroom, row, in-loop row)``: the bytes a write may take besides its
+        data (a chunk of every chunked dataset, each of which it may start; the
+        storage of the fixed ones, which a checkpoint's first write allocates;
+        HDF5's bookkeeping), and the bytes of data of an output row and of an
+        in-loop monitor row."""
+        series, inloop = self._series
+        outs = [d for dsets, _, _ in series for d in dsets]
+        loops = [d for dsets in inloop.values() for d in dsets]
+        fixed = list(self._restart.values()) + list(self._ws.values())
+
+        def row(d):
+            return int(np.prod(d.shape[1:], dtype=np.int64)) * d.dtype.itemsize
+
+        def chunk(d):
+            return int(np.prod(d.chunks) if d.chunks else d.size) * d.dtype.itemsize
+        headroom = _METADATA_BYTES + sum(map(chunk, outs + loops + fixed))
+        return headroom, sum(map(row, outs)), sum(map(row, loops))
+
+    def _reserve(self, nbytes):
+        """Room on disk for a write of ``nbytes`` of data and what is still
+        unflushed (:func:`_reserve`); where the file system cannot reserve,
+        the writes go on unreserved."""
+        self._unflushed += nbytes
+        if self._fd is not None and not _reserve(self._fd, self.f.id.get_filesize(),
+                                                 self._unflushed + self._headroom):
+            self._fd = None
+
+    def _stopped_by(self, exc):
+        """The OrbitsFileError of ``exc``, a write that failed, saying what the file holds."""
+        sim = self.sim
+        then = f" at t = {sim.time:.10g} (step {sim.steps})"
+        if self._checkpoint_step is None:
+            then += "; the file holds no checkpoint to resume from"
+        else:
+            then += (f"; the file holds the run up to its last checkpoint (step "
+                     f"{self._checkpoint_step})")
+            if not isinstance(exc, _NoRoom):
+                then += (", but HDF5 was stopped in the middle of a write, and it may "
+                         "not resume")
+            else:
+                room = ("there is room again" if _error_number(exc) in _DISK_FULL
+                        else "the file can be written again")
+                then += (f": once {room}, 'orbits resume {self.path}' (or Simulation."
+                         f"from_file(path).resume()) finishes the run")
+        return _write_error(self.path, exc, then)
+
+    def _shut(self):
+        # the file closed and the lock released, whatever the disk holds: a
+        # file whose last flush failed is abandoned (_abandon), else the space
+        # reserved ahead is given back
+        try:
+            if self.f is not None and _close_written(self.f) is None:
+                _trim(self.path)
+        finally:
+            _release(self.path)
 
     def _check_same_layout(self):
         n = self.f["particles/bodies/names"].shape[0]
@@ -920,6 +1731,7 @@ class FileRecorder:
             self._note("angular_momentum", rows[:, 1:4])
 
     # Recorder interface ----------------------------------------------------------------
+    @_writes
     def output(self, sim, final=False):
         """Record the simulation's current state as the next output row (buffered).
 
@@ -977,6 +1789,7 @@ class FileRecorder:
             self._rowbuf = np.zeros((k, width))
         return self._rowbuf[:k]
 
+    @_writes
     def output_rows(self, sim, steps, t, rows):
         """The loop wrote ``rows`` (from :meth:`row_buffer`) at ``steps`` and
         times ``t``: written to the file as they are, after the buffered
@@ -986,6 +1799,7 @@ class FileRecorder:
             self._flush_outputs(sync=False)
         series, _ = self._series
         w, n, k = MONITOR_WIDTH, len(self.desc.names), len(t)
+        self._reserve(k * self._row_bytes)
         x = rows[:, w:w + 3 * n].reshape(k, n, 3)
         v = rows[:, w + 3 * n:w + 6 * n].reshape(k, n, 3)
         if not np.array_equal(self.inv, np.arange(n)):
@@ -1005,7 +1819,13 @@ class FileRecorder:
         self.outputs_written += k
         self.last = (float(t[-1]), int(steps[-1]), x[-1], v[-1], mon[-1].copy())
         self._checkpoint_due = True
+        if self._unflushed > _RESERVE_BYTES:
+            # flushed every few MB, so that the space reserved ahead need not
+            # cover more than that of written data HDF5 has not placed yet
+            self.f.flush()
+            self._unflushed = 0
 
+    @_writes
     def between_chunks(self):
         """The simulation's clock and state agree again: write the checkpoint
         that outputs recorded in the loop made due, if its interval passed."""
@@ -1079,12 +1899,14 @@ class FileRecorder:
         x[cols], v[cols], m[cols] = snap.x, snap.v, snap.masses
         return (snap.t, snap.steps, x, v, snap.monitors, m)
 
+    @_writes
     def collision_rows(self, sim, rows):
         """Append the collisions a run resolved (rows of
         :func:`orbits.collisions.table`, internal units) to the file's group
         ``collisions``, made on first use."""
         if not rows or self.closed:
             return
+        self._reserve(_LOG_ROW_BYTES * len(rows))
         U = sim.units
         g = self.f.require_group("collisions")
         text = h5py.string_dtype()
@@ -1106,6 +1928,7 @@ class FileRecorder:
             ds.resize((start + len(values),))
             ds[start:] = np.asarray(values, dtype=object if dtype is text else dtype)
 
+    @_writes
     def encounter_rows(self, sim, rows):
         """Append rows ``(t, body_1, body_2, distance, speed)`` of the encounter
         log (internal units) to the file's group ``encounters``, made on first
@@ -1113,7 +1936,7 @@ class FileRecorder:
         ``unit``) and ``body_1``, ``body_2`` (names), of a length that grows."""
         if not rows or self.closed:
             return
-        import h5py
+        self._reserve(_LOG_ROW_BYTES * len(rows))
         U = sim.units
         g = self.f.require_group("encounters")
         cols = {"time": ([r[0] for r in rows], np.float64, U.unit("time").to_string()),
@@ -1155,10 +1978,10 @@ class FileRecorder:
         if not self.closed:
             self.closed = True
             try:
-                self._flush_outputs()
-                self.f.close()
+                if self._failed is None:
+                    self._flush_outputs()
             finally:
-                _release(self.path)
+                self._shut()
 
     def result(self, sim, wall, status="completed"):
         """The run's :class:`~orbits.Result`, as :meth:`orbits.Simulation.run`
@@ -1212,7 +2035,7 @@ class FileRecorder:
                       steps=sim.steps - self.steps0,
                       force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
                       steps_rejected=sim.steps_rejected - self.rejected0,
-                      integrator=sim.integrator.info(), units=sim.units.to_dict(),
+                      integrator=sim.integrator.info(), units=sim.units,
                       dt=sim.dt, status=status, monitors=sim.monitors, path=str(self.path),
                       forces=tuple(map(repr, sim.forces)),
                       start_time=q(self.plan.start_time, "time"),
@@ -1229,10 +2052,14 @@ class FileRecorder:
         return Result(**fields)
 
     # writing ---------------------------------------------------------------------------
+    @_writes
     def _flush_outputs(self, sync=True):
         # the buffered outputs and in-loop rows into their datasets; sync:
         # and the file flushed to disk
         series, inloop = self._series
+        if self.buffer or self.mon_buffer:
+            self._reserve(len(self.buffer) * self._row_bytes
+                          + sum(len(part[0]) for part in self.mon_buffer) * self._inloop_bytes)
         if self.buffer:
             k = len(self.buffer)
             n0 = self.rows
@@ -1259,7 +2086,9 @@ class FileRecorder:
             self.mon_buffer = []
         if sync:
             self.f.flush()
+            self._unflushed = 0
 
+    @_writes
     def checkpoint(self, finished=False):
         """Write the restart state into the free slot, then advance ``count``.
 
@@ -1296,6 +2125,7 @@ class FileRecorder:
         """
         sim = self.sim
         self._flush_outputs()
+        self._reserve(0)        # the slot's datasets are in the headroom
         r = self._restart
         count = int(r["count"][()])
         slot = count % _SLOTS
@@ -1331,7 +2161,9 @@ class FileRecorder:
         r["count"][()] = count + 1
         r["count"].flush()
         self.f.flush()
+        self._unflushed = 0
         self.checkpoints += 1
+        self._checkpoint_step = state.steps
         self.last_checkpoint = _time.perf_counter()
 
 
@@ -1486,14 +2318,39 @@ def _jacobian(tangents, layout):
 
 def _create(path, desc, state):
     """A new file for the simulation described by ``desc`` (a
-    :class:`~orbits.records.SimulationDescription`) at ``state``."""
+    :class:`~orbits.records.SimulationDescription`) at ``state``, open for
+    appending in SWMR mode.
+
+    It is written whole as ``<path>.creating`` (made exclusively, see
+    :func:`_new_file`) and then renamed to ``path``, which replaces a file or
+    a link there, never what a link names.  Where that fails (a full disk),
+    the temporary is removed and ``path`` is left as it was.
+    """
+    tmp = path.with_name(path.name + ".creating")
+    f = _new_file(tmp)
+    try:
+        _write_layout(f, desc, state)
+    except BaseException as exc:
+        _close_written(f)
+        tmp.unlink(missing_ok=True)
+        if isinstance(exc, (OSError, RuntimeError)) and not isinstance(exc, OrbitsError):
+            raise _write_error(path, exc, " when making it; nothing was written") from None
+        raise
+    f.close()
+    os.replace(tmp, path)
+    f = h5py.File(path, "a", libver="latest")
+    f.swmr_mode = True
+    return f
+
+
+def _write_layout(f, desc, state):
+    """The groups, datasets and metadata of a new file ``f`` (the layout of the
+    module's notes) for the simulation ``desc`` describes, at ``state``; flushed."""
     __version__ = _package_version()
     import astropy
     import numba
 
     U = desc.units
-    tmp = path.with_name(path.name + ".creating")
-    f = h5py.File(tmp, "w", libver="latest")
     f.attrs["orbits_format"] = FORMAT
     f.attrs["orbits_format_version"] = FORMAT_VERSION
     h = f.create_group("h5md")
@@ -1594,11 +2451,6 @@ def _create(path, desc, state):
                 unit(kind)
         r.create_dataset("orders", shape=(_SLOTS, n), dtype=np.int64)
     f.flush()
-    f.close()
-    os.replace(tmp, path)
-    f = h5py.File(path, "a", libver="latest")
-    f.swmr_mode = True
-    return f
 
 
 # -- reading ---------------------------------------------------------------------------
@@ -1614,6 +2466,10 @@ def _damaged(func):
         except (OSError, RuntimeError, KeyError, ValueError) as exc:
             raise OrbitsFileError(f"{path}: damaged or incomplete orbits file "
                                   f"(truncated?): {exc}") from None
+        except (TypeError, AttributeError, IndexError) as exc:
+            # a value of a kind the checks above did not foresee: still the file's
+            raise OrbitsFileError(f"{path}: damaged orbits file: a value of the wrong kind "
+                                  f"({type(exc).__name__}: {exc})") from exc
     return wrapper
 
 
@@ -1626,9 +2482,12 @@ def _rows(f, monitors, in_loop=False):
     if in_loop:
         groups = [obs[name] for name in names]
     else:
-        groups = [f["particles/bodies/position"], f["particles/bodies/velocity"]]
-        groups += [obs[name] for name in names]
-    return min((g[k].shape[0] for g in groups for k in ("step", "time", "value")), default=0)
+        b = f["particles/bodies"]
+        groups = [b["position"], b["velocity"]] + [obs[name] for name in names]
+        if "masses_at_outputs" in b:
+            groups.append(b["masses_at_outputs"])
+    # only the rows the file stores data for (see _covered)
+    return min((_covered(g[k]) for g in groups for k in ("step", "time", "value")), default=0)
 
 
 def _totals(f):
@@ -1767,10 +2626,9 @@ def _collisions(g, par):
     units = UnitSystem.from_dict(json.loads(par.attrs["units"]))
     if g is None:
         return table([], units)
-    text = lambda name: _decode(g[name][()])  # noqa: E731
-    cols = [g["time"][()], g["step_time"][()], text("body_1"), text("body_2"),
-            text("resolution"), text("survivor"), g["distance"][()], g["speed"][()],
-            g["energy_change"][()]]
+    k = _log_rows(g, _COLLISION_COLUMNS)
+    cols = [_decode(g[name][:k]) if kind == "str" else g[name][:k]
+            for name, kind in _COLLISION_COLUMNS.items()]
     return table(list(zip(*cols)), units)
 
 
@@ -1779,9 +2637,10 @@ def _encounters(g):
     ``Result.encounters``."""
     import astropy.units as u
     from astropy.table import QTable
-    col = lambda name: g[name][()] << u.Unit(g[name].attrs["unit"])  # noqa: E731
-    return QTable({"time": col("time"), "body_1": np.array(_decode(g["body_1"][()]), dtype=str),
-                   "body_2": np.array(_decode(g["body_2"][()]), dtype=str),
+    k = _log_rows(g, _ENCOUNTER_COLUMNS)
+    col = lambda name: g[name][:k] << u.Unit(g[name].attrs["unit"])  # noqa: E731
+    text = lambda name: np.array(_decode(g[name][:k]), dtype=str)  # noqa: E731
+    return QTable({"time": col("time"), "body_1": text("body_1"), "body_2": text("body_2"),
                    "distance": col("distance"), "speed": col("speed")})
 
 
@@ -1931,7 +2790,7 @@ def describe(path):
             f"outputs         {n_out}"
             + (f", t = {t[0]:g} .. {t[n_out - 1]:g} {tu}" if n_out else ""),
             f"monitors        {', '.join(monitors) or 'none'}",
-            f"forces          {_describe_forces(par)}",
+            f"forces          {_describe_forces(par, path)}",
         ]
         config = _config(f)
         layout = _config_layout(config, len(names))
@@ -1954,26 +2813,35 @@ def describe(path):
             lines.append(f"work            {totals[0]} steps, {totals[1]} force evaluations, "
                          f"wall time {totals[3]:.3g} s")
         if "masses" in f["restart"]:
-            k = f["collisions/time"].shape[0] if "collisions" in f else 0
+            k = _log_rows(f["collisions"], _COLLISION_COLUMNS) if "collisions" in f else 0
             left = (int(np.isfinite(f["restart/masses"][(count - 1) % _SLOTS]).sum())
                     if count else None)
             lines.append(f"collisions      {k} resolved" + (
                 f"; {left} bodies at the last checkpoint" if left is not None else ""))
         if "encounters" in f:
-            lines.append(f"encounters      {f['encounters/time'].shape[0]} logged")
+            lines.append(f"encounters      {_log_rows(f['encounters'], _ENCOUNTER_COLUMNS)} "
+                         f"logged")
         lines.append(f"status          {_status(f, path)}")
         return "\n".join(lines)
 
 
-def _describe_forces(par):
-    # Newtonian gravity and the added terms, as their constructors would be written
+def _describe_forces(par, path):
+    # Newtonian gravity and the added terms, as their constructors would be
+    # written; a term of the user's functions by the names the file records
+    # (a file names functions, never holds them, and nothing is imported)
     from .. import forces
     text = ["Newtonian gravity"]
-    for d in json.loads(par.attrs.get("forces", "[]")):
+    records = json.loads(par.attrs["forces"]) if "forces" in par.attrs else []
+    for d in records:
         try:
-            text.append(repr(forces.from_dict(d)))
-        except forces.ForceTermError:   # a user function that cannot be imported here
-            text.append(f"{d.get('type')}({d.get('func', '')})")
+            needed = forces.functions_needed([d])
+            if needed:
+                text.append(f"{d['type']}({', '.join(needed)})")
+            else:
+                text.append(repr(forces.from_dict(d)))
+        except (OrbitsError, TypeError, ValueError, KeyError) as exc:
+            raise OrbitsFileError(f"{path}: the force term {d!r} in /parameters does not "
+                                  f"rebuild: {exc}") from None
     return " + ".join(text)
 
 
@@ -2029,7 +2897,6 @@ def read_checkpoint(path):
     (True, 10.0)
     """
     from ..bodies import BodySet
-    from ..units import UnitSystem
 
     with _open_read(path) as f:
         count = int(f["restart/count"][()])
@@ -2038,7 +2905,7 @@ def read_checkpoint(path):
         slot = (count - 1) % _SLOTS
         par = f["parameters"]
         r = f["restart"]
-        units = UnitSystem.from_dict(json.loads(par.attrs["units"]))
+        units = _unit_system(par, path)
         order = r["order"][()]
         inv = np.argsort(order)
         names = _decode(f["particles/bodies/names"][()])
@@ -2057,10 +2924,18 @@ def read_checkpoint(path):
             order = r["orders"][slot][:n]
             inv = np.argsort(order)
             x, v = x[:n], v[:n]
-        bodies = BodySet.from_arrays(m, x[inv], v[inv], names=names, units=units, radii=radii)
+        try:
+            bodies = BodySet.from_arrays(m, x[inv], v[inv], names=names, units=units,
+                                         radii=radii)
+        except OrbitsError as exc:
+            raise OrbitsFileError(f"{path}: the bodies at its last checkpoint are not a body "
+                                  f"set: {exc}") from None
         bodies.history = json.loads(par.attrs["bodies_history"])
-        config = (json.loads(par.attrs["config"]) if "config" in par.attrs
-                  else _legacy_config(par, units))
+        if "config" in par.attrs:
+            config = json.loads(par.attrs["config"])
+        else:
+            config = _legacy_config(par, units, path)
+            _check_config(config, path, config["monitors"])
         _check_tangent_rows(r["ws"], config, len(names), path)
         clock = r["clock"][slot]
         state = SimulationState(
@@ -2073,6 +2948,11 @@ def read_checkpoint(path):
                        float(p[6]))
         written, finished, _ = (int(a) for a in r["progress"][slot])
         rows = int(clock[3])
+        held = _rows(f, json.loads(par.attrs["monitors"]))
+        if rows > held:
+            raise OrbitsFileError(f"{path}: /restart/clock at the last checkpoint counts "
+                                  f"{rows} output rows, but the file holds {held}; the "
+                                  f"checkpoint does not belong to these outputs")
         t = state.t_base + state.steps_since_base * float(par.attrs["dt"])
     return Checkpoint(bodies, config, state, ResumePoint(plan, written, bool(finished), rows, t),
                       str(path))
@@ -2096,9 +2976,17 @@ def _check_tangent_rows(ws, config, n, path):
             + "; the file cannot restore the simulation", expected=want, found=found)
 
 
-def _legacy_config(par, units):
+def _legacy_config(par, units, path):
     # files written before the configuration record: the same record, from the
     # attributes they have
+    try:
+        return _legacy_record(par, units)
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+        raise OrbitsFileError(f"{path}: the attributes of /parameters do not make a "
+                              f"configuration ({type(exc).__name__}: {exc})") from None
+
+
+def _legacy_record(par, units):
     soft = float(par.attrs["softening"])
     unit = lambda val, kind: None if val is None else [val, units.unit(kind).to_string()]  # noqa: E731
     stop = json.loads(par.attrs["stop_conditions"])
@@ -2157,8 +3045,9 @@ class ResumePoint(NamedTuple):
 def truncate(path, point):
     """Drop what was written after the checkpoint ``point`` (a :class:`ResumePoint`).
 
-    The file is copied, which also leaves a file whose writer was killed
-    clean for writing again.  The writers' lock is taken first
+    The file is copied (into ``<path>.resume``, made exclusively, with room
+    for the whole copy reserved first), which also leaves a file whose writer
+    was killed clean for writing again.  The writers' lock is taken first
     (:class:`FileInUse` if a live process holds it) and kept for the
     :class:`FileRecorder` that writes on, which releases it when it closes.
 
@@ -2173,6 +3062,10 @@ def truncate(path, point):
     ------
     FileInUse
         Another live process is writing the file.
+    OrbitsFileError
+        ``path`` is a symbolic link, is damaged, or the disk has no room for
+        the copy (the message says which); the file is then as it was, and
+        neither the copy nor the lock is left behind.
 
     Examples
     --------
@@ -2188,20 +3081,53 @@ def truncate(path, point):
     >>> orbits.load(path).times
     <Quantity [0.] d>
     """
+    if os.path.islink(path):
+        raise OrbitsFileError(f"{path}: a symbolic link (to {os.readlink(path)}); resume the "
+                              f"file it names, so that the copy resuming makes does not "
+                              f"replace the link")
     _acquire(path)
     tmp = pathlib.Path(str(path) + ".resume")
-    with _open_read(path) as src, h5py.File(tmp, "w", libver="latest") as dst:
-        for k, v in src.attrs.items():
-            dst.attrs[k] = v
-        for name in src:
-            src.copy(src[name], dst, name=name)
-        groups = [dst["particles/bodies/position"], dst["particles/bodies/velocity"]]
-        groups += [dst["observables"][k] for k in dst["observables"] if k != "in_loop"]
-        for g in groups:
-            for ds in g.values():
-                ds.resize(min(ds.shape[0], point.rows), axis=0)
-        for g in dst["observables/in_loop"].values():
-            keep = int(np.count_nonzero(g["time"][()] <= point.time))
-            for ds in g.values():
-                ds.resize(keep, axis=0)
-    os.replace(tmp, path)
+    size = os.path.getsize(path)
+    need = size + size // 8 + _METADATA_BYTES       # the copy, laid out anew, and HDF5's own
+    dst = None
+    try:
+        with _open_read(path) as src:
+            dst = _new_file(tmp)
+            fd = _descriptor(dst)
+            if fd is not None:
+                # room for the whole copy first: a full disk stops it before it starts
+                _reserve(fd, 0, need)
+            for k, v in src.attrs.items():
+                dst.attrs[k] = v
+            for name in src:
+                src.copy(src[name], dst, name=name)
+            groups = [dst["particles/bodies/position"], dst["particles/bodies/velocity"]]
+            groups += [dst["observables"][k] for k in dst["observables"] if k != "in_loop"]
+            for g in groups:
+                for ds in g.values():
+                    ds.resize(min(ds.shape[0], point.rows), axis=0)
+            for g in dst["observables/in_loop"].values():
+                # only the rows stored (see _covered): a series declared longer holds no more
+                keep = int(np.count_nonzero(g["time"][:_covered(g["time"])] <= point.time))
+                for ds in g.values():
+                    ds.resize(keep, axis=0)
+        failed, dst = _close_written(dst), None
+        if failed is not None:
+            raise failed
+        _trim(tmp)
+        os.replace(tmp, path)
+    except BaseException as exc:
+        # the file as it was, and neither the copy nor the lock left behind
+        if dst is not None:
+            _close_written(dst)
+        tmp.unlink(missing_ok=True)
+        _release(path)
+        if isinstance(exc, OrbitsError) or not isinstance(exc, (OSError, RuntimeError)):
+            raise
+        if _error_number(exc) in _DISK_FULL:
+            raise _write_error(path, exc, f" when copying it to resume (resuming needs "
+                                          f"about {need / 1e6:.3g} MB free beside it); the "
+                                          f"file is unchanged") from None
+        raise OrbitsFileError(f"{path}: damaged, or its copy cannot be written: resuming "
+                              f"copies the file, and the copy failed ({exc}); the file is "
+                              f"unchanged") from None
