@@ -430,7 +430,7 @@ class Driven:
         self.steps_rejected += int(rej)
         self.force_evaluations += int(fev)
         if status == Status.LOG_FULL:
-            self._drain_log(rec)
+            self._log_full(rec, wall0)
         elif status != Status.OK:
             if status != Status.NON_FINITE and status != Status.STEP_UNDERFLOW:
                 self._stop_info[:] = self._ws["info"]
@@ -469,7 +469,7 @@ class Driven:
                 self._between_chunks(rec, wall0)
                 continue
             if status == Status.LOG_FULL:
-                self._drain_log(rec)
+                self._log_full(rec, wall0)
                 self._between_chunks(rec, wall0)
                 continue
             if status == Status.COLLISION and self._resolves_collisions:
@@ -602,20 +602,43 @@ class Driven:
             # the chaos indicators' tangent vector grew large, the encounter
             # log filled, or bodies collided: scaled back, emptied or
             # resolved, the rest of the chunk goes on
-            self._count(steps, dt)
+            lag, grid = self._count_stopped(steps, dt)
             if status == Status.RENORMALISE:
                 self._renormalise()
             elif resolve:
                 self._resolve_collisions(rec, wall0)
+                if lag:
+                    # resolved where the loop left the bodies, before the step
+                    # count: the survivors are carried up to it
+                    self._advance(1, rec, wall0, dt=lag)
+                    self._t_base, self._steps_since_base = grid
             else:
-                self._drain_log(rec)
+                self._log_full(rec, wall0)
             left -= steps
             if left == 0:
                 return
         if status != Status.OK:
-            self._count(steps, dt)
+            self._count_stopped(steps, dt)
             self._fail(status, rec, wall0)
         self._count(left, dt)
+
+    def _count_stopped(self, steps, dt):
+        """Count the ``steps`` of a loop that stopped early; where the integrator
+        left the state before them (:meth:`~orbits.integrators.base.Integrator.behind`:
+        a step it could not finish), the clock goes back to it.  Returns that
+        lag and the clock at the steps' end, ``(t_base, steps_since_base)``."""
+        self._count(steps, dt)
+        grid = (self._t_base, self._steps_since_base)
+        lag = self.integrator.behind(self._ws)
+        if lag:
+            self._t_base = self._now() - lag
+            self._steps_since_base = 0
+        return lag, grid
+
+    def _log_full(self, rec, wall0):
+        # the loop handed back a full encounter log: emptied (an owner with
+        # one finishes a check that the log cut short, orbits.Simulation)
+        self._drain_log(rec)
 
     def _count(self, n, dt):
         if n == 0:

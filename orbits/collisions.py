@@ -26,7 +26,14 @@ Every collision a run resolves is a row of ``result.collisions`` (an astropy
 table; also in output files) with its time, the two bodies, the resolution,
 the body that survived a merger and the energy change.  A collision is
 resolved at the end of the step in which it happened, with the state there
-(the pair's time of contact, found inside the step, is in the table).  All
+(the pair's time of contact, found inside the step, is in the table); the
+step can be the first, whose start the check records.  Bodies that touch at
+the start are merged there with ``"merge"`` (their row has time 0).  Where
+the integrator cannot carry the bodies through their contact (``trace``,
+whose inner step collapses as a planet falls head-on into its star), the
+collision is resolved at the last state it reached whole, before the contact
+(the table's ``step_time`` then precedes ``time``), and the survivors are
+carried on to the step's end.  All
 the collisions of one step are resolved in the order of their contact times;
 a merged body that then overlaps a third is merged again (chains).  A pair
 already moving apart at the end of the step (it passed through within one

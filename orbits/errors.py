@@ -421,7 +421,11 @@ class Collision(SimulationStopped):
     contact_time : astropy.units.Quantity
         When the pair was closest inside the step in which they touched (the
         end of that step if they already overlapped there).  ``time`` is the
-        end of the step, where the run stopped and the state is kept.
+        end of the step, where the run stopped and the state is kept; where
+        the integrator could not carry the bodies through their contact
+        (``trace``'s inner step collapsing on a head-on fall), it is the last
+        state reached whole, before the contact, and ``contact_time`` the
+        first touch of the pair's two-body orbits from there.
     distance, speed : astropy.units.Quantity
         Their separation and relative speed at ``contact_time``.
 

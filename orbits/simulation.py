@@ -32,7 +32,12 @@ from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDesc
 from .result import Result
 
 __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescription",
-           "Snapshot", "RunPlan", "PARALLEL_THRESHOLD"]
+           "Snapshot", "RunPlan", "PARALLEL_THRESHOLD", "LOG_ROWS"]
+
+#: Rows of the encounter log's table when a run starts (``encounter_log``):
+#: the compiled loop hands it back half full, and a step with more
+#: approaches than it holds has it doubled (see orbits._kernels.stopping).
+LOG_ROWS = 1024
 
 #: Bodies from which the threaded gravity kernel is used.  Measured with
 #: benchmarks/bench_gravity.py (whole leapfrog steps, two cores): against the
@@ -87,27 +92,37 @@ class Simulation(Driven):
         threaded from :data:`PARALLEL_THRESHOLD` bodies on.
     encounter_distance : Quantity (length), optional
         Stop with :class:`~orbits.errors.CloseEncounter` when two bodies come
-        closer than this.
+        closer than this, at the end of a step or inside it: the closest
+        approach along the step from both its ends, as for ``collisions``
+        (:func:`orbits._kernels.stopping.encounter_check`), so that a fast
+        pass between two step ends stops a fixed-step run too.  The run stops
+        at the end of that step; the message names when the pair was closest
+        and how close.
     encounter_hill : float, optional
         Stop with :class:`~orbits.errors.CloseEncounter` when two bodies other
         than the central (most massive) one come within this many mutual Hill
-        radii, ``((m_i + m_j) / (3 m_c))^(1/3) (r_i + r_j) / 2``.
+        radii, ``((m_i + m_j) / (3 m_c))^(1/3) (r_i + r_j) / 2`` (the
+        distances ``r`` from the central body at the end of the step), found
+        as for ``encounter_distance``.
     escape_distance : Quantity (length), optional
         Stop with :class:`~orbits.errors.Escape` when a body is farther than
         this from the centre of mass.
     escape_unbound : bool
         With ``escape_distance``: count a body beyond it only if it is also
         unbound (positive energy about the centre of mass).
-    collisions : {None, "halt"}
+    collisions : {None, "halt", "merge", "bounce"} or callable
         ``"halt"``: stop with :class:`~orbits.errors.Collision` when two bodies
         touch, their separation below the sum of their radii
-        (:meth:`BodySet.add`'s ``radius``; a body without one is a point).
-        The pairs are looked at the end of every step and inside it, along
-        their relative motion between its ends
-        (:mod:`orbits._kernels.stopping`), so a grazing passage inside one
-        step is caught too.  The bodies must not touch at the start, and at
-        least one must have a radius.  For integrators that check stopping
-        conditions (not the Wisdom-Holman family).
+        (:meth:`BodySet.add`'s ``radius``; a body without one is a point);
+        ``"merge"``, ``"bounce"`` or a function resolve the collision and go
+        on (:mod:`orbits.collisions`).  The pairs are looked at the end of
+        every step and inside it, the first step included, along their
+        relative motion between its ends (:mod:`orbits._kernels.stopping`), so
+        a grazing passage inside one step is caught too.  At least one body
+        must have a radius.  Bodies that touch at the start are merged there
+        with ``"merge"`` (a row of the first run's ``result.collisions`` at
+        t = 0); otherwise they are refused, naming the pair.  For integrators
+        that check stopping conditions (not the Wisdom-Holman family).
     encounter_log : float or Quantity (length), optional
         Log, without stopping, every closest approach of two bodies within
         this many mutual Hill radii (a number; pairs without the central
@@ -262,6 +277,10 @@ class Simulation(Driven):
         self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
         self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
                                      * np.linalg.norm(self._v, axis=1))) or 1.0
+        if self.__dict__.pop("_merge_at_start", False):
+            # bodies in contact at the start with collisions="merge": merged
+            # now, at t = 0, as a run merges them (collisions table, offsets)
+            self._resolve_collisions(None, None)
 
     def _bind_variations(self, variations, seed):
         """Tangent rows after the bodies' and the force of the augmented system
@@ -629,14 +648,16 @@ class Simulation(Driven):
                              "restitution": restitution,
                              "encounter_log": (log_distance or None, log_hill or None)}
         n = len(self._m)
-        # the encounter log's rows: room for every pair in one step beyond a
-        # reserve, emptied by the driver when the reserve is used
-        self._log = np.zeros((1024 + n * (n - 1) // 2, 5))
-        self._log_n = np.zeros(1, dtype=np.int64)
+        # the encounter log's rows (emptied by the driver, enlarged when a
+        # step has more approaches than they hold), and its count and where a
+        # look that filled it stopped
+        self._log = np.zeros((LOG_ROWS if mask & _s.ENCOUNTER_LOG else 0, 5))
+        self._log_n = np.zeros(3, dtype=np.int64)
         self._encounters = []
-        # the previous state and its time (for collisions inside a step),
-        # scratch, and where a collision was found
-        self._stop_clock = np.zeros(2)
+        # the state of the previous check and its time (for looking inside a
+        # step): the start, so that the first step is looked inside too;
+        # scratch, and where a collision or an encounter was found
+        self._stop_clock = np.array([0.0, 1.0])
         self._stop_hit = np.zeros(3)
         if not mask:
             return None
@@ -646,8 +667,8 @@ class Simulation(Driven):
                                         f"{what}; use 'ias15' or another method that does")
         central = int(np.argmax(self._m))
         return (mask, d2, k, esc2, self._gm, central, self._stop_info, self._r,
-                np.zeros((2, n, 3)), self._stop_clock, np.zeros((4, 3)), self._stop_hit,
-                log_hill, log_distance, self._log, self._log_n)
+                np.stack([self._x, self._v]), self._stop_clock, np.zeros((4, 3)),
+                self._stop_hit, log_hill, log_distance, self._log, self._log_n)
 
     def _drain_log(self, rec=None):
         """Move the encounter log's rows from the loop's buffer into the run's
@@ -662,6 +683,44 @@ class Simulation(Driven):
             keep = getattr(rec, "encounter_rows", None)
             if keep is not None:
                 keep(self, rows)
+
+    def _grow_log(self):
+        """A log table twice as long (a step had more approaches than it held)."""
+        self._log = np.zeros((max(2 * len(self._log), 1), 5))
+        self._stop = self._stop[:14] + (self._log,) + self._stop[15:]
+
+    def _log_step(self, x, v, t, rec=None):
+        """The encounter log's look at the step that ended at ``t`` with state
+        ``x``, ``v`` (a look the loop did not take), emptying and enlarging the
+        table as it fills."""
+        from ._kernels import stopping as _s
+        if not self._stop[0] & _s.ENCOUNTER_LOG:
+            return
+        while _s.encounter_log(x, v, t, self._stop):
+            self._drain_log(rec)
+            if not self._log_n[1]:
+                break
+            self._grow_log()
+
+    def _log_full(self, rec, wall0):
+        """The loop handed the encounter log back (``Status.LOG_FULL``): its rows
+        go into the run's list; if it filled inside a step, it is enlarged and
+        the loop's check of that step is finished (the log's look from where it
+        stopped, then the other conditions, which may stop the run)."""
+        from ._kernels import stopping as _s
+        self._drain_log(rec)
+        if not self._log_n[1]:
+            return
+        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
+        t = self._now()
+        x, v, t = self.integrator.checked_state(self._ws, t) or (self._x, self._v, t)
+        status = Status.LOG_FULL
+        while status == Status.LOG_FULL and self._log_n[1]:
+            self._grow_log()
+            status = _s.check_stop(x, v, t, self._stop)
+            self._drain_log(rec)
+        if status not in (0, Status.LOG_FULL):
+            self._fail(Status(status), rec, wall0)
 
     def _encounter_table(self):
         """``result.encounters``: an astropy QTable (None without ``encounter_log``)."""
@@ -684,10 +743,17 @@ class Simulation(Driven):
     @property
     def _keeps_previous(self):
         # the stopping conditions keep the state of the step before
-        # (collisions, the encounter log)
+        # (collisions, encounters, the encounter log)
         from ._kernels import stopping as _s
-        return self._stop is not None and bool(self._stop[0] & (_s.COLLISION
-                                                                | _s.ENCOUNTER_LOG))
+        return self._stop is not None and bool(self._stop[0] & _s.LOOKS_INSIDE)
+
+    def _keep_current(self):
+        """The current state as the one the conditions' next look inside a
+        step starts from (the state was set from outside)."""
+        if self._stop is not None:
+            self._stop[8][0] = self._x
+            self._stop[8][1] = self._v
+            self._stop_clock[:] = (self._now(), 1.0)
 
     @property
     def _resolves_collisions(self):
@@ -711,13 +777,18 @@ class Simulation(Driven):
         for i in range(1, len(r)):
             d = np.sqrt(((x[:i] - x[i]) ** 2).sum(axis=1))
             touch = np.flatnonzero(d < r[:i] + r[i])
+            if touch.size and collisions == "merge":
+                # what the user asked for: they merge at the start (__init__'s end)
+                self._merge_at_start = True
+                return
             if touch.size:
                 j = int(touch[0])
                 raise BodyError(f"{self._names[self._order[j]]!r} and "
                                 f"{self._names[self._order[i]]!r} touch at the start "
                                 f"(separation {d[j]:.6g} < radii {r[j] + r[i]:.6g} "
-                                f"{self.units.length}); with collisions= the bodies must "
-                                f"start apart", body=self._names[self._order[i]],
+                                f"{self.units.length}); with collisions={collisions!r} the "
+                                f"bodies must start apart (collisions='merge' merges them "
+                                f"at the start)", body=self._names[self._order[i]],
                                 field="radius")
 
     # -- collisions that the run resolves ----------------------------------------------
@@ -758,11 +829,16 @@ class Simulation(Driven):
             xk, vk, tk = seen
             found = _s.collision_pairs(xk, vk, tk, self._stop, out)
             found_rows += out[:found].tolist()
-            if self._stop[0] & _s.ENCOUNTER_LOG and _s.encounter_log(xk, vk, tk, self._stop):
-                self._drain_log(rec)
+            self._log_step(xk, vk, tk, rec)
             _s.keep_state(xk, vk, tk, self._stop)
         found = _s.collision_pairs(self._x, self._v, t, self._stop, out)
         found_rows += out[:found].tolist()
+        j, i = (float(k) for k in self._stop_info)
+        if rec is not None and j != i and (j, i) not in {(row[0], row[1]) for row in found_rows}:
+            # the pair the loop stopped for, touching after the state it left
+            # (an integrator that could not carry them through their contact,
+            # Trace.behind): resolved here, before its contact
+            found_rows.append([j, i] + [float(a) for a in self._stop_hit])
         first = {}
         for row in sorted(found_rows, key=lambda row: row[2]):
             first.setdefault((row[0], row[1]), row)    # a pair once, at its first contact
@@ -849,9 +925,7 @@ class Simulation(Driven):
         off = self._ws["collision_offset"]
         off[0] -= E1 - E0
         off[1:4] -= L1 - L0
-        if self._stop[0] & _s.ENCOUNTER_LOG and _s.encounter_log(self._x, self._v, t,
-                                                                  self._stop):
-            self._drain_log(rec)      # the step's approaches, which the loop left
+        self._log_step(self._x, self._v, t, rec)   # the step's approaches, which the loop left
         _s.keep_state(self._x, self._v, t, self._stop)
         self._collisions.extend(rows)
         keep = getattr(rec, "collision_rows", None)
@@ -1162,6 +1236,8 @@ class Simulation(Driven):
         if self._keeps_previous and "stop_prev" in state.workspace:
             self._stop[8][...] = state.workspace["stop_prev"]
             self._stop_clock[...] = state.workspace["stop_clock"]
+        else:
+            self._keep_current()
         if self._n_tangent:
             tangent = state.workspace.get("tangent")
             if tangent is None or tangent.shape != (2,) + self._rows_x[len(self._m):].shape:
@@ -1468,7 +1544,8 @@ class Simulation(Driven):
                 result=result)
         name = lambda k: self._names[self._order[k]]  # noqa: E731
         if status == Status.STEP_UNDERFLOW:
-            who = [name(int(k)) for k in self._ws["info"] if k >= 0]
+            # the bodies that drove it, where the method names them (not trace)
+            who = [name(int(k)) for k in self._ws.get("info", ()) if k >= 0]
             raise StepSizeUnderflow(
                 f"the step size of {self.integrator.name!r} collapsed at t = {t:.10g} "
                 f"(step {self.steps})" + (f", driven by {', '.join(map(repr, who))}"
@@ -1478,7 +1555,10 @@ class Simulation(Driven):
         i, j = (int(k) for k in self._stop_info)
         if status == Status.CLOSE_ENCOUNTER:
             bodies = (name(i), name(j))
-            raise CloseEncounter(f"close encounter of {bodies[0]!r} and {bodies[1]!r} at "
+            tc, dist = (float(a) for a in self._stop_hit[:2])
+            raise CloseEncounter(f"close encounter of {bodies[0]!r} and {bodies[1]!r} "
+                                 f"(closest at t = {tc:.10g} {self.units.time}, separation "
+                                 f"{dist:.6g} {self.units.length}) in the step ending at "
                                  f"t = {t:.10g} (step {self.steps}); the result up to here "
                                  f"is kept on .result", time=t, step=self.steps,
                                  result=result, bodies=bodies)

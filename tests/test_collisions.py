@@ -115,3 +115,67 @@ def test_a_restart_looks_inside_its_first_step(tmp_path):
         again.run(until=20 * u.day, outputs=2, progress=False)
     assert second.value.time == first.value.time == 5.5 * u.day
     assert second.value.contact_time == first.value.contact_time
+
+
+def _line(x_b, radius=1.0):
+    # two bodies of radius 1 on a line (G = 1, masses 1e-6): "b" at x_b moves
+    # at -1 towards "a" at rest; they touch when 2 apart, at t = x_b - 2
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("a", mass=1e-6, position=[0, 0, 0], velocity=[0, 0, 0], radius=radius)
+    b.add("b", mass=1e-6, position=[x_b, 0, 0], velocity=[-1, 0, 0], radius=radius)
+    return b
+
+
+@pytest.mark.parametrize("integrator", ["leapfrog", "rk4"])
+def test_a_collision_inside_the_first_step_halts(integrator):
+    # from x = 3 the bodies touch at t = 1, inside the first step of 10 (at
+    # its end they are 7 apart, passed through each other): the check looks
+    # inside the first step as inside every other
+    sim = orbits.Simulation(_line(3.0), integrator, dt=10, collisions="halt")
+    with pytest.raises(Collision) as info:
+        sim.run(until=40, outputs=2, progress=False)
+    exc = info.value
+    assert exc.bodies == ("a", "b") and exc.step == 1 and exc.time.value == 10
+    # the pair's relative motion is a straight line (their pull, 1e-6 / 4,
+    # moves them by < 1e-4 over the step), whose closest approach is 0 at
+    # t = 3; the contact (separation 2) is at t = 1
+    assert 0.0 <= exc.contact_time.value <= 3.0 + 1e-3
+    assert exc.distance.value < 2.0
+
+
+@pytest.mark.parametrize("integrator", ["leapfrog", "rk4"])
+def test_a_collision_inside_the_first_step_merges(integrator):
+    sim = orbits.Simulation(_line(3.0), integrator, dt=10, collisions="merge")
+    res = sim.run(until=40, outputs=2, progress=False)
+    assert len(sim.bodies) == 1 and len(res.collisions) == 1
+    row = res.collisions[0]
+    assert (row["body_1"], row["body_2"], row["resolution"]) == ("a", "b", "merge")
+    assert row["step_time"].value == 10 and row["time"].value <= 10
+    # mass and momentum: the merged body moves at the pair's mean velocity
+    assert sim.bodies._m[0] == 2e-6
+    assert np.allclose(sim.bodies._v[0], [-0.5, 0, 0], rtol=1e-12)
+
+
+def test_bodies_overlapping_at_the_start_merge_there():
+    # "b" inside "a" at t = 0: collisions="merge" asks for the merger, which
+    # happens at the start (the table's first row, at t = 0)
+    touching = _line(1.5)
+    sim = orbits.Simulation(touching, "leapfrog", dt=10, collisions="merge")
+    assert len(sim.bodies) == 1
+    res = sim.run(until=20, outputs=2, progress=False)
+    assert len(res.collisions) == 1
+    row = res.collisions[0]
+    assert row["time"].value == 0 and row["step_time"].value == 0
+    assert (row["body_1"], row["body_2"], row["survivor"]) == ("a", "b", "a")
+    assert row["distance"].value == 1.5
+    # momentum 1e-6 * (-1), now of a body of 2e-6; E plus the merger's offset
+    # stays the initial energy (a single body drifts: to rounding)
+    assert np.allclose(sim.bodies._v[0], [-0.5, 0, 0], rtol=1e-12)
+    assert abs(res.energy_error[-1]) < 1e-12
+
+
+@pytest.mark.parametrize("how", ["halt", "bounce"])
+def test_bodies_overlapping_at_the_start_are_refused_unless_merged(how):
+    with pytest.raises(BodyError, match="'a' and 'b' touch at the start") as info:
+        orbits.Simulation(_line(1.5), "leapfrog", dt=10, collisions=how)
+    assert info.value.field == "radius" and "merge" in str(info.value)

@@ -148,3 +148,54 @@ def test_the_log_goes_into_the_output_file(tmp_path):
     plain = orbits.Simulation(_bodies(y0), "ias15", monitors=())
     plain.run(until=10 * u.day, outputs=2, progress=False, output=tmp_path / "plain.h5")
     assert orbits.load(tmp_path / "plain.h5").encounters is None
+
+
+def test_a_simulation_reserves_no_room_for_every_pair():
+    # 3000 bodies have 4.5e6 pairs: a table of a row each (5 floats) would be
+    # 180 MB.  What a simulation allocates is O(N) (the state, a pair kernel's
+    # scratch), with a stopping condition too, and with the log a table of a
+    # fixed number of rows
+    import tracemalloc
+    n = 3000
+    rng = np.random.default_rng(3)
+    b = orbits.BodySet.from_arrays(np.full(n, 1e-9) * u.Msun, rng.normal(size=(n, 3)) * u.au,
+                                   np.zeros((n, 3)) * u.au / u.day)
+    for kw in ({}, {"escape_distance": 100 * u.au}, {"encounter_log": 0.01 * u.au}):
+        tracemalloc.start()
+        sim = orbits.Simulation(b, "leapfrog", dt=1 * u.day, monitors=(), parallel=False, **kw)
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        assert peak < 20e6, (kw, peak)
+        assert sim._log.shape[0] <= orbits.simulation.LOG_ROWS
+
+
+def _crossing_pairs(k):
+    # k pairs of massless bodies 100 apart in z, each pair's bodies flying at
+    # each other along x at 1 (G = 1) and passing 0.1 apart at t = 1.5, half
+    # way through the step from 1 to 2 (dt = 1): k approaches in one step
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("star", mass=1.0, position=[0, 0, -1e4], velocity=[0, 0, 0])
+    for i in range(k):
+        b.add(f"a{i}", mass=0.0, position=[-1.5, 0, 100 * i], velocity=[1, 0, 0])
+        b.add(f"b{i}", mass=0.0, position=[1.5, 0.1, 100 * i], velocity=[-1, 0, 0])
+    return b
+
+
+def test_more_approaches_in_one_step_than_the_log_holds_are_all_logged(monkeypatch):
+    # a log of 4 rows and 10 approaches in one step: the step's look is cut
+    # short when the log is full, the driver empties and enlarges it, and the
+    # look goes on where it stopped; every approach is logged, once
+    monkeypatch.setattr(orbits.simulation, "LOG_ROWS", 4)
+    sim = orbits.Simulation(_crossing_pairs(10), "leapfrog", dt=1.0,
+                            encounter_log=0.3 * u.dimensionless_unscaled, monitors=())
+    assert sim._log.shape[0] == 4
+    res = sim.run(until=4.0, outputs=2, progress=False)
+    log = res.encounters
+    assert len(log) == 10
+    assert sorted(zip(log["body_1"], log["body_2"])) == sorted(
+        (f"a{i}", f"b{i}") for i in range(10))
+    # straight lines (the star's pull from 1e4 away moves them by 1e-8):
+    # the Hermite interpolant is exact for them
+    assert np.allclose(log["time"].value, 1.5, atol=1e-6)
+    assert np.allclose(log["distance"].value, 0.1, atol=1e-6)
+    assert sim._log.shape[0] >= 10 // 2

@@ -1,5 +1,7 @@
 """Stopping conditions: close encounters and escapes, inside the compiled loop."""
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -179,3 +181,42 @@ def test_a_planet_about_its_star_is_passed_over():
     h = 20.0
     work = np.array([x0, v0, x0 + h * v0, v0])
     assert not _within_reach(work, mu, h, 0.00465)
+
+
+def _jupiter_probe():
+    # Sun, Jupiter on a circular 5.2 au orbit and a massless probe that
+    # passes it at 0.005 au and 0.05 au/day half way through the step from
+    # 10 to 11 days (dt = 1 day): 0.025 au from it at both step ends.  The
+    # probe starts 10.5 days before the pass on the straight line of the
+    # pass; the Sun's tide over those days (2e-6 au/day^2) and Jupiter's
+    # focusing (G m_J / v^2 = 1.1e-4 au) move the pass by ~1e-4 au.
+    gm_sun = orbits.UnitSystem().G
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    xj = np.array([5.2, 0.0, 0.0])
+    vj = np.array([0.0, np.sqrt(gm_sun / 5.2), 0.0])
+    b.add("Jupiter", mass=1 * u.Mjup, position=xj * u.au, velocity=vj * u.au / u.day)
+    w = np.array([0.05, 0.0, 0.0])
+    b.add("probe", mass=0 * u.kg, position=(xj - 10.5 * w + [0, 0, 0.005]) * u.au,
+          velocity=(vj + w) * u.au / u.day)
+    return b
+
+
+@pytest.mark.parametrize("integrator", ["leapfrog", "rk4"])
+def test_an_encounter_between_step_ends_stops_a_fixed_step_run(integrator):
+    # the closest approach along the step, as for collisions and the log:
+    # the run stops at the end of the step that holds the pass
+    sim = orbits.Simulation(_jupiter_probe(), integrator, dt=1 * u.day,
+                            encounter_distance=0.02 * u.au)
+    with pytest.raises(CloseEncounter) as info:
+        sim.run(until=30 * u.day, outputs=2, progress=False)
+    exc = info.value
+    assert set(exc.bodies) == {"Jupiter", "probe"}
+    assert exc.time == 11 * u.day and exc.step == 11
+    # both ends of that step are outside the distance: only the look inside
+    # the step sees the pass
+    x = sim.bodies.positions.to_value(u.au)
+    assert np.linalg.norm(x[2] - x[1]) > 0.02
+    # the message names the pass: when it was closest and how close
+    found = re.search(r"closest at t = ([-+.e0-9]+) .*separation ([-+.e0-9]+)", str(exc))
+    assert found and 10 < float(found[1]) < 11 and float(found[2]) < 0.02

@@ -9,6 +9,9 @@ collision detector and an encounter log:
   position through both ends (exact for motion that is a cubic in time);
 * :func:`kepler_closest`: on the two-body orbit of the pair through one
   state, inside a time window (exact for an isolated pair);
+* :func:`kepler_contact`: on that orbit, the first time the pair comes
+  within a given separation (where a step cannot be finished, as two bodies
+  meet head-on);
 * :func:`closest_approach`: the estimate for one step of an N-body
   integration, from both ends: two-body motion in a tidal field fitted to
   the step during an encounter, the Hermite interpolant when the pair barely
@@ -45,6 +48,7 @@ __all__ = [
     "ROOT_MAX_ITER",
     "hermite_closest",
     "kepler_closest",
+    "kepler_contact",
     "closest_approach",
 ]
 
@@ -517,6 +521,88 @@ def kepler_closest(mu, dx, dv, t_lo, t_hi):
     Danby (1988), sect. 6.9.
     """
     return _kepler_closest(mu, dx[0], dx[1], dx[2], dv[0], dv[1], dv[2], t_lo, t_hi)
+
+
+@njit
+def _separation_at(mu, x, y, z, vx, vy, vz, dt):
+    """Separation and speed on the two-body orbit (a line for ``mu = 0``)
+    ``dt`` after the state."""
+    if mu == 0.0:
+        return (_norm3(x + vx * dt, y + vy * dt, z + vz * dt), _norm3(vx, vy, vz))
+    return _radius_and_speed(mu, x, y, z, vx, vy, vz, dt)
+
+
+@njit
+def kepler_contact(mu, dx, dv, r, t_hi):
+    """The first time in ``[0, t_hi]`` at which the two-body orbit of a pair
+    comes within ``r``.
+
+    Parameters
+    ----------
+    mu : float
+        ``G (m_i + m_j)`` [length^3 / time^2], ``>= 0`` (0: a straight line).
+    dx, dv : ndarray, shape (3,)
+        Relative position [length] and velocity [length / time] at time 0.
+    r : float
+        The separation of contact [length], ``> 0``.
+    t_hi : float
+        The end of the window [time], ``>= 0``.
+
+    Returns
+    -------
+    t_c : float
+        The time the separation falls to ``r`` (0 if it is below ``r``
+        already) [time].
+    d : float
+        The separation there (``r`` up to the bisection's resolution)
+        [length].
+    speed : float
+        The relative speed there [length / time].
+
+    All NaN where the orbit stays beyond ``r`` in the window (or for invalid
+    input, as :func:`kepler_closest`).
+
+    Notes
+    -----
+    The closest approach in the window is :func:`kepler_closest`'s, at
+    ``t_min``.  Before it the separation decreases from the last apocentre
+    passage on, and is larger than at time 0 before that, so it crosses
+    ``r`` exactly once in ``[0, t_min]``: bisection on the two-body drift
+    (the f and g functions of :func:`kepler_closest`) finds it to a few ulps
+    of ``t_min`` in :data:`ROOT_MAX_ITER` halvings at most.  A radial orbit
+    (``q = 0``, the bodies meeting head-on) is resolved as any other: the
+    contact lies before the meeting, where the drift is regular.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits._kernels.encounters import kepler_contact
+    >>> t, d, s = kepler_contact(0.0, np.array([3.0, 0, 0]), np.array([-1.0, 0, 0]),
+    ...                          2.0, 10.0)
+    >>> round(t, 12), round(d, 12), s
+    (1.0, 2.0, 1.0)
+    """
+    x, y, z = dx[0], dx[1], dx[2]
+    vx, vy, vz = dv[0], dv[1], dv[2]
+    t_min, q, _ = _kepler_closest(mu, x, y, z, vx, vy, vz, 0.0, t_hi)
+    if not (q < r) or not (r > 0.0):
+        return _NAN, _NAN, _NAN
+    d0 = _norm3(x, y, z)
+    if d0 <= r:
+        return 0.0, d0, _norm3(vx, vy, vz)
+    lo = 0.0
+    hi = t_min
+    for _ in range(ROOT_MAX_ITER):
+        mid = 0.5 * (lo + hi)
+        if not (lo < mid < hi):
+            break
+        if _separation_at(mu, x, y, z, vx, vy, vz, mid)[0] > r:
+            lo = mid
+        else:
+            hi = mid
+    # hi: the first time found inside r (lo, just before it, is still beyond)
+    d, speed = _separation_at(mu, x, y, z, vx, vy, vz, hi)
+    return hi, d, speed
 
 
 # --------------------------------------------------------------------------

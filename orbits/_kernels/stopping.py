@@ -11,11 +11,13 @@ nothing, so such a scene pays nothing for the feature.
 clock, work, hit, log_hill, log_distance, log, log_n)``:
 
 * ``mask``: bits :data:`ENCOUNTER_DISTANCE`, :data:`ENCOUNTER_HILL`,
-  :data:`ESCAPE`, :data:`UNBOUND`, :data:`COLLISION`;
+  :data:`ESCAPE`, :data:`UNBOUND`, :data:`COLLISION`, :data:`ENCOUNTER_LOG`;
 * ``distance2``: squared encounter distance;
 * ``hill_k``: encounter at ``k`` mutual Hill radii,
   ``R_H = ((m_i + m_j) / (3 m_c))^(1/3) (r_i + r_j) / 2`` with ``r`` the
-  distances from the central (most massive) body ``c`` (Chambers 1996);
+  distances from the central (most massive) body ``c`` (Chambers 1996),
+  taken at the end of the step; an encounter is found at the end of a step
+  or inside it (:func:`encounter_check`), as a collision is;
 * ``escape2``: squared escape distance from the centre of mass; with
   :data:`UNBOUND` a body beyond it counts only if its energy about the centre
   of mass, ``v^2/2 - G M / r``, is positive;
@@ -25,30 +27,38 @@ clock, work, hit, log_hill, log_distance, log, log_n)``:
   at the end of a step or inside it (:func:`collision_check`);
 * ``prev`` (shape (2, n, 3)) and ``clock`` (``[t, valid]``): the positions
   and velocities at the previous check and their time, for looking inside
-  the step; ``clock[1] = 0`` (set by the driver when the state was changed
-  from outside) makes the next check look at the end of its step only;
+  the step (the conditions of :data:`LOOKS_INSIDE`); the simulation records
+  its state there before the first step, so that the first step is looked
+  inside as every other; ``clock[1] = 0`` makes the next check look at the
+  end of its step only;
 * ``work`` (shape (4, 3)): scratch;
-* ``hit`` (``[t, d, speed]``): where a collision fired, its time (of the
-  closest approach inside the step, or the end of the step where the bodies
-  already overlap), the separation and the relative speed there;
+* ``hit`` (``[t, d, speed]``): where a collision or an encounter fired, its
+  time (of the closest approach inside the step, or the end of the step
+  where the pair is inside already), the separation and the relative speed
+  there;
 * with :data:`ENCOUNTER_LOG` (:func:`encounter_log`), every closest approach
   of a pair inside ``log_hill`` mutual Hill radii (pairs without the central
   body; 0: not used) or ``log_distance`` is written as a row ``(t, j, i,
   distance, speed)`` of ``log`` (shape (capacity, 5)), ``log_n[0]`` counting
   them; the run does not stop for it, but hands back
-  :data:`~orbits._kernels.status.Status.LOG_FULL` when fewer rows are left
-  than pairs, for the driver to empty it and carry on.
+  :data:`~orbits._kernels.status.Status.LOG_FULL` when the log is half full,
+  for the driver to empty it and carry on, or at once when it fills inside a
+  step: the look at that step then stops at the pair ``(log_n[1], log_n[2])``
+  (``log_n[1] = 0`` when none is pending), with the state of the step before
+  kept, and the driver, having emptied (and enlarged) the log, calls
+  :func:`check_stop` again on the same state to finish it.
 """
 
 import math
 
 from ._jit import njit
-from .encounters import closest_approach
+from .encounters import closest_approach, kepler_contact
 from .status import Status
 
 __all__ = ["no_stop", "check_stop", "collision_check", "collision_pairs", "keep_state",
-           "encounter_log", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE", "UNBOUND",
-           "COLLISION", "ENCOUNTER_LOG"]
+           "encounter_log", "encounter_check", "collision_ahead", "ENCOUNTER_DISTANCE",
+           "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG",
+           "LOOKS_INSIDE"]
 
 ENCOUNTER_DISTANCE = 1
 ENCOUNTER_HILL = 2
@@ -56,6 +66,8 @@ ESCAPE = 4
 UNBOUND = 8
 COLLISION = 16
 ENCOUNTER_LOG = 32
+#: the conditions that look inside the step, from the state of the check before
+LOOKS_INSIDE = COLLISION | ENCOUNTER_LOG | ENCOUNTER_DISTANCE | ENCOUNTER_HILL
 
 
 @njit(inline="always")
@@ -245,7 +257,9 @@ def _keep(x, v, t, prev, clock, n):
 @njit
 def encounter_log(x, v, t, sargs):
     """Log the closest approaches inside the step that ended at ``t`` (see the
-    module docstring); True when the log should be emptied.
+    module docstring); True when the log should be emptied: it is half full,
+    or it filled before the look at the step was done (``log_n[1] != 0``:
+    the pair to go on from, when called again on the same state).
 
     A pair's separation has a minimum inside the step where it was closing at
     the start (``dx . dv < 0``) and is not at the end (``>= 0``); that
@@ -262,8 +276,13 @@ def encounter_log(x, v, t, sargs):
     if clock[1] == 0.0 or h == 0.0:
         return False
     third_gmc = 1.0 / (3.0 * gm[central])
-    for i in range(1, n):
-        for j in range(i):
+    # where a look that filled the log stopped (0: from the first pair)
+    i0 = max(1, log_n[1])
+    j0 = log_n[2] if log_n[1] > 0 else 0
+    log_n[1] = 0
+    log_n[2] = 0
+    for i in range(i0, n):
+        for j in range(j0 if i == i0 else 0, i):
             if dist > 0.0:
                 thr = dist
             else:
@@ -286,13 +305,131 @@ def encounter_log(x, v, t, sargs):
             tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
             if dm < thr:
                 r = log_n[0]
+                if r == log.shape[0]:
+                    # full: this pair and the rest when the driver has emptied it
+                    log_n[1] = i
+                    log_n[2] = j
+                    return True
                 log[r, 0] = clock[0] + tm
                 log[r, 1] = j
                 log[r, 2] = i
                 log[r, 3] = dm
                 log[r, 4] = sm
                 log_n[0] = r + 1
-    return log_n[0] > log.shape[0] - n * (n - 1) // 2
+    return 2 * log_n[0] > log.shape[0]
+
+
+@njit(inline="always")
+def _note(info, hit, j, i, tc, d, speed):
+    # the pair behind a condition, and where it was found
+    info[0] = j
+    info[1] = i
+    hit[0] = tc
+    hit[1] = d
+    hit[2] = speed
+
+
+@njit
+def encounter_check(x, v, t, sargs):
+    """The first pair (in the order of the pair loop) that came within the
+    encounter distance, or within ``hill_k`` mutual Hill radii, during the
+    step that ended at ``t``: at its end, or inside it, where
+    :func:`~orbits._kernels.encounters.closest_approach` of the pair from
+    both ends of the step comes within it.  Writes the pair into ``info``
+    and its time, separation and speed into ``hit``; returns True if there
+    was one.
+
+    The look inside the step costs a few multiplications a pair: a pair
+    ``d`` apart at the end with ``d`` above twice its threshold ``r``,
+    above ``16 v_max |h|`` (``v_max`` the fastest body's speed at either end,
+    so that ``2 v_max`` bounds the pair's relative speed there) and above
+    ``(16 mu h^2)^(1/3)`` cannot have come within ``r`` by the bound of
+    :func:`collision_check` taken at ``D = d / 2`` (its separation can have
+    fallen by at most ``2 (2 v_max |h| + mu h^2 / (2 D^2)) < d / 2``), and
+    is passed over, compared squared; the others get that bound with both
+    ends and then the closest approach.  A pair that was inside its
+    threshold at the previous check already counts only if it is at the end
+    (an encounter under way when the run started or went on)."""
+    mask, d2, hill_k, gm, central = sargs[0], sargs[1], sargs[2], sargs[4], sargs[5]
+    info, prev, clock, work, hit = sargs[6], sargs[8], sargs[9], sargs[10], sargs[11]
+    n = min(x.shape[0], gm.shape[0])
+    h = t - clock[0]
+    inside = clock[1] != 0.0 and h != 0.0
+    by_distance = (mask & ENCOUNTER_DISTANCE) != 0
+    by_hill = (mask & ENCOUNTER_HILL) != 0
+    third_gmc = 1.0 / (3.0 * gm[central]) if by_hill else 0.0
+    fast2 = 0.0
+    if inside:
+        vmax2 = 0.0
+        for i in range(n):
+            vmax2 = max(vmax2, v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2,
+                        prev[1, i, 0] ** 2 + prev[1, i, 1] ** 2 + prev[1, i, 2] ** 2)
+        fast2 = 256.0 * vmax2 * h * h
+    pull2 = 256.0 * h * h * h * h
+    for i in range(1, n):
+        for j in range(i):
+            dx = x[i, 0] - x[j, 0]
+            dy = x[i, 1] - x[j, 1]
+            dz = x[i, 2] - x[j, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            mu = gm[i] + gm[j]
+            thr2 = d2 if by_distance else 0.0
+            if by_hill and i != central and j != central and mu > 0.0:
+                ri = math.sqrt((x[i, 0] - x[central, 0]) ** 2 + (x[i, 1] - x[central, 1]) ** 2
+                               + (x[i, 2] - x[central, 2]) ** 2)
+                rj = math.sqrt((x[j, 0] - x[central, 0]) ** 2 + (x[j, 1] - x[central, 1]) ** 2
+                               + (x[j, 2] - x[central, 2]) ** 2)
+                rh = hill_k * (mu * third_gmc) ** (1.0 / 3.0) * 0.5 * (ri + rj)
+                thr2 = max(thr2, rh * rh)
+            if r2 < thr2:
+                ux = v[i, 0] - v[j, 0]
+                uy = v[i, 1] - v[j, 1]
+                uz = v[i, 2] - v[j, 2]
+                _note(info, hit, j, i, t, math.sqrt(r2), math.sqrt(ux * ux + uy * uy + uz * uz))
+                return True
+            if not inside or not (thr2 > 0.0):
+                continue
+            if r2 > 4.0 * thr2 and r2 > fast2 and r2 * r2 * r2 > pull2 * mu * mu:
+                continue
+            _pair_ends(x, v, prev, work, i, j)
+            if work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2 < thr2:
+                continue
+            thr = math.sqrt(thr2)
+            if not _within_reach(work, mu, h, thr):
+                continue
+            tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
+            if dm < thr:
+                _note(info, hit, j, i, clock[0] + tm, dm, sm)
+                return True
+    return False
+
+
+@njit
+def collision_ahead(x, v, t, h, sargs):
+    """The pair whose two-body orbit from ``x``, ``v`` at ``t`` touches
+    first within ``h > 0`` (:func:`~orbits._kernels.encounters.kepler_contact`),
+    with :data:`COLLISION` asked for: for a step an integrator could not
+    finish, its step size collapsing as two bodies met head-on.  Writes the
+    pair into ``info`` and the time, separation and speed of the contact
+    into ``hit``; returns True if one touches."""
+    if not (sargs[0] & COLLISION):
+        return False
+    gm, info, radii, work, hit = sargs[4], sargs[6], sargs[7], sargs[10], sargs[11]
+    n = min(x.shape[0], gm.shape[0])
+    first = math.inf
+    for i in range(1, n):
+        for j in range(i):
+            rs = radii[i] + radii[j]
+            if rs <= 0.0:
+                continue
+            for d in range(3):
+                work[0, d] = x[i, d] - x[j, d]
+                work[1, d] = v[i, d] - v[j, d]
+            tc, dc, sc = kepler_contact(gm[i] + gm[j], work[0], work[1], rs, h)
+            if tc < first:
+                first = tc
+                _note(info, hit, j, i, t + tc, dc, sc)
+    return first < math.inf
 
 
 @njit
@@ -301,40 +438,24 @@ def check_stop(x, v, t, sargs):
     mask, d2, hill_k, esc2, gm, central, info = sargs[:7]
     # the bodies' rows (a run with variations has tangent rows after them)
     n = min(x.shape[0], gm.shape[0])
-    if mask & (COLLISION | ENCOUNTER_LOG):
+    full = False
+    if mask & LOOKS_INSIDE:
         prev, clock = sargs[8], sargs[9]
         if mask & COLLISION and collision_check(x, v, t, sargs):
             # prev stays the state before the step: the driver lists every
             # pair of the step (collision_pairs) and then keeps the state
             return Status.COLLISION
-        full = (mask & ENCOUNTER_LOG) != 0 and encounter_log(x, v, t, sargs)
+        if mask & ENCOUNTER_LOG:
+            full = encounter_log(x, v, t, sargs)
+            if sargs[15][1] != 0:
+                # the log filled inside the step: prev stays the state before
+                # it, for the driver to finish the look once it is emptied
+                return Status.LOG_FULL
+        close = (mask & (ENCOUNTER_DISTANCE | ENCOUNTER_HILL)) != 0 and encounter_check(
+            x, v, t, sargs)
         _keep(x, v, t, prev, clock, n)
-    else:
-        full = False
-    if mask & (ENCOUNTER_DISTANCE | ENCOUNTER_HILL):
-        third_gmc = 1.0 / (3.0 * gm[central])
-        for i in range(1, n):
-            for j in range(i):
-                dx = x[i, 0] - x[j, 0]
-                dy = x[i, 1] - x[j, 1]
-                dz = x[i, 2] - x[j, 2]
-                r2 = dx * dx + dy * dy + dz * dz
-                hit = (mask & ENCOUNTER_DISTANCE) != 0 and r2 < d2
-                if not hit and (mask & ENCOUNTER_HILL) and i != central and j != central:
-                    mu = gm[i] + gm[j]
-                    if mu > 0.0:
-                        ri = math.sqrt((x[i, 0] - x[central, 0]) ** 2
-                                       + (x[i, 1] - x[central, 1]) ** 2
-                                       + (x[i, 2] - x[central, 2]) ** 2)
-                        rj = math.sqrt((x[j, 0] - x[central, 0]) ** 2
-                                       + (x[j, 1] - x[central, 1]) ** 2
-                                       + (x[j, 2] - x[central, 2]) ** 2)
-                        rh = (mu * third_gmc) ** (1.0 / 3.0) * 0.5 * (ri + rj)
-                        hit = r2 < (hill_k * rh) ** 2
-                if hit:
-                    info[0] = j
-                    info[1] = i
-                    return Status.CLOSE_ENCOUNTER
+        if close:
+            return Status.CLOSE_ENCOUNTER
     if mask & ESCAPE:
         mt = 0.0
         cx = cy = cz = 0.0

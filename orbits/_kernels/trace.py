@@ -66,6 +66,7 @@ from .coordinates import from_democratic_heliocentric, to_democratic_heliocentri
 from .gravity import pair_accelerations
 from .status import Status
 from .stepping import GO, _record, epilogue, first_record
+from .stopping import collision_ahead, keep_state
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 __all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
@@ -592,6 +593,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             if flagged or peri:
                 ok = _drift(xh, vb, gm, eta, n_active, enc, flagged, peri, seg, w1, w2, x, v,
                             inner, tabs, rtol)
+                if not ok:
+                    break
             else:
                 kepler_drift_all(xh, vb, eta, seg, w1, w2)
             if peri:
@@ -641,6 +644,23 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                     jump(xh, vb, gm, n_active, owed)
                 continue
             break
+        if not ok:
+            # the inner integrator's step collapsed (bodies meeting head-on:
+            # no step goes through a point mass); the state goes back to the
+            # segment's start, the last the run reached whole, as a
+            # synchronised state that the next call starts from (state[0] =
+            # 0), owed_box[0] before the steps done (Trace.behind).  With
+            # collisions asked for, the pair whose two-body orbits touch
+            # within the segment is the collision that stopped it.
+            t_start = t + k * dt - owed
+            from_democratic_heliocentric(xc, vc, gm, x, v)
+            state[0] = 0
+            checked[1] = 0.0
+            if STOP:  # noqa: F821 - bound by specialize
+                keep_state(x, v, t_start, sargs)
+                if collision_ahead(x, v, t_start, seg, sargs):
+                    return Status.COLLISION, k, n_mon
+            return Status.STEP_UNDERFLOW, k, n_mon
         if flagged or peri:
             counts[0] += 1
         # the criterion point: the next segment's start and flags
@@ -688,8 +708,6 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             jump(xh, vb, gm, n_active, half)
         owed = half
         owed_box[0] = owed
-        if not ok:
-            return Status.STEP_UNDERFLOW, k, n_mon
         # the epilogue sees the inertial state when it records, and at the
         # last step of the call when it checks the stopping conditions;
         # otherwise these are checked at the criterion point, where the state

@@ -27,7 +27,9 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
    where the method keeps them apart; a no-op for methods that never do) and
    ``invalidate(ws)`` (forget cached forces after the state was changed from
    outside); a method whose loop checks the stopping conditions elsewhere
-   than at the ends of its steps says where in ``checked_state(ws, t)``;
+   than at the ends of its steps says where in ``checked_state(ws, t)``, and
+   one whose loop can stop with the state before the steps it counts (a
+   step it cannot finish) says how far before in ``behind(ws)``;
 6. is registered in :mod:`orbits.integrators` and documented with its update
    equations, its reference and an example.
 
@@ -101,7 +103,9 @@ class Integrator:
     summary = ""
     #: force evaluations per step (for the counts in results)
     forces_per_step = 1
-    #: whether ``advance`` checks the stopping conditions (``stop=``) inside its loop
+    #: whether ``advance`` checks the stopping conditions (``stop=``) inside its
+    #: loop: True for all of them, or a tuple of the :class:`~orbits.Simulation`
+    #: keywords of those it checks
     stop_conditions = False
     #: whether its loop updates the chaos indicators after every step (the
     #: shared step epilogue, :mod:`orbits._kernels.variational`)
@@ -293,6 +297,20 @@ class Integrator:
         None (the default) when they were checked at the end of its last step,
         on the state that :meth:`synchronize` gives."""
         return None
+
+    def behind(self, ws):
+        """How far before the end of the steps a loop call counted the state
+        lies (the synchronised ``x``, ``v``), after a call that stopped early:
+        0.0 (the default) where a loop stops only at the end of a step.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> integ = orbits.integrators.get("leapfrog")
+        >>> integ.behind(integ.workspace(2))
+        0.0
+        """
+        return 0.0
 
     def info(self):
         """The integrator and its options, for results and files.

@@ -110,7 +110,13 @@ class Trace(Integrator):
     where the map's own state is synchronised) and at the end of each run
     call, so that they cost no synchronisation a step; a run that stops for
     one stops at the end of that step, and a collision's listed contact time
-    is where the check found it.
+    is where the check found it.  Where the inner integrator's step
+    collapses (two bodies meeting head-on: no step goes through a point
+    mass), the run goes back to the start of that segment, the last state it
+    reached whole (:meth:`behind`): with ``collisions=`` the pair whose
+    two-body orbits touch within the segment is the collision (merged there,
+    or halting with :class:`~orbits.errors.Collision`), otherwise the run
+    stops with :class:`~orbits.errors.StepSizeUnderflow`.
     Only Newtonian gravity without softening, and the conservative force
     terms that depend on positions alone (``GRPotential``, ``ZonalHarmonics``),
     kicked with the interaction as ``wh`` kicks them (a segment integrated
@@ -312,6 +318,22 @@ class Trace(Integrator):
         x, v = np.zeros((n, 3)), np.zeros((n, 3))
         from_democratic_heliocentric(ws["xc"], ws["vc"], ws["gm"], x, v)
         return x, v, tc
+
+    def behind(self, ws):
+        """How far before the steps counted the state lies after a call whose
+        inner integrator's step collapsed (bodies meeting head-on): the loop
+        left ``x``, ``v`` at the start of the segment it could not finish, the
+        last state it reached whole, half a step before the end of the last
+        step done (0 otherwise).
+
+        Examples
+        --------
+        >>> import orbits
+        >>> integ = orbits.integrators.get("trace")
+        >>> integ.behind(integ.workspace(2))
+        0.0
+        """
+        return float(ws["owed"][0]) if ws["state"][0] == 0 else 0.0
 
     def invalidate(self, ws):
         """The state was changed from outside (a merger, say): start again from

@@ -224,3 +224,58 @@ def test_warns_without_a_dominant_body():
         warnings.simplefilter("error", NoDominantBodyWarning)
         with pytest.raises(NoDominantBodyWarning):
             _run(b, "trace", 1 * u.day, 10 * u.day)
+
+
+def _radial_fall():
+    # a planet (1e-4, radius 1.4e-3) falling straight onto a star (1, radius
+    # 0.00465) from x = 1 at 0.4 (G = 1): they touch at t = 0.8113 and meet
+    # at 0.8114, a head-on fall through which no step goes (the inner
+    # integrator's step collapses)
+    b = orbits.BodySet(units=orbits.UnitSystem.nbody())
+    b.add("star", mass=1.0, position=[0, 0, 0], velocity=[0, 0, 0], radius=0.00465)
+    b.add("planet", mass=1e-4, position=[1, 0, 0], velocity=[-0.4, 0, 0], radius=1.4e-3)
+    return b
+
+
+def test_a_head_on_fall_halts_with_the_collision():
+    from orbits.errors import Collision
+    sim = orbits.Simulation(_radial_fall(), "trace", dt=0.01, collisions="halt")
+    with pytest.raises(Collision) as info:
+        sim.run(until=2, outputs=2, progress=False)
+    exc = info.value
+    assert exc.bodies == ("star", "planet")
+    # the contact time of the two-body fall (solve_ivp at rtol 1e-12:
+    # 0.811277) to the error of the two-body estimate from the segment's start
+    assert abs(exc.contact_time.value - 0.811277) < 1e-4
+    assert abs(exc.distance.value - (0.00465 + 1.4e-3)) < 1e-6
+    # the state kept is the last the run reached whole, before the contact
+    assert exc.time <= exc.contact_time
+    x = sim.bodies.positions.value
+    assert np.linalg.norm(x[1] - x[0]) > 0.00465 + 1.4e-3
+
+
+def test_a_head_on_fall_merges():
+    sim = orbits.Simulation(_radial_fall(), "trace", dt=0.01, collisions="merge")
+    res = sim.run(until=2, outputs=3, progress=False)
+    assert res.times[-1].value == 2 and len(sim.bodies) == 1
+    assert len(res.collisions) == 1 and res.collisions[0]["survivor"] == "star"
+    # mass and momentum of the pair (momentum 1e-4 * -0.4 at the start)
+    assert sim.bodies._m[0] == 1.0 + 1e-4
+    assert np.allclose(sim.bodies._m[0] * sim.bodies._v[0], [-4e-5, 0, 0], rtol=1e-12)
+    # energy with the merger's offset: the merger changes nothing, what is
+    # left is trace's own error on the fall before it (measured without
+    # collisions: 3.8e-5 at t = 0.8, r = 0.083, the fall's last step at dt =
+    # 0.01 before the pericentre criterion; 3.3e-5 here; REBOUND's TRACE
+    # 1.4e-5)
+    assert np.abs(res.energy_error).max() < 5e-5
+
+
+def test_a_head_on_fall_without_collisions_is_a_named_underflow():
+    # point masses: nothing carries the planet through the star's centre
+    from orbits.errors import StepSizeUnderflow
+    sim = orbits.Simulation(_radial_fall(), "trace", dt=0.01)
+    with pytest.raises(StepSizeUnderflow) as info:
+        sim.run(until=2, outputs=2, progress=False)
+    assert info.value.time.value < 0.8114
+    x = sim.bodies.positions.value
+    assert np.all(np.isfinite(x)) and np.linalg.norm(x[1] - x[0]) > 0.006
