@@ -84,6 +84,7 @@ import numpy as np
 
 from . import integrators as _integrators
 from .errors import OrbitsError, RunError
+from .forces import functions_of
 
 __all__ = ["Ensemble", "local_cluster", "MissingMainGuard", "EnsembleOptionError",
            "INDEX_FILE", "SWEEP_FILE", "ELEMENTS_MAX_BODIES", "PROGRESS_DELAY",
@@ -962,6 +963,10 @@ class _Perturbation:
     def __init__(self, sim, scale, seed):
         self.bodies = sim.bodies
         self.config = sim.config
+        # the user's functions of the force terms, by the names the
+        # configuration records: shipped as objects (pickled by reference),
+        # since a record names a function and is never imported from
+        self.functions = functions_of(sim.forces)
         self.scale = scale
         self.seed = seed
 
@@ -976,7 +981,7 @@ class _Perturbation:
         bodies._x = x + (self.scale * r)[:, None] * direction
         bodies.history.append({"from": "perturbed", "scale": self.scale, "seed": self.seed,
                                "member": int(member)})
-        return Simulation.from_config(bodies, self.config)
+        return Simulation.from_config(bodies, self.config, functions=self.functions)
 
     def fingerprint(self):
         b = self.bodies

@@ -64,8 +64,9 @@ Dynamics*, sect. 4.9 (:class:`ZonalHarmonics`); Papaloizou & Larwood 2000, MNRAS
 Burns, Lamy & Soter 1979, Icarus 40, 1 (:class:`RadiationPressure`).
 """
 
-import importlib
+import inspect
 import math
+from collections.abc import Mapping
 from typing import NamedTuple
 
 import astropy.constants as const
@@ -79,7 +80,7 @@ from .errors import BodyUnitsError, ForceTermError, UnknownBodyError
 
 __all__ = ["ForceTerm", "Gravity", "GR", "GRPotential", "GRFull", "ZonalHarmonics",
            "Migration", "TidesConstantTimeLag", "RadiationPressure", "UserForce",
-           "from_dict", "BoundTerm"]
+           "from_dict", "functions_needed", "functions_of", "BoundTerm"]
 
 
 class BoundTerm(NamedTuple):
@@ -156,6 +157,9 @@ class ForceTerm:
     wisdom_holman = False
     #: why the Wisdom-Holman interaction step cannot take it (for the error)
     why_not_wisdom_holman = ""
+    #: whether the term holds functions of the user's, which its dictionary
+    #: names but cannot hold: :func:`from_dict` takes them from the caller
+    takes_functions = False
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -203,6 +207,32 @@ class ForceTerm:
         """
         raise NotImplementedError
 
+    @classmethod
+    def functions_needed(cls, d):
+        """The functions the dictionary ``d`` of this term names and
+        :func:`from_dict` takes from its caller: recorded name -> what it is
+        (none for a term that holds only numbers).
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.forces.GR.functions_needed({"type": "GR", "source": "Sun", "c": None})
+        {}
+        """
+        return {}
+
+    def functions(self):
+        """The user's functions this term holds, by the names its dictionary
+        records (none for a term that holds only numbers).
+
+        Examples
+        --------
+        >>> import orbits
+        >>> orbits.forces.GR("Sun").functions()
+        {}
+        """
+        return {}
+
     def __eq__(self, other):
         return type(self) is type(other) and self.to_dict() == other.to_dict()
 
@@ -216,13 +246,26 @@ class ForceTerm:
         return f"{type(self).__name__}({args})"
 
 
-def from_dict(d):
+def from_dict(d, functions=None):
     """The term a :meth:`ForceTerm.to_dict` dictionary describes.
+
+    Nothing a dictionary names is imported: the functions of a
+    :class:`UserForce` come from ``functions``.
+
+    Parameters
+    ----------
+    d : dict
+        As :meth:`ForceTerm.to_dict` gives it.
+    functions : mapping, optional
+        The functions the dictionary names (see :meth:`UserForce.from_dict`):
+        recorded name (``"module:qualname"``, or the bare ``qualname``) ->
+        the function.
 
     Raises
     ------
     ForceTermError
-        The dictionary's ``type`` names no known term.
+        The dictionary's ``type`` names no known term, or it names a function
+        that ``functions`` does not give.
 
     Examples
     --------
@@ -233,12 +276,77 @@ def from_dict(d):
     >>> orbits.forces.from_dict(term.to_dict()) == term
     True
     """
+    cls = _record_class(d)
     d = dict(d)
-    name = d.pop("type", None)
-    if name not in _REGISTRY:
+    d.pop("type")
+    if cls.takes_functions:
+        return cls.from_dict(d, functions=functions)
+    return cls.from_dict(d)
+
+
+def _record_class(d):
+    # the registered class a term's dictionary names, or a named error
+    if not isinstance(d, Mapping):
+        raise ForceTermError(f"a force term's record must be a dictionary, got {d!r}")
+    name = d.get("type")
+    if not isinstance(name, str) or name not in _REGISTRY:
         raise ForceTermError(f"unknown force term type {name!r}; known: "
                              f"{', '.join(sorted(_REGISTRY))}")
-    return _REGISTRY[name].from_dict(d)
+    return _REGISTRY[name]
+
+
+def functions_needed(records):
+    """The functions that force terms' dictionaries name but cannot hold.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        :meth:`ForceTerm.to_dict` dictionaries.
+
+    Returns
+    -------
+    dict
+        Recorded name (``"module:qualname"``) -> what it is, in words, for
+        every function :func:`from_dict` needs from its caller.
+
+    Raises
+    ------
+    ForceTermError
+        A record names no known term, or names a function in a form that is
+        not ``"module:qualname"``.
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.forces.functions_needed([{"type": "UserForce", "func": "models:drag",
+    ...                                  "velocity_dependent": True, "potential": None}])
+    {'models:drag': 'UserForce func(x, v, t, m), velocity-dependent'}
+    """
+    needed = {}
+    for d in records:
+        needed.update(_record_class(d).functions_needed(d))
+    return needed
+
+
+def functions_of(terms):
+    """The functions of the user's that ``terms`` hold, by the names their
+    dictionaries record: what :func:`from_dict` takes to rebuild them (an
+    ensemble ships these with a simulation's configuration).
+
+    Examples
+    --------
+    >>> import numba, orbits
+    >>> @numba.njit
+    ... def drag(x, v, t, m):
+    ...     return -1e-6 * v
+    >>> term = orbits.forces.UserForce(drag, velocity_dependent=True)
+    >>> [name.split(":")[1] for name in orbits.forces.functions_of([term])]
+    ['drag']
+    """
+    out = {}
+    for term in terms:
+        out.update(term.functions())
+    return out
 
 
 def _quantity_dict(value):
@@ -1401,10 +1509,15 @@ class UserForce(ForceTerm):
         self.why_not_wisdom_holman = ("it depends on velocities" if self.velocity_dependent
                                       else "it has no potential")
 
+    takes_functions = True
+    #: the parameters of each function, as the class documents them
+    _SIGNATURES = {"func": ("x", "v", "t", "m"), "potential": ("x", "m")}
+
     def to_dict(self):
-        """Plain values: the functions as ``"module:qualname"`` references, which
-        :meth:`from_dict` imports again (so they must be defined at the top level
-        of an importable module).
+        """Plain values: the functions by name, ``"module:qualname"``, beside
+        whether the term reads velocities.  A dictionary names the functions
+        but never holds them: :meth:`from_dict` takes them from its caller,
+        and nothing is imported from a name.
 
         Examples
         --------
@@ -1417,46 +1530,118 @@ class UserForce(ForceTerm):
         >>> d["type"], d["func"].endswith(":drag"), d["potential"]
         ('UserForce', True, None)
         """
-        ref = lambda f: None if f is None else f"{f.__module__}:{f.__qualname__}"  # noqa: E731
-        return {"type": "UserForce", "func": ref(self.func),
+        return {"type": "UserForce", "func": _reference(self.func),
                 "velocity_dependent": self.velocity_dependent,
-                "potential": ref(self.potential)}
+                "potential": _reference(self.potential)}
+
+    def functions(self):
+        """The term's functions by the names its dictionary records.
+
+        Examples
+        --------
+        >>> import numba, orbits
+        >>> @numba.njit
+        ... def drag(x, v, t, m):
+        ...     return -1e-6 * v
+        >>> term = orbits.forces.UserForce(drag, velocity_dependent=True)
+        >>> list(term.functions().values()) == [drag]
+        True
+        """
+        return {_reference(f): f for f in (self.func, self.potential) if f is not None}
 
     @classmethod
-    def from_dict(cls, d):
-        """The term that :meth:`to_dict` describes.
+    def functions_needed(cls, d):
+        """The functions the dictionary ``d`` names, each with what it is.
 
         Raises
         ------
         ForceTermError
-            A function cannot be imported from its reference.
+            ``d`` names them in a form other than ``"module:qualname"``, or
+            its ``velocity_dependent`` is not a bool.
 
         Examples
         --------
         >>> import orbits
-        >>> try:
-        ...     orbits.forces.UserForce.from_dict({"func": "no_such_module:f",
-        ...                                        "velocity_dependent": False})
-        ... except orbits.ForceTermError as exc:
-        ...     print(exc.field)
-        func
+        >>> orbits.forces.UserForce.functions_needed(
+        ...     {"func": "models:pull", "velocity_dependent": False, "potential": "models:pot"})
+        {'models:pull': 'UserForce func(x, v, t, m)', 'models:pot': 'UserForce potential(x, m)'}
         """
-        def load(ref):
-            if ref is None:
-                return None
-            module, _, qualname = ref.partition(":")
-            try:
-                obj = importlib.import_module(module)
-                for part in qualname.split("."):
-                    obj = getattr(obj, part)
-            except (ImportError, AttributeError):
+        if not isinstance(d, Mapping):
+            raise ForceTermError(f"a UserForce record must be a dictionary, got {d!r}",
+                                 term="UserForce")
+        if not isinstance(d.get("velocity_dependent"), bool):
+            raise ForceTermError(f"velocity_dependent must be true or false, got "
+                                 f"{d.get('velocity_dependent')!r}", term="UserForce",
+                                 field="velocity_dependent")
+        needed = {}
+        for field in ("func", "potential"):
+            ref = d.get(field)
+            if ref is None and field == "potential":
+                continue
+            if not _is_reference(ref):
                 raise ForceTermError(
-                    f"cannot import the user function {ref!r}: define it at the top level "
-                    "of an importable module to restore or ship this simulation",
-                    term="UserForce", field="func") from None
-            return obj
-        return cls(load(d["func"]), velocity_dependent=d["velocity_dependent"],
-                   potential=load(d.get("potential")))
+                    f"{field} must be named as 'module:qualname', got {ref!r}",
+                    term="UserForce", field=field)
+            what = f"UserForce {field}({', '.join(cls._SIGNATURES[field])})"
+            if field == "func" and d["velocity_dependent"]:
+                what += ", velocity-dependent"
+            needed[ref] = what
+        return needed
+
+    @classmethod
+    def from_dict(cls, d, functions=None):
+        """The term that :meth:`to_dict` describes, with its functions taken from
+        ``functions``.
+
+        Parameters
+        ----------
+        d : dict
+            As :meth:`to_dict` gives it.
+        functions : mapping, optional
+            Recorded name -> function: the name as the dictionary records it
+            (``"module:qualname"``) or its ``qualname`` alone.  Each function
+            must have the recorded ``qualname`` and the parameters the class
+            documents (``func(x, v, t, m)``, ``potential(x, m)``).
+
+        Raises
+        ------
+        ForceTermError
+            ``functions`` does not give a function the dictionary names (the
+            error lists them), or gives one of another name or signature.
+
+        Examples
+        --------
+        >>> import numba, orbits
+        >>> @numba.njit
+        ... def drag(x, v, t, m):
+        ...     return -1e-6 * v
+        >>> d = orbits.forces.UserForce(drag, velocity_dependent=True).to_dict()
+        >>> orbits.forces.UserForce.from_dict(d, functions={"drag": drag})
+        UserForce(drag, velocity_dependent=True)
+        >>> try:
+        ...     orbits.forces.UserForce.from_dict(d)
+        ... except orbits.ForceTermError as exc:
+        ...     print(exc.field, "functions={'drag': ...}" in str(exc))
+        func True
+        """
+        needed = cls.functions_needed(d)
+        functions = {} if functions is None else functions
+        if not isinstance(functions, Mapping):
+            raise ForceTermError(f"functions must be a mapping of recorded names to "
+                                 f"functions, got {functions!r}", term="UserForce",
+                                 field="functions")
+        missing = [ref for ref in needed if _lookup(functions, ref) is None]
+        if missing:
+            raise ForceTermError(
+                "the record names the function(s) "
+                + "; ".join(f"{ref!r} ({needed[ref]})" for ref in missing)
+                + ", which a record cannot hold; pass them: functions={"
+                + ", ".join(f"{_qualname(ref)!r}: ..." for ref in missing) + "}",
+                term="UserForce", field="func" if d["func"] in missing else "potential")
+        func = _take(functions, d["func"], "func")
+        potential = (None if d.get("potential") is None
+                     else _take(functions, d["potential"], "potential"))
+        return cls(func, velocity_dependent=d["velocity_dependent"], potential=potential)
 
     def __repr__(self):
         return (f"UserForce({getattr(self.func, '__name__', self.func)}, "
@@ -1531,6 +1716,60 @@ class UserForce(ForceTerm):
             if not (np.ndim(e) == 0 and math.isfinite(float(e))):
                 raise ForceTermError(f"potential must return a finite float, got {e!r}",
                                      term=repr(self), field="potential")
+
+
+def _reference(f):
+    # how a record names a function: "module:qualname"
+    return None if f is None else f"{f.__module__}:{f.__qualname__}"
+
+
+def _is_reference(ref):
+    if not isinstance(ref, str):
+        return False
+    module, colon, qualname = ref.partition(":")
+    return bool(colon and module and qualname)
+
+
+def _qualname(ref):
+    return ref.partition(":")[2]
+
+
+def _lookup(functions, ref):
+    # the caller's function for a recorded name: by the whole name, or its qualname
+    if ref in functions:
+        return functions[ref]
+    return functions.get(_qualname(ref))
+
+
+def _take(functions, ref, field):
+    """The caller's function for the recorded ``ref``, checked against it: its
+    ``qualname`` and its parameters (those :class:`UserForce` documents)."""
+    f = _lookup(functions, ref)
+    given = getattr(f, "__qualname__", None)
+    if given != _qualname(ref):
+        raise ForceTermError(
+            f"the function given for {ref!r} is {f!r} (qualname {given!r}); the record "
+            f"names one of qualname {_qualname(ref)!r}", term="UserForce", field=field)
+    py_func = getattr(f, "py_func", f)
+    want = UserForce._SIGNATURES[field]
+    try:
+        params = inspect.signature(py_func).parameters.values()
+    except (TypeError, ValueError):
+        params = None
+    positional = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    if params is None or len(params) != len(want) or any(p.kind not in positional
+                                                          for p in params):
+        raise ForceTermError(
+            f"the function given for {ref!r} takes {_signature_text(py_func)}; a UserForce "
+            f"{field} takes ({', '.join(want)})", term="UserForce", field=field)
+    return f
+
+
+def _signature_text(f):
+    try:
+        return str(inspect.signature(f))
+    except (TypeError, ValueError):
+        return "arguments that cannot be read"
 
 
 _USER_FORCE_SIZE = _stepping_kernels.USER_FORCE_SIZE

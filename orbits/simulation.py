@@ -10,6 +10,7 @@ import math
 import numbers
 import time as _time
 import warnings
+from collections.abc import Mapping
 
 import astropy.units as u
 import numpy as np
@@ -24,7 +25,7 @@ from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
-                     Escape, IntegratorOptionError, NonFiniteState, OrbitsWarning,
+                     Escape, IntegratorOptionError, NonFiniteState, OrbitsError, OrbitsWarning,
                      SimulationOptionError, StepSizeUnderflow)
 from .monitors import DEFAULT_MONITORS, monitor_field_names, monitor_fields, monitor_mask
 from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDescription,
@@ -54,6 +55,60 @@ DEFAULT_OUTPUTS = 500
 #: The most steps one run may take: beyond 2**53 float64 no longer tells the
 #: times of neighbouring steps apart.
 MAX_STEPS = float(2 ** 53)
+
+
+def _with_callers_functions(path, config, collisions, functions):
+    """The configuration ``config`` that the file ``path`` records, with the
+    collisions function the caller gives; a :class:`SimulationOptionError`
+    unless the caller gives every function of the user's that it names, and
+    no other (see :meth:`Simulation.from_file`)."""
+    from . import forces as _forces
+    from .io.hdf5 import OrbitsFileError
+    try:
+        needed = _forces.functions_needed(config["forces"])
+    except _forces.ForceTermError as exc:
+        raise OrbitsFileError(f"{path}: its recorded force terms do not rebuild: "
+                              f"{exc}") from None
+    given = lambda ref: ref in functions or ref.partition(":")[2] in functions  # noqa: E731
+    used = {k for k in functions for ref in needed if k in (ref, ref.partition(":")[2])}
+    missing = {ref: what for ref, what in needed.items() if not given(ref)}
+    asks = [ref.partition(":")[2] for ref in missing]
+    missing = [f"{ref!r} ({what})" for ref, what in missing.items()]
+    named = config["stop_conditions"].get("collisions")
+    if isinstance(named, str) and named.startswith(FUNCTION_PREFIX):
+        recorded = named[len(FUNCTION_PREFIX):]
+        keys = [k for k in functions if _names_function(recorded, k)]
+        used.update(keys)
+        if collisions is None and keys:
+            collisions = functions[keys[0]]
+        if collisions is None:
+            missing.append(f"{recorded!r} (the collisions function; or collisions=...)")
+            asks.append(recorded.rpartition(".")[2])
+        elif not (_function_name(collisions) == named or _names_function(
+                recorded, getattr(collisions, "__qualname__", ""))):
+            raise SimulationOptionError(
+                f"{path}: its run resolved collisions with the function {recorded}; the "
+                f"function given, {collisions!r}, has another name")
+        else:
+            config = dict(config, stop_conditions=dict(config["stop_conditions"],
+                                                       collisions=collisions))
+    if missing:
+        raise SimulationOptionError(
+            f"{path}: its run used function(s) that a file names but never holds: "
+            + "; ".join(missing) + "; pass them again: Simulation.from_file(path, "
+            "functions={" + ", ".join(f"{name!r}: ..." for name in asks) + "})")
+    unused = sorted(set(functions) - used)
+    if unused:
+        raise SimulationOptionError(
+            f"{path}: functions names {', '.join(map(repr, unused))}, which its run did "
+            f"not use; it records: {', '.join(map(repr, needed)) or 'no functions'}")
+    return config
+
+
+def _names_function(recorded, name):
+    """Whether ``name`` (a qualname, or ``module.qualname``) is the function a
+    plain record names as ``recorded`` (``module.qualname``)."""
+    return bool(name) and (recorded == name or recorded.endswith("." + name))
 
 
 class Simulation(Driven):
@@ -478,9 +533,13 @@ class Simulation(Driven):
             self._variations, self._seed)
 
     @classmethod
-    def from_config(cls, bodies, config, _restoring=False):
+    def from_config(cls, bodies, config, _restoring=False, functions=None):
         """A simulation of ``bodies`` made as ``config`` (a :class:`SimulationConfig`
         or its :meth:`~SimulationConfig.to_dict`) says.
+
+        ``functions`` gives the user's functions that the configuration's
+        force terms name (see :func:`orbits.forces.from_dict`): a record names
+        a function but never holds it.
 
         Examples
         --------
@@ -495,7 +554,7 @@ class Simulation(Driven):
         if isinstance(config, dict):
             config = SimulationConfig.from_dict(config)
         integ = _integrators.get(config.integrator, **config.integrator_options)
-        terms = [t if isinstance(t, _forces.ForceTerm) else _forces.from_dict(t)
+        terms = [t if isinstance(t, _forces.ForceTerm) else _forces.from_dict(t, functions)
                  for t in config.forces]
         sim = cls.__new__(cls)
         # a state restored from a file may hold bodies in contact (a bounce
@@ -1008,7 +1067,7 @@ class Simulation(Driven):
 
     # -- files ------------------------------------------------------------------------
     @classmethod
-    def from_file(cls, path, collisions=None):
+    def from_file(cls, path, collisions=None, functions=None):
         """The simulation at the last checkpoint of an output file.
 
         Everything is restored, the integrator's internal state included, so
@@ -1016,12 +1075,33 @@ class Simulation(Driven):
         the run that wrote the file was interrupted, :meth:`resume` finishes
         it; :meth:`run` with ``output=path`` appends a new run to the file.
 
+        A file carries data, never code: the functions of the user's that its
+        run used (a :class:`~orbits.forces.UserForce`'s, a collisions
+        function) are named in it, never held, and nothing a file names is
+        imported.  They come from the caller, and are checked against the
+        names (and, for a force term, the parameters) the file records.
+
         Parameters
         ----------
         path : str or path-like
         collisions : callable, optional
-            The collisions function of a run that resolved collisions with one
-            (a file names it but cannot hold it).
+            The collisions function of a run that resolved collisions with one.
+        functions : mapping, optional
+            The user's functions by the names the file records: the whole
+            name (``"module:qualname"``) or the ``qualname`` alone, as in
+            ``functions={"drag": drag}``; a collisions function may come here
+            too.
+
+        Raises
+        ------
+        SimulationOptionError
+            The file's run used functions that were not given (the message
+            lists them), or ``functions`` names one the file does not record.
+        orbits.forces.ForceTermError
+            A function given has another name or other parameters than the
+            file records.
+        orbits.io.hdf5.OrbitsFileError
+            The file is damaged, or holds values that do not rebuild a simulation.
 
         Examples
         --------
@@ -1036,21 +1116,36 @@ class Simulation(Driven):
         (<Quantity 10. d>, True)
         """
         from .io import hdf5
+        if functions is None:
+            functions = {}
+        if not isinstance(functions, Mapping) or not all(
+                isinstance(k, str) and callable(f) for k, f in functions.items()):
+            raise SimulationOptionError(
+                f"functions must map the names a file records to functions, as "
+                f"{{'drag': drag}}; got {functions!r}")
         cp = hdf5.read_checkpoint(path)
-        config = cp.config
-        named = config["stop_conditions"].get("collisions")
-        if isinstance(named, str) and named.startswith(FUNCTION_PREFIX):
-            if collisions is None:
-                raise SimulationOptionError(
-                    f"{path}: its run resolved collisions with the function "
-                    f"{named[len(FUNCTION_PREFIX):]}, which a file cannot hold; pass it "
-                    f"again: Simulation.from_file(path, collisions=...)")
-            config = dict(config, stop_conditions=dict(config["stop_conditions"],
-                                                       collisions=collisions))
-        sim = cls.from_config(cp.bodies, config, _restoring=True)
+        config = _with_callers_functions(path, cp.config, collisions, functions)
+        try:
+            sim = cls.from_config(cp.bodies, config, _restoring=True, functions=functions)
+        except OrbitsError:
+            raise
+        except (TypeError, ValueError, KeyError, AttributeError, IndexError,
+                u.UnitsError) as exc:
+            raise hdf5.OrbitsFileError(f"{path}: its recorded configuration does not make a "
+                                       f"simulation: {exc}") from None
         if not np.array_equal(sim._order, cp.state.order):
             raise hdf5.OrbitsFileError(f"{path}: the stored body order does not match the "
                                        f"masses")
+        made = sim.state.workspace
+        for name, arr in cp.state.workspace.items():
+            want = made.get(name)
+            if want is not None and (np.shape(arr) != np.shape(want) or np.asarray(
+                    arr).dtype.kind != np.asarray(want).dtype.kind):
+                raise hdf5.OrbitsFileError(
+                    f"{path}: /restart/ws/{name} holds {np.asarray(arr).dtype} values of "
+                    f"shape {np.shape(arr)} at the checkpoint; the simulation the file "
+                    f"describes keeps {np.asarray(want).dtype} values of shape "
+                    f"{np.shape(want)} there")
         sim.set_state(cp.state)
         sim.output_path = cp.path
         sim._resume = cp.point

@@ -134,7 +134,7 @@ def test_restart_from_a_file_continues_the_work_bit_for_bit(tmp_path, name):
     r_ref = ref.run(until=200 * u.day, outputs=5, progress=False)
     first = _sim(name, dt)
     first.run(until=100 * u.day, outputs=5, output=path, progress=False)
-    again = orbits.Simulation.from_file(path)
+    again = orbits.Simulation.from_file(path, functions={"drag": drag})
     assert again.work == first.work and first.work.value > 0
     r = again.run(until=200 * u.day, outputs=5, output=path, progress=False)
     assert np.array_equal(again.state.x, ref.state.x)
@@ -173,7 +173,7 @@ def test_interrupted_run_resumes_to_the_same_work_series(tmp_path, monkeypatch):
         _sim("leapfrog", 1 * u.day, monitor_every=10).run(
             until=400 * u.day, outputs=21, output=cut, progress=False, checkpoint_interval=0)
     monkeypatch.setattr(FileRecorder, "output", real)
-    r_cut = orbits.Simulation.from_file(cut).resume(progress=False)
+    r_cut = orbits.Simulation.from_file(cut, functions={"drag": drag}).resume(progress=False)
     a, b = orbits.load(whole), orbits.load(cut)
     assert np.array_equal(a.work.value, b.work.value) and a.work.value[-1] > 0
     assert np.array_equal(a.energy_error, b.energy_error)
