@@ -1610,7 +1610,8 @@ class FileRecorder:
         sim = self.sim
         then = f" at t = {sim.time:.10g} (step {sim.steps})"
         if self._checkpoint_step is None:
-            then += "; the file holds no checkpoint to resume from"
+            then += ("; the file holds no checkpoint to resume from: run again (with "
+                     "overwrite=True, or --force) once there is room")
         else:
             then += (f"; the file holds the run up to its last checkpoint (step "
                      f"{self._checkpoint_step})")
