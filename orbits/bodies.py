@@ -201,9 +201,7 @@ class BodySet:
             raise BodyError(f"expected {n} names (one per mass), got {len(names)}",
                             field="names")
         for name in names:
-            if not isinstance(name, str) or not name:
-                raise BodyError(f"name must be a non-empty string, got {name!r}",
-                                body=name, field="name")
+            _check_name_text(name)
         if len(set(names)) != n:
             seen = set()
             dup = next(nm for nm in names if nm in seen or seen.add(nm))
@@ -684,9 +682,7 @@ class BodySet:
         self._v = np.vstack([self._v, np.asarray(v, dtype=float).reshape(1, 3)])
 
     def _check_name(self, name):
-        if not isinstance(name, str) or not name:
-            raise BodyError(f"name must be a non-empty string, got {name!r}",
-                            body=name, field="name")
+        _check_name_text(name)
         if name in self._names:
             raise DuplicateBodyError("a body of this name is already in the set",
                                      body=name, field="name")
@@ -791,6 +787,23 @@ class BodySet:
             raise ElementsError(_kepler.describe_status(status), body=name,
                                 field="f" if ang["f"] is not None else "elements")
         return xp + pos, vp + vel
+
+
+def _check_name_text(name):
+    """Refuse a name that is not a non-empty string, or that an HDF5 file cannot
+    hold: a NUL character, or a lone surrogate (text that UTF-8 cannot encode)."""
+    if not isinstance(name, str) or not name:
+        raise BodyError(f"name must be a non-empty string, got {name!r}",
+                        body=name, field="name")
+    if "\0" in name:
+        raise BodyError("name must not contain a NUL character ('\\x00'), which an output "
+                        "file cannot hold", body=name, field="name")
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise BodyError(f"name must be text that UTF-8 can encode; character "
+                        f"{exc.object[exc.start]!r} at {exc.start} is a lone surrogate",
+                        body=name, field="name") from None
 
 
 def _describe(value):

@@ -251,6 +251,21 @@ def test_unknown_primary_and_duplicate_name():
         b.add("Jupiter", mass=1 * u.Mjup, position=[1, 2, 3] * u.au)
 
 
+@pytest.mark.parametrize("name, what", [("Pla\0net", "NUL"), ("Pla\ud800net", "surrogate")])
+def test_a_name_an_output_file_cannot_hold_is_refused_where_it_enters(name, what):
+    # an HDF5 file holds neither a NUL nor a lone surrogate: without this check
+    # the set is made, and a run writing a file fails at its first write
+    b = sun_jupiter()
+    with pytest.raises(BodyError, match=what) as exc:
+        b.add(name, mass=0 * u.kg, position=[1, 0, 0] * u.au)
+    assert exc.value.body == name and exc.value.field == "name"
+    assert b.names == ["Sun", "Jupiter"]
+    U = orbits.UnitSystem.nbody()
+    with pytest.raises(BodyError, match=what):
+        orbits.BodySet.from_arrays([1, 0], [[0, 0, 0], [1, 0, 0]], np.zeros((2, 3)),
+                                   names=["Sun", name], units=U)
+
+
 def test_wrong_array_shapes():
     U = orbits.UnitSystem.nbody()
     with pytest.raises(BodyError, match="positions.*shape \\(2, 3\\)"):
