@@ -63,12 +63,14 @@ worker as in a serial loop (``client="serial"``).
 """
 
 import ast
+import contextlib
 import csv
 import functools
 import hashlib
 import io
 import json
 import linecache
+import logging
 import math
 import multiprocessing
 import numbers
@@ -83,6 +85,7 @@ import astropy.units as u
 import numpy as np
 
 from . import integrators as _integrators
+from ._csvcells import read_cell, safe_cell
 from .errors import OrbitsError, RunError
 from .forces import functions_of
 
@@ -94,11 +97,16 @@ __all__ = ["Ensemble", "local_cluster", "MissingMainGuard", "EnsembleOptionError
 #: each finishes (one write of a whole line, then fsync), so that an interrupted
 #: sweep knows what it has done.  On reading, only complete rows count: a line
 #: cut off by a crash, or any row that does not parse whole, is dropped with a
-#: warning and its run is done again.
+#: warning and its run is done again.  A text cell that a spreadsheet would take
+#: for a formula (a body named ``=HYPERLINK(...)``, in a column's name or in
+#: ``stop_bodies``) begins with a single quote, which reading takes away.
 INDEX_FILE = "index.csv"
 
 #: What the sweep in ``out_dir`` is (runs, ``until``, outputs, a hash of the
 #: parameters), so that a different sweep is not resumed into it by mistake.
+#: Every row of the index is also checked against the parameters of the run of
+#: its number, so that without this file (deleted) another sweep is still
+#: refused.
 SWEEP_FILE = "sweep.json"
 
 #: Final elements are reported for every non-central body up to this many
@@ -126,11 +134,15 @@ WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
 #: s with it; idle for 10 s, the workers used 0.07-0.12 s of CPU with these
 #: settings against 0.40-0.54 s with only the profiler off, and the
 #: scheduler's process 0.10-0.14 s against 0.52-0.61 (0.40-0.45 s against
-#: 0.90-1.07 s over the map).
+#: 0.90-1.07 s over the map).  The preload (``orbits._daskworker``) has
+#: each worker process ignore SIGINT, which Ctrl-C in a terminal sends to every
+#: process of the foreground group: the process that started the cluster closes
+#: it, instead of each worker stopping with its own tracebacks.
 WORKER_DASK_CONFIG = {"distributed.worker.profile.enabled": False,
                       "distributed.admin.system-monitor.interval": "2s",
                       "distributed.admin.tick.interval": "500ms",
-                      "distributed.worker.memory.monitor-interval": "1s"}
+                      "distributed.worker.memory.monitor-interval": "1s",
+                      "distributed.worker.preload": "orbits._daskworker"}
 
 
 _GUARD_ADVICE = ('each worker process of a local cluster imports the main script again and '
@@ -177,8 +189,10 @@ class MissingMainGuard(OrbitsError, RuntimeError):
 
 
 class EnsembleOptionError(OrbitsError, ValueError):
-    """An argument of :meth:`Ensemble.run` that cannot be taken as given (the
-    message names it, the value and what is expected).
+    """An argument of :class:`Ensemble` or :meth:`Ensemble.run` that cannot be
+    taken as given (the message names it, the value and what is expected): a
+    parameter with the name of a result column, an ``out_dir`` that holds
+    another sweep, a ``batch`` that is no whole number.
 
     Examples
     --------
@@ -207,7 +221,9 @@ class Ensemble:
         does; Dask's cloudpickle also sends most closures and lambdas.
     parameters : iterable of dict, or pandas.DataFrame
         One dictionary (or row) per run.  Values may be numbers, strings or
-        scalar Quantities.
+        scalar Quantities.  A name (or ``name_<unit>`` of a Quantity) may not
+        be that of a result column (``outcome``, ``steps``, ``file``, ...;
+        the module docstring lists them): :class:`EnsembleOptionError`.
 
     Examples
     --------
@@ -233,6 +249,7 @@ class Ensemble:
             if bad:
                 raise ValueError(f"parameter set {i}: names must be identifiers "
                                  f"(they are passed as keywords), got {bad}")
+            _check_parameter_names(p, i)
         self.build = build
         self.parameters = params
 
@@ -386,12 +403,17 @@ class Ensemble:
             the module docstring.  A failed run is a row with its outcome; an
             exception from ``build`` other than an
             :class:`~orbits.errors.OrbitsError` stops the sweep (the rows
-            finished before are kept in ``out_dir``).
+            finished before are kept in ``out_dir``).  So does Ctrl-C, after
+            one line on standard error saying how many runs ``out_dir`` holds:
+            the same call continues from there.
 
         Raises
         ------
         EnsembleOptionError
-            ``batch`` is not None or a whole number >= 1.
+            ``batch`` is not None or a whole number >= 1; ``out_dir`` holds
+            another sweep (its ``sweep.json`` says so, or a row of its index
+            has other parameters than this sweep's run of that number); a
+            parameter has the name of a column of the results.
         MissingMainGuard
             With ``client=None``, when called from the top level of a script
             outside ``if __name__ == "__main__":``: each worker process imports
@@ -418,14 +440,19 @@ class Ensemble:
         done = {}
         if out_dir is not None:
             out_dir = pathlib.Path(out_dir)
-            done = _open_out_dir(out_dir, self._fingerprint(spec), n)
+            done = _open_out_dir(out_dir, self._fingerprint(spec), self.parameters)
         todo = [i for i in range(n) if i not in done]
         rows = dict(done)
-        if todo:
-            if isinstance(client, str) and client == "serial":
+        try:
+            if todo and isinstance(client, str) and client == "serial":
                 self._run_serial(todo, spec, out_dir, rows, progress, batch)
-            else:
+            elif todo:
                 self._run_dask(todo, spec, out_dir, rows, progress, client, n_workers, batch)
+        except KeyboardInterrupt as exc:
+            # one line, not the traceback through Dask's internals: how many runs
+            # are safe, and what to do next
+            print(_interrupted(out_dir, n, len(rows)), file=sys.stderr, flush=True)
+            raise exc.with_traceback(None) from None
         frame = pd.DataFrame([rows[i] for i in range(n)])
         frame = frame[_column_order(frame.columns, self.parameters)].set_index("run")
         frame.attrs.update(_frame_attrs(spec, frame))
@@ -499,9 +526,13 @@ class Ensemble:
                 client.cancel(unfinished)
             if own is not None:
                 cluster = own.cluster
-                own.close()
-                if cluster is not None:
-                    cluster.close()
+                # a worker busy with a run (one cut short by Ctrl-C) is killed
+                # after Dask's grace period, with a warning that says no more
+                # than that: the run is done again by the next call
+                with _without_warnings("distributed.nanny"):
+                    own.close()
+                    if cluster is not None:
+                        cluster.close()
 
     def _fingerprint(self, spec):
         h = hashlib.sha1()
@@ -641,6 +672,30 @@ def _where(script, line):
     return "the main script" if script is None else f"line {line} of {script}"
 
 
+@contextlib.contextmanager
+def _without_warnings(logger):
+    """Leave out the records below ERROR of ``logger`` (a name) inside a ``with``."""
+    log = logging.getLogger(logger)
+
+    def keep(record):
+        return record.levelno >= logging.ERROR
+    log.addFilter(keep)
+    try:
+        yield
+    finally:
+        log.removeFilter(keep)
+
+
+def _interrupted(out_dir, n, finished):
+    """The line that :meth:`Ensemble.run` prints when Ctrl-C stops it."""
+    if out_dir is None:
+        return (f"orbits ensemble: interrupted after {finished} of {n} runs; without "
+                f"out_dir nothing is kept, and the same call starts again from the first")
+    saved = _saved_runs(out_dir / INDEX_FILE, n)
+    return (f"orbits ensemble: interrupted; {saved} of {n} runs are saved in {out_dir}, "
+            f"and the same call (with this out_dir) continues with the other {n - saved}")
+
+
 # -- one run (on a worker) -------------------------------------------------------------
 
 class _Spec:
@@ -728,6 +783,34 @@ def run_chunk(build, params, indices, spec, paths, batch=None):
     return rows, None
 
 
+def _check_parameter_names(params, i):
+    """Refuse a parameter whose column would be a result column: the result
+    would overwrite it (``run`` would even lose the rows' numbering)."""
+    for k, val in params.items():
+        col = _column(k, val.unit) if isinstance(val, u.Quantity) else k
+        if col in _RESULT_COLUMNS or any(col == p or col.startswith(p + "_")
+                                         for p in _RESULT_PREFIXES):
+            named = f"{k!r}" if col == k else f"{k!r} (the column {col!r})"
+            raise EnsembleOptionError(
+                f"parameter set {i}: the parameter {named} has the name of a column "
+                f"of the results, which would overwrite it; give it another name")
+
+
+def _add_results(row, results):
+    """``row`` (the run number and parameters) with the run's ``results``; a
+    parameter whose name a result takes (a body's final elements,
+    ``<body>_e``, above all) stops the sweep rather than lose its values."""
+    clash = [k for k in results if k in row]
+    if clash:
+        raise EnsembleOptionError(
+            f"the parameter {clash[0]!r} has the name of a column of the results of "
+            f"run {row['run']} (the final elements of a body are '<body>_a_<unit>', "
+            f"'<body>_e' and '<body>_inc_rad'), which would overwrite it; give the "
+            f"parameter another name")
+    row.update(results)
+    return row
+
+
 def run_one(build, params, index, spec, path=None):
     """Build and run one simulation; return its row (a dict).  Runs on a worker.
 
@@ -760,38 +843,38 @@ def _parameter_row(params, index):
 
 def _invalid_row(row, err, worker):
     """The row of a run whose parameters made no simulation (``err``)."""
-    row.update(outcome="invalid", message=str(err), stop_bodies="", steps=0,
-               energy_error_max=math.nan, angular_momentum_error_max=math.nan,
-               wall_time_s=0.0, **worker, file="")
-    return row
+    return _add_results(row, dict(
+        outcome="invalid", message=str(err), stop_bodies="", steps=0,
+        energy_error_max=math.nan, angular_momentum_error_max=math.nan,
+        wall_time_s=0.0, **worker, file=""))
 
 
 def _run_row(row, sim, spec, path, outcome, exc, wall, result, worker):
     """The row of a run that ran (``worker()``: where, and its kernels)."""
-    row["outcome"] = outcome
-    row["message"] = "" if exc is None else str(exc)
-    row["stop_bodies"] = ",".join(getattr(exc, "bodies", ()) or ())
+    out = {"outcome": outcome}
+    out["message"] = "" if exc is None else str(exc)
+    out["stop_bodies"] = ",".join(getattr(exc, "bodies", ()) or ())
     units = sim.units
     t_end = sim.time_value if exc is None or exc.time is None else exc.time
-    row[_column("t_stop", units.time)] = _value(t_end, units.time)
-    row["steps"] = sim.steps
+    out[_column("t_stop", units.time)] = _value(t_end, units.time)
+    out["steps"] = sim.steps
     if path is not None:   # the result of a run to a file holds only its last output
         from .io.hdf5 import load
         result = load(path)
     e = result.max_energy_error() if result is not None else None
     lerr = result.max_angular_momentum_error() if result is not None else None
-    row["energy_error_max"] = math.nan if e is None else e
-    row["angular_momentum_error_max"] = math.nan if lerr is None else lerr
-    row.update(_chaos_indicators(sim, result))
+    out["energy_error_max"] = math.nan if e is None else e
+    out["angular_momentum_error_max"] = math.nan if lerr is None else lerr
+    out.update(_chaos_indicators(sim, result))
     if result is not None and getattr(result, "collisions", None) is not None:
         # collisions the run resolved (merged or bounced) and the bodies left
-        row["collisions"] = len(result.collisions)
-        row["bodies_left"] = len(sim.bodies.names)
-    row.update(_final_elements(sim, spec.elements))
-    row["wall_time_s"] = wall
-    row.update(worker())
-    row["file"] = "" if path is None else path.name
-    return row
+        out["collisions"] = len(result.collisions)
+        out["bodies_left"] = len(sim.bodies.names)
+    out.update(_final_elements(sim, spec.elements))
+    out["wall_time_s"] = wall
+    out.update(worker())
+    out["file"] = "" if path is None else path.name
+    return _add_results(row, out)
 
 
 _NUMBA_SYNCED = []
@@ -997,26 +1080,136 @@ class _Perturbation:
 
 # -- output directory ---------------------------------------------------------------------
 
-def _open_out_dir(out_dir, fingerprint, n_runs):
-    """Create ``out_dir`` or check it holds this sweep; the rows already finished."""
+def _open_out_dir(out_dir, fingerprint, parameters):
+    """Create ``out_dir`` or check it holds this sweep; the rows already finished.
+
+    The sweep is this one if ``sweep.json`` says so and every row of the index
+    has the parameters of this sweep's run of its number; without a
+    ``sweep.json`` (deleted), the rows alone decide.
+    """
     out_dir.mkdir(parents=True, exist_ok=True)
     sweep = out_dir / SWEEP_FILE
-    if sweep.exists():
-        stored = json.loads(sweep.read_text()).get("fingerprint")
-        if stored != fingerprint:
-            raise ValueError(f"{out_dir} holds another sweep (different build, parameters, "
-                             f"until, outputs or elements); use a new out_dir")
-    else:
-        _write_whole(sweep, json.dumps({"fingerprint": fingerprint}) + "\n")
+    stored = _stored_fingerprint(sweep) if sweep.exists() else None
+    if stored is not None and stored != fingerprint:
+        raise EnsembleOptionError(f"{out_dir} holds another sweep (different build, "
+                                  f"parameters, until, outputs or elements); use a new "
+                                  f"out_dir")
     index = out_dir / INDEX_FILE
-    if not index.exists():
-        return {}
-    frame = _read_index(index, n_runs)
     rows = {}
-    for rec in frame.to_dict(orient="records"):
-        rec = {k: _from_csv(k, val) for k, val in rec.items()}
-        rows[int(rec["run"])] = rec
+    if index.exists():
+        frame = _read_index(index, len(parameters))
+        for rec in frame.to_dict(orient="records"):
+            rec = {k: _from_csv(k, val) for k, val in rec.items()}
+            rows[int(rec["run"])] = rec
+        _check_rows_are_of(rows, parameters, out_dir)
+    if stored is None:
+        _write_whole(sweep, json.dumps({"fingerprint": fingerprint}) + "\n")
     return rows
+
+
+def _stored_fingerprint(sweep):
+    """The fingerprint ``sweep.json`` records; a file that holds none is refused
+    by name rather than trusted or overwritten."""
+    try:
+        stored = json.loads(sweep.read_bytes().decode("utf-8"))
+    except (UnicodeDecodeError, ValueError) as exc:
+        stored = exc
+    if not (isinstance(stored, dict) and isinstance(stored.get("fingerprint"), str)):
+        raise EnsembleOptionError(
+            f"{sweep} does not record a sweep (expected a JSON object with its "
+            f"'fingerprint'); delete it to resume the sweep whose rows {INDEX_FILE} "
+            f"holds, which are checked against the parameters, or use a new out_dir")
+    return stored["fingerprint"]
+
+
+def _check_rows_are_of(rows, parameters, out_dir):
+    """Refuse rows of another sweep: every row must hold the parameters of the
+    run of its number, and no parameter this sweep does not have."""
+    expected = [_parameter_row(p, i) for i, p in enumerate(parameters)]
+    columns = {k for row in expected for k in row}
+    for i, rec in rows.items():
+        want = expected[i]
+        for col in sorted(set(rec) | set(want)):
+            if col == "run" or (col not in columns and _is_result_column(col)):
+                continue
+            got = rec.get(col, _ABSENT)
+            if col not in want and _is_empty(got):
+                continue
+            if not _same_value(want.get(col, _ABSENT), got):
+                raise EnsembleOptionError(
+                    f"{out_dir} holds another sweep: in its {INDEX_FILE}, run {i} has "
+                    f"{col} = {_shown(got)}, where this sweep's run {i} has "
+                    f"{col} = {_shown(want.get(col, _ABSENT))}; use a new out_dir")
+
+
+_ABSENT = type("_Absent", (), {"__repr__": lambda self: "(no such column)"})()
+
+
+def _shown(value):
+    return "(none)" if value is _ABSENT else repr(value)
+
+
+def _is_empty(value):
+    return value is None or value == "" or (isinstance(value, float) and math.isnan(value))
+
+
+def _same_value(want, got):
+    """Whether ``got``, a parameter as read back from the index, is ``want``."""
+    if want is _ABSENT or got is _ABSENT:
+        return want is got
+    if want is None or _is_empty(want):
+        return _is_empty(got)
+    if isinstance(want, bool) or isinstance(got, bool):
+        return str(want) == str(got)
+    if isinstance(want, numbers.Real) or isinstance(got, numbers.Real):
+        # a number, or text that pandas reads as one ("5")
+        try:
+            a, b = float(want), float(got)
+        except (TypeError, ValueError):
+            return False
+        return a == b or (math.isnan(a) and math.isnan(b))
+    return str(want) == str(got)
+
+
+def _is_result_column(name):
+    """Whether ``name`` is, or has the form of, a column of a run's results."""
+    return (name in _RESULT_COLUMNS
+            or any(name == p or name.startswith(p + "_") for p in _RESULT_PREFIXES)
+            or name.endswith(("_e", "_inc_rad", "_a")) or "_a_" in name)
+
+
+def _index_records(data, n_runs):
+    """What an index's bytes hold: ``(header, header_raw, good, dropped)``, the
+    header's fields and text, ``(fields, raw text)`` of each complete row, and
+    how many rows were not complete (see :func:`_read_index`)."""
+    # every write ends a row with "\n": whatever follows the last one is a cut-off row
+    end = data.rfind(b"\n") + 1
+    records = list(_csv_records(data[:end].decode("utf-8", errors="replace")))
+    dropped = int(end < len(data))
+    header, header_raw = records.pop(0) if records else (None, "")
+    if header is None or "run" not in header or "outcome" not in header:
+        header, dropped = None, dropped + len(records)   # without a header no row counts
+        records = []
+    good = []
+    for fields, raw in records:
+        if fields is not None and _complete_row(dict(zip(header, fields)), len(fields),
+                                                len(header), n_runs):
+            good.append((fields, raw))
+        else:
+            dropped += 1
+    return header, header_raw, good, dropped
+
+
+def _saved_runs(index, n_runs):
+    """How many runs ``index`` holds complete rows of (read only)."""
+    try:
+        header, _, good, _ = _index_records(index.read_bytes(), n_runs)
+    except OSError:
+        return 0
+    if header is None:
+        return 0
+    at = header.index("run")
+    return len({float(fields[at]) for fields, _ in good})
 
 
 def _read_index(index, n_runs):
@@ -1031,22 +1224,8 @@ def _read_index(index, n_runs):
     """
     import pandas as pd
 
-    data = index.read_bytes()
-    # every write ends a row with "\n": whatever follows the last one is a cut-off row
-    end = data.rfind(b"\n") + 1
-    records = list(_csv_records(data[:end].decode("utf-8", errors="replace")))
-    dropped = int(end < len(data))
-    header, header_raw = records.pop(0) if records else (None, "")
-    if header is None or "run" not in header or "outcome" not in header:
-        header, dropped = None, dropped + len(records)   # without a header no row counts
-        records = []
-    good = []
-    for fields, raw in records:
-        if fields is not None and _complete_row(dict(zip(header, fields)), len(fields),
-                                                len(header), n_runs):
-            good.append(raw)
-        else:
-            dropped += 1
+    header, header_raw, good, dropped = _index_records(index.read_bytes(), n_runs)
+    good = [raw for _, raw in good]
     if dropped:
         warnings.warn(f"{index}: dropped {dropped} incomplete or unreadable row(s) "
                       f"(a write cut off); their runs will be run again", stacklevel=4)
@@ -1064,7 +1243,13 @@ def _parse_index(text):
     # floats come back bit for bit: pandas 3 parses them exactly by default,
     # pandas 2 only when asked for "round_trip"
     exact = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
-    return pd.read_csv(io.StringIO(text), keep_default_na=False, na_values=[""], **exact)
+    frame = pd.read_csv(io.StringIO(text), keep_default_na=False, na_values=[""], **exact)
+    # text cells as they were before _to_csv made them safe for a spreadsheet
+    frame = frame.rename(columns=read_cell)
+    for c in frame.columns:
+        if frame[c].dtype.kind == "O":
+            frame[c] = frame[c].map(lambda v: read_cell(v) if isinstance(v, str) else v)
+    return frame
 
 
 def _csv_records(text):
@@ -1156,10 +1341,17 @@ def _index_header(index):
             first = f.readline()
     except FileNotFoundError:
         return None
-    return next(csv.reader([first]), None) if first.endswith("\n") else None
+    header = next(csv.reader([first]), None) if first.endswith("\n") else None
+    return None if header is None else [read_cell(c) for c in header]
 
 
 def _to_csv(frame, header):
+    """``frame`` as CSV rows, every text cell (a header, a name, a message) safe
+    to open in a spreadsheet (``orbits._csvcells``); numbers as they are."""
+    frame = frame.rename(columns=safe_cell)
+    for c in frame.columns:
+        if frame[c].dtype.kind == "O":
+            frame[c] = frame[c].map(lambda v: safe_cell(v) if isinstance(v, str) else v)
     return frame.to_csv(index=False, header=header, lineterminator="\n")
 
 
@@ -1191,6 +1383,13 @@ def _write_whole(path, text):
 _FIRST = ("outcome", "message", "stop_bodies")
 _MIDDLE = ("steps", "energy_error_max", "angular_momentum_error_max")
 _LAST = ("wall_time_s", "worker", "kernels_compiled", "kernels_loaded", "file")
+
+#: Columns of the results whatever the bodies (those of the elements,
+#: ``<body>_a_<unit>``, ``<body>_e``, ``<body>_inc_rad``, depend on them), and
+#: the beginnings of those that end with a unit (``t_stop_day``)
+_RESULT_COLUMNS = frozenset(("run", *_FIRST, *_MIDDLE, "megno", "fli", "collisions",
+                             "bodies_left", *_LAST))
+_RESULT_PREFIXES = ("t_stop", "lyapunov_per")
 
 
 def _column_order(columns, parameters):

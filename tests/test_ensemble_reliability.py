@@ -12,7 +12,8 @@ import pandas as pd
 import pytest
 
 import orbits
-from orbits.ensemble import INDEX_FILE, Ensemble, MissingMainGuard, local_cluster
+from orbits.ensemble import (INDEX_FILE, SWEEP_FILE, Ensemble, EnsembleOptionError,
+                             MissingMainGuard, local_cluster)
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -102,6 +103,114 @@ def test_an_index_row_with_an_unknown_outcome_or_a_bad_number_is_run_again(tmp_p
     assert list(df.outcome) == ["completed", "completed"] and list(df.steps) == [183, 183]
 
 
+# -- parameters and rows of another sweep ------------------------------------------------
+
+def build_with(e, **extra):
+    """``build`` that takes (and ignores) other parameters."""
+    return build(e)
+
+
+@pytest.mark.parametrize("name", ["outcome", "steps", "file", "message", "run",
+                                  "stop_bodies", "t_stop"])
+def test_a_parameter_named_as_a_result_column_is_refused_by_name(name):
+    # the result would overwrite it without a word (and "run", the rows'
+    # numbering, made the sweep end in KeyError: 0)
+    with pytest.raises(EnsembleOptionError, match=f"parameter '{name}'.*name of a column"):
+        Ensemble(build_with, [{"e": 0.1}, {"e": 0.3, name: 7}])
+    # a Quantity's column has its unit: t_stop in days would be t_stop_day
+    with pytest.raises(EnsembleOptionError, match="'t_stop_day'"):
+        Ensemble(build_with, [{"e": 0.1, "t_stop": 3 * u.day}])
+
+
+def test_a_parameter_named_as_a_bodys_final_element_stops_the_sweep():
+    # "Planet_e" is the column of the planet's final eccentricity: a column
+    # that only the bodies of a run name, so the first run stops the sweep
+    BUILT.clear()
+    with pytest.raises(EnsembleOptionError, match="parameter 'Planet_e'.*run 0"):
+        Ensemble(build_with, [{"e": 0.1, "Planet_e": 0.5}, {"e": 0.3, "Planet_e": 0.6}]).run(
+            UNTIL, client="serial", progress=False)
+    assert BUILT == [0.1]
+    # with its elements not asked for, the name is free
+    df = Ensemble(build_with, [{"e": 0.1, "Planet_e": 0.5}]).run(
+        UNTIL, client="serial", progress=False, elements=[])
+    assert df.Planet_e.tolist() == [0.5]
+
+
+def test_without_sweep_json_the_rows_of_another_sweep_are_refused(tmp_path):
+    Ensemble(build, PARAMS[:2]).run(UNTIL, client="serial", progress=False, out_dir=tmp_path)
+    (tmp_path / SWEEP_FILE).unlink()
+    # another grid in the same folder: its run 1 would be the old run 1's row
+    with pytest.raises(EnsembleOptionError, match=r"another sweep.*run 0 has e = 0\.1, where "
+                                                  r"this sweep's run 0 has e = 0\.2"):
+        Ensemble(build, [{"e": 0.2}, {"e": 0.3}]).run(UNTIL, client="serial", progress=False,
+                                                      out_dir=tmp_path)
+    # a parameter the index has and this sweep lacks
+    with pytest.raises(EnsembleOptionError, match=r"run 0 has tag = 'x', where this sweep's "
+                                                  r"run 0 has tag = \(none\)"):
+        Ensemble(build_with, PARAMS[:2]).run(UNTIL, client="serial", progress=False,
+                                             out_dir=_copy_index(tmp_path, "tag", "x"))
+    assert not (tmp_path / SWEEP_FILE).exists()     # nothing was written for a refusal
+    # the same sweep resumes from its rows, and records itself again
+    BUILT.clear()
+    df = Ensemble(build, PARAMS[:2]).run(UNTIL, client="serial", progress=False,
+                                         out_dir=tmp_path)
+    assert BUILT == [] and list(df.e) == [0.1, 0.3] and (tmp_path / SWEEP_FILE).exists()
+
+
+def _copy_index(out, column, value):
+    """A new out_dir whose index has one more parameter column."""
+    import csv
+    new = out.parent / (out.name + "-" + column)
+    new.mkdir()
+    rows = list(csv.reader((out / INDEX_FILE).read_text().splitlines()))
+    rows = [rows[0][:1] + [column] + rows[0][1:]] + [r[:1] + [value] + r[1:] for r in rows[1:]]
+    (new / INDEX_FILE).write_text("".join(",".join(r) + "\n" for r in rows))
+    return new
+
+
+def test_a_sweep_json_that_records_no_sweep_is_refused_by_name(tmp_path):
+    (tmp_path / SWEEP_FILE).write_bytes(b"\xff[]")
+    with pytest.raises(EnsembleOptionError, match="sweep.json does not record a sweep"):
+        Ensemble(build, PARAMS[:1]).run(UNTIL, client="serial", progress=False,
+                                        out_dir=tmp_path)
+
+
+# -- text cells of the index in a spreadsheet ------------------------------------------------
+
+LINK = '=HYPERLINK("http://example.com","x")'
+
+
+def linked(e, tag, shift):
+    """A massless planet named as a spreadsheet formula, escaping beyond 1.5 au
+    when its apocentre is beyond (e > 0.5)."""
+    b = orbits.BodySet()
+    b.add("Star", mass=1 * u.Msun)
+    b.add(LINK, mass=0 * u.kg, primary="Star", a=1 * u.au, e=e)
+    return orbits.Simulation(b, integrator="leapfrog", dt=1 * u.day,
+                             escape_distance=1.5 * u.au)
+
+
+def test_text_cells_of_the_index_are_safe_in_a_spreadsheet_and_read_back(tmp_path):
+    import csv
+    params = [{"e": 0.1, "tag": "-x", "shift": -1.5}, {"e": 0.9, "tag": "'=y", "shift": 2.0}]
+    df = Ensemble(linked, params).run(UNTIL, client="serial", progress=False, out_dir=tmp_path)
+    assert df.loc[1].outcome == "escape" and df.loc[1].stop_bodies == LINK
+    assert f"{LINK}_e" in df.columns and list(df.tag) == ["-x", "'=y"]
+    rows = list(csv.reader((tmp_path / INDEX_FILE).read_text().splitlines()))
+    cells = [c for row in rows for c in row]
+    for cell in cells:
+        try:
+            float(cell)
+        except ValueError:      # text: never the start of a formula (OWASP)
+            assert not cell.startswith(("=", "+", "-", "@", "\t", "\r")), cell
+    assert f"'{LINK}_e" in rows[0] and "-1.5" in cells        # numbers stay numbers
+    assert "'-x" in cells and "''=y" in cells
+    # and every text reads back as it was
+    again = Ensemble(linked, params).run(UNTIL, client="serial", progress=False,
+                                         out_dir=tmp_path)
+    assert again.equals(df)
+
+
 # -- a script without the main guard -------------------------------------------------------
 
 UNGUARDED = """\
@@ -138,6 +247,71 @@ def test_local_cluster_refuses_to_start_while_a_worker_imports_the_main_script(m
     with pytest.raises(MissingMainGuard, match=r'if __name__ == "__main__":'):
         local_cluster(1)
     assert issubclass(MissingMainGuard, orbits.OrbitsError)
+
+
+# -- Ctrl-C --------------------------------------------------------------------------------
+
+INTERRUPTED = """\
+import sys
+import time
+
+import astropy.units as u
+import orbits
+
+def build(e):
+    while e > 0.3:       # the runs after the first two go on until Ctrl-C
+        time.sleep(0.05)
+    return orbits.Simulation(orbits.scenes.kepler(e=e), integrator="leapfrog", dt=1 * u.day)
+
+if __name__ == "__main__":
+    try:
+        orbits.Ensemble(build, [{"e": e} for e in (0.1, 0.3, 0.5, 0.7)]).run(
+            0.5 * u.yr, n_workers=1, progress=False, out_dir=sys.argv[1])
+    except KeyboardInterrupt:
+        sys.exit(130)
+"""
+
+
+def test_ctrl_c_on_a_local_cluster_prints_one_line_and_the_same_call_continues(tmp_path):
+    import os
+    import signal
+    import time
+
+    script, out = tmp_path / "sweep.py", tmp_path / "sweep"
+    script.write_text(INTERRUPTED)
+    # a session of its own: Ctrl-C in a terminal signals the whole foreground
+    # group, the worker processes too
+    proc = subprocess.Popen([sys.executable, str(script), str(out)], cwd=tmp_path,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:
+        # generous: a scheduler and a spawned worker start on a shared machine
+        # (a few seconds when idle); the two runs that can finish take 183
+        # steps each
+        deadline = time.monotonic() + 180
+        index = out / INDEX_FILE
+        while not (index.exists() and index.read_text().count("\n") == 3):
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.1)
+        os.killpg(proc.pid, signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+    assert proc.returncode == 130
+    assert stdout == ""
+    assert stderr.splitlines() == [
+        f"orbits ensemble: interrupted; 2 of 4 runs are saved in {out}, and the same call "
+        f"(with this out_dir) continues with the other 2"], stderr[-3000:]
+    # the same call goes on from there (build is this module's, under the same name)
+    params = [{"e": e} for e in (0.1, 0.3, 0.5, 0.7)]
+    BUILT.clear()
+    resumed = Ensemble(build, params).run(UNTIL, client="serial", progress=False, out_dir=out)
+    assert BUILT == [0.5, 0.7]
+    whole = Ensemble(build, params).run(UNTIL, client="serial", progress=False,
+                                        out_dir=tmp_path / "whole")
+    assert resumed.drop(columns=WHERE).equals(whole.drop(columns=WHERE))
 
 
 # -- the README's example, as written --------------------------------------------------------
