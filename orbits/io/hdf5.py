@@ -1302,15 +1302,20 @@ def _reserve(fd, end, need):
     (where HDF5 allocates next), and :data:`_RESERVE_BYTES` more if it can.
 
     ``posix_fallocate`` allocates the blocks, so that the writes after it
-    cannot fail for space; the file grows past its end meanwhile, and
-    :func:`_trim` gives that back when it closes.  Returns False where the
-    file system cannot reserve space (the writes then go on unreserved);
-    raises :class:`_NoRoom` where there is no room for ``need``.
+    cannot fail for space (on a file system that writes in place; one that
+    copies on write, such as btrfs or ZFS, may still run out); the file grows
+    past its end meanwhile, and :func:`_trim` gives that back when it
+    closes.  Returns False where the file system (or the platform) cannot
+    reserve space: the writes then go on unreserved.  Raises
+    :class:`_NoRoom` where there is no room for ``need``.
     """
     want = end + need
     size = os.fstat(fd).st_size
     if size >= want:
         return True
+    fallocate = getattr(os, "posix_fallocate", None)     # not on macOS or Windows
+    if fallocate is None:
+        return False
     limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0] if resource else None
     failed = None
     for target in (want + _RESERVE_BYTES, want):
@@ -1319,7 +1324,7 @@ def _reserve(fd, end, need):
             failed = errno.EFBIG
             continue
         try:
-            os.posix_fallocate(fd, size, target - size)
+            fallocate(fd, size, target - size)
             return True
         except OSError as exc:
             if exc.errno not in _DISK_FULL:
@@ -1579,21 +1584,23 @@ class FileRecorder:
 
     def _sizes(self):
         """``(headroom, row, in-loop row)``: the bytes a write may take besides its
-        data (a chunk of every chunked dataset, each of which it may start; the
-        storage of the fixed ones, which a checkpoint's first write allocates;
+        data (a chunk of every time series, each of which it may start, and
         HDF5's bookkeeping), and the bytes of data of an output row and of an
-        in-loop monitor row."""
+        in-loop monitor row.  The checkpoints' datasets not yet given their
+        storage, which a checkpoint's first write allocates, are kept in
+        ``_unplaced``."""
         series, inloop = self._series
         outs = [d for dsets, _, _ in series for d in dsets]
         loops = [d for dsets in inloop.values() for d in dsets]
         fixed = list(self._restart.values()) + list(self._ws.values())
+        self._unplaced = [d for d in fixed if d.id.get_storage_size() == 0]
 
         def row(d):
             return int(np.prod(d.shape[1:], dtype=np.int64)) * d.dtype.itemsize
 
         def chunk(d):
-            return int(np.prod(d.chunks) if d.chunks else d.size) * d.dtype.itemsize
-        headroom = _METADATA_BYTES + sum(map(chunk, outs + loops + fixed))
+            return int(np.prod(d.chunks)) * d.dtype.itemsize
+        headroom = _METADATA_BYTES + sum(map(chunk, outs + loops))
         return headroom, sum(map(row, outs)), sum(map(row, loops))
 
     def _reserve(self, nbytes):
@@ -1601,8 +1608,13 @@ class FileRecorder:
         unflushed (:func:`_reserve`); where the file system cannot reserve,
         the writes go on unreserved."""
         self._unflushed += nbytes
-        if self._fd is not None and not _reserve(self._fd, self.f.id.get_filesize(),
-                                                 self._unflushed + self._headroom):
+        if self._fd is None:
+            return
+        if self._unplaced:
+            self._unplaced = [d for d in self._unplaced if d.id.get_storage_size() == 0]
+        need = (self._unflushed + self._headroom
+                + sum(d.size * d.dtype.itemsize for d in self._unplaced))
+        if not _reserve(self._fd, self.f.id.get_filesize(), need):
             self._fd = None
 
     def _stopped_by(self, exc):
