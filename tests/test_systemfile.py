@@ -329,3 +329,136 @@ def test_names_with_quotes_commas_and_accents_round_trip():
     for kind in ("toml", "csv"):
         assert systemfile.loads(systemfile.dumps(bodies, kind), kind).bodies.names \
             == bodies.names, kind
+
+
+# -- what used to escape as another exception, and spreadsheets ------------------------
+
+def test_a_file_that_is_not_utf8_names_its_line(tmp_path):
+    for ext, data in (("toml", GOOD.encode() + b'\n[[body]]\nname = "Ab\xe9"\nmass = 0\n'),
+                      ("csv", (HEADER + ROWS).encode() + b"Ab\xe9,0,2,0,0,0,30,0\n")):
+        path = tmp_path / f"latin1.{ext}"
+        path.write_bytes(data)       # "Abé" in Latin-1, as an old editor saves it
+        line = data.count(b"\n", 0, data.index(b"\xe9")) + 1
+        with pytest.raises(SystemFileError, match=re.escape(
+                f"{path}, line {line}: not UTF-8 text: the byte 0xe9 at column ")) as exc:
+            systemfile.read(path)
+        assert exc.value.path == str(path) and exc.value.line == line
+
+
+@pytest.mark.parametrize("text, line, field", [
+    # whole numbers of 400 digits: TOML takes them, a float cannot
+    (one_body("") + '[[body]]\nname = "b"\nmass = ' + "9" * 400 + "\n", 7, "mass"),
+    (one_body("") + '[[body]]\nname = "b"\nmass = 0\na = "1 au"\ne = ' + "9" * 400 + "\n", 9,
+     "e"),
+    ("[units]\nG = " + "9" * 400 + "\n" + one_body(""), 2, "G"),
+    (one_body("") + '[run]\nintegrator = "ias15"\n[run.options]\nepsilon = ' + "9" * 400
+     + "\n", 8, "epsilon"),
+], ids=["mass", "e", "G", "run option"])
+def test_a_whole_number_too_large_for_a_float_names_its_line(text, line, field):
+    with pytest.raises(SystemFileError, match="too large for a 64-bit float") as exc:
+        systemfile.loads(text, source="system.toml")
+    assert exc.value.line == line and exc.value.field == field
+    assert str(exc.value).startswith(f"system.toml, line {line}: ")
+
+
+def test_arrays_nested_too_deeply_and_values_python_cannot_hold_name_their_line():
+    # the parser recurses once for each level: 5000 levels pass Python's limit
+    deep = one_body("") + "x = 1\ny = " + "[" * 5000 + "]" * 5000 + "\n"
+    with pytest.raises(SystemFileError, match=r"system.toml, line 6: .*nested too deeply"):
+        systemfile.loads(deep, source="system.toml")
+    # valid TOML that Python's int() refuses: more than 4300 digits
+    digits = one_body("") + '[[body]]\nname = "b"\nmass = ' + "1" * 5000 + "\n"
+    with pytest.raises(SystemFileError, match=r"system.toml, line 7: not valid TOML here: "
+                                              r".*4300 digits"):
+        systemfile.loads(digits, source="system.toml")
+
+
+def test_a_utf8_byte_order_mark_as_a_spreadsheet_writes_it_is_read_past(tmp_path):
+    bodies = python_set()
+    for ext in ("csv", "toml"):
+        path = tmp_path / f"marked.{ext}"
+        path.write_bytes(b"\xef\xbb\xbf" + systemfile.dumps(bodies, ext).encode())
+        assert same_set(systemfile.read(path).bodies, bodies), ext
+
+
+def test_long_runs_of_spaces_and_digits_are_read_in_linear_time():
+    # each of these took time quadratic (or worse) in the run's length: 80 000
+    # spaces or digits took minutes; a test that hangs shows as the suite's timeout
+    from orbits.systemfile import _TomlLines
+    spaces = " " * 80_000
+    text = f'[[body{spaces}]]\nname = "Sun"\nmass = "1 Msun"\n[[body]]\nname = "b"\n' \
+           f'mass = 0\n'
+    assert systemfile.loads(text).bodies.names == ["Sun", "b"]
+    # lines the line finder sees, but that no header: a multi-line string's text
+    lines = _TomlLines(f'[[body]]\nnote = """\n[a{spaces}\n[{spaces}\n"""\nname = "S"\n')
+    assert lines.find(("body", 0, "name")) == 6
+    with pytest.raises(SystemFileError, match="line 3: body 'Sun', field 'mass': cannot read"):
+        systemfile.loads(one_body("").replace('"1 Msun"', '"' + "1" * 80_000 + 'x"'))
+    with pytest.raises(SystemFileError, match="line 1: cannot read the column"):
+        systemfile.loads(f"name{spaces}x,mass [Msun]\nSun,1\n", "csv")
+
+
+def test_a_table_of_states_reads_as_row_by_row_bit_for_bit():
+    # the columns converted at once, as the cells one by one: km/s and Rsun to
+    # the set's au/day and au, plain numbers in the file's units, empty cells
+    rng = np.random.default_rng(7)
+    n = 300
+    rows = [f"b{k},{m!r},{r!r},{x!r},{y!r},{z!r},{vx!r},{vy!r},{vz!r}"
+            for k, (m, r, x, y, z, vx, vy, vz) in enumerate(
+                (rng.lognormal(size=(n, 8)) * np.array([1, 1, 1, -1, 1, 1, -1, 1])).tolist())]
+    rows[5] = "b5,0,,,,,,,"                      # at rest at the origin, no radius
+    text = ("name,mass [Mearth],radius [Rsun],x [au],y [km],z [pc],vx [km/s],vy [au/d],"
+            "vz [m/s]\n" + "\n".join(rows) + "\n")
+    reader = systemfile._CsvReader(text, "<string>")
+    table = reader.read_table()
+    assert table is not None
+    one_by_one = systemfile._CsvReader(text, "<string>").read_rows()
+    assert table.names == one_by_one.names
+    for a, b in ((table._m, one_by_one._m), (table._r, one_by_one._r),
+                 (table._x, one_by_one._x), (table._v, one_by_one._v)):
+        assert a.tobytes() == b.tobytes()
+    units = "# units: length = km; mass = kg; time = s\n"
+    plain = units + "name,mass,x,y,z,vx,vy,vz\nEarth,5.972e24,0,0,0,0,0,0\nsat,0,7000,0,0,0,7.5,0\n"
+    assert same_set(systemfile._CsvReader(plain, "").read_table(),
+                    systemfile._CsvReader(plain, "").read_rows())
+
+
+def test_a_table_of_states_is_read_as_one_piece():
+    # 2000 bodies by columns: the set's history records the table once, where
+    # a body at a time recorded 2000 entries (and took seconds, 1e5 bodies
+    # minutes)
+    n = 2000
+    bodies = orbits.BodySet.from_arrays(np.full(n, 1e-3) * u.Msun,
+                                        np.arange(3.0 * n).reshape(n, 3) * u.au,
+                                        np.zeros((n, 3)) * u.au / u.day,
+                                        names=[f"b{k}" for k in range(n)])
+    back = systemfile.loads(systemfile.dumps(bodies, "csv"), "csv").bodies
+    assert same_set(back, bodies)
+    assert back.history == [{"from": "arrays", "n": n}, {"from": "file", "path": "<string>"}]
+
+
+def test_an_error_in_a_table_still_names_its_line_body_and_field():
+    rows = "".join(f"b{k},1e-9,{k},0,0,0,1,0\n" for k in range(1, 50))
+    bad = HEADER + "Sun,1,0,0,0,0,0,0\n" + rows.replace("b30,1e-9,", "b30,-1e-9,")
+    with pytest.raises(SystemFileError, match=r"system.csv, line 32: body 'b30', field 'mass'"):
+        systemfile.loads(bad, "csv", source="system.csv")
+    nul = HEADER + "Sun,1,0,0,0,0,0,0\n" + rows.replace("b30,", "b\x0030,")
+    with pytest.raises(SystemFileError, match=r"system.csv, line 32: body 'b\\x0030', "
+                                              r"field 'name'.*NUL"):
+        systemfile.loads(nul, "csv", source="system.csv")
+
+
+def test_names_a_spreadsheet_would_run_as_formulas_are_written_as_text():
+    names = ['=HYPERLINK("http://example.com","x")', "+1", "-x", "@SUM(A1)", "\tx",
+             "'quoted", "Sun"]
+    bodies = orbits.BodySet(units=orbits.UnitSystem(name="mine, with a comma"))
+    for k, name in enumerate(names):
+        bodies.add(name, mass=1.0, position=[k, 0, 0])
+    text = systemfile.dumps(bodies, "csv")
+    import csv
+    import io
+    rows = list(csv.reader(io.StringIO(text)))
+    assert [r[0] for r in rows[3:]] == ["'" + n for n in names[:-1]] + ["Sun"]
+    assert len(rows[1]) == 1 and rows[1][0].startswith("# units:")   # one cell
+    back = systemfile.loads(text, "csv").bodies
+    assert back.names == names and back.units.name == "mine, with a comma"
