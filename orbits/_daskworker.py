@@ -3,8 +3,8 @@
 Dask runs :func:`dask_setup` as a preload (``distributed.worker.preload`` in
 :data:`orbits.ensemble.WORKER_DASK_CONFIG`) when a worker starts.  Ctrl-C in a
 terminal sends SIGINT to every process of the foreground group, the workers
-too; each one stopping on its own printed about 60 lines of asyncio and Dask
-tracebacks.  A worker ignores SIGINT instead: the process that started the
+too; each one stopping on its own would print about 60 lines of asyncio and
+Dask tracebacks.  A worker ignores SIGINT instead: the process that started the
 cluster is interrupted, and closes it.  Closing it cancels the runs in
 progress, which the worker's state machine would report as a warning each; a
 run that the sweep does again is no news, so those reports are left out.

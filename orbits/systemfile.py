@@ -94,8 +94,8 @@ Errors
 Everything wrong in a file is a :class:`~orbits.errors.SystemFileError` whose
 message starts with the file and the line, then names the body and the field:
 ``system.toml, line 12: body 'Jupiter', field 'inc': ...``.  That includes a
-file that is not UTF-8 text, a number too large for a float, a date TOML
-cannot hold (February 30), and arrays nested too deeply to read.
+file that is not UTF-8 text, a whole number too large for a float or with
+more digits than Python converts, and arrays nested too deeply to read.
 """
 
 import csv
@@ -485,8 +485,8 @@ class _TomlReader(_Reader):
                              "deeply to read", _failing_line(self.text, RecursionError)) \
                 from None
         except ValueError as exc:
-            # a value of valid form that Python cannot hold: a date such as
-            # 1979-02-30, an integer of more digits than int() converts
+            # a value of valid form that Python cannot hold: an integer of
+            # more digits than int() converts (4300)
             raise self.error(f"not valid TOML here: {exc}",
                              _failing_line(self.text, ValueError)) from None
         lines = _TomlLines(self.text)
@@ -621,7 +621,8 @@ class _CsvReader(_Reader):
         A column's numbers are converted to the set's unit at once, with the
         factor by which a cell-by-cell reading converts each: the same numbers,
         bit for bit.  (Row by row, each body costs a few astropy conversions
-        and an ``add``, 0.6 ms; 1e5 bodies took minutes.)
+        and an ``add``, and each ``add`` copies the arrays: 1e5 bodies take
+        minutes.)
         """
         try:
             # a row whose first cell has text is not blank: the question is
@@ -853,8 +854,8 @@ class _TomlLines:
 def _table_header(line):
     """``(double, key)`` of a table header line, ``[key]`` or ``[[key]]`` with
     an optional comment after it; None for any other line.  Split by hand: a
-    regular expression with a space-matching part on each side of the key took
-    time quadratic (or worse) in the spaces of a line that is no header."""
+    regular expression with a space-matching part on each side of the key
+    takes time quadratic (or worse) in the spaces of a line that is no header."""
     text = line.strip()
     if not text.startswith("["):
         return None

@@ -114,7 +114,7 @@ def build_with(e, **extra):
                                   "stop_bodies", "t_stop"])
 def test_a_parameter_named_as_a_result_column_is_refused_by_name(name):
     # the result would overwrite it without a word (and "run", the rows'
-    # numbering, made the sweep end in KeyError: 0)
+    # numbering, would end the sweep in KeyError: 0)
     with pytest.raises(EnsembleOptionError, match=f"parameter '{name}'.*name of a column"):
         Ensemble(build_with, [{"e": 0.1}, {"e": 0.3, name: 7}])
     # a Quantity's column has its unit: t_stop in days would be t_stop_day

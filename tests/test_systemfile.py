@@ -382,8 +382,9 @@ def test_a_utf8_byte_order_mark_as_a_spreadsheet_writes_it_is_read_past(tmp_path
 
 
 def test_long_runs_of_spaces_and_digits_are_read_in_linear_time():
-    # each of these took time quadratic (or worse) in the run's length: 80 000
-    # spaces or digits took minutes; a test that hangs shows as the suite's timeout
+    # patterns with two adjacent runs that match spaces (or digits) take time
+    # quadratic (or worse) in the run's length: minutes for 80 000; a test that
+    # hangs shows as the suite's timeout
     from orbits.systemfile import _TomlLines
     spaces = " " * 80_000
     text = f'[[body{spaces}]]\nname = "Sun"\nmass = "1 Msun"\n[[body]]\nname = "b"\n' \
@@ -424,8 +425,8 @@ def test_a_table_of_states_reads_as_row_by_row_bit_for_bit():
 
 
 def test_a_table_of_states_is_read_as_one_piece():
-    # 2000 bodies by columns: the set's history records the table once, where
-    # a body at a time recorded 2000 entries (and took seconds, 1e5 bodies
+    # 2000 bodies by columns: the set's history records the table once; a
+    # body at a time records 2000 entries (and takes seconds, 1e5 bodies
     # minutes)
     n = 2000
     bodies = orbits.BodySet.from_arrays(np.full(n, 1e-3) * u.Msun,
