@@ -161,7 +161,8 @@ class Simulation(Driven):
         as for ``encounter_distance``.
     escape_distance : Quantity (length), optional
         Stop with :class:`~orbits.errors.Escape` when a body is farther than
-        this from the centre of mass.
+        this from the centre of mass at the end of a step.  The one condition
+        that ``wh`` and the SABA methods check too.
     escape_unbound : bool
         With ``escape_distance``: count a body beyond it only if it is also
         unbound (positive energy about the centre of mass).
@@ -720,10 +721,20 @@ class Simulation(Driven):
         self._stop_hit = np.zeros(3)
         if not mask:
             return None
-        if not self.integrator.stop_conditions:
+        checked = self.integrator.stop_conditions
+        if not checked:
             what = "collisions" if collisions is not None else "stopping conditions"
             raise IntegratorOptionError(f"integrator {self.integrator.name!r} does not check "
                                         f"{what}; use 'ias15' or another method that does")
+        if checked is not True:
+            given = {"encounter_distance": distance, "encounter_hill": hill,
+                     "escape_distance": escape, "escape_unbound": unbound or None,
+                     "collisions": collisions, "encounter_log": log}
+            refused = [k for k, value in given.items() if value is not None and k not in checked]
+            if refused:
+                raise IntegratorOptionError(
+                    f"integrator {self.integrator.name!r} checks only {', '.join(checked)}, "
+                    f"not {', '.join(refused)}; use 'ias15' or another method that does")
         central = int(np.argmax(self._m))
         return (mask, d2, k, esc2, self._gm, central, self._stop_info, self._r,
                 np.stack([self._x, self._v]), self._stop_clock, np.zeros((4, 3)),

@@ -90,8 +90,11 @@ def test_runs_that_cannot_be_batched_run_alone_and_keep_their_rows():
     df = Ensemble(mixed, params).run(100 * u.yr, client="serial", outputs=5,
                                      progress=False, batch=3)
     assert_same_rows(alone, df)
-    # the unknown kind, and 'wh' with a stopping condition, which it does not check
-    assert df.outcome[df.outcome == "invalid"].index.tolist() == [6, 8]
+    # the unknown kind is invalid; 'wh' with an escape distance runs alone, and
+    # its planet, at 4.4 au beside Jupiter, passes 100 au in step 720 of its
+    # 30-day steps (as a run without the condition shows)
+    assert df.outcome[df.outcome == "invalid"].index.tolist() == [8]
+    assert df.outcome[6] == "escape" and df.steps[6] == 720
 
 
 def test_which_simulations_batch():

@@ -251,13 +251,15 @@ def step_epilogue(force, stop=False):
 def epilogue(record, key, jit=True, cache=True, runtime=False, stop=False, work_note=None,
              tangent_step=None):
     """The step epilogue with monitor recorder ``record``, compiled under ``key``
-    (``runtime``: for loops that need numba's runtime; ``work_note``: what
-    writes the work of non-conservative terms into a monitor row, see
-    :func:`work_kernels`; none by default; ``tangent_step``: the chaos
-    indicators' update after a step, see :mod:`.variational`; none by
-    default)."""
+    (``runtime``: for loops that need numba's runtime; ``stop``: True for the
+    stopping conditions of :mod:`.stopping`, or a check of the same signature
+    that a loop binds instead; ``work_note``: what writes the work of
+    non-conservative terms into a monitor row, see :func:`work_kernels`; none
+    by default; ``tangent_step``: the chaos indicators' update after a step,
+    see :mod:`.variational`; none by default)."""
+    stop_check = stop if callable(stop) else check_stop if stop else no_stop
     return specialize(_step_end, key, jit=jit, inline=True, nrt=runtime, cache=cache,
-                      _record=record, stop_check=check_stop if stop else no_stop,
+                      _record=record, stop_check=stop_check,
                       work_note=_no_work_note if work_note is None else work_note,
                       tangent_step=_no_tangent_step if tangent_step is None else tangent_step)
 

@@ -97,8 +97,8 @@ from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democrat
                           to_jacobi)
 from .kepler import advance_tangent_by_anomaly, kepler_drift_tangent, short_step_anomaly
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
-                            _synchronize, _wh_loop, heliocentric_interaction_kick,
-                            interaction_kick, jump)
+                            _synchronize, _wh_loop, escape_kernels,
+                            heliocentric_interaction_kick, interaction_kick, jump)
 
 __all__ = ["drift_tangent", "interaction_kick_and_tangent",
            "jump_tangent",
@@ -723,6 +723,13 @@ def _tangent_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
     _record(x, v, t, mon_args, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
 
 
+def _tangent_bodies(xj, vj, sync):
+    # the bodies alone synchronised into x, v (for the escape check)
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
+    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+                _carrying(targs, 0))
+
+
 def _chaos_step(xj, vj, t, sync):
     # after every step: the chaos accumulators advanced with tangent vector 0
     # in inertial coordinates at the step's internal point (before the
@@ -802,14 +809,16 @@ def tangent_synchronizer(coordinates, terms, force):
     return _kernels(coordinates, terms, _key(coordinates, force), force.cache)[3]
 
 
-def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
+def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force, escape=False):
     """The Wisdom-Holman loop of :func:`orbits._kernels.wisdom_holman.wh_loop`
     compiled with the tangent of every operator, for a force with variations
     ``force`` (its ``inner`` the gravity, with ``terms``); with the chaos
-    indicators after every step if ``force.chaos``.  Called with
-    ``targs = (terms' args, tp)`` (see the module notes), ``gm`` and ``eta`` of
-    the bodies alone (``n`` entries) and the state arrays of ``n (1 + K)``
-    rows."""
+    indicators after every step if ``force.chaos``, and with the escape check
+    of :func:`~orbits._kernels.wisdom_holman.escape_kernels` on the bodies if
+    ``escape``.  Called with ``targs = (terms' args, tp)`` (see the module
+    notes), ``gm`` and ``eta`` of the bodies alone (``n`` entries), the state
+    arrays of ``n (1 + K)`` rows and the stopping arguments (``()`` without
+    ``escape``)."""
     from .stepping import epilogue, work_kernels
     from .variational import chaos_update, renormalise
     key = _key(coordinates, force)
@@ -826,9 +835,16 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
                           renormalise=renormalise)
     note = specialize(_chaos_note, key, cache=cache, inline=True, nrt=nrt,
                       note=work_kernels(force)["work_note"])
+    stop, stopping = False, {}
+    if escape:
+        key = f"{key}_escape"
+        bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,
+                            synchronize=sync)
+        stopping["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
                       drift=_drift, perturbation=perturbation, apply_corrector=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache,
-                                        work_note=note, tangent_step=step))
+                                        work_note=note, tangent_step=step, stop=stop),
+                      **stopping)

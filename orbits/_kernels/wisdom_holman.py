@@ -106,6 +106,7 @@ from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
+from .stopping import check_stop
 from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, resident_drift_twice,
                        resident_finite, resident_jump_kick, resident_kick, resident_load,
                        resident_store)
@@ -113,7 +114,8 @@ from .wh_lanes import resident_drift as resident_drift_rows
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
-           "synchronize", "apply_corrector", "COORDINATE_SYSTEMS"]
+           "synchronize", "apply_corrector", "may_escape", "escape_kernels",
+           "COORDINATE_SYSTEMS", "ESCAPE_MARGIN"]
 
 
 @njit(inline="always")
@@ -460,9 +462,11 @@ def _lanes_note(xj, vj, t, mon, n_mon, mon_t, mon_out):
 
 
 def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
-             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs):
+             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs, sargs):
     # xj, vj: the internal (Jacobi or democratic heliocentric) state;
-    # eta: G times the mass each row's Kepler drift orbits.
+    # eta: G times the mass each row's Kepler drift orbits; sargs: the
+    # stopping arguments of a loop compiled with the escape check (see
+    # escape_kernels), () for the others.
     # state[0]: xj, vj hold the current state (else start from x, v);
     # owed_box[0]: the drift the internal state still owes, deferred from the
     # last step's closing drift; cdt[0]: the step the mapping state's
@@ -527,7 +531,8 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         if finite:
             status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
                 xj, vj, t + (k + 1) * dt, k, nsteps, not RESIDENT, until_check, check_every,
-                until_record, every, (mon, sync), n_mon, mon_t, mon_out, (), sync)
+                until_record, every, (mon, sync), n_mon, mon_t, mon_out,
+                stop_args(sargs, sync), sync)
         else:
             status, done = Status.NON_FINITE, k
         if status != GO:
@@ -544,6 +549,99 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                     corr, cdt[0], targs)
     owed_box[0] = owed
     return Status.OK, nsteps, n_mon
+
+
+@njit(inline="always")
+def stop_args(sargs, sync):
+    # what the epilogue's stopping check takes: nothing in a loop without one
+    return ()
+
+
+#: Relative margin of :func:`may_escape`'s bound, for the rounding of the
+#: Kepler drift and of the transformation to inertial coordinates (some
+#: 1e-15 of the distances).
+ESCAPE_MARGIN = 1e-8
+
+
+@njit(inline="always")
+def may_escape(xj, vj, gm, eta, owed, corr, esc2):
+    """Whether a body may be farther than ``sqrt(esc2)`` from the centre of
+    mass in the inertial state that :func:`synchronize` makes of the internal
+    state ``xj``, ``vj`` (which owes the drift ``owed``); False only where none
+    can be.
+
+    Each internal row ``i >= 1`` drifts on its Kepler orbit about ``eta[i]``,
+    so after any drift it lies within twice the orbit's semi-major axis,
+    ``2 a = -eta_i / E_i >= a (1 + e)`` with ``E_i`` its Kepler energy per unit
+    mass, of its origin (within its distance now, with nothing owed); the
+    apocentre itself would cost a cross product, a square root and a
+    division more a row, for a bound at most twice as tight.  The inertial
+    position relative to the centre of mass is that row's vector less a
+    mass-weighted sum of the others: ``x_i - X = (1 - w_i) x'_i - sum_{k>i}
+    w_k x'_k`` with ``w_k = m_k / eta_k`` in Jacobi coordinates, ``Q_i -
+    sum_k (m_k / M) Q_k`` in democratic heliocentric ones.  Both weights are
+    at most ``m_k / m_0``, so every body is within ``R + sum_k (m_k / m_0)
+    R_k`` of the centre of mass, ``R`` the largest of the bounds ``R_k``.  A
+    row on an unbounded orbit while a drift is owed, a corrector (which moves
+    the state by an amount not bounded here) or a non-finite state answers
+    True.
+    """
+    if corr.shape[0] > 0:
+        return True
+    n = min(xj.shape[0], gm.shape[0])
+    far = 0.0
+    pull = 0.0
+    for i in range(1, n):
+        rx, ry, rz = xj[i, 0], xj[i, 1], xj[i, 2]
+        ux, uy, uz = vj[i, 0], vj[i, 1], vj[i, 2]
+        r = math.sqrt(rx * rx + ry * ry + rz * rz)
+        if owed == 0.0:
+            bound = r
+        else:
+            energy = 0.5 * (ux * ux + uy * uy + uz * uz) - eta[i] / r
+            if not energy < 0.0:
+                return True
+            bound = -eta[i] / energy
+        if bound > far:
+            far = bound
+        pull += gm[i] / gm[0] * bound
+    reach = (far + pull) * (1.0 + ESCAPE_MARGIN)
+    return not reach * reach <= esc2
+
+
+def _escape_args(sargs, sync):
+    return (sargs, sync)
+
+
+def _escape_check(xj, vj, t, args):
+    # the escape conditions of orbits._kernels.stopping (ESCAPE, UNBOUND) on
+    # the inertial state at the end of the step, which is synchronised into
+    # x, v (as for an output) only where a body may be beyond the distance
+    sargs, sync = args
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
+    if not may_escape(xj, vj, gm, eta, owed, corr, sargs[3]):
+        return 0
+    synchronize_bodies(xj, vj, sync)  # noqa: F821 - bound by specialize
+    return check_stop(x, v, t, sargs)
+
+
+def _synchronize_bodies(xj, vj, sync):
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
+    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+                targs)
+
+
+def escape_kernels(key, synchronize_bodies, cache=True, nrt=False):
+    """The bindings of :func:`_wh_loop` and of its step epilogue's stopping
+    check for a loop that checks escapes (``escape_distance``, and
+    ``escape_unbound``, of :class:`orbits.Simulation`), compiled under
+    ``key``: ``(stop_args, check)``.  ``synchronize_bodies(xj, vj, sync)``
+    writes the bodies' inertial state into ``x``, ``v`` of ``sync`` (the
+    synchronisation's arguments, as the loop hands them to its epilogue)."""
+    check = specialize(_escape_check, key, cache=cache, nrt=nrt,
+                       synchronize_bodies=synchronize_bodies)
+    args = specialize(_escape_args, key, cache=cache, inline=True, nrt=nrt)
+    return args, check
 
 
 def _wh_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
@@ -729,7 +827,7 @@ def synchronizer(coordinates, terms=None, lanes=False):
 
 
 def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record,
-            lanes=False):
+            lanes=False, escape=False):
     """The Wisdom-Holman loop compiled for one table of Kepler drifts (DRIFT) and
     perturbation steps (KICK) in ``coordinates`` (a key of
     :data:`COORDINATE_SYSTEMS`); ``name`` names the table.  ``terms`` (a
@@ -739,9 +837,14 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     lanes (:mod:`orbits._kernels.wh_lanes`), bit for bit the same results;
     the loop's ``targs`` are then ``(wh_lanes.lanes_scratch(N),)``.  The
     corrector and the synchronisation stay scalar (they run once a call or
-    an output)."""
+    an output).  ``escape`` (not with ``lanes``): the loop checks the escape
+    conditions of :mod:`orbits._kernels.stopping` after every step on the
+    synchronised state (:func:`escape_kernels`) and takes their ``sargs``
+    (a loop without takes ``()``)."""
     if lanes and terms is not None:
         raise ValueError("wh_loop: the lanes' loop takes no added terms")
+    if lanes and escape:
+        raise ValueError("wh_loop: the lanes' loop checks no escapes")
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, lanes)
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
@@ -770,11 +873,18 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     else:
         recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, synchronize=sync,
                               _record=record)
+    stop = False
+    if escape:
+        key = f"{key}_escape"
+        bodies = specialize(_synchronize_bodies, key, cache=cache, inline=True, nrt=nrt,
+                            synchronize=sync)
+        outputs["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
                       drift=drift, perturbation=perturbation, apply_corrector=corrector,
-                      step_end=epilogue(recorder, f"wh_{key}", cache=cache), **outputs)
+                      step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
+                      **outputs)
 
 
 #: the Jacobi versions, compiled on first use

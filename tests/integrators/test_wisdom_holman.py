@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import orbits
-from orbits.errors import IntegratorOptionError
+from orbits.errors import Escape, IntegratorOptionError
 from orbits.integrators.wisdom_holman import NoDominantBodyWarning
 
 from helpers import kepler_bodies
@@ -512,3 +512,135 @@ def test_democratic_heliocentric_run_continued_from_a_file_is_bit_identical(tmp_
     assert again.integrator.config == {"coordinates": DH, "corrector": 5}
     again.run(until=20_000 * u.day, outputs=5, output=path, progress=False)
     assert np.array_equal(again._x, ref._x) and np.array_equal(again._v, ref._v)
+
+
+# -- escapes ------------------------------------------------------------------------------
+
+def launched(e=1.5):
+    """The Sun, Jupiter, Saturn and a massless comet of eccentricity ``e``: for
+    e = 1.5 a hyperbola (a = -20 au, pericentre 10 au) leaving past 50 au in
+    step 837 of 10 days; for e = 0.9 a bound orbit (a = 30 au) that reaches
+    53 au from the centre of mass at 75 years."""
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    b.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.048)
+    b.add("Saturn", mass=0.2994 * u.Mjup, primary="Sun", a=9.58 * u.au, e=0.056, f=2 * u.rad)
+    b.add("comet", mass=0 * u.kg, primary="Sun", a=(-20 if e > 1 else 30) * u.au, e=e,
+          f=0.3 * u.rad)
+    b.move_to_com()
+    return b
+
+
+def test_wh_stops_at_an_escape_in_the_step_leapfrog_does():
+    stopped = {}
+    for name in ("leapfrog", "wh"):
+        sim = orbits.Simulation(launched(), name, dt=10 * u.day, escape_distance=50 * u.au)
+        with pytest.raises(Escape) as info:
+            sim.run(until=1000 * u.yr, outputs=2, progress=False)
+        stopped[name] = (sim, info.value)
+    (lf, lf_exc), (wh, wh_exc) = stopped["leapfrog"], stopped["wh"]
+    # the comet is 49.98327 au from the centre of mass after step 836 and
+    # 50.03171 au after step 837, in both methods, whose distances differ by
+    # 1.4e-6 au there (measured): the same step, by a margin of 0.017 au
+    assert wh_exc.bodies == lf_exc.bodies == ("comet",)
+    assert wh_exc.step == lf_exc.step == wh.steps == 837
+    assert wh_exc.time == wh.time == lf.time
+    # the simulation is left at the synchronised state of that step, the
+    # result ends there, and the check changed no step: bit for bit the
+    # state of a run without it (whose four bodies drift in the vector lanes)
+    x = wh.bodies.positions.to_value(u.au)
+    m = wh.bodies.masses.value
+    assert np.linalg.norm(x[3] - m @ x / m.sum()) > 50
+    np.testing.assert_array_equal(wh_exc.result.positions[-1].value, wh.bodies.positions.value)
+    ref = orbits.Simulation(launched(), "wh", dt=10 * u.day)
+    ref.run(until=wh.time, outputs=2, progress=False)
+    np.testing.assert_array_equal(wh.bodies.positions.value, ref.bodies.positions.value)
+    np.testing.assert_array_equal(wh.bodies.velocities.value, ref.bodies.velocities.value)
+
+
+def test_wh_escape_unbound_passes_over_a_bound_body():
+    bound = launched(0.9)
+    with pytest.raises(Escape, match="comet"):
+        orbits.Simulation(bound, "wh", dt=10 * u.day, escape_distance=50 * u.au).run(
+            until=200 * u.yr, outputs=2, progress=False)
+    r = orbits.Simulation(bound, "wh", dt=10 * u.day, escape_distance=50 * u.au,
+                          escape_unbound=True).run(until=200 * u.yr, outputs=2, progress=False)
+    assert r.status == "completed"
+
+
+@pytest.mark.parametrize("given, refused", [
+    (dict(encounter_distance=0.1 * u.au), "encounter_distance"),
+    (dict(escape_distance=50 * u.au, encounter_hill=3.0), "encounter_hill")])
+def test_wh_refuses_the_conditions_it_does_not_check_by_name(given, refused):
+    b = launched()
+    with pytest.raises(IntegratorOptionError,
+                       match=f"'wh' checks only escape_distance, escape_unbound, not {refused}"):
+        orbits.Simulation(b, "wh", dt=10 * u.day, **given)
+
+
+def _random_system(rng, n):
+    # a star and n - 1 bodies (some massless) at 0.5 to 20 from it, at 0.3 to
+    # 1.6 times the circular speed (G M = 1; 1.41 escapes): mostly bound
+    gm = np.concatenate([[1.0], rng.uniform(0.0, 1e-2, n - 1) * (rng.random(n - 1) < 0.7)])
+    r = rng.uniform(0.5, 20.0, (n, 1))
+    x = rng.normal(size=(n, 3))
+    x *= r / np.linalg.norm(x, axis=1, keepdims=True)
+    t = np.cross(x, rng.normal(size=(n, 3)))
+    v = t / np.linalg.norm(t, axis=1, keepdims=True) * rng.uniform(0.3, 1.6, (n, 1)) / np.sqrt(r)
+    x[0] = v[0] = 0.0
+    return gm, x, v
+
+
+@pytest.mark.parametrize("coordinates", ["jacobi", DH])
+def test_the_escape_filter_never_passes_over_a_body_beyond_the_distance(coordinates):
+    # may_escape lets a step go unsynchronised only where no body can be
+    # beyond the distance: against the synchronised state itself, for
+    # distances a hair inside the farthest body's
+    from orbits._kernels import coordinates as kc
+    from orbits._kernels import wisdom_holman as kwh
+    sync = kwh.synchronizer(coordinates)
+    no_corrector = np.zeros((0, 2))
+    rng = np.random.default_rng(36)
+    passed = 0
+    for trial in range(200):
+        n = 5
+        gm, x, v = _random_system(rng, n)
+        xj, vj = np.empty((n, 3)), np.empty((n, 3))
+        eta = np.empty(n)
+        if coordinates == "jacobi":
+            kc.interior_gm(gm, eta)
+            kc.to_jacobi(x, v, gm, eta, xj, vj)
+        else:
+            eta[:] = gm[0]
+            kc.to_democratic_heliocentric(x, v, gm, xj, vj)
+        # nothing owed (the bound is then the rows' distances, and the centre
+        # of mass's offset is what the other bodies' pull adds), or a drift
+        owed = 0.0 if trial % 3 == 0 else float(rng.uniform(-30.0, 30.0))
+        xs, vs, xo, vo, acc = (np.empty((n, 3)) for _ in range(5))
+        sync(xj, vj, gm, eta, owed, xs, vs, xo, vo, acc, n, no_corrector, 0.0, ())
+        far = np.linalg.norm(xo - gm @ xo / gm.sum(), axis=1).max()
+        assert kwh.may_escape(xj, vj, gm, eta, owed, no_corrector, (far * (1 - 1e-12)) ** 2)
+        passed += not kwh.may_escape(xj, vj, gm, eta, owed, no_corrector, (1e3 * far) ** 2)
+    # and where every orbit is bound and far inside the distance it lets
+    # steps go (its bound is twice the semi-major axes): all four bound in
+    # about half the systems here
+    assert passed > 60
+    # a corrector moves the state by an amount it does not bound: always looked at
+    assert kwh.may_escape(xj, vj, gm, eta, 0.0, np.ones((1, 2)), 1e300)
+
+
+def test_a_chaos_map_of_wh_runs_has_escapes_as_outcomes():
+    # the ensemble path of a MEGNO map (its runs carry a tangent vector: the
+    # tangent loop, compiled with the escape check)
+    pytest.importorskip("pandas")
+    from orbits.ensemble import Ensemble
+    df = Ensemble(_megno_member, [{"e": 1.5}, {"e": 0.9}]).run(
+        40 * u.yr, client="serial", outputs=2, progress=False)
+    assert df.outcome.tolist() == ["escape", "completed"]
+    assert df.stop_bodies[0] == "comet" and df.steps.tolist() == [837, 1461]
+    assert np.isfinite(df.megno).all()
+
+
+def _megno_member(e):
+    return orbits.Simulation(launched(e), "wh", dt=10 * u.day, escape_distance=50 * u.au,
+                             monitors=("energy", "megno"), seed=1)
