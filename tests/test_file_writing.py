@@ -278,3 +278,26 @@ def test_results_carry_their_unit_system_and_files_give_it_back(tmp_path):
                                            names=r.names, units=r.units)
         assert again.units.G == 2.95912208286e-4
     assert "units           HLW, G = 0.000295912208286" in back.summary()
+
+
+def test_a_lock_that_is_not_a_file_is_not_read_through(tmp_path, capsys):
+    # run.h5.lock made beforehand as a link to a named pipe: reading it blocked
+    # for ever (open waits for a writer).  A lock orbits makes is a regular
+    # file, so this one is not a writer's and is taken over.
+    import signal
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    (tmp_path / "run.h5.lock").symlink_to(pipe)
+
+    def hung(signum, frame):
+        raise Crash("reading the lock blocked")     # not an OSError, which the reader catches
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(60)        # the run takes a few seconds
+    try:
+        code = cli.main([*RUN, "--until", "10d", "--outputs", "3",
+                         "--out", str(tmp_path / "run.h5")])
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    assert code == 0, capsys.readouterr().err
+    assert pipe.exists() and not os.path.lexists(tmp_path / "run.h5.lock")

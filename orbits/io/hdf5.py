@@ -159,6 +159,7 @@ import os
 import pathlib
 import re
 import socket
+import stat
 import struct
 import time as _time
 import uuid
@@ -1090,14 +1091,31 @@ def _process_start(pid):
     return fields[0], int(fields[19])           # stat(5) fields 3 and 22
 
 
+#: the most bytes of a writers' lock read (one holds about 150)
+_LOCK_BYTES = 4096
+
+
 def _read_lock(lock):
-    """The lock's record; None if there is no lock, {} if it cannot be read."""
+    """The lock's record; None if there is no lock, {} if it cannot be read.
+
+    Read without following a link, and only from a regular file, the kind a
+    writer makes (a link to a named pipe would block the read for ever).
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
     try:
-        text = lock.read_text()
+        fd = os.open(lock, flags)
     except FileNotFoundError:
         return None
     except OSError:
         return {}
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return {}
+        text = os.read(fd, _LOCK_BYTES).decode("utf-8", "replace")
+    except OSError:
+        return {}
+    finally:
+        os.close(fd)
     try:
         rec = json.loads(text)
     except ValueError:
@@ -1118,9 +1136,9 @@ def _alive(rec):
         return False
     except PermissionError:
         pass
-    stat = _process_start(pid)
-    if stat is not None:
-        state, start = stat
+    found = _process_start(pid)
+    if found is not None:
+        state, start = found
         if state in ("Z", "X"):                 # exited, not yet reaped
             return False
         if rec.get("start") is not None and rec["start"] != start:
@@ -1144,10 +1162,10 @@ def _acquire(path):
     key = str(lock)
     if key in _HELD and (_read_lock(lock) or {}).get("token") == _HELD[key]:
         return
-    stat = _process_start(os.getpid())
+    started = _process_start(os.getpid())
     token = uuid.uuid4().hex
     me = {"host": socket.gethostname(), "pid": os.getpid(),
-          "start": stat[1] if stat else None, "token": token,
+          "start": started[1] if started else None, "token": token,
           "since": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
     tmp = lock.with_name(f"{lock.name}.{token}")
     made = False
@@ -1170,10 +1188,13 @@ def _acquire(path):
             alive = _alive(rec) if rec else None
             if not rec:
                 try:
-                    age = _time.time() - lock.stat().st_mtime
+                    info = lock.lstat()
                 except FileNotFoundError:
                     continue
-                if age > _LOCK_UNREADABLE_SECONDS:
+                # a writer's lock is a regular file: anything else there (a
+                # link, a pipe) is not one, and is taken over at once
+                if not stat.S_ISREG(info.st_mode) or \
+                        _time.time() - info.st_mtime > _LOCK_UNREADABLE_SECONDS:
                     alive = False
             if alive is False:
                 _remove_stale(lock, rec)
