@@ -1466,6 +1466,15 @@ class FileRecorder:
     output and in-loop row it passes on, so that :meth:`result`, which holds
     only the last output, still reports them for the whole run.
 
+    A destination that is a symbolic link is refused unless ``overwrite``
+    (which replaces the link).  Appending to a file whose last output is the
+    simulation's present state (a run continued into its file), it does not
+    write that output again.  Before each write it reserves the space the
+    write may take (see the module's notes); where the disk has none, or a
+    write fails, it raises an :class:`OrbitsFileError` (whose message says
+    the disk is full where it is, and what the file holds), writes nothing
+    more, and its :meth:`close` only closes the file.
+
     Examples
     --------
     >>> import os, tempfile
