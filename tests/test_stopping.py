@@ -147,7 +147,7 @@ def test_the_collision_filter_never_passes_over_a_contact():
     # grazing flybys to a planet about its star, steps from a small to a
     # large part of the orbit.
     from orbits._kernels.kepler import kepler_drift
-    from orbits._kernels.stopping import _within_reach
+    from orbits._kernels.stopping import _may_reach, _within_reach
     rng = np.random.default_rng(7)
     examined = 0
     for _ in range(300):
@@ -166,6 +166,8 @@ def test_the_collision_filter_never_passes_over_a_contact():
         r = dist.min() * rng.uniform(1.0001, 1.5)
         work = np.array([x0, v0, xs[-1], vs[-1]])
         assert _within_reach(work, mu, h, r)
+        # the first bound, from the end of the step alone
+        assert _may_reach(xs[-1] @ xs[-1], vs[-1] @ vs[-1], mu, h, r * r)
         examined += 1
     assert examined == 300
 

@@ -104,6 +104,21 @@ def _pericentre(work, row, mu):
 
 
 @njit(inline="always")
+def _may_reach(d2, s2, mu, h, r2):
+    # whether a pair sqrt(d2) apart at the end of the step h, at relative
+    # speed sqrt(s2) there, may have come within sqrt(r2) during it, from the
+    # end alone (no square root, no division: a few multiplications a pair
+    # before the look with both ends, _within_reach): going back from the end,
+    # while at least D apart its separation grows by at most
+    # s |h| + mu h^2 / (2 D^2) (the speed at the end, their mutual pull; twice
+    # that allowed for the other bodies' tides).  With D = d / 2 (d above
+    # twice the threshold) that stays below d / 2 when d > 8 s |h| and
+    # d^3 > 16 mu h^2, and the pair stayed beyond D.
+    hh = h * h
+    return not (d2 > 4.0 * r2 and d2 > 64.0 * s2 * hh and d2 * d2 * d2 > 256.0 * mu * mu * hh * hh)
+
+
+@njit
 def _within_reach(work, mu, h, r):
     # whether the pair of _pair_ends could have come within r during the step
     # h: while at least D apart its separation falls by at most
@@ -164,8 +179,10 @@ def _pair_contact(x, v, t, sargs, i, j, inside, h):
         return True, t, math.sqrt(d1), math.sqrt(ux * ux + uy * uy + uz * uz)
     if not inside:
         return False, 0.0, 0.0, 0.0
-    _pair_ends(x, v, prev, work, i, j)
     mu = gm[i] + gm[j]
+    if not _may_reach(d1, ux * ux + uy * uy + uz * uz, mu, h, rs2):
+        return False, 0.0, 0.0, 0.0
+    _pair_ends(x, v, prev, work, i, j)
     if not _within_reach(work, mu, h, rs):
         return False, 0.0, 0.0, 0.0
     tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
@@ -188,7 +205,9 @@ def collision_check(x, v, t, sargs):
     with the relative speeds ``s0``, ``s1`` at the ends, a pair's separation
     can fall by at most ``max(s0, s1) |h| + mu h^2 / (2 R^2)`` (its mutual
     pull while at least ``R`` apart; the tides of the other bodies are left
-    out), and twice that is allowed for.  A pair that was already in contact
+    out), and twice that is allowed for; the same bound from the end of the
+    step alone, at half the pair's separation there, passes over most pairs
+    first with a few multiplications.  A pair that was already in contact
     at the previous check (bodies that bounced and have not yet separated)
     counts again only if it overlaps at the end and is still closing."""
     clock, hit, info = sargs[9], sargs[11], sargs[6]
@@ -294,12 +313,22 @@ def encounter_log(x, v, t, sargs):
                 rj = math.sqrt((x[j, 0] - x[central, 0]) ** 2 + (x[j, 1] - x[central, 1]) ** 2
                                + (x[j, 2] - x[central, 2]) ** 2)
                 thr = k_hill * (mu * third_gmc) ** (1.0 / 3.0) * 0.5 * (ri + rj)
+            dx = x[i, 0] - x[j, 0]
+            dy = x[i, 1] - x[j, 1]
+            dz = x[i, 2] - x[j, 2]
+            ux = v[i, 0] - v[j, 0]
+            uy = v[i, 1] - v[j, 1]
+            uz = v[i, 2] - v[j, 2]
+            if dx * ux + dy * uy + dz * uz < 0.0:
+                continue    # still closing at the end: no minimum inside the step
+            mu = gm[i] + gm[j]
+            if not _may_reach(dx * dx + dy * dy + dz * dz, ux * ux + uy * uy + uz * uz, mu, h,
+                              thr * thr):
+                continue
             _pair_ends(x, v, prev, work, i, j)
             closing0 = work[0, 0] * work[1, 0] + work[0, 1] * work[1, 1] + work[0, 2] * work[1, 2]
-            closing1 = work[2, 0] * work[3, 0] + work[2, 1] * work[3, 1] + work[2, 2] * work[3, 2]
-            if not (closing0 < 0.0 and closing1 >= 0.0):
+            if not closing0 < 0.0:
                 continue
-            mu = gm[i] + gm[j]
             if not _within_reach(work, mu, h, thr):
                 continue
             tm, dm, sm = closest_approach(mu, work[0], work[1], work[2], work[3], h)
@@ -339,41 +368,51 @@ def encounter_check(x, v, t, sargs):
     and its time, separation and speed into ``hit``; returns True if there
     was one.
 
-    The look inside the step costs a few multiplications a pair: a pair
-    ``d`` apart at the end with ``d`` above twice its threshold ``r``,
-    above ``16 v_max |h|`` (``v_max`` the fastest body's speed at either end,
-    so that ``2 v_max`` bounds the pair's relative speed there) and above
-    ``(16 mu h^2)^(1/3)`` cannot have come within ``r`` by the bound of
-    :func:`collision_check` taken at ``D = d / 2`` (its separation can have
-    fallen by at most ``2 (2 v_max |h| + mu h^2 / (2 D^2)) < d / 2``), and
-    is passed over, compared squared; the others get that bound with both
-    ends and then the closest approach.  A pair that was inside its
-    threshold at the previous check already counts only if it is at the end
-    (an encounter under way when the run started or went on)."""
-    mask, d2, hill_k, gm, central = sargs[0], sargs[1], sargs[2], sargs[4], sargs[5]
+    The look inside the step costs a few multiplications a pair: from the
+    pair's separation ``d`` and relative speed ``s`` at the end, one that
+    cannot have come within its threshold ``r`` (``d > 2 r``, ``d > 8 s |h|``
+    and ``d^3 > 16 mu h^2``: the bound of :func:`collision_check` taken from
+    the end at half the separation) is passed over, first with twice the
+    fastest body's speed for ``s`` (without the pair's velocities); the
+    others get that bound with both ends and then the closest approach.  A pair that was
+    inside its threshold at the previous check already counts only if it is
+    at the end (an encounter under way when the run started or went on)."""
+    mask, hill_k, gm, central = sargs[0], sargs[2], sargs[4], sargs[5]
     info, prev, clock, work, hit = sargs[6], sargs[8], sargs[9], sargs[10], sargs[11]
     n = min(x.shape[0], gm.shape[0])
     h = t - clock[0]
     inside = clock[1] != 0.0 and h != 0.0
-    by_distance = (mask & ENCOUNTER_DISTANCE) != 0
+    d2 = sargs[1] if mask & ENCOUNTER_DISTANCE else 0.0
     by_hill = (mask & ENCOUNTER_HILL) != 0
     third_gmc = 1.0 / (3.0 * gm[central]) if by_hill else 0.0
-    fast2 = 0.0
+    # the bound of _may_reach for every pair at once, with twice the fastest
+    # body's speed at the end for the pair's and the two largest G m for its
+    # mu: most pairs are passed over by one comparison
+    reach2 = 0.0
     if inside:
         vmax2 = 0.0
+        g1 = g2 = 0.0
         for i in range(n):
-            vmax2 = max(vmax2, v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2,
-                        prev[1, i, 0] ** 2 + prev[1, i, 1] ** 2 + prev[1, i, 2] ** 2)
-        fast2 = 256.0 * vmax2 * h * h
-    pull2 = 256.0 * h * h * h * h
+            vmax2 = max(vmax2, v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2])
+            if gm[i] > g1:
+                g2 = g1
+                g1 = gm[i]
+            elif gm[i] > g2:
+                g2 = gm[i]
+        hh = h * h
+        reach2 = max(256.0 * vmax2 * hh, (256.0 * (g1 + g2) ** 2 * hh * hh) ** (1.0 / 3.0))
+    # beyond far2 a pair is neither inside the distance at the end nor can
+    # have been inside it (by distance alone: sargs[1] is 0 without it)
+    far2 = max(4.0 * d2, reach2) if inside else d2
     for i in range(1, n):
         for j in range(i):
             dx = x[i, 0] - x[j, 0]
             dy = x[i, 1] - x[j, 1]
             dz = x[i, 2] - x[j, 2]
             r2 = dx * dx + dy * dy + dz * dz
+            thr2 = d2
+            lim2 = far2
             mu = gm[i] + gm[j]
-            thr2 = d2 if by_distance else 0.0
             if by_hill and i != central and j != central and mu > 0.0:
                 ri = math.sqrt((x[i, 0] - x[central, 0]) ** 2 + (x[i, 1] - x[central, 1]) ** 2
                                + (x[i, 2] - x[central, 2]) ** 2)
@@ -381,15 +420,17 @@ def encounter_check(x, v, t, sargs):
                                + (x[j, 2] - x[central, 2]) ** 2)
                 rh = hill_k * (mu * third_gmc) ** (1.0 / 3.0) * 0.5 * (ri + rj)
                 thr2 = max(thr2, rh * rh)
-            if r2 < thr2:
-                ux = v[i, 0] - v[j, 0]
-                uy = v[i, 1] - v[j, 1]
-                uz = v[i, 2] - v[j, 2]
-                _note(info, hit, j, i, t, math.sqrt(r2), math.sqrt(ux * ux + uy * uy + uz * uz))
-                return True
-            if not inside or not (thr2 > 0.0):
+                lim2 = max(4.0 * thr2, reach2) if inside else thr2
+            if r2 > lim2 or (r2 == lim2 and not inside) or not (thr2 > 0.0):
                 continue
-            if r2 > 4.0 * thr2 and r2 > fast2 and r2 * r2 * r2 > pull2 * mu * mu:
+            ux = v[i, 0] - v[j, 0]
+            uy = v[i, 1] - v[j, 1]
+            uz = v[i, 2] - v[j, 2]
+            s2 = ux * ux + uy * uy + uz * uz
+            if r2 < thr2:
+                _note(info, hit, j, i, t, math.sqrt(r2), math.sqrt(s2))
+                return True
+            if not _may_reach(r2, s2, mu, h, thr2):
                 continue
             _pair_ends(x, v, prev, work, i, j)
             if work[0, 0] ** 2 + work[0, 1] ** 2 + work[0, 2] ** 2 < thr2:
