@@ -1883,7 +1883,7 @@ class _Recorder:
             names=list(self.names0),
             steps=sim.steps - self.steps0,
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
-            integrator=sim.integrator.info(), units=U.to_dict(), status=status,
+            integrator=sim.integrator.info(), units=U, status=status,
             monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
             forces=tuple(map(repr, sim.forces)))
         if sim._n_tangent:
