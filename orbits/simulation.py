@@ -1672,10 +1672,18 @@ class Simulation(Driven):
             bodies = (name(i), name(j))
             q = self.units.quantity
             tc, dist, speed = (float(a) for a in self._stop_hit)
-            raise Collision(f"{bodies[0]!r} and {bodies[1]!r} collided (closest at "
-                            f"t = {tc:.10g}, separation {dist:.6g} {self.units.length}) in the "
-                            f"step ending at t = {t:.10g} (step {self.steps}); the result up "
-                            f"to here is kept on .result", time=t, step=self.steps,
+            # after the state kept: a step the integrator could not finish (beyond
+            # the rounding of a contact at a step's end)
+            now = self._now()
+            inside = tc <= now + 1e-9 * abs(self._dt) + 1e-15 * abs(now)
+            where = (f"in the step ending at t = {t:.10g} (step {self.steps})" if inside else
+                     f"in a step the integrator could not finish; the run stopped at "
+                     f"t = {t:.10g} (step {self.steps}), the last state it reached whole")
+            raise Collision(f"{bodies[0]!r} and {bodies[1]!r} collided "
+                            f"({'closest' if inside else 'touching'} at t = {tc:.10g}, "
+                            f"separation {dist:.6g} {self.units.length}) "
+                            f"{where}; the result up to here is kept on .result",
+                            time=t, step=self.steps,
                             result=result, bodies=bodies, contact_time=q(tc, "time"),
                             distance=q(dist, "length"),
                             speed=q(speed, "length") / self.units.time)
