@@ -322,6 +322,8 @@ CRAFTED = [
      "the configuration in /parameters lacks 'integrator_options'"),
     ("dt", lambda f: f["parameters"].attrs.__setitem__("dt", "1 day"),
      "the 'dt' attribute of /parameters is '1 day'"),
+    ("mixed-plain-units", lambda f: set_json(f, "units", lambda us: dict(us, mass="")),
+     "plain numbers for some of length, mass and time but not all"),
     ("version", lambda f: f.attrs.__setitem__("orbits_format_version", "1"),
      "layout version '1'"),
     ("body-axes", lambda f: f["restart/ws/acc"].attrs.__setitem__("body_axes", [7]),
@@ -363,3 +365,16 @@ def test_the_finished_run_reads_as_before(finished):
     assert "status          completed" in orbits.io.describe(finished)
     with h5py.File(finished, "r") as f:
         assert hdf5._inventory(f, finished).groups >= {"restart/ws", "parameters"}
+
+
+def test_a_run_in_n_body_units_reads_back(tmp_path):
+    # N-body units write plain numbers (an empty unit) for every kind of
+    # quantity; the unit checks above accept them
+    b = orbits.BodySet.from_arrays([1.0, 1e-3], [[0, 0, 0], [1, 0, 0]],
+                                   [[0, 0, 0], [0, 1, 0]], units=orbits.UnitSystem.nbody())
+    path = tmp_path / "nbody.h5"
+    orbits.Simulation(b, "leapfrog", dt=0.01).run(until=1.0, outputs=3, output=path,
+                                                  progress=False)
+    assert list(orbits.load(path).times) == [0.0, 0.5, 1.0]
+    assert orbits.Simulation.from_file(path).time == 1.0
+    assert "completed" in orbits.io.describe(path)

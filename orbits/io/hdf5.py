@@ -721,13 +721,16 @@ def _checked(stored, name, path, shape, kind, backed=True):
 @functools.lru_cache(maxsize=256)
 def _parsed_unit(text, like):
     """``(unit, of the kind of like)`` for a unit's name; None if it names none
-    (parsed once: astropy takes about a millisecond for ``"AU / d"``)."""
+    (parsed once: astropy takes about a millisecond for ``"AU / d"``).  The
+    empty name, plain numbers, stands for every kind: N-body units
+    (``UnitSystem.nbody()``) write it for lengths, masses and times alike."""
     import astropy.units as u
     try:
         unit = u.Unit(text)
     except (ValueError, TypeError):
         return None
-    return unit, like is None or unit.is_equivalent(u.Unit(like))
+    return unit, (like is None or unit == u.dimensionless_unscaled
+                  or unit.is_equivalent(u.Unit(like)))
 
 
 #: the physical type that a unit's name in _unit's ``like`` stands for
@@ -797,12 +800,18 @@ def _attr(par, key, path, check, expected):
 def _check_units_record(units, path):
     """Raise an OrbitsFileError where the unit system a file records (a
     UnitSystem.to_dict()) does not have the fields and kinds of units it needs."""
+    plain = []
     for key, like in (("length", "m"), ("mass", "kg"), ("time", "s")):
         text = units.get(key)
         parsed = _parsed_unit(text, like) if isinstance(text, str) else None
         if parsed is None or not parsed[1]:
             raise OrbitsFileError(f"{path}: the unit system in /parameters has {key} "
                                   f"{text!r}; expected a unit of {_KIND_OF[like]}")
+        plain.append(text == "")
+    if any(plain) and not all(plain):
+        raise OrbitsFileError(f"{path}: the unit system in /parameters has plain numbers "
+                              f"for some of length, mass and time but not all: "
+                              f"{[units[k] for k in ('length', 'mass', 'time')]}")
     if not (_is_number(units.get("G")) and units["G"] > 0):
         raise OrbitsFileError(f"{path}: the unit system in /parameters has G = "
                               f"{units.get('G')!r}; expected a number > 0")
