@@ -230,7 +230,8 @@ class Driven:
     status.  :meth:`execute` carries out a plan (a
     :class:`~orbits.records.RunPlan` or anything with its ``marks``,
     ``n_full``, ``has_partial``, ``total_steps``, ``start_step``,
-    ``outputs``, ``output_time`` and ``until``) into a recorder, which takes
+    ``outputs``, ``output_time``, ``output_times`` and ``until``) into a
+    recorder, which takes
     ``output(owner, final)``, ``monitor_rows(t, rows)``, ``checkpoint()``,
     ``stopped(owner)``, ``close()`` and ``result(owner, wall, status)``.
     """
@@ -409,7 +410,7 @@ class Driven:
         integ = self.integrator
         cap = getattr(rec, "max_rows", None) or 65536
         m = min(last - first, cap)
-        marks = np.array([plan.output_time(j) for j in range(first, first + m)])
+        marks = plan.output_times(first, m)
         rows = rec.row_buffer(m)
         mon_t = np.empty(m)
         steps = np.zeros(m, dtype=np.int64)

@@ -66,6 +66,24 @@ class RunPlan(NamedTuple):
             return self.until
         return self.start_time + k * (self.until - self.start_time) / (self.outputs - 1)
 
+    def output_times(self, first, count):
+        """Times of outputs ``first`` to ``first + count - 1`` (an array), each
+        the float :meth:`output_time` gives, computed at once.
+
+        Examples
+        --------
+        >>> from orbits.records import RunPlan
+        >>> plan = RunPlan(until=10.0, outputs=4, ratio=0.0, n_full=0, has_partial=False,
+        ...                start_step=0, start_time=1.0)
+        >>> plan.output_times(1, 3).tolist(), [plan.output_time(k) for k in (1, 2, 3)]
+        ([4.0, 7.0, 10.0], [4.0, 7.0, 10.0])
+        """
+        k = np.arange(first, first + count, dtype=np.float64)
+        # the operations of output_time, in its order, on every k
+        times = self.start_time + k * (self.until - self.start_time) / (self.outputs - 1)
+        times[k >= self.outputs - 1] = self.until
+        return times
+
     def marks(self, first=0):
         """Step counts (from the run's start) of the outputs between the first and
         last, from the ``first``-th on; a generator, so a run of a million outputs

@@ -269,3 +269,19 @@ def test_ias15_outputs_streamed_to_a_file_in_pieces(tmp_path, monkeypatch):
     with h5py.File(path, "r") as f, h5py.File(path2, "r") as g:
         assert np.array_equal(f["particles/bodies/position/step"][()],
                               g["particles/bodies/position/step"][()])
+
+
+def test_an_adaptive_runs_output_times_are_those_of_output_time_to_the_bit():
+    # the loop's marks are made at once for every output a call may reach
+    # (RunPlan.output_times); each must be the float output_time gives,
+    # which the outputs taken between calls land on
+    from orbits.records import RunPlan
+    rng = np.random.default_rng(13)
+    for _ in range(300):
+        outputs = int(rng.integers(2, 10**5))
+        start = float(rng.normal() * 10 ** rng.uniform(-3, 6))
+        plan = RunPlan(start + float(10 ** rng.uniform(-3, 7)), outputs, 0.0, 0, False, 0, start)
+        first = int(rng.integers(0, outputs))
+        count = int(rng.integers(1, outputs - first + 2))
+        expected = [plan.output_time(k) for k in range(first, first + count)]
+        assert plan.output_times(first, count).tolist() == expected
