@@ -156,9 +156,9 @@ CHUNK_SECONDS = 0.25
 #: Steps in a simulation's first call of its compiled loop.  What a step costs
 #: is not known before one is taken (0.2 us for the outer solar system on
 #: ``leapfrog``, 40 ms for 2000 bodies on ``ias15``), so the first call takes
-#: one and its time sizes the next (a call's fixed cost, some 20 us, makes
-#: the next chunk of a cheap step about 1e4 steps, and the one after it
-#: ``CHUNK_SECONDS`` long).
+#: one and its time sizes the next (a call's fixed cost, 20 to 100 us, makes
+#: the next chunk of a cheap step some 10^3 to 10^4 steps, and the one after
+#: it ``CHUNK_SECONDS`` long).
 FIRST_CHUNK = 1
 
 #: The shortest time :func:`next_chunk` takes a call to have lasted: below a
