@@ -756,37 +756,66 @@ class BodySet:
         for key, val in (("inc", inc), ("Omega", Omega), ("omega", omega), ("f", f),
                          ("M", M)):
             ang[key] = None if val is None else self._scalar(val, "angle", name, key)
-        for key, val in (("a", a_), ("e", e_), *ang.items()):
-            if val is not None and not math.isfinite(val):
-                raise ElementsError(f"must be finite, got {val}", body=name, field=key)
-        if e_ < 0:
-            raise ElementsError(f"eccentricity must be >= 0, got {e_}", body=name, field="e")
-        if a_ == 0:
-            raise ElementsError("semi-major axis must be non-zero", body=name, field="a")
-        if a_ > 0 and e_ >= 1:
-            raise ElementsError(f"e = {e_} >= 1 needs a < 0 (a hyperbolic orbit); "
-                                f"got a = {a_} {self.units.length}. Parabolic orbits "
-                                f"(e = 1) must be given as a state", body=name, field="e")
-        if a_ < 0 and e_ <= 1:
-            raise ElementsError(f"a < 0 means a hyperbolic orbit and needs e > 1; "
-                                f"got e = {e_}", body=name, field="e")
-        if ang["f"] is not None and ang["M"] is not None:
-            raise ElementsError("give the true anomaly f or the mean anomaly M, not both",
-                                body=name, field="f")
-        anomaly = ang["f"] if ang["f"] is not None else (
-            _kepler.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
-        mu = self.units.G * (mp + m)
-        if mu <= 0:
-            raise ElementsError("the primary and the body are both massless; an orbit "
-                                "needs mass", body=name, field="primary")
-        pos, vel = np.empty(3), np.empty(3)
-        status = _kepler.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
-                                           ang["Omega"] or 0.0, ang["omega"] or 0.0,
-                                           anomaly, pos, vel)
-        if status != 0:
-            raise ElementsError(_kepler.describe_status(status), body=name,
-                                field="f" if ang["f"] is not None else "elements")
+        pos, vel = _relative_state(name, self.units, mp, m, a_, e_, **ang)
         return xp + pos, vp + vel
+
+
+def _relative_state(name, units, mp, m, a, e, inc, Omega, omega, f, M):
+    """Position and velocity, shape (3,) each, of body ``name`` (mass ``m``)
+    relative to its primary (mass ``mp``), from its elements as plain floats in
+    ``units`` (angles in rad; ``None`` for an angle not given).
+
+    What :meth:`BodySet.add` computes for a body given by elements, and
+    :mod:`orbits.systemfile` for a table of them: the same arithmetic, so the
+    same state bit for bit.
+
+    Raises
+    ------
+    ElementsError
+        The elements are not finite, not an orbit, or both masses are zero.
+
+    Examples
+    --------
+    >>> from orbits import UnitSystem
+    >>> from orbits.bodies import _relative_state
+    >>> pos, vel = _relative_state("Earth", UnitSystem(), 1.0, 0.0, 1.0, 0.0, None,
+    ...                            None, None, None, None)
+    >>> pos.tolist()
+    [1.0, 0.0, 0.0]
+    """
+    a_, e_ = a, e
+    ang = dict(inc=inc, Omega=Omega, omega=omega, f=f, M=M)
+    for key, val in (("a", a_), ("e", e_), *ang.items()):
+        if val is not None and not math.isfinite(val):
+            raise ElementsError(f"must be finite, got {val}", body=name, field=key)
+    if e_ < 0:
+        raise ElementsError(f"eccentricity must be >= 0, got {e_}", body=name, field="e")
+    if a_ == 0:
+        raise ElementsError("semi-major axis must be non-zero", body=name, field="a")
+    if a_ > 0 and e_ >= 1:
+        raise ElementsError(f"e = {e_} >= 1 needs a < 0 (a hyperbolic orbit); "
+                            f"got a = {a_} {units.length}. Parabolic orbits "
+                            f"(e = 1) must be given as a state", body=name, field="e")
+    if a_ < 0 and e_ <= 1:
+        raise ElementsError(f"a < 0 means a hyperbolic orbit and needs e > 1; "
+                            f"got e = {e_}", body=name, field="e")
+    if ang["f"] is not None and ang["M"] is not None:
+        raise ElementsError("give the true anomaly f or the mean anomaly M, not both",
+                            body=name, field="f")
+    anomaly = ang["f"] if ang["f"] is not None else (
+        _kepler.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
+    mu = units.G * (mp + m)
+    if mu <= 0:
+        raise ElementsError("the primary and the body are both massless; an orbit "
+                            "needs mass", body=name, field="primary")
+    pos, vel = np.empty(3), np.empty(3)
+    status = _kepler.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
+                                       ang["Omega"] or 0.0, ang["omega"] or 0.0,
+                                       anomaly, pos, vel)
+    if status != 0:
+        raise ElementsError(_kepler.describe_status(status), body=name,
+                            field="f" if ang["f"] is not None else "elements")
+    return pos, vel
 
 
 def _check_name_text(name):

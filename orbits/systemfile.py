@@ -111,7 +111,7 @@ import astropy.units as u
 import numpy as np
 
 from ._csvcells import read_cell, safe_cell
-from .bodies import BodySet
+from .bodies import BodySet, _relative_state, _unit_string
 from .errors import BodyError, SystemFileError, _where
 from .units import UnitSystem
 
@@ -613,16 +613,20 @@ class _CsvReader(_Reader):
         return bodies
 
     def read_table(self):
-        """The bodies of a table of states (what :func:`write` writes), read a
-        column at a time; None for anything else (rows of elements, a cell that
-        is not a number, a row of the wrong length, a bad header...), which
-        :meth:`read_rows` reads, or finds the error in.
+        """The bodies of a table of states or elements, read a column at a
+        time; None for anything else (a cell that is not a number, a row of the
+        wrong length, a bad header, elements that are no orbit, a primary not
+        among the rows above...), which :meth:`read_rows` reads, or finds the
+        error in.
 
         A column's numbers are converted to the set's unit at once, with the
         factor by which a cell-by-cell reading converts each: the same numbers,
-        bit for bit.  (Row by row, each body costs a few astropy conversions
-        and an ``add``, and each ``add`` copies the arrays: 1e5 bodies take
-        minutes.)
+        bit for bit.  A row of elements is then turned into a state with the
+        arithmetic of :meth:`~orbits.BodySet.add` (``bodies._relative_state``
+        and the primary's state, or the centre of mass of the rows above), and
+        its history entry is the one ``add`` records: the same set, bit for
+        bit.  (Row by row, each body costs a few astropy conversions and an
+        ``add``, and each ``add`` copies the arrays: 1e5 bodies take minutes.)
         """
         try:
             # a row whose first cell has text is not blank: the question is
@@ -651,49 +655,134 @@ class _CsvReader(_Reader):
             return None
         units = dict(header)
         at = {c: j for j, c in enumerate(units)}
-        if any(r[at[c]].strip() for c in ("primary", *_ELEMENTS) if c in at for r in rows):
-            return None         # elements: each body about those above, row by row
         names = [read_cell(r[at["name"]].strip()) for r in rows]
         try:
             numbers = {c: self.column([r[at[c]] for r in rows], c, units[c]) for c in units
                        if self.kind(c) != "text"}
         except ValueError:
             return None
-        mass, empty = numbers.pop("mass")
-        if not all(names) or empty.any():
-            return None
+        mass, empty, _ = numbers.pop("mass")
         n = len(names)
-        radius = numbers.pop("radius", (np.zeros(n), None))[0]
+        if not all(names) or empty.any() or len(set(names)) != n:
+            return None
+        radius = numbers.pop("radius", (np.zeros(n), None, None))[0]
         state = {}
+        stated = np.zeros(n, dtype=bool)
         for vec, comps in _VECTORS.items():
             if comps[0] not in numbers:
                 state[vec] = np.zeros((n, 3))
                 continue
-            (x, ex), (y, ey), (z, ez) = (numbers[c] for c in comps)
+            (x, ex, _), (y, ey, _), (z, ez, _) = (numbers[c] for c in comps)
             if not (np.array_equal(ex, ey) and np.array_equal(ey, ez)):
                 return None      # a vector given in part: read_rows names the row
             state[vec] = np.column_stack((x, y, z))
+            stated |= ~ex
+        primaries = [None] * n
+        if "primary" in at:
+            primaries = [read_cell(r[at["primary"]].strip()) or None
+                         if r[at["primary"]].strip() else False for r in rows]
+            if None in primaries:
+                return None      # a cell that reads as no name
+            primaries = [p or None for p in primaries]
+        elements = {c: numbers[c] for c in _ELEMENTS if c in numbers}
+        given = np.array([p is not None for p in primaries])
+        for _, e_empty, _ in elements.values():
+            given |= ~e_empty
+        if (given & stated).any():
+            return None          # both a state and elements: read_rows names the row
+        history = None
+        if given.any():
+            history = self.element_states(names, mass, primaries, elements, units, given,
+                                          state)
+            if history is None:
+                return None
         to = (self.units or UnitSystem.default()).unit
         try:
-            return BodySet.from_arrays(mass << to("mass"), state["position"] << to("length"),
-                                       state["velocity"] << to("velocity"), names=names,
-                                       units=self.units, radii=radius << to("length"))
+            bodies = BodySet.from_arrays(mass << to("mass"), state["position"] << to("length"),
+                                         state["velocity"] << to("velocity"), names=names,
+                                         units=self.units, radii=radius << to("length"))
         except BodyError:
             return None
+        if history is not None:
+            bodies.history = history     # what BodySet.add records, a body at a time
+        return bodies
+
+    def element_states(self, names, mass, primaries, elements, column_units, given, state):
+        """Fill ``state``'s rows of the bodies ``given`` by elements, in order,
+        as :meth:`~orbits.BodySet.add` computes them; the history entries that
+        ``add`` records, or None where a row is in error (:meth:`read_rows`
+        names it)."""
+        units = self.units or UnitSystem.default()
+        x, v = state["position"], state["velocity"]
+        if not (np.all(mass >= 0) and np.all(np.isfinite(mass)) and np.all(np.isfinite(x))
+                and np.all(np.isfinite(v))):
+            return None          # read_rows names the row before any orbit about it
+        index = {}
+        history = []
+        # the history's text of each cell: str of the Quantity's value and its
+        # unit, as bodies._describe writes a cell of a column with a unit
+        text = {}
+        for c, (_, empty, raw) in elements.items():
+            unit = column_units[c]
+            ustr = _unit_string(unit) if unit is not None else ""
+            if unit is None:
+                text[c] = [None if e else str(float(r)) for r, e in zip(raw, empty)]
+            elif ustr:
+                text[c] = [None if e else f"{r} {ustr}" for r, e in zip(raw, empty)]
+            else:
+                text[c] = [None if e else str(r) for r, e in zip(raw, empty)]
+        columns = {c: (values.tolist(), empty.tolist()) for c, (values, empty, _)
+                   in elements.items()}
+        for i, name in enumerate(names):
+            index[name] = i
+            if not given[i]:
+                history.append({"name": name, "from": "state"})
+                continue
+            el = {c: (None if c not in columns or columns[c][1][i] else columns[c][0][i])
+                  for c in _ELEMENTS}
+            primary = primaries[i]
+            if el["a"] is None:
+                return None
+            if primary is None:
+                m = mass[:i]
+                if i == 0 or not np.any(m > 0):
+                    return None
+                mt = m.sum()
+                if not mt > 0:
+                    return None
+                mp, xp, vp = mt, (m @ x[:i]) / mt, (m @ v[:i]) / mt
+            else:
+                j = index.get(primary)
+                if j is None or j == i:
+                    return None
+                mp, xp, vp = mass[j], x[j], v[j]
+            e = 0.0 if el["e"] is None else el["e"]
+            try:
+                pos, vel = _relative_state(name, units, mp, float(mass[i]), el["a"], e,
+                                           el["inc"], el["Omega"], el["omega"], el["f"],
+                                           el["M"])
+            except BodyError:
+                return None
+            x[i] = xp + pos
+            v[i] = vp + vel
+            history.append({"name": name, "from": "elements", "primary": primary,
+                            **{c: text[c][i] for c in _ELEMENTS
+                               if c in text and text[c][i] is not None}})
+        return history
 
     def column(self, cells, column, unit):
-        """``(values, empty)`` of a column of numbers (a list of its cells), in
-        the set's unit, an empty cell 0; ValueError where a cell is not a
-        number to ``float``, as in :meth:`fields`."""
+        """``(values, empty, raw)`` of a column of numbers (a list of its
+        cells): in the set's unit, and as written; an empty cell 0; ValueError
+        where a cell is not a number to ``float``, as in :meth:`fields`."""
         cells = list(map(str.strip, cells))
         empty = np.array(cells) == ""
         if empty.any():
             cells = [c or "0" for c in cells]
-        values = np.fromiter(map(float, cells), dtype=np.float64, count=len(cells))
+        raw = values = np.fromiter(map(float, cells), dtype=np.float64, count=len(cells))
         if unit is not None:
             values = (values * unit).to_value((self.units or UnitSystem.default())
                                               .unit(self.kind(column)))
-        return values, empty
+        return values, empty, raw
 
     def comment(self, row, line, after_header):
         """A comment row: the ``# units:`` line gives the unit system."""

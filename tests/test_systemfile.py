@@ -463,3 +463,74 @@ def test_names_a_spreadsheet_would_run_as_formulas_are_written_as_text():
     assert len(rows[1]) == 1 and rows[1][0].startswith("# units:")   # one cell
     back = systemfile.loads(text, "csv").bodies
     assert back.names == names and back.units.name == "mine, with a comma"
+
+
+ELEMENT_TABLE = (
+    "name,mass [Msun],radius [km],x [au],y [au],z [au],vx [km/s],vy [km/s],vz [km/s],"
+    "primary,a [au],e,inc [deg],Omega [rad],omega [deg],f [deg],M [deg]\n"
+    "Sun,1,695700,0,0,0,0,0,0,,,,,,,,\n"
+    "Jupiter,9.547919e-4,71492,,,,,,,Sun,5.2026,0.0484,1.30,1.754,273.9,,20\n"
+    "Io,4.7e-8,,,,,,,,Jupiter,0.002819,0.0041,0.05,,,,\n"               # angles' defaults
+    "Saturn,2.858e-4,,,,,,,,,9.537,0.0539,2.49,,,120,\n"                # about the COM above
+    "probe,0,,1.5,-0.25,0.01,3,28,-0.5,,,,,,,,\n"                       # a state
+    "comet,1e-12,,,,,,,,Sun,-2.5,1.7,-0.0,0.3,12.5,-40,\n"              # hyperbolic, f
+    "flyby,0,,,,,,,,Jupiter,-0.01,3.2,150,-2.1,,,0.5\n"                 # hyperbolic, M
+    "moonlet,0,1.5,,,,,,,Io,1e-5,0,,,,359,\n"                           # about a moon
+    "Trojan,1e-13,,,,,,,,Sun,5.2026,0.1,10,2,60,,80\n"
+    "far,0,,,,,,,,,40,0.25,,,,,-170\n"                                  # COM of all above
+)
+
+
+def test_a_table_of_elements_reads_as_row_by_row_bit_for_bit():
+    # the element rows by columns: several primaries (named, and the centre of
+    # mass of the rows above), elliptic and hyperbolic, f and M, angles left
+    # to their defaults, a state among them; every attribute as BodySet.add
+    # makes it, the history included
+    table = systemfile._CsvReader(ELEMENT_TABLE, "<string>").read_table()
+    assert table is not None
+    one_by_one = systemfile._CsvReader(ELEMENT_TABLE, "<string>").read_rows()
+    assert vars(table).keys() == vars(one_by_one).keys()
+    for key, value in vars(one_by_one).items():
+        if isinstance(value, np.ndarray):
+            assert getattr(table, key).tobytes() == value.tobytes(), key
+        else:
+            assert getattr(table, key) == value, key
+    assert [systemfile._elements_note(table, i) for i in range(len(table))] == \
+        [systemfile._elements_note(one_by_one, i) for i in range(len(table))]
+    assert systemfile.dumps(table, "toml") == systemfile.dumps(one_by_one, "toml")
+    # plain numbers in the file's units, e without a unit
+    plain = ("# units: length = km; mass = kg; time = s\n"
+             "name,mass,primary,a,e,inc [rad],f [deg]\n"
+             "Earth,5.972e24,,,,,\nsat,0,Earth,7000,0.001,0.9,33\nsat2,0,,-9000,1.5,,-10\n")
+    table = systemfile._CsvReader(plain, "").read_table()
+    assert table is not None
+    one_by_one = systemfile._CsvReader(plain, "").read_rows()
+    assert same_set(table, one_by_one) and table.history == one_by_one.history
+
+
+
+@pytest.mark.parametrize("old, new, line, body, field", [
+    ("Jupiter,0.002819,0.0041,", "Jupiter,0.002819,1.5,", 4, "Io", "e"),     # e >= 1, a > 0
+    (",Io,1e-5,", ",Titan,1e-5,", 9, "moonlet", "primary"),                  # no such body
+    (",Jupiter,0.002819,", ",moonlet,0.002819,", 4, "Io", "primary"),       # given below
+    ("28,-0.5,,,", "28,-0.5,,1.2,", 6, "probe", "position"),                # state and a
+    ("Sun,5.2026,0.1,", "Sun,,0.1,", 10, "Trojan", "a"),                     # no a
+    ("Sun,-2.5,1.7,-0.0,0.3,12.5,-40,", "Sun,-2.5,1.7,-0.0,0.3,12.5,-40,3", 7, "comet", "f"),
+])
+def test_an_error_in_a_table_of_elements_names_its_line_body_and_field(old, new, line, body,
+                                                                       field):
+    assert ELEMENT_TABLE.count(old) == 1
+    with pytest.raises(SystemFileError, match=rf"system.csv, line {line}: body '{body}', "
+                                              rf"field '{field}'"):
+        systemfile.loads(ELEMENT_TABLE.replace(old, new), "csv", source="system.csv")
+
+
+@pytest.mark.parametrize("old, new, line, body, field", [
+    ("Saturn,2.858e-4,", "Saturn,-2.858e-4,", 5, "Saturn", "mass"),
+    ("Jupiter,9.547919e-4,", "Jupiter,nan,", 3, "Jupiter", "mass"),
+    ("probe,0,,1.5,", "probe,0,,inf,", 6, "probe", "position"),
+])
+def test_a_bad_mass_or_state_among_elements_names_its_row(old, new, line, body, field):
+    with pytest.raises(SystemFileError, match=rf"system.csv, line {line}: body '{body}', "
+                                              rf"field '{field}'"):
+        systemfile.loads(ELEMENT_TABLE.replace(old, new), "csv", source="system.csv")
