@@ -855,8 +855,9 @@ class Simulation(Driven):
                 j = int(touch[0])
                 raise BodyError(f"{self._names[self._order[j]]!r} and "
                                 f"{self._names[self._order[i]]!r} touch at the start "
-                                f"(separation {d[j]:.6g} < radii {r[j] + r[i]:.6g} "
-                                f"{self.units.length}); with collisions={collisions!r} the "
+                                f"(separation {d[j]:.6g} < radii {r[j] + r[i]:.6g}"
+                                f"{f' {self.units.length}' if str(self.units.length) else ''}"
+                                f"); with collisions={collisions!r} the "
                                 f"bodies must start apart (collisions='merge' merges them "
                                 f"at the start)", body=self._names[self._order[i]],
                                 field="radius")
