@@ -13,6 +13,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from . import _user_functions
 from . import integrators as _integrators
 from ._driver import FIRST_CHUNK, Driven
 from ._kernels import implicit as _implicit
@@ -181,6 +182,9 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
     if velocity_dependent:
         force = force._replace(velocity_dependent=True)
     fargs = (size, tuple(int(s) for s in shape))
+    if _is_jitted(accel):
+        fargs += (_user_functions.force_pointer(accel, len(shape)),
+                  np.zeros(1, dtype=np.int64))
     if integ.adaptive:
         ws = integ.workspace(rows, 0.0 if dt is None else float(dt))
         t0, until = float(t0), float(until)
@@ -292,6 +296,8 @@ class _UserRun(Driven):
         kind, label, text = _FAILURES.get(Status(status), _FAILURES[Status.NON_FINITE])
         rec.output(self, final=True)
         t = self._now()
+        if len(self._fargs) > 3 and self._fargs[3][0] == _user_functions.FORCE_SIZE:
+            _resize_error(ValueError(_stepping.USER_FORCE_SIZE), self.shape, t)
         raise kind(text.format(name=self.integrator.name, next=self.steps + 1, t=t,
                                steps=self.steps)
                    + f"; the trajectory up to the last good step {self.steps} is kept on "

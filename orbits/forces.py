@@ -73,9 +73,7 @@ import astropy.constants as const
 import astropy.units as u
 import numpy as np
 
-from ._kernels import stepping as _stepping_kernels
 from ._kernels import terms as _k
-from ._kernels._jit import specialize
 from .errors import BodyUnitsError, ForceTermError, UnknownBodyError
 
 __all__ = ["ForceTerm", "Gravity", "GR", "GRPotential", "GRFull", "ZonalHarmonics",
@@ -84,7 +82,10 @@ __all__ = ["ForceTerm", "Gravity", "GR", "GRPotential", "GRFull", "ZonalHarmonic
 
 
 class BoundTerm(NamedTuple):
-    """A term bound to one simulation's bodies: its kernels and arguments.
+    """A term bound to one simulation's bodies: its row of the simulation's
+    table of terms (:class:`orbits._kernels.terms.TermTable`), and for a
+    :class:`UserForce` the term itself, whose functions the table calls
+    through a compiled pointer.
 
     Examples
     --------
@@ -100,9 +101,14 @@ class BoundTerm(NamedTuple):
     ('BoundTerm', 0)
     """
 
-    kernel: _k.TermKernel
-    args: tuple       # of the accelerations and the Jacobian
-    energy_args: tuple
+    row: _k.TermRow
+    user: "UserForce" = None
+
+    @property
+    def args(self):
+        """The row's integers, then its reals, then its per-body values, if any."""
+        r = self.row
+        return tuple(r.ints) + tuple(r.reals) + (() if r.per_body is None else (r.per_body,))
 
 
 class Context(NamedTuple):
@@ -550,7 +556,7 @@ class GR(_SourceTerm):
         """
         src = self._source(ctx)
         ic2 = self._inv_c2(ctx)
-        return BoundTerm(_GR_KERNEL, (src, ctx.gm, ic2), (src, ctx.gm, ic2, ctx.m))
+        return BoundTerm(_k.TermRow(_k.GR, (src,), (ic2,)))
 
 
 class GRPotential(_SourceTerm):
@@ -610,7 +616,7 @@ class GRPotential(_SourceTerm):
         """
         src = self._source(ctx)
         ic2 = self._inv_c2(ctx)
-        return BoundTerm(_GR_POTENTIAL_KERNEL, (src, ctx.gm, ic2), (src, ctx.gm, ic2, ctx.m))
+        return BoundTerm(_k.TermRow(_k.GR_POTENTIAL, (src,), (ic2,)))
 
 
 class GRFull(ForceTerm):
@@ -695,9 +701,7 @@ class GRFull(ForceTerm):
         2
         """
         ic2 = _inv_c2(self, self.c, ctx)
-        n = len(ctx.m)
-        args = (ctx.gm, ctx.n_active, ic2, np.zeros((n, 3)), np.zeros(n))
-        return BoundTerm(_GR_FULL_KERNEL, args, args + (ctx.m,))
+        return BoundTerm(_k.TermRow(_k.GR_FULL, (ctx.n_active,), (ic2,)))
 
 
 class ZonalHarmonics(ForceTerm):
@@ -836,9 +840,9 @@ class ZonalHarmonics(ForceTerm):
                                         field="radius"))
         self._check_radius(R, repr(self))
         gmb = float(ctx.gm[b])
-        args = (b, ctx.gm, gmb * self.J2 * R ** 2, gmb * self.J4 * R ** 4,
-                np.array(self.pole))
-        return BoundTerm(_ZONAL_KERNEL, args, args + (ctx.m,))
+        return BoundTerm(_k.TermRow(_k.ZONAL, (b,), (gmb * self.J2 * R ** 2,
+                                                     gmb * self.J4 * R ** 4)
+                                    + tuple(float(c) for c in self.pole)))
 
 
 # -- dissipative terms --------------------------------------------------------------------
@@ -1081,8 +1085,8 @@ class Migration(ForceTerm):
             inv.append(1.0 / float(tau))
         gb = float(ctx.gm[b])
         gp = float(ctx.gm[p])
-        args = (b, p, gp / (gp + gb), gb / (gp + gb), inv[0], inv[1], inv[2])
-        return BoundTerm(_MIGRATION_KERNEL, args, args)
+        return BoundTerm(_k.TermRow(_k.MIGRATION, (b, p), (gp / (gp + gb), gb / (gp + gb),
+                                                           inv[0], inv[1], inv[2])))
 
 
 class TidesConstantTimeLag(ForceTerm):
@@ -1262,8 +1266,8 @@ class TidesConstantTimeLag(ForceTerm):
         tau = _given(self.time_lag, "time", ctx, "time_lag")
         self._check_lag(tau, term)
         spin = _angular_velocity(self.spin, ctx, term)
-        args = (b, ctx.gm, 3.0 * self.k2 * R ** 5, tau, spin)
-        return BoundTerm(_TIDES_KERNEL, args, args)
+        return BoundTerm(_k.TermRow(_k.TIDES, (b,), (3.0 * self.k2 * R ** 5, tau)
+                                    + tuple(float(c) for c in spin)))
 
 
 class RadiationPressure(ForceTerm):
@@ -1440,8 +1444,7 @@ class RadiationPressure(ForceTerm):
             beta[s] = 0.0
         self._check_bound(ctx, s, beta, term)
         ic = 1.0 / _speed_of_light(self, self.c, ctx)
-        args = (s, float(ctx.gm[s]), beta, ic)
-        return BoundTerm(_RADIATION_KERNEL, args, args)
+        return BoundTerm(_k.TermRow(_k.RADIATION, (s,), (float(ctx.gm[s]), ic), beta))
 
     def _check_bound(self, ctx, s, beta, term):
         # beta >= 1 cancels the source's pull or more: a bound body would be flung out
@@ -1680,21 +1683,13 @@ class UserForce(ForceTerm):
         ... def drag(x, v, t, m):
         ...     return -1e-6 * v
         >>> bound = orbits.forces.UserForce(drag, velocity_dependent=True).bind(ctx)
-        >>> bound.args[0]    # internal row of each body of the set
-        array([0, 1])
+        >>> bound.user.func is drag
+        True
         """
-        n = len(ctx.m)
         # the body set's row k is internal row pos[k]
-        pos = np.argsort(ctx.order).astype(np.int64)
-        m_user = np.ascontiguousarray(ctx.m[pos])
-        args = (pos, np.zeros((n, 3)), np.zeros((n, 3)), m_user)
-        self._check(ctx, m_user)
-        key = f"user{id(self.func)}_{id(self.potential)}"
-        accel = specialize(_user_accel, key, cache=False, user=self.func)
-        energy = (specialize(_user_energy, key, cache=False, user_potential=self.potential)
-                  if self.potential is not None else _k.NONE.energy)
-        jac = _k.difference_jacobian(accel, key, self.velocity_dependent, cache=False)
-        return BoundTerm(_k.TermKernel(accel, energy, jac, key, cache=False), args, args)
+        pos = np.argsort(ctx.order)
+        self._check(ctx, np.ascontiguousarray(ctx.m[pos]))
+        return BoundTerm(_k.TermRow(_k.USER), user=self)
 
     def _check(self, ctx, m_user):
         x = ctx.x_user
@@ -1770,45 +1765,3 @@ def _signature_text(f):
         return str(inspect.signature(f))
     except (TypeError, ValueError):
         return "arguments that cannot be read"
-
-
-_USER_FORCE_SIZE = _stepping_kernels.USER_FORCE_SIZE
-
-
-def _user_accel(x, v, t, args, acc):
-    # the user's rows are the body set's order; internal row pos[k] is user row k
-    pos, xu, vu, mu = args
-    n = pos.shape[0]
-    for k in range(n):
-        for d in range(3):
-            xu[k, d] = x[pos[k], d]
-            vu[k, d] = v[pos[k], d]
-    a = user(xu, vu, t, mu)  # noqa: F821 - bound by specialize
-    if a.shape[0] != n or a.shape[1] != 3:
-        raise ValueError(_USER_FORCE_SIZE)  # checked at bind too; here if it varies
-    for k in range(n):
-        for d in range(3):
-            acc[pos[k], d] += a[k, d]
-
-
-def _user_energy(x, v, args):
-    pos, xu, vu, mu = args
-    for k in range(pos.shape[0]):
-        for d in range(3):
-            xu[k, d] = x[pos[k], d]
-    return user_potential(xu, mu)  # noqa: F821 - bound by specialize
-
-
-_GR_KERNEL = _k.TermKernel(_k.gr_accel, _k.gr_energy, _k.gr_jacobian, "gr")
-_GR_POTENTIAL_KERNEL = _k.TermKernel(_k.gr_potential_accel, _k.gr_potential_energy,
-                                     _k.gr_potential_jacobian, "gr_potential")
-_GR_FULL_KERNEL = _k.TermKernel(_k.gr_full_accel, _k.gr_full_energy,
-                                _k.difference_jacobian(_k.gr_full_accel, "gr_full", True),
-                                "gr_full")
-_ZONAL_KERNEL = _k.TermKernel(_k.zonal_accel, _k.zonal_energy, _k.zonal_jacobian, "zonal")
-_MIGRATION_KERNEL = _k.TermKernel(_k.migration_accel, _k.dissipative_energy,
-                                  _k.migration_jacobian, "migration")
-_TIDES_KERNEL = _k.TermKernel(_k.tides_accel, _k.dissipative_energy, _k.tides_jacobian,
-                              "tides_ctl")
-_RADIATION_KERNEL = _k.TermKernel(_k.radiation_accel, _k.dissipative_energy,
-                                  _k.radiation_jacobian, "radiation")

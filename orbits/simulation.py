@@ -25,8 +25,8 @@ from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
-                     Escape, IntegratorOptionError, NonFiniteState, OrbitsError, OrbitsWarning,
-                     SimulationOptionError, StepSizeUnderflow)
+                     Escape, ForceTermError, IntegratorOptionError, NonFiniteState, OrbitsError,
+                     OrbitsWarning, SimulationOptionError, StepSizeUnderflow)
 from .monitors import DEFAULT_MONITORS, monitor_field_names, monitor_fields, monitor_mask
 from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDescription,
                       SimulationState, Snapshot, _function_name)
@@ -500,17 +500,35 @@ class Simulation(Driven):
                               self._n_active, self.units, self._bare_ok, self._order,
                               np.ascontiguousarray(bodies._x), np.ascontiguousarray(bodies._v))
         bound = [term.bind(ctx) for term in self._terms]
-        chain = _kterms.chain([b.kernel for b in bound])
         dissipative = [b for term, b in zip(self._terms, bound) if not term.conservative]
-        work = _kterms.chain([b.kernel for b in dissipative]) if dissipative else None
-        self._force = _stepping.with_terms(self._force, chain,
+        terms = _kterms.TABLE
+        self._force = _stepping.with_terms(self._force, terms,
                                            any(t.velocity_dependent for t in self._terms),
-                                           work=work)
-        self._fargs = (self._fargs, _kterms.nest([b.args for b in bound]))
-        if work is not None:
-            self._fargs += (_stepping.work_args(_kterms.nest([b.args for b in dissipative]),
-                                                self._m),)
-        self._eargs = _kterms.nest([b.energy_args for b in bound])
+                                           work=terms if dissipative else None)
+        table = self._term_table(bound, ctx)
+        self._fargs = (self._fargs, table)
+        if dissipative:
+            self._fargs += (_stepping.work_args(self._term_table(dissipative, ctx), self._m),)
+        self._eargs = table
+
+    def _term_table(self, bound, ctx):
+        """The :class:`~orbits._kernels.terms.TermTable` of bound terms, with
+        the pointers of their user functions, if any."""
+        from . import _user_functions
+        from ._kernels import terms as _kterms
+        users = [b.user for b in bound if b.user is not None]
+        rows = [b.row for b in bound if b.user is None]
+        user = None
+        if users:
+            accel, energy = _user_functions.term_pointers(users)
+            pos = np.argsort(ctx.order).astype(np.int64)
+            n = len(pos)
+            user = _kterms.UserTerms(accel, energy, pos, np.zeros((n, 3)), np.zeros((n, 3)),
+                                     np.ascontiguousarray(ctx.m[pos]),
+                                     np.zeros(1, dtype=np.int64),
+                                     any(u.velocity_dependent for u in users))
+            rows.append(_kterms.TermRow(_kterms.USER))
+        return _kterms.table(rows, self._gm, self._m, user)
 
     @property
     def config(self):
@@ -1637,6 +1655,12 @@ class Simulation(Driven):
         result = self._with_log(rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
                                            status=reason))
         t = self.time
+        if _user_function_failed(self._fargs):
+            raise ForceTermError(
+                f"a user force returned an array of another shape than during the check "
+                f"before the run, in step {self.steps + 1} (from t = {t:.10g}); the "
+                f"simulation was left at the last good state, step {self.steps}",
+                term="UserForce", field="func")
         if status == Status.NON_FINITE:
             raise NonFiniteState(
                 f"the state became non-finite in step {self.steps + 1} (from t = {t:.10g}); "
@@ -1965,3 +1989,14 @@ def _merge_energy_change(m, x, v, alive, a, b, G, eps2):
     pot = lambda p: np.sqrt(((xk - p) ** 2).sum(axis=1) + eps2)  # noqa: E731
     dE -= G * float(np.sum(mk * (M / pot(X) - m[a] / pot(x[a]) - m[b] / pot(x[b]))))
     return dE
+
+
+def _user_function_failed(fargs):
+    """Whether a user term of a table in ``fargs`` (nested tuples) returned the
+    wrong shape (see :mod:`orbits._user_functions`)."""
+    from ._kernels.terms import TermTable
+    if isinstance(fargs, TermTable):
+        return bool(fargs.user.flag[0])
+    if isinstance(fargs, tuple):
+        return any(_user_function_failed(f) for f in fargs)
+    return False

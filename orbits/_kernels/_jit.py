@@ -42,7 +42,8 @@ from numba.extending import intrinsic
 
 from . import _inlining  # noqa: F401 - installs itself
 
-__all__ = ["njit", "njit_parallel", "specialize", "fma", "KERNEL_STAMP", "NUMBA_OPTIONS"]
+__all__ = ["njit", "njit_parallel", "specialize", "cfunc", "fma", "KERNEL_STAMP",
+           "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -75,6 +76,15 @@ def _compile(func, options):
         func.__qualname__ = qualname
     dispatcher.__qualname__ = qualname
     return dispatcher
+
+
+def cfunc(signature, func):
+    """``func`` compiled as a C callable of the declared ``signature``, with the
+    package's options: a pointer that compiled loops take as an argument of
+    that type (numba's first-class functions), so that one loop serves every
+    function of the signature.  Cached on disk under ``func``'s qualified name."""
+    options = {k: v for k, v in NUMBA_OPTIONS.items() if k != "nogil"}
+    return numba.cfunc(signature, **options)(func)
 
 
 @intrinsic

@@ -277,14 +277,20 @@ def _gravity_force_exact(x, v, t, fargs, acc):
     accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc)
 
 
-#: the message of the error a user force of the wrong size raises in the loop
+#: the message of the error a user's Python force of the wrong size raises in the loop
 USER_FORCE_SIZE = "orbits: the user force returned a different number of values than the state has"
 
 
 def _user_force(x, v, t, fargs, acc):
-    # the user's arrays (any shape, ``size`` values) fill the (rows, 3) state
-    # arrays in order; the padding stays zero
-    size, shape = fargs
+    # a user's compiled force, through its pointer (orbits._user_functions):
+    # fargs = (size, shape, pointer, flag)
+    fargs[2](x, v, t, fargs[0], fargs[1], fargs[3], acc)
+
+
+def _user_python_force(x, v, t, fargs, acc):
+    # a user's Python function, run as Python: the user's arrays (any shape,
+    # size values) fill the (rows, 3) state arrays in order; the padding stays zero
+    size, shape = fargs[0], fargs[1]
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
     a = np.asarray(user_accel(xu, vu, t)).ravel()  # noqa: F821 - bound by specialize
@@ -525,10 +531,17 @@ def work_total(ws):
 
 
 def user_force(accel, jit):
-    """A force from a user's ``accel(x, v, t)``; compiled if ``accel`` is a numba function."""
+    """A force from a user's ``accel(x, v, t)``.  A numba function runs through
+    its pointer, ``fargs = (size, shape, pointer, flag)``
+    (:func:`orbits._user_functions.force_pointer`): the loops are compiled
+    once, cached, for any such function.  A Python function runs the loops
+    as Python, ``fargs = (size, shape)``."""
+    if jit:
+        kernel = specialize(_user_force, "user_pointer", inline=True)
+        return ForceKernel(kernel, "user_pointer", True, True, opaque=True)
     key = f"user{id(accel)}"
-    kernel = specialize(_user_force, key, jit=jit, cache=False, user_accel=accel)
-    return ForceKernel(kernel, key, jit, False, opaque=True)
+    kernel = specialize(_user_python_force, key, jit=False, cache=False, user_accel=accel)
+    return ForceKernel(kernel, key, False, False, opaque=True)
 
 
 # -- splitting methods --------------------------------------------------------------

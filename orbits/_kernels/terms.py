@@ -10,9 +10,9 @@ bodies first), with its parameters in one tuple ``args``:
 * ``jacobian(x, v, t, args, jx, jv)`` *adds* ``da/dx`` and ``da/dv`` (shape
   (3N, 3N), rows and columns ``3 i + d``) to ``jx`` and ``jv``.
 
-:func:`chain` joins the kernels of several terms into one kernel of each kind
-over a nested tuple of their ``args`` (``(args_1, (args_2, ()))``), compiled
-once per combination by :func:`orbits._kernels._jit.specialize`.
+Any combination of terms is one :class:`TermTable` (a row of codes and
+parameters a term), read by one kernel of each kind (:data:`TABLE`), so a loop
+compiled for gravity with terms serves every combination of them.
 
 ``gm`` is ``G`` times the masses and ``m`` the masses, both in the internal
 order; ``inv_c2`` is ``1 / c^2`` in the simulation's units.
@@ -39,10 +39,13 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from ._jit import njit, specialize
+from numba.core import types as nbtypes
+
+from ._jit import cfunc, njit, specialize
 from .invariants import _add
 
-__all__ = ["TermKernel", "chain", "nest", "gr_accel", "gr_energy", "gr_jacobian",
+__all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "TABLE", "table",
+           "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
            "migration_accel", "migration_jacobian", "tides_accel", "tides_jacobian",
@@ -814,63 +817,238 @@ def difference_jacobian(accel, key, velocity_dependent, cache=True):
                       VELOCITY=bool(velocity_dependent))
 
 
-# -- several terms as one ----------------------------------------------------------------
+# -- several terms as one table ------------------------------------------------------------
+#
+# Any combination of terms is data of one type, a :class:`TermTable`, read by
+# one set of kernels (:data:`TABLE`): the loops compiled for gravity with terms
+# are compiled once for every combination.  A user's functions enter the table
+# through function pointers of declared signatures (:data:`USER_ACCEL`,
+# :data:`USER_ENERGY`), so they too leave the loop's type unchanged.
 
-def _none_accel(x, v, t, args, acc):
+#: the term codes of a table row
+GR, GR_POTENTIAL, GR_FULL, ZONAL, MIGRATION, TIDES, RADIATION, USER = range(1, 9)
+#: the integers and reals of a table row
+INTS = 2
+REALS = 5
+
+_A2 = nbtypes.float64[:, :]
+_I1 = nbtypes.int64[::1]
+_F1 = nbtypes.float64[::1]
+_F2 = nbtypes.float64[:, ::1]
+#: the signature of a table's user accelerations: ``(x, v, t, pos, xu, vu, mu,
+#: flag, acc)`` adds the user's terms to ``acc`` (see :class:`UserTerms`)
+USER_ACCEL = nbtypes.void(_A2, _A2, nbtypes.float64, _I1, _F2, _F2, _F1, _I1, _A2)
+#: the signature of a table's user potential: ``(x, pos, xu, mu) -> energy``
+USER_ENERGY = nbtypes.float64(_A2, _I1, _F2, _F1)
+
+
+class UserTerms(NamedTuple):
+    """A table's user terms: the compiled pointers and their work arrays.
+
+    ``pos[k]`` is the internal row of the body set's row ``k`` (the user's
+    functions see the bodies in the body set's order); ``xu``, ``vu`` are
+    scratch in that order, ``mu`` the masses in it.  A function that returns
+    the wrong shape fills ``acc`` with NaN and sets ``flag[0] = 1``: the loop
+    then stops as for a non-finite state, and the caller names the cause."""
+
+    accel: object
+    energy: object
+    pos: np.ndarray
+    xu: np.ndarray
+    vu: np.ndarray
+    mu: np.ndarray
+    flag: np.ndarray
+    velocity_dependent: bool
+
+
+class TermTable(NamedTuple):
+    """Force terms as data: row ``k`` is term ``codes[k]`` with its integers
+    ``ints[k]``, reals ``reals[k]`` and per-body values ``per_body[k]``."""
+
+    codes: np.ndarray     # int64 (n,)
+    ints: np.ndarray      # int64 (n, INTS)
+    reals: np.ndarray     # float64 (n, REALS)
+    per_body: np.ndarray  # float64 (n, N)
+    gm: np.ndarray        # G m, internal order
+    m: np.ndarray         # masses, internal order
+    an: np.ndarray        # scratch (N, 3)
+    pot: np.ndarray       # scratch (N,)
+    user: UserTerms
+
+
+class TermRow(NamedTuple):
+    """One term's row of a :class:`TermTable`, as a term's ``bind`` gives it."""
+
+    code: int
+    ints: tuple = ()
+    reals: tuple = ()
+    per_body: object = None
+
+
+def _no_user_accel(x, v, t, pos, xu, vu, mu, flag, acc):
     pass
 
 
-def _none_energy(x, v, args):
+def _no_user_energy(x, pos, xu, mu):
     return 0.0
 
 
-def _none_jacobian(x, v, t, args, jx, jv):
-    pass
+_NO_USER = None
 
 
-def _chain_accel(x, v, t, args, acc):
-    head(x, v, t, args[0], acc)  # noqa: F821 - bound by specialize
-    tail(x, v, t, args[1], acc)  # noqa: F821
+def _no_user(n):
+    global _NO_USER
+    if _NO_USER is None:
+        _NO_USER = (cfunc(USER_ACCEL, _no_user_accel), cfunc(USER_ENERGY, _no_user_energy))
+    accel, energy = _NO_USER
+    return UserTerms(accel, energy, np.zeros(0, dtype=np.int64), np.zeros((0, 3)),
+                     np.zeros((0, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), False)
 
 
-def _chain_energy(x, v, args):
-    return head(x, v, args[0]) + tail(x, v, args[1])  # noqa: F821 - bound by specialize
+def table(rows, gm, m, user=None):
+    """The :class:`TermTable` of ``rows`` (:class:`TermRow`) over bodies with
+    ``G m`` ``gm`` and masses ``m`` (internal order); ``user`` the
+    :class:`UserTerms` of the rows coded :data:`USER`, if any."""
+    n = len(m)
+    rows = list(rows)
+    codes = np.array([r.code for r in rows], dtype=np.int64)
+    ints = np.zeros((len(rows), INTS), dtype=np.int64)
+    reals = np.zeros((len(rows), REALS))
+    per_body = np.zeros((len(rows), n))
+    for k, r in enumerate(rows):
+        ints[k, :len(r.ints)] = r.ints
+        reals[k, :len(r.reals)] = r.reals
+        if r.per_body is not None:
+            per_body[k] = r.per_body
+    return TermTable(codes, ints, reals, per_body, np.ascontiguousarray(gm, dtype=np.float64),
+                     np.ascontiguousarray(m, dtype=np.float64), np.zeros((n, 3)), np.zeros(n),
+                     _no_user(n) if user is None else user)
 
 
-def _chain_jacobian(x, v, t, args, jx, jv):
-    head(x, v, t, args[0], jx, jv)  # noqa: F821 - bound by specialize
-    tail(x, v, t, args[1], jx, jv)  # noqa: F821
+@njit
+def table_accel(x, v, t, tab, acc):
+    """Adds the accelerations of every term of the table ``tab`` to ``acc``."""
+    gm = tab.gm
+    for k in range(tab.codes.shape[0]):
+        c = tab.codes[k]
+        ints = tab.ints[k]
+        reals = tab.reals[k]
+        if c == GR:
+            gr_accel(x, v, t, (ints[0], gm, reals[0]), acc)
+        elif c == GR_POTENTIAL:
+            gr_potential_accel(x, v, t, (ints[0], gm, reals[0]), acc)
+        elif c == GR_FULL:
+            gr_full_accel(x, v, t, (gm, ints[0], reals[0], tab.an, tab.pot), acc)
+        elif c == ZONAL:
+            zonal_accel(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]), acc)
+        elif c == MIGRATION:
+            migration_accel(x, v, t, (ints[0], ints[1], reals[0], reals[1], reals[2],
+                                      reals[3], reals[4]), acc)
+        elif c == TIDES:
+            tides_accel(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]), acc)
+        elif c == RADIATION:
+            radiation_accel(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), acc)
+        elif c == USER:
+            u = tab.user
+            u.accel(x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc)
 
 
-NONE = TermKernel(specialize(_none_accel, "none", inline=True),
-                  specialize(_none_energy, "none", inline=True),
-                  specialize(_none_jacobian, "none", inline=True), "none")
+@njit
+def table_energy(x, v, tab):
+    """The terms' contribution to the conserved energy (see the module notes)."""
+    gm = tab.gm
+    m = tab.m
+    e = 0.0
+    for k in range(tab.codes.shape[0]):
+        c = tab.codes[k]
+        ints = tab.ints[k]
+        reals = tab.reals[k]
+        if c == GR:
+            e += gr_energy(x, v, (ints[0], gm, reals[0], m))
+        elif c == GR_POTENTIAL:
+            e += gr_potential_energy(x, v, (ints[0], gm, reals[0], m))
+        elif c == GR_FULL:
+            e += gr_full_energy(x, v, (gm, ints[0], reals[0], tab.an, tab.pot, m))
+        elif c == ZONAL:
+            e += zonal_energy(x, v, (ints[0], gm, reals[0], reals[1], reals[2:5], m))
+        elif c == USER:
+            u = tab.user
+            e += u.energy(x, u.pos, u.xu, u.mu)
+    return e
 
 
-def chain(kernels):
-    """One :class:`TermKernel` for several, over nested ``args`` ``(a_1, (a_2, ()))``.
-
-    The energy kernels of the chain take ``(a_1e, (a_2e, ()))``, each term's
-    energy arguments; :func:`nest` builds both.
-    """
-    out = NONE
-    for k in reversed(list(kernels)):
-        key = f"{k.key}+{out.key}" if out is not NONE else k.key
-        cache = k.cache and out.cache
-        out = TermKernel(
-            specialize(_chain_accel, key, cache=cache, inline=True, head=k.accel,
-                       tail=out.accel),
-            specialize(_chain_energy, key, cache=cache, inline=True, head=k.energy,
-                       tail=out.energy),
-            specialize(_chain_jacobian, key, cache=cache, inline=True, head=k.jacobian,
-                       tail=out.jacobian),
-            key, cache)
-    return out
+@njit
+def _row_accel(x, v, t, tab, k, acc):
+    # the accelerations of row k alone, for the central differences below
+    c = tab.codes[k]
+    if c == GR_FULL:
+        gr_full_accel(x, v, t, (tab.gm, tab.ints[k, 0], tab.reals[k, 0], tab.an, tab.pot),
+                      acc)
+    elif c == USER:
+        u = tab.user
+        u.accel(x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc)
 
 
-def nest(items):
-    """``(a_1, (a_2, (..., ())))`` from a sequence, the argument layout of :func:`chain`."""
-    out = ()
-    for item in reversed(list(items)):
-        out = (item, out)
-    return out
+@njit
+def _row_difference_jacobian(x, v, t, tab, k, velocity, jx, jv):
+    # central differences of row k, column by column (as _difference_jacobian)
+    n = x.shape[0]
+    m = 3 * n
+    xp = x.copy()
+    vp = v.copy()
+    ap = np.zeros((n, 3))
+    am = np.zeros((n, 3))
+    for half in range(2 if velocity else 1):
+        src = x if half == 0 else v
+        dst = xp if half == 0 else vp
+        out = jx if half == 0 else jv
+        for q in range(m):
+            i = q // 3
+            d = q % 3
+            delta = FD_STEP * max(abs(src[i, d]), 1e-3 * _scale(src))
+            hi = src[i, d] + delta
+            lo = src[i, d] - delta
+            ap[...] = 0.0
+            am[...] = 0.0
+            dst[i, d] = hi
+            _row_accel(xp, vp, t, tab, k, ap)
+            dst[i, d] = lo
+            _row_accel(xp, vp, t, tab, k, am)
+            dst[i, d] = src[i, d]
+            inv = 1.0 / (hi - lo)
+            for p in range(m):
+                out[p, q] += (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
+
+
+@njit
+def table_jacobian(x, v, t, tab, jx, jv):
+    """Adds the terms' ``da/dx`` and ``da/dv`` to ``jx`` and ``jv``: analytic
+    where a term has one, central differences for the full 1PN term and the
+    user's terms."""
+    gm = tab.gm
+    for k in range(tab.codes.shape[0]):
+        c = tab.codes[k]
+        ints = tab.ints[k]
+        reals = tab.reals[k]
+        if c == GR:
+            gr_jacobian(x, v, t, (ints[0], gm, reals[0]), jx, jv)
+        elif c == GR_POTENTIAL:
+            gr_potential_jacobian(x, v, t, (ints[0], gm, reals[0]), jx, jv)
+        elif c == GR_FULL:
+            _row_difference_jacobian(x, v, t, tab, k, True, jx, jv)
+        elif c == ZONAL:
+            zonal_jacobian(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]), jx, jv)
+        elif c == MIGRATION:
+            migration_jacobian(x, v, t, (ints[0], ints[1], reals[0], reals[1], reals[2],
+                                         reals[3], reals[4]), jx, jv)
+        elif c == TIDES:
+            tides_jacobian(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]),
+                           jx, jv)
+        elif c == RADIATION:
+            radiation_jacobian(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), jx, jv)
+        elif c == USER:
+            _row_difference_jacobian(x, v, t, tab, k, tab.user.velocity_dependent, jx, jv)
+
+
+#: the kernels of every table of terms: one key, so one loop for any combination
+TABLE = TermKernel(table_accel, table_energy, table_jacobian, "terms")

@@ -1,0 +1,229 @@
+"""A user's compiled functions as pointers of declared signatures, cached by their code.
+
+A compiled loop that called a user's function by name would be a new loop for
+every function, compiled again in every process (numba cannot cache a loop
+that binds a function it did not compile from a file).  Here each user
+function is wrapped in a small function of a fixed signature, compiled as a C
+callable (``numba.cfunc``) and cached on disk under a name made from the
+user's code (:func:`code_key`); the loops take the pointer as an argument of
+that signature (numba's first-class function types), so one cached loop
+serves every user function, and a new process loads both from the cache.
+
+A wrapper cannot raise into the loop (an exception in a C callable is printed
+and dropped), so a function that returns the wrong shape fills the
+accelerations with NaN and sets ``flag[0] = 1``: the loop stops as for a
+non-finite state and the caller names the cause (:func:`check_flag`).
+"""
+
+import hashlib
+import math
+import types
+
+import numpy as np
+from numba.core import types as nbtypes
+
+from ._kernels._jit import KERNEL_STAMP, cfunc, specialize
+from ._kernels import terms as _kterms
+
+__all__ = ["code_key", "term_pointers", "force_pointer", "FORCE_SIZE"]
+
+#: ``flag[0]`` after a user function returned the wrong number of values
+FORCE_SIZE = 1
+
+_SIMPLE = (bool, int, float, complex, str, bytes, type(None))
+
+
+def _describe_value(value):
+    # what of a global or a closure cell numba freezes into the compiled code
+    if isinstance(value, _SIMPLE):
+        return repr(value)
+    if isinstance(value, np.ndarray):
+        return f"ndarray{value.shape}{value.dtype}" + hashlib.sha1(
+            np.ascontiguousarray(value).tobytes()).hexdigest()
+    if isinstance(value, (tuple, list)):
+        return "(" + ",".join(_describe_value(v) for v in value) + ")"
+    py = getattr(value, "py_func", None)
+    if py is not None:
+        return "jit:" + code_key(value)
+    if isinstance(value, types.ModuleType):
+        return "module:" + value.__name__
+    return "object:" + type(value).__qualname__
+
+
+def _code_text(code, out):
+    out.append(code.co_code)
+    out.append(repr(code.co_names).encode())
+    out.append(repr(code.co_varnames).encode())
+    for c in code.co_consts:
+        if isinstance(c, types.CodeType):
+            _code_text(c, out)
+        else:
+            out.append(repr(c).encode())
+
+
+def code_key(func, _seen=None):
+    """A short hash of what numba compiles of ``func`` (a numba dispatcher or a
+    Python function): its module and name, its byte code and constants, the
+    simple values of the globals and closure cells it reads (numba freezes
+    them), and the functions it calls, recursively.  Editing any of them gives
+    a new key, so a cached wrapper is never reused for changed code."""
+    py = getattr(func, "py_func", func)
+    seen = set() if _seen is None else _seen
+    if id(py) in seen:
+        return "recursive"
+    seen.add(id(py))
+    parts = [f"{py.__module__}:{py.__qualname__}".encode()]
+    code = py.__code__
+    _code_text(code, parts)
+    glob = py.__globals__
+    for name in code.co_names:
+        if name in glob:
+            value = glob[name]
+            parts.append(name.encode())
+            if getattr(value, "py_func", None) is not None:
+                parts.append(code_key(value, seen).encode())
+            else:
+                parts.append(_describe_value(value).encode())
+    for cell in py.__closure__ or ():
+        try:
+            parts.append(_describe_value(cell.cell_contents).encode())
+        except ValueError:  # an empty cell
+            parts.append(b"empty")
+    parts.append(repr(getattr(func, "targetoptions", {})).encode())
+    return hashlib.sha1(b"\0".join(parts)).hexdigest()[:16]
+
+
+def _cfunc(template, signature, suffix, **bindings):
+    # a copy of template with bindings as its globals, compiled as a cached C callable
+    glob = dict(template.__globals__)
+    glob.update(bindings)
+    name = f"{template.__name__}__{suffix}__{KERNEL_STAMP}"
+    func = types.FunctionType(template.__code__, glob, name, template.__defaults__,
+                              template.__closure__)
+    func.__qualname__ = name
+    func.__module__ = template.__module__
+    return cfunc(signature, func)
+
+
+# -- user terms of a simulation (orbits.forces.UserForce) ------------------------------
+
+def _term_add(x, v, t, pos, xu, vu, mu, flag, acc):
+    # the user's rows are the body set's order; internal row pos[k] is user row k
+    n = pos.shape[0]
+    for k in range(n):
+        for d in range(3):
+            xu[k, d] = x[pos[k], d]
+            vu[k, d] = v[pos[k], d]
+    a = user(xu, vu, t, mu)  # noqa: F821 - bound by specialize
+    if a.shape[0] != n or a.shape[1] != 3:
+        flag[0] = FORCE_SIZE
+        for k in range(n):
+            for d in range(3):
+                acc[pos[k], d] = math.nan
+        return
+    for k in range(n):
+        for d in range(3):
+            acc[pos[k], d] += a[k, d]
+
+
+def _term_chain(x, v, t, pos, xu, vu, mu, flag, acc):
+    head(x, v, t, pos, xu, vu, mu, flag, acc)  # noqa: F821 - bound by specialize
+    tail(x, v, t, pos, xu, vu, mu, flag, acc)  # noqa: F821
+
+
+def _term_none(x, v, t, pos, xu, vu, mu, flag, acc):
+    pass
+
+
+def _term_pointer(x, v, t, pos, xu, vu, mu, flag, acc):
+    adder(x, v, t, pos, xu, vu, mu, flag, acc)  # noqa: F821 - bound by specialize
+
+
+def _potential_one(x, pos, xu, mu):
+    for k in range(pos.shape[0]):
+        for d in range(3):
+            xu[k, d] = x[pos[k], d]
+    return user_potential(xu, mu)  # noqa: F821 - bound by specialize
+
+
+def _potential_chain(x, pos, xu, mu):
+    return head(x, pos, xu, mu) + tail(x, pos, xu, mu)  # noqa: F821 - bound by specialize
+
+
+def _potential_none(x, pos, xu, mu):
+    return 0.0
+
+
+def _potential_pointer(x, pos, xu, mu):
+    return adder(x, pos, xu, mu)  # noqa: F821 - bound by specialize
+
+
+_POINTERS = {}
+
+
+def term_pointers(terms):
+    """The compiled pointers ``(accel, energy)`` of :data:`~orbits._kernels.terms.USER_ACCEL`
+    and :data:`~orbits._kernels.terms.USER_ENERGY` that add up the
+    :class:`~orbits.forces.UserForce` terms ``terms``: compiled once for their
+    code and cached on disk, so a new process loads them."""
+    keys = tuple((code_key(t.func), None if t.potential is None else code_key(t.potential))
+                 for t in terms)
+    if keys in _POINTERS:
+        return _POINTERS[keys]
+    add = specialize(_term_none, "none")
+    pot = specialize(_potential_none, "none")
+    akey = "none"
+    pkey = "none"
+    for term, (fk, pk) in reversed(list(zip(terms, keys))):
+        one = specialize(_term_add, fk, user=term.func, FORCE_SIZE=FORCE_SIZE)
+        akey = f"{fk}_{akey}" if akey != "none" else fk
+        add = specialize(_term_chain, hashlib.sha1(akey.encode()).hexdigest()[:16],
+                         head=one, tail=add)
+        if pk is not None:
+            pone = specialize(_potential_one, pk, user_potential=term.potential)
+            pkey = f"{pk}_{pkey}" if pkey != "none" else pk
+            pot = specialize(_potential_chain, hashlib.sha1(pkey.encode()).hexdigest()[:16],
+                             head=pone, tail=pot)
+    suffix = hashlib.sha1(f"{akey}|{pkey}".encode()).hexdigest()[:16]
+    out = (_cfunc(_term_pointer, _kterms.USER_ACCEL, suffix, adder=add),
+           _cfunc(_potential_pointer, _kterms.USER_ENERGY, suffix, adder=pot))
+    _POINTERS[keys] = out
+    return out
+
+
+# -- a user's force replacing gravity (orbits.integrate) ----------------------------------
+
+_C2 = nbtypes.float64[:, ::1]
+
+
+def force_signature(ndim):
+    """The signature of :func:`force_pointer`'s pointer for a state of ``ndim``
+    dimensions: ``(x, v, t, size, shape, flag, acc)``."""
+    return nbtypes.void(_C2, _C2, nbtypes.float64, nbtypes.int64,
+                        nbtypes.UniTuple(nbtypes.int64, ndim), nbtypes.int64[::1], _C2)
+
+
+def _force_pointer(x, v, t, size, shape, flag, acc):
+    # the user's arrays (any shape, size values) fill the (rows, 3) state
+    # arrays in order; the padding stays zero
+    xu = x.ravel()[:size].reshape(shape)
+    vu = v.ravel()[:size].reshape(shape)
+    a = np.asarray(user_accel(xu, vu, t)).ravel()  # noqa: F821 - bound by specialize
+    flat = acc.ravel()
+    if a.size != size:
+        flag[0] = FORCE_SIZE
+        for i in range(size):
+            flat[i] = math.nan
+        return
+    for i in range(size):
+        flat[i] = a[i]
+
+
+def force_pointer(accel, ndim):
+    """The compiled pointer of ``accel(x, v, t)`` for a state of ``ndim``
+    dimensions (:func:`force_signature`), cached on disk for its code."""
+    key = (code_key(accel), ndim)
+    if key not in _POINTERS:
+        _POINTERS[key] = _cfunc(_force_pointer, force_signature(ndim), f"{key[0]}_{ndim}",
+                                user_accel=accel, FORCE_SIZE=FORCE_SIZE)
+    return _POINTERS[key]
