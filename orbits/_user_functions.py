@@ -25,7 +25,7 @@ from numba.core import types as nbtypes
 from ._kernels._jit import KERNEL_STAMP, cfunc, specialize
 from ._kernels import terms as _kterms
 
-__all__ = ["code_key", "term_pointers", "force_pointer", "FORCE_SIZE"]
+__all__ = ["code_key", "term_pointers", "force_pointer", "force_args", "FORCE_SIZE"]
 
 #: ``flag[0]`` after a user function returned the wrong number of values
 FORCE_SIZE = 1
@@ -227,3 +227,13 @@ def force_pointer(accel, ndim):
         _POINTERS[key] = _cfunc(_force_pointer, force_signature(ndim), f"{key[0]}_{ndim}",
                                 user_accel=accel, FORCE_SIZE=FORCE_SIZE)
     return _POINTERS[key]
+
+
+def force_args(accel, shape):
+    """The ``fargs`` of :func:`orbits._kernels.stepping.user_force` for a
+    compiled ``accel`` on a state of ``shape``: ``(size, shape, pointer, flag)``."""
+    shape = tuple(int(s) for s in shape)
+    size = 1
+    for s in shape:
+        size *= s
+    return (size, shape, force_pointer(accel, len(shape)), np.zeros(1, dtype=np.int64))

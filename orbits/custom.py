@@ -181,10 +181,8 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
                                key=f"{force.key}_jac{id(jacobian)}")
     if velocity_dependent:
         force = force._replace(velocity_dependent=True)
-    fargs = (size, tuple(int(s) for s in shape))
-    if _is_jitted(accel):
-        fargs += (_user_functions.force_pointer(accel, len(shape)),
-                  np.zeros(1, dtype=np.int64))
+    fargs = (_user_functions.force_args(accel, shape) if _is_jitted(accel)
+             else (size, tuple(int(s) for s in shape)))
     if integ.adaptive:
         ws = integ.workspace(rows, 0.0 if dt is None else float(dt))
         t0, until = float(t0), float(until)

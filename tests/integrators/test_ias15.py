@@ -342,13 +342,15 @@ def test_non_finite_force_restores_the_last_good_state():
             a[0, 0] = np.nan
         return a
 
+    from orbits._user_functions import force_args
     force = user_force(accel, jit=True)
     integ = get("ias15")
     x = np.array([[1.0, 0.0, 0.0]])
     v = np.array([[0.0, 1.0, 0.0]])
     ws = integ.workspace(1, 0.01)
     status, t, acc, rej, fev, _ = integ.advance_to(
-        ws, x, v, 0.0, 5.0, force, (3, (1, 3)), (0, 0, np.ones(1), 1.0, 1, 0.0), 0,
+        ws, x, v, 0.0, 5.0, force, force_args(accel, (1, 3)),
+        (0, 0, np.ones(1), 1.0, 1, 0.0), 0,
         np.empty(0), np.zeros((0, 11)), None, 10**6)
     assert status == Status.NON_FINITE
     assert 0 < t <= 1.0
