@@ -26,7 +26,7 @@ import time
 HERE = pathlib.Path(__file__).resolve().parent
 BENCHMARKS = ("bench_fixed_step", "bench_gravity", "bench_monitors", "bench_ias15", "bench_wh",
               "bench_batch", "bench_divider", "bench_trace", "bench_adaptive", "bench_ensemble",
-              "bench_forces", "bench_compile")
+              "bench_forces", "bench_compile", "bench_startup")
 
 
 def cpu_model():

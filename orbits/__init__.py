@@ -6,27 +6,36 @@
 >>> sim = orbits.Simulation(bodies, integrator="leapfrog", dt=10 * u.day)
 >>> result = sim.run(until=1000 * u.yr, outputs=100, progress=False)
 >>> print(result.summary())                               # doctest: +SKIP
+
+The names below are imported on first use (PEP 562): ``import orbits`` alone
+loads neither astropy, numba nor h5py, so that ``orbits --help`` and a script's
+start stay quick; ``orbits.Simulation`` or ``from orbits import Simulation``
+imports what it needs.
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib import import_module as _import_module
+from importlib.util import find_spec as _find_spec
 
-from . import analysis, errors, forces, integrators, io, monitors, scenes, systemfile
-from .bodies import BodySet
-from .custom import Trajectory, integrate
-from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
-                     ElementsError, Escape, ForceTermError, IntegratorOptionError,
-                     NonFiniteState, OrbitsError, RunInterrupted, SimulationOptionError,
-                     StepSizeUnderflow, SystemFileError, UnknownIntegratorError,
-                     WallTimeExceeded)
-from .result import Result
-from .simulation import Simulation
-from .units import UnitSystem
-from .io.hdf5 import load
-
-try:
-    __version__ = _version("orbits")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0+unknown"
+#: public name -> the module that defines it, relative to this package; a name
+#: whose module is itself (``scenes``) is a submodule
+_EXPORTS = {
+    "BodySet": ".bodies",
+    "Simulation": ".simulation",
+    "Result": ".result",
+    "UnitSystem": ".units",
+    "integrate": ".custom",
+    "Trajectory": ".custom",
+    "load": ".io.hdf5",
+    # Ensemble needs dask and pandas when it runs; its module imports them itself
+    "Ensemble": ".ensemble",
+    **{name: f".{name}" for name in ("scenes", "integrators", "monitors", "analysis",
+                                      "errors", "forces", "systemfile", "io")},
+    **{name: ".errors" for name in (
+        "OrbitsError", "BodyError", "ForceTermError", "BodyUnitsError", "ElementsError",
+        "IntegratorOptionError", "UnknownIntegratorError", "NonFiniteState",
+        "StepSizeUnderflow", "ConvergenceFailure", "CloseEncounter", "Collision", "Escape",
+        "SimulationOptionError", "WallTimeExceeded", "RunInterrupted", "SystemFileError")},
+}
 
 __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajectory",
            "scenes", "integrators", "monitors", "analysis", "errors", "forces", "OrbitsError",
@@ -37,9 +46,30 @@ __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajec
            "load", "io", "Ensemble", "__version__"]
 
 
+def _version():
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("orbits")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "0+unknown"
+
+
 def __getattr__(name):
-    # Ensemble needs dask and pandas: imported on first use, not with orbits
-    if name == "Ensemble":
-        from .ensemble import Ensemble
-        return Ensemble
-    raise AttributeError(f"module 'orbits' has no attribute {name!r}")
+    if name == "__version__":
+        value = _version()
+    elif name in _EXPORTS:
+        module = _import_module(_EXPORTS[name], __name__)
+        value = module if _EXPORTS[name] == f".{name}" else getattr(module, name)
+    elif name.isidentifier() and not name.startswith("__") \
+            and _find_spec(f"{__name__}.{name}") is not None:
+        # any other submodule, as ``orbits.bodies`` was reachable when this
+        # package imported all of them
+        value = _import_module(f".{name}", __name__)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

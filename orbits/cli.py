@@ -4,6 +4,11 @@
 call it with a list.  It returns the exit status: one of
 :data:`EXIT_STATUSES`, or 128 + the signal number for a run stopped by
 SIGINT or SIGTERM.
+
+Building the parser and ``--help`` import neither numpy nor astropy nor the
+library: each command's work imports them, and a unit in a value (``10d``)
+imports ``astropy.units`` when it is read.  ``tests/test_startup.py`` checks it
+and ``benchmarks/bench_startup.py`` times it.
 """
 
 import argparse
@@ -13,9 +18,6 @@ import sys
 import textwrap
 import threading
 import traceback
-
-import astropy.units as u
-import numpy as np
 
 __all__ = ["main", "parse_quantity", "EXIT_STATUSES", "EXIT_COMPLETED", "EXIT_STOPPED",
            "EXIT_USAGE", "EXIT_INPUT", "EXIT_FILE", "EXIT_RUN_FAILED", "EXIT_INTERNAL"]
@@ -66,6 +68,7 @@ def parse_quantity(text, physical_type="time"):
     value, unit = float(m.group(1)), m.group(2)
     if not unit:
         return value
+    import astropy.units as u
     try:
         q = value * u.Unit(unit.strip())
     except ValueError:
@@ -143,7 +146,7 @@ columns 'primary,a [au],e,inc [deg]'), a row per body; see orbits.systemfile.
 
 
 def _dominant(bodies):
-    return bodies.names[int(np.argmax(bodies.masses.value))]
+    return bodies.names[int(bodies.masses.value.argmax())]
 
 
 #: ``--gr`` choice -> the term it adds for a body set
@@ -298,6 +301,7 @@ _TIME_OPTIONS = ("--dt", "--until", "--epsilon", "--tol", "--rtol", "--atol", "-
 
 def _in_scene_units(value, bodies, kind="time"):
     """A plain number is read in the scene's unit of time (or ``kind``), as the help says."""
+    import astropy.units as u
     if value is None or isinstance(value, u.Quantity):
         return value
     return value * bodies.units.unit(kind)
@@ -313,6 +317,7 @@ def main(argv=None):
     (:data:`EXIT_STATUSES`; argparse exits with :data:`EXIT_USAGE` itself)."""
     argv = _negative_values(sys.argv[1:] if argv is None else list(argv))
     args = _parser().parse_args(argv)
+    import astropy.units as u
     import orbits
     from orbits.errors import OrbitsError, RunError, RunInterrupted, SimulationStopped
 
