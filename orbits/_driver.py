@@ -319,11 +319,12 @@ class Driven:
 
     @property
     def _loop_may_raise(self):
-        # whether the compiled loop can raise: it calls a user's function
-        # (a Python force, or a force term the user wrote); the package's own
-        # kernels are compiled with numpy's error model and raise nothing
-        # (a user's function is never cached on disk, and a loop that calls
-        # one is not either: orbits._kernels.stepping.with_terms)
+        # whether the compiled loop can raise: it runs a user's Python force
+        # as Python, or calls a function it was compiled with and not loaded
+        # from the cache; the package's own kernels are compiled with numpy's
+        # error model and raise nothing, and users' compiled functions run
+        # through pointers that report a failure in a flag instead
+        # (orbits._user_functions)
         force = self._force
         return force.opaque or not force.jit or not force.cache
 

@@ -1,0 +1,101 @@
+"""Compile time of variants: what a new combination of force terms, or a
+user's force, costs once an integrator's loops are compiled.
+
+What is measured
+----------------
+One numba cache directory (a new, empty one), and a new process for each row
+in turn, so that each row starts from what the rows above left in the cache.
+Each process imports the package, makes the outer solar system with the
+row's integrator and terms, and runs it for ten steps; the row reports the
+CPU seconds of making the simulation and that run (the import excluded),
+nearly all of it compiling or loading compiled code.
+
+The rows: the integrator alone (its loop compiled), then with ``GR``
+(the loop for gravity with terms compiled once, for every combination), then
+other combinations of built-in terms, then a :class:`~orbits.forces.UserForce`
+from an importable module (its pointer compiled once), then the same again in
+a new process (loaded).  Goals (issue "Start in seconds"): a combination of
+built-in terms after the first costs <= 1 s, and a user force in a new
+process <= 1 s.
+
+Run ``python benchmarks/bench_variants.py [INTEGRATOR ...]`` (default
+``leapfrog ias15``; a minute or two each).
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+
+_USER_MODULE = textwrap.dedent("""
+    import numba
+
+    @numba.njit
+    def drag(x, v, t, m):
+        return -1e-12 * v
+""")
+
+_CHILD = textwrap.dedent("""
+    import json, sys, time
+    import astropy.units as u
+    import orbits
+    from orbits import forces as F
+    integrator, combo = sys.argv[1], sys.argv[2]
+    made = {
+        "none": lambda: [],
+        "GR": lambda: [F.GR("Sun")],
+        "GRPotential + J2": lambda: [F.GRPotential("Sun"),
+                                     F.ZonalHarmonics("Sun", 0.00465 * u.au, J2=2e-7)],
+        "GR + migration": lambda: [F.GR("Sun"), F.Migration("Neptune", tau_a=1e7 * u.yr)],
+    }
+    if combo.startswith("UserForce"):
+        import benchuser
+        terms = [F.UserForce(benchuser.drag, velocity_dependent=True)]
+    else:
+        terms = made[combo]()
+    adaptive = orbits.integrators.get(integrator).adaptive
+    kw = {} if adaptive else dict(dt=30 * u.day)
+    t0 = time.process_time()
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator, forces=terms,
+                            **kw)
+    sim.run(until=300 * u.day, outputs=3, progress=False)
+    print(json.dumps({"cpu": time.process_time() - t0}))
+""")
+
+ROWS = ["none", "GR", "GRPotential + J2", "GR + migration", "UserForce",
+        "UserForce (new process)"]
+#: rows held to the goal of <= 1 s: the combinations after the first, the user force loaded
+GOAL_ROWS = {"GRPotential + J2": 1.0, "GR + migration": 1.0, "UserForce (new process)": 1.0}
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("integrators", nargs="*", default=["leapfrog", "ias15"])
+    args = parser.parse_args(argv)
+    print("outer solar system, 10 steps; one new numba cache, one new process a row; "
+          "CPU s of making and running (import excluded)")
+    ok = True
+    for integrator in args.integrators:
+        with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as mod:
+            with open(os.path.join(mod, "benchuser.py"), "w") as f:
+                f.write(_USER_MODULE)
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache,
+                       PYTHONPATH=mod + os.pathsep + os.environ.get("PYTHONPATH", ""))
+            for row in ROWS:
+                out = subprocess.run([sys.executable, "-c", _CHILD, integrator, row], env=env,
+                                     capture_output=True, text=True, check=True)
+                cpu = json.loads(out.stdout.strip().splitlines()[-1])["cpu"]
+                goal = GOAL_ROWS.get(row)
+                verdict = ""
+                if goal is not None:
+                    verdict = f"goal <= {goal:.0f} s: {'PASS' if cpu <= goal else 'MISS'}"
+                    ok = ok and cpu <= goal
+                print(f"{integrator:10s} {row:26s} {cpu:7.2f} s  {verdict}", flush=True)
+    print("all goals met" if ok else "some goals missed")
+
+
+if __name__ == "__main__":
+    main()
