@@ -308,10 +308,10 @@ def test_mass_variation_of_a_test_particle_is_that_of_the_map_where_it_pulls(coo
 def _gr_terms():
     # the GR potential about the Sun with c = 3 au/day (c^2 58000 times too
     # small) so that the term's kick is about a planet's and its Jacobian shows
-    kernel = T.chain([T.TermKernel(T.gr_potential_accel, T.gr_potential_energy,
-                                   T.gr_potential_jacobian, "gr_potential")])
-    return (kernel, lambda m: T.nest([(0, G * m, 1.0 / 9.0)]),
-            lambda m: T.nest([(0, G * m, 1.0 / 9.0, m)]))
+    def table(m):
+        return T.table([T.TermRow(T.GR_POTENTIAL, (0,), (1.0 / 9.0,))], G * m, m)
+
+    return T.TABLE, table, table
 
 
 # 2-3 min of compiling each: the loops with the terms, with and without variations
