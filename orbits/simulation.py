@@ -1054,7 +1054,7 @@ class Simulation(Driven):
         carry = ("_t_base", "_steps_since_base", "steps", "force_evaluations",
                  "steps_rejected", "_chunk", "output_path", "_resume", "_reference",
                  "_E_scale", "_L_scale", "_encounters", "_collisions", "_wall0", "_signals",
-                 "_wall_limit", "_in_loop", "_history", "_bodies_changed")
+                 "_compile_clock", "_wall_limit", "_in_loop", "_history", "_bodies_changed")
         for key in carry:
             if key in self.__dict__:
                 new.__dict__[key] = self.__dict__[key]
