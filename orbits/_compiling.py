@@ -26,14 +26,20 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "lo
 
 #: Seconds a loop's first compile takes on an empty cache: the compiling
 #: inside the first ``Simulation.run`` of the outer solar system, on the
-#: reference machine (2-core AMD EPYC, AVX2, a busy host; measured with
-#: ``benchmarks/bench_compile.py --notice``, benchmarks/RESULTS.md).  Keyed by
-#: :func:`loop_label`; only the notice's estimate reads it.
+#: reference machine (2-core AMD EPYC, AVX2, a busy host, where the same
+#: figure scatters by up to a factor of two from run to run; measured with
+#: ``benchmarks/bench_first_compile.py``, which prints this table anew, and
+#: recorded in benchmarks/RESULTS.md).  Keyed by :func:`loop_label`; only the
+#: notice's estimate reads it.
 FIRST_COMPILE_SECONDS = {
-    "leapfrog": 5.0,
-    "ias15": 10.0,
-    "wh": 30.0,
-    "wh democratic-heliocentric": 30.0,
+    "euler": 4.0, "symplectic-euler": 5.0, "verlet": 4.0, "leapfrog": 4.0,
+    "rk2": 3.0, "rk4": 4.0, "yoshida4": 4.0, "yoshida6": 4.0, "yoshida8": 4.0,
+    "wh": 45.0, "wh democratic-heliocentric": 35.0,
+    "saba2": 35.0, "saba2 democratic-heliocentric": 40.0,
+    "saba3": 45.0, "saba3 democratic-heliocentric": 35.0,
+    "saba4": 35.0, "saba4 democratic-heliocentric": 45.0,
+    "dopri5": 5.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 8.0, "taylor": 6.0,
+    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 35.0,
 }
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
@@ -77,7 +83,7 @@ def notice(label):
     --------
     >>> from orbits._compiling import notice
     >>> notice("wh")
-    'orbits: compiling the wh loop for this CPU, once (about 30 s; `orbits compile` does it ahead)'
+    'orbits: compiling the wh loop for this CPU, once (about 45 s; `orbits compile` does it ahead)'
     """
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
@@ -180,7 +186,7 @@ class CompileClock(_event.Listener):
 
 class _LoopWindow:
     """:meth:`CompileClock.loop`: arms the notice for one call (made once per
-    clock, so that a chunk of a run pays two attribute writes)."""
+    clock: a call of the loop allocates nothing for it)."""
 
     __slots__ = ("clock",)
 
@@ -204,7 +210,7 @@ _AHEAD_STEPS = 10
 def _variants(name):
     """The integrators (configured) whose loops ``name`` compiles: one per
     set of coordinates for the methods that take them."""
-    from . import integrators
+    from . import integrators      # which imports this module
     integ = integrators.get(name)
     coords = type(integ).options.get("coordinates")
     if coords is None:
@@ -230,7 +236,8 @@ def compile(names=None, progress=None, report=None):
     Parameters
     ----------
     names : sequence of str, optional
-        Registry names; default :data:`COMMON`.  All of them:
+        Registry names; default ``leapfrog``, ``ias15`` and ``wh``
+        (:data:`COMMON`).  All of them:
         ``[i.name for i in orbits.integrators.available()]``.
     progress : bool, optional
         A progress bar over the loops on the standard error: shown on a

@@ -214,7 +214,8 @@ def _parser():
     run.add_argument("--com", action="store_true",
                      help="move the bodies to their centre-of-mass frame first (scenes in "
                           "a published frame, such as outer-solar-system, drift otherwise)")
-    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run.add_argument("--no-progress", action="store_true",
+                     help="no progress bar, and no line when a loop starts to compile")
     run.add_argument("--out", help="stream outputs and checkpoints to this HDF5 file")
     run.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     run.add_argument("--checkpoint-interval", type=float, default=None,

@@ -1502,7 +1502,10 @@ class Simulation(Driven):
             needed, to end exactly at ``until``.
         progress : bool, optional
             Show a progress bar.  Default: shown only if the run goes on for
-            more than a few seconds.
+            more than a few seconds.  False also silences the line on the
+            standard error that a stepping loop's first compile prints
+            ("orbits: compiling the wh loop for this CPU, once ...";
+            :mod:`orbits._compiling`).
         output : str or path, optional
             Stream the outputs and monitors to this HDF5 file instead of
             keeping them in memory, with restart checkpoints (see
