@@ -88,7 +88,7 @@ def notice(label):
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
         return None
-    about = UNKNOWN_ESTIMATE if seconds is None else f"about {seconds:.2g} s"
+    about = UNKNOWN_ESTIMATE if seconds is None else f"about {float(f'{seconds:.2g}'):g} s"
     return (f"orbits: compiling the {label} loop for this CPU, once ({about}; "
             f"`orbits compile` does it ahead)")
 
@@ -260,11 +260,11 @@ def compile(names=None, progress=None, report=None):
     Examples
     --------
     >>> import orbits
-    >>> [label for label, seconds in orbits.integrators.compile(["leapfrog"],
-    ...                                                        progress=False)]
+    >>> [label for label, _ in orbits.integrators.compile(["leapfrog"], progress=False)]
     ['leapfrog']
-    >>> [label for label, _ in orbits.integrators.compile(["wh"], progress=False)]  # doctest: +SKIP
-    ['wh', 'wh democratic-heliocentric']
+
+    ``wh`` (and ``saba2`` to ``saba4``) compile a loop for each set of
+    coordinates: ``['wh', 'wh democratic-heliocentric']``.
     """
     import astropy.units as u
 
