@@ -9,6 +9,7 @@ import time as _time
 import _signal as _csignal
 import numpy as np
 
+from ._compiling import CompileClock, loop_label
 from ._kernels.invariants import MONITOR_WIDTH
 from ._kernels.status import Status
 from ._kernels.stepping import USER_FORCE_SIZE
@@ -269,6 +270,11 @@ class Driven:
         into the loop for many outputs rather than one each.  Their times
         are computed as :meth:`_now` would at their steps, and the state and
         monitors are those the output would have taken outside the loop.
+
+        The seconds spent compiling are measured (the result's
+        ``compile_time``), and a stepping loop that starts to compile says
+        so on the standard error, unless ``progress`` is False
+        (:class:`~orbits._compiling.CompileClock`).
         """
         adaptive = self.integrator.adaptive
         if adaptive:
@@ -277,10 +283,12 @@ class Driven:
         else:
             bar = _ProgressBar(plan.total_steps, progress)
             bar.update(self.steps - plan.start_step)
+        self._compile_clock = CompileClock(loop_label(self.integrator),
+                                           quiet=progress is False)
         wall0 = _time.perf_counter()
         self._wall0 = wall0
         self._encounters = []
-        with Signals() as self._signals:
+        with self._compile_clock, Signals() as self._signals:
             try:
                 if adaptive:
                     self._outputs_adaptive(plan, rec, bar, first_mark)
@@ -300,7 +308,10 @@ class Driven:
 
     def _with_log(self, result):
         """``result`` with the encounter log and the collisions of the run (if
-        the owner keeps them)."""
+        the owner keeps them), and the seconds it spent compiling."""
+        clock = getattr(self, "_compile_clock", None)
+        if clock is not None and result is not None and hasattr(result, "compile_time"):
+            result.compile_time = clock.seconds
         table = getattr(self, "_encounter_table", None)
         if table is not None and result is not None:
             self._drain_log()
@@ -418,7 +429,7 @@ class Driven:
         t0 = _time.perf_counter()
         guard = (restored_on_error(self._X, self._V, self._ws) if self._loop_may_raise
                  else contextlib.nullcontext())
-        with guard:
+        with guard, self._compile_clock.loop():
             status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
                 self._ws, self._X, self._V, self._t_base, marks[-1], self._force,
                 self._fargs, self._mon(0), self.steps, mon_t, rows, self._stop, self._chunk,
@@ -455,7 +466,7 @@ class Driven:
             # user's function in it): the package's kernels cannot
             guard = (restored_on_error(self._X, self._V, self._ws) if self._loop_may_raise
                      else contextlib.nullcontext())
-            with guard:
+            with guard, self._compile_clock.loop():
                 status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
                     self._ws, self._X, self._V, self._t_base, t_end, self._force,
                     self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)
@@ -584,9 +595,10 @@ class Driven:
             # outputs are written straight where the recorder keeps them
             mon_out = (rec.row_buffer(size) if self._in_loop and size
                        else np.zeros((size, width)))
-            status, steps, n_mon, self._ws = advance_checked(
-                self.integrator, self._ws, self._X, self._V, self._now(), dt, left,
-                self._force, self._fargs, mon, s0, mon_t, mon_out, stop=self._stop)
+            with self._compile_clock.loop():
+                status, steps, n_mon, self._ws = advance_checked(
+                    self.integrator, self._ws, self._X, self._V, self._now(), dt, left,
+                    self._force, self._fargs, mon, s0, mon_t, mon_out, stop=self._stop)
             if n_mon and self._in_loop:
                 # the outputs' steps, and their times as _now() gives them there
                 if every > 0:

@@ -1,4 +1,5 @@
-"""Command line: ``orbits run | resume | info | plot | elements | validate | scenes | integrators``.
+"""Command line: ``orbits run | resume | info | plot | elements | validate | scenes |
+integrators | compile``.
 
 ``main(argv=None)`` only parses arguments and calls the library; the tests
 call it with a list.  It returns the exit status: one of
@@ -216,7 +217,8 @@ def _parser():
     run.add_argument("--com", action="store_true",
                      help="move the bodies to their centre-of-mass frame first (scenes in "
                           "a published frame, such as outer-solar-system, drift otherwise)")
-    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run.add_argument("--no-progress", action="store_true",
+                     help="no progress bar, and no line when a loop starts to compile")
     run.add_argument("--out", help="stream outputs and checkpoints to this HDF5 file")
     run.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     run.add_argument("--checkpoint-interval", type=float, default=None,
@@ -273,7 +275,40 @@ def _parser():
 
     sub.add_parser("scenes", help="list the built-in scenes")
     sub.add_parser("integrators", help="list the integrators")
+
+    comp = sub.add_parser("compile", help="compile integrators' stepping loops now, so that "
+                                          "later runs load them from numba's cache",
+                          description="Compile the stepping loops of integrators now (a "
+                                      "few steps of the outer solar system each, in both "
+                                      "Wisdom-Holman coordinate systems), so that later "
+                                      "runs on this machine load them from numba's cache "
+                                      "instead of compiling. The cache is per CPU and "
+                                      "numba version: run it once where the runs will run "
+                                      "(a cluster node, a container image, a CI job) "
+                                      "before many processes start.",
+                          epilog=COMPILE_EXAMPLES + "\n" + _exit_help(),
+                          formatter_class=argparse.RawDescriptionHelpFormatter)
+    comp.add_argument("integrators", nargs="*", metavar="INTEGRATOR",
+                      help="integrator names (see 'orbits integrators'); default: "
+                           + ", ".join(COMPILE_DEFAULT))
+    comp.add_argument("--all", action="store_true",
+                      help="every integrator with a compiled loop")
+    comp.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
+
+
+#: what ``orbits compile`` compiles without names (orbits._compiling.COMMON,
+#: written out here so that the help is built without importing numba;
+#: tests/test_compiling.py checks that the two agree)
+COMPILE_DEFAULT = ("leapfrog", "ias15", "wh")
+
+COMPILE_EXAMPLES = """\
+examples:
+  orbits compile                      # leapfrog, ias15 and wh
+  orbits compile dop853 trace         # these
+  orbits compile --all                # every integrator (several minutes)
+  NUMBA_CACHE_DIR=/shared/numba orbits compile --all   # a cache the nodes share
+"""
 
 
 def _negative_values(argv):
@@ -316,7 +351,10 @@ def main(argv=None):
     """Entry point of the ``orbits`` command; returns the exit status
     (:data:`EXIT_STATUSES`; argparse exits with :data:`EXIT_USAGE` itself)."""
     argv = _negative_values(sys.argv[1:] if argv is None else list(argv))
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.command == "compile" and args.all and args.integrators:
+        parser.error("compile: give integrator names or --all, not both")
     import astropy.units as u
     import orbits
     from orbits.errors import OrbitsError, RunError, RunInterrupted, SimulationStopped
@@ -405,7 +443,34 @@ def _main(args, orbits):
         print(f"wrote {path}")
     elif args.command == "elements":
         _elements(args, orbits)
+    elif args.command == "compile":
+        _compile(args, orbits)
     return 0
+
+
+def _compile(args, orbits):
+    """``orbits compile``: a line per loop, then the total and where the cache is."""
+    import time
+    from tqdm import tqdm
+    from orbits import _compiling
+
+    names = ([i.name for i in orbits.integrators.available()] if args.all
+             else args.integrators or None)
+    skipped = [name for name in (names or ()) if not orbits.integrators.get(name).compiled]
+
+    def report(label, seconds):
+        done = f"{seconds:6.1f} s compiling" if seconds >= 0.05 else "   loaded from the cache"
+        tqdm.write(f"{label:28s} {done}", file=sys.stdout)
+
+    t0 = time.perf_counter()
+    loops = orbits.integrators.compile(names, progress=False if args.no_progress else None,
+                                       report=report)
+    wall = time.perf_counter() - t0
+    if skipped and not args.all:
+        print(f"{', '.join(skipped)}: run in Python, nothing to compile")
+    compiling = sum(seconds for _, seconds in loops)
+    print(f"{len(loops)} loop{'' if len(loops) == 1 else 's'} ready in {wall:.1f} s "
+          f"({compiling:.1f} s compiling); numba's cache: {_compiling.cache_dir()}")
 
 
 def _elements(args, orbits):

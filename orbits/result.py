@@ -135,6 +135,11 @@ class Result:
         is None where it was not recorded (files written by older versions).
     wall_time : float or None
         Seconds of wall-clock time the run took (None where not recorded).
+    compile_time : float or None
+        Seconds of ``wall_time`` that numba spent compiling the run's loops
+        and kernels (0 when all were loaded from its cache, or compiled by an
+        earlier run of the process); the rest was stepping.  None where not
+        recorded (a result read from a file).
     start_time : Quantity or None
         Time the run started from, where ``times`` may not begin there (a run
         written to a file returns only its last output).
@@ -191,6 +196,7 @@ class Result:
         self.masses_at_outputs = self.collisions = None
         self.status = "completed"
         self.steps_rejected = 0
+        self.compile_time = None
         self.forces = ()
         self.start_time = None
         self.largest_errors = None
@@ -379,12 +385,7 @@ class Result:
         """
         opts = ", ".join(f"{k[7:]}={v}" for k, v in self.integrator.items()
                          if k.startswith("option."))
-        wall = self.wall_time
-        if wall is None or not np.isfinite(wall):
-            wall_text = "wall time not recorded"
-        else:
-            rate = self.steps / wall if wall > 0 else float("inf")
-            wall_text = f"wall time {wall:.3g} s ({rate:.3g} steps/s)"
+        wall_text = _wall_text(self.wall_time, self.__dict__.get("compile_time"), self.steps)
         forces = ("force evaluations not recorded" if self.force_evaluations is None
                   else f"{self.force_evaluations} force evaluations")
         if len(self.times):
@@ -950,6 +951,29 @@ def _label(name, unit):
     """``"name [unit]"``, or ``"name"`` for a dimensionless quantity."""
     text = "" if unit is None else u.Unit(unit).to_string()
     return f"{name} [{text}]" if text else name
+
+
+def _wall_text(wall, compiling, steps):
+    """The run's time for :meth:`Result.summary`: steps per second over the
+    time spent stepping, the compiling apart.
+
+    Examples
+    --------
+    >>> from orbits.result import _wall_text
+    >>> _wall_text(34.0, 31.0, 290000)
+    'wall time 34 s (compiling 31 s, stepping 3 s, 9.67e+04 steps/s)'
+    >>> _wall_text(0.5, 0.0, 50000)
+    'wall time 0.5 s (1e+05 steps/s)'
+    """
+    if wall is None or not np.isfinite(wall):
+        return "wall time not recorded"
+    if not compiling or not np.isfinite(compiling):
+        rate = steps / wall if wall > 0 else float("inf")
+        return f"wall time {wall:.3g} s ({rate:.3g} steps/s)"
+    stepping = max(wall - compiling, 0.0)
+    rate = steps / stepping if stepping > 0 else float("inf")
+    return (f"wall time {wall:.3g} s (compiling {compiling:.3g} s, stepping {stepping:.3g} s, "
+            f"{rate:.3g} steps/s)")
 
 
 def _final(series):

@@ -1072,7 +1072,7 @@ class Simulation(Driven):
         carry = ("_t_base", "_steps_since_base", "steps", "force_evaluations",
                  "steps_rejected", "_chunk", "output_path", "_resume", "_reference",
                  "_E_scale", "_L_scale", "_encounters", "_collisions", "_wall0", "_signals",
-                 "_wall_limit", "_in_loop", "_history", "_bodies_changed")
+                 "_compile_clock", "_wall_limit", "_in_loop", "_history", "_bodies_changed")
         for key in carry:
             if key in self.__dict__:
                 new.__dict__[key] = self.__dict__[key]
@@ -1520,7 +1520,10 @@ class Simulation(Driven):
             needed, to end exactly at ``until``.
         progress : bool, optional
             Show a progress bar.  Default: shown only if the run goes on for
-            more than a few seconds.
+            more than a few seconds.  False also silences the line on the
+            standard error that a stepping loop's first compile prints
+            ("orbits: compiling the wh loop for this CPU, once ...";
+            :mod:`orbits._compiling`).
         output : str or path, optional
             Stream the outputs and monitors to this HDF5 file instead of
             keeping them in memory, with restart checkpoints (see

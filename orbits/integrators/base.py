@@ -103,6 +103,9 @@ class Integrator:
     summary = ""
     #: force evaluations per step (for the counts in results)
     forces_per_step = 1
+    #: whether its steps run in a loop that numba compiles (``orbits compile``
+    #: fills the cache with it ahead of time); False for methods run in Python
+    compiled = True
     #: whether ``advance`` checks the stopping conditions (``stop=``) inside its
     #: loop: True for all of them, or a tuple of the :class:`~orbits.Simulation`
     #: keywords of those it checks

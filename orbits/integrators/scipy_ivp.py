@@ -41,6 +41,7 @@ class ScipyIntegrator(AdaptiveIntegrator):
     options = {"rtol": 1e-9, "atol": 1e-12}
     stop_conditions = False
     chaos_indicators = False
+    compiled = False
 
     def _check_options(self):
         self._relative_tolerance("rtol")

@@ -1,0 +1,194 @@
+"""Compile time: measured apart from stepping, announced once, and paid ahead
+(``orbits._compiling``, ``orbits compile``)."""
+
+import io
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import threading
+
+import astropy.units as u
+import numba
+import pytest
+
+import orbits
+from orbits import _compiling, cli
+from orbits._compiling import CompileClock, loop_label, notice
+from orbits.cli import main
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+#: a fresh process that runs ``euler`` on the Kepler problem twice, with the
+#: default progress (no terminal: no bar), and prints each run's compile
+#: seconds and the first run's summary.  Euler's loop is the cheapest to
+#: compile (about 4 s on an empty cache on the reference machine).
+RUN_TWICE = """
+import json
+import astropy.units as u
+import orbits
+results = []
+for _ in range(2):
+    sim = orbits.Simulation(orbits.scenes.kepler(), "euler", dt=1 * u.day)
+    results.append(sim.run(until=5 * u.day, outputs=2))
+print(json.dumps([r.compile_time for r in results]))
+print(results[0].summary())
+"""
+
+
+def _python(args, cache):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, *args], cwd=ROOT, env=env, capture_output=True,
+                          text=True, timeout=600)
+
+
+def _notices(stderr):
+    return [line for line in stderr.splitlines() if line.startswith("orbits: compiling")]
+
+
+def test_a_first_compile_is_announced_once_and_measured(tmp_path):
+    proc = _python(["-c", RUN_TWICE], tmp_path / "cache")
+    assert proc.returncode == 0, proc.stderr
+    first, second = json.loads(proc.stdout.splitlines()[0])
+    # one line, on a stderr that is not a terminal, for the loop the first
+    # run compiled; the second run of the process compiles nothing
+    assert _notices(proc.stderr) == [notice("euler")], proc.stderr
+    assert first > 0 and second == 0
+    assert "compiling" in proc.stdout and "stepping" in proc.stdout
+
+
+def test_orbits_compile_fills_the_cache_that_the_next_process_loads(tmp_path):
+    cache = tmp_path / "cache"
+    proc = _python(["-m", "orbits.cli", "compile", "euler"], cache)
+    assert proc.returncode == cli.EXIT_COMPLETED, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert lines[0].startswith("euler") and "s compiling" in lines[0]
+    assert lines[-1].startswith("1 loop ready") and str(cache) in lines[-1]
+    assert _notices(proc.stderr) == []          # orbits compile says it in its own lines
+    # a new process, another scene and output spacing: loaded, so nothing said
+    proc = _python(["-c", RUN_TWICE], cache)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout.splitlines()[0]) == [0, 0]
+    assert _notices(proc.stderr) == []
+    assert "compiling" not in proc.stdout
+
+
+# -- the clock, in this process, on functions of its own ------------------------------------
+
+def _fresh():
+    """A function of two levels that no process has compiled yet."""
+    inner = numba.njit(lambda a: a * 2.0)
+    return numba.njit(lambda a: inner(a) + 1.0)
+
+
+def test_the_clock_counts_nested_compiles_once_and_loads_not_at_all():
+    outer = _fresh()
+    with CompileClock() as clock:
+        outer(1.0)
+    assert clock.compiled == 1 and clock.seconds > 0
+    with CompileClock() as again:
+        outer(2.0)                          # compiled already: nothing to do
+    assert again.compiled == 0 and again.seconds == 0
+
+
+def test_the_notice_is_said_in_a_loop_window_only_and_once():
+    out = io.StringIO()
+    with CompileClock("wh", stream=out) as clock:
+        _fresh()(1.0)                       # a kernel outside the loop's call
+        assert out.getvalue() == ""
+        with clock.loop():
+            _fresh()(1.0)
+            _fresh()(1.0)                   # the same call: one line for all it compiles
+        with clock.loop():
+            pass                            # nothing compiled: nothing said
+    assert out.getvalue() == notice("wh") + "\n"
+    assert clock.compiled == 3
+
+
+def test_the_notice_is_silenced_with_the_progress_bar():
+    out = io.StringIO()
+    with CompileClock("wh", quiet=True, stream=out) as clock:
+        with clock.loop():
+            _fresh()(1.0)
+    assert out.getvalue() == "" and clock.compiled == 1
+
+
+def test_compiles_in_another_thread_are_not_counted():
+    out = io.StringIO()
+    with CompileClock("wh", stream=out) as clock:
+        with clock.loop():
+            worker = threading.Thread(target=_fresh(), args=(1.0,))
+            worker.start()
+            worker.join()
+    assert clock.compiled == 0 and out.getvalue() == ""
+
+
+def test_the_notice_names_the_loop_and_its_expected_time(monkeypatch):
+    wh = orbits.integrators.get("wh", coordinates="democratic-heliocentric")
+    assert loop_label(wh) == "wh democratic-heliocentric"
+    monkeypatch.setitem(_compiling.FIRST_COMPILE_SECONDS, "wh democratic-heliocentric", 30.0)
+    assert "the wh democratic-heliocentric loop" in notice(loop_label(wh))
+    assert "about 30 s" in notice(loop_label(wh))
+    assert "a few seconds" in notice("no-such-loop")
+    # a loop expected to compile in under NOTICE_FROM is not announced
+    monkeypatch.setitem(_compiling.FIRST_COMPILE_SECONDS, "quick", 0.5 * _compiling.NOTICE_FROM)
+    assert notice("quick") is None
+
+
+# -- the summary ----------------------------------------------------------------------------
+
+def test_the_summary_parts_compiling_from_stepping():
+    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    result = sim.run(until=30 * u.day, outputs=2, progress=False)
+    assert result.compile_time >= 0
+    result.wall_time, result.compile_time, result.steps = 4.0, 3.0, 1000
+    line = next(ln for ln in result.summary().splitlines() if ln.startswith("steps"))
+    # steps per second over the stepping time alone: 1000 / (4 - 3)
+    assert line.endswith("wall time 4 s (compiling 3 s, stepping 1 s, 1e+03 steps/s)")
+    result.compile_time = 0.0
+    line = next(ln for ln in result.summary().splitlines() if ln.startswith("steps"))
+    assert line.endswith("wall time 4 s (250 steps/s)")
+
+
+def test_a_result_read_from_a_file_has_no_compile_time(tmp_path):
+    path = tmp_path / "run.h5"
+    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    assert sim.run(until=3 * u.day, outputs=2, progress=False, output=path) \
+        .compile_time is not None
+    loaded = orbits.load(path)
+    assert loaded.compile_time is None
+    assert "compiling" not in loaded.summary()
+
+
+# -- the command -----------------------------------------------------------------------------
+
+def test_orbits_compile_checks_its_arguments(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["compile", "leapfrog", "--all"])
+    assert info.value.code == cli.EXIT_USAGE
+    capsys.readouterr()
+    assert main(["compile", "no-such-method"]) == cli.EXIT_INPUT
+    assert "valid names" in capsys.readouterr().err
+    # scipy's methods run in Python: said, and nothing compiled
+    assert main(["compile", "radau", "--no-progress"]) == cli.EXIT_COMPLETED
+    out = capsys.readouterr().out
+    assert "radau: run in Python, nothing to compile" in out
+    assert out.splitlines()[-1].startswith("0 loops ready")
+    assert _compiling.cache_dir() in out
+
+
+def test_the_default_loops_are_those_the_help_names(capsys):
+    assert cli.COMPILE_DEFAULT == _compiling.COMMON
+    with pytest.raises(SystemExit):
+        main(["compile", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "default: " + ", ".join(_compiling.COMMON) in help_text
+
+
+def test_every_compiled_integrator_has_a_loop_label():
+    labels = [loop_label(orbits.integrators.get(i.name))
+              for i in orbits.integrators.available()]
+    assert labels == [i.name for i in orbits.integrators.available()]
+    assert [i.name for i in orbits.integrators.available()
+            if not orbits.integrators.get(i.name).compiled] == ["radau", "lsoda"]
