@@ -24,6 +24,7 @@ _EXPORTS = {
     "Result": ".result",
     "UnitSystem": ".units",
     "integrate": ".custom",
+    "compile_ahead": "._ahead",
     "Trajectory": ".custom",
     "load": ".io.hdf5",
     # Ensemble needs dask and pandas when it runs; its module imports them itself
@@ -38,6 +39,7 @@ _EXPORTS = {
 }
 
 __all__ = ["BodySet", "Simulation", "Result", "UnitSystem", "integrate", "Trajectory",
+           "compile_ahead",
            "scenes", "integrators", "monitors", "analysis", "errors", "forces", "OrbitsError",
            "BodyError", "ForceTermError",
            "BodyUnitsError", "ElementsError", "IntegratorOptionError",

@@ -8,10 +8,10 @@ spends compiling with a :class:`CompileClock` (numba's public event API, the
 not for a load from its cache), so that its summary can part compiling from
 stepping; the clock also prints one line on the standard error when a
 stepping loop starts to compile, terminal or not, since a first run can
-otherwise sit silent for half a minute.  :func:`compile`
-(``orbits.integrators.compile``, ``orbits compile``) compiles the loops
-ahead, for clusters, containers and CI, where many processes would otherwise
-each compile the same loops at once.
+otherwise sit silent for half a minute.  :func:`orbits.compile_ahead`
+(``orbits compile``, in :mod:`orbits._ahead`) compiles the loops ahead, for
+clusters, containers and CI, where many processes would otherwise each
+compile the same loops at once.
 """
 
 import os
@@ -22,7 +22,7 @@ import time
 from numba.core import event as _event
 
 __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "loop_label",
-           "notice", "compile", "cache_dir"]
+           "notice", "cache_dir", "stderr_is_terminal"]
 
 #: Seconds a loop's first compile takes on an empty cache: the compiling
 #: inside the first ``Simulation.run`` of the outer solar system, on the
@@ -201,108 +201,6 @@ class _LoopWindow:
         return False
 
 
-#: The step of the fixed-step runs that compile a loop ahead, in days.
-_AHEAD_DT_DAYS = 10.0
-#: Steps of each such run (enough for the loop's in-loop outputs to be used).
-_AHEAD_STEPS = 10
-
-
-def _variants(name):
-    """The integrators (configured) whose loops ``name`` compiles: one per
-    set of coordinates for the methods that take them."""
-    from . import integrators      # which imports this module
-    integ = integrators.get(name)
-    coords = type(integ).options.get("coordinates")
-    if coords is None:
-        return [integ]
-    from .integrators.wisdom_holman import COORDINATES
-    return [integ] + [integrators.get(name, coordinates=c) for c in COORDINATES if c != coords]
-
-
-def compile(names=None, progress=None, report=None):
-    """Compile the stepping loops of ``names`` now, so that later runs load them.
-
-    ``orbits compile`` on the command line.
-
-    Each integrator runs the outer solar system
-    (:func:`orbits.scenes.outer_solar_system`) for a few steps, in both
-    Wisdom-Holman coordinate systems where it takes them, which compiles its
-    loop and the kernels it calls into numba's cache (:func:`cache_dir`).
-    Integrators that run in Python (scipy's ``radau`` and ``lsoda``) have
-    nothing to compile and are skipped.  The cache is per CPU and numba
-    version: compile on the machine (or image) that runs, before many
-    processes start at once.
-
-    Parameters
-    ----------
-    names : sequence of str, optional
-        Registry names; default ``leapfrog``, ``ias15`` and ``wh``
-        (:data:`COMMON`).  All of them:
-        ``[i.name for i in orbits.integrators.available()]``.
-    progress : bool, optional
-        A progress bar over the loops on the standard error: shown on a
-        terminal by default.
-    report : callable, optional
-        Called with ``(label, seconds)`` after each loop (``orbits compile``
-        prints a line with it).
-
-    Returns
-    -------
-    list of (str, float)
-        Each loop's name (:func:`loop_label`) and the seconds spent
-        compiling it (0 for a loop that was loaded from the cache).
-
-    Raises
-    ------
-    UnknownIntegratorError
-        A name that is not registered (checked before anything compiles).
-
-    Examples
-    --------
-    >>> import orbits
-    >>> [label for label, _ in orbits.integrators.compile(["leapfrog"], progress=False)]
-    ['leapfrog']
-
-    ``wh`` (and ``saba2`` to ``saba4``) compile a loop for each set of
-    coordinates: ``['wh', 'wh democratic-heliocentric']``.
-    """
-    import astropy.units as u
-
-    from . import scenes
-    from .simulation import Simulation   # the run driver imports this module
-
-    names = COMMON if names is None else tuple(names)
-    loops = [integ for name in names for integ in _variants(name)
-             if getattr(integ, "compiled", True)]
-    if progress is None:
-        progress = _stderr_is_terminal()
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=len(loops), unit="loop", desc="compiling", leave=False)
-    bodies = scenes.outer_solar_system()
-    done = []
-    try:
-        for integ in loops:
-            label = loop_label(integ)
-            if bar is not None:
-                bar.set_postfix_str(label)
-            dt = None if integ.adaptive else _AHEAD_DT_DAYS * u.day
-            until = _AHEAD_STEPS * _AHEAD_DT_DAYS * u.day
-            with CompileClock() as clock:
-                sim = Simulation(bodies.copy(), integrator=integ, dt=dt)
-                sim.run(until=until, outputs=3, progress=False)
-            done.append((label, clock.seconds))
-            if report is not None:
-                report(label, clock.seconds)
-            if bar is not None:
-                bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
-    return done
-
-
 def cache_dir():
     """The folder numba keeps the package's compiled loops in.
 
@@ -329,7 +227,8 @@ def cache_dir():
     return os.path.join(os.path.dirname(os.path.abspath(stepping.__file__)), "__pycache__")
 
 
-def _stderr_is_terminal():
+def stderr_is_terminal():
+    """Whether the standard error is a terminal (False where it cannot say)."""
     try:
         return sys.stderr.isatty()
     except (AttributeError, ValueError):

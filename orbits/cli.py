@@ -463,7 +463,7 @@ def _compile(args, orbits):
         tqdm.write(f"{label:28s} {done}", file=sys.stdout)
 
     t0 = time.perf_counter()
-    loops = orbits.integrators.compile(names, progress=False if args.no_progress else None,
+    loops = orbits.compile_ahead(names, progress=False if args.no_progress else None,
                                        report=report)
     wall = time.perf_counter() - t0
     if skipped and not args.all:

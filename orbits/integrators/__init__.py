@@ -9,7 +9,6 @@ RK4()
 
 from typing import NamedTuple
 
-from .._compiling import compile
 from ..errors import UnknownIntegratorError
 from .base import ExplicitRungeKutta, Integrator, SplittingMethod
 from .composition import Yoshida4, Yoshida6, Yoshida8
@@ -25,7 +24,7 @@ from .taylor import Taylor
 from .trace import Trace
 from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
-__all__ = ["get", "available", "register", "compile", "Integrator", "IntegratorInfo",
+__all__ = ["get", "available", "register", "Integrator", "IntegratorInfo",
            "SplittingMethod", "ExplicitRungeKutta"]
 
 _REGISTRY = {}
