@@ -42,7 +42,7 @@ from numba.extending import intrinsic
 
 from . import _inlining  # noqa: F401 - installs itself
 
-__all__ = ["njit", "njit_parallel", "specialize", "cfunc", "fma", "KERNEL_STAMP",
+__all__ = ["njit", "njit_parallel", "specialize", "called", "cfunc", "fma", "KERNEL_STAMP",
            "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
@@ -166,4 +166,32 @@ def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, *
         options["_nrt"] = False
     result = numba.njit(**options)(func) if jit else func
     _SPECIALISED[key] = result
+    return result
+
+
+_CALLED = {}
+
+
+def called(kernel, nrt=True):
+    """``kernel`` (a compiled function, inlined where it is called) as a
+    function of its own that callers call instead of inlining: for the paths
+    a loop runs rarely (the corrector, an output's synchronisation, the
+    conversions at a call's start), where a call costs nothing that shows and
+    each inlined copy would cost its compilation again.  The same code, so
+    the same results bit for bit; compiled once and cached under the
+    kernel's name.  ``nrt`` as in :func:`specialize`."""
+    key = (kernel, nrt)
+    if key in _CALLED:
+        return _CALLED[key]
+    py = kernel.py_func
+    name = f"{py.__name__}__called__{KERNEL_STAMP}"
+    func = types.FunctionType(py.__code__, py.__globals__, name, py.__defaults__,
+                              py.__closure__)
+    func.__qualname__ = name
+    func.__module__ = py.__module__
+    func.__doc__ = py.__doc__
+    options = dict(NUMBA_OPTIONS)
+    if not nrt:
+        options["_nrt"] = False
+    _CALLED[key] = result = numba.njit(**options)(func)
     return result

@@ -92,7 +92,7 @@ References
 
 import math
 
-from ._jit import njit, specialize
+from ._jit import called, njit, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democratic_heliocentric,
                           to_jacobi)
 from .kepler import advance_tangent_by_anomaly, kepler_drift_tangent, short_step_anomaly
@@ -781,10 +781,12 @@ def _kernels(coordinates, terms, key, cache):
         tangent = specialize(term_tangent, key, cache=cache, nrt=nrt, jacobian=jac)
         perturbation = specialize(pert, key, cache=cache, nrt=nrt, TERMS=True,
                                   term_kick=kick, term_tangent=tangent)
+    # the corrector and the synchronisation call the drift (see wisdom_holman._kernels)
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
-                           drift=_drift, perturbation=perturbation)
-    sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt, drift=_drift,
-                      from_internal=from_internal, apply_corrector=corrector)
+                           drift=called(_drift, nrt), perturbation=perturbation)
+    sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt,
+                      drift=called(_drift, nrt), from_internal=from_internal,
+                      apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
 
 
@@ -843,8 +845,9 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force, escape=False)
         stopping["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
-                      COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
-                      drift=_drift, perturbation=perturbation, apply_corrector=corrector,
+                      COEFS=tuple(float(c) for c in coefs), to_internal=called(to_internal, nrt),
+                      drift=_drift, owed_drift=called(_drift, nrt), perturbation=perturbation,
+                      apply_corrector=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache,
                                         work_note=note, tangent_step=step, stop=stop),
                       **stopping)

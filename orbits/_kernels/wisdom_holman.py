@@ -99,7 +99,7 @@ References
 
 import math
 
-from ._jit import njit, specialize
+from ._jit import called, njit, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
                           to_democratic_heliocentric, to_jacobi)
 from .gravity import pair_accelerations
@@ -485,7 +485,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         # a new step size (a shorter last step): through the true state to the
         # mapping state of the new step's corrector
         if owed_box[0] != 0.0:
-            drift(xj, vj, eta, owed_box[0], xs, vs, targs)  # noqa: F821 - bound
+            owed_drift(xj, vj, eta, owed_box[0], xs, vs, targs)  # noqa: F821 - bound
             owed_box[0] = 0.0
         apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], FORWARD, targs)
         apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
@@ -808,14 +808,18 @@ def _kernels(coordinates, terms=None, lanes=False):
         perturbation = specialize(_perturbation_with_terms, key, cache=cache, inline=True,
                                   nrt=nrt, term_kick=kick,
                                   HELIOCENTRIC=coordinates != "jacobi")
+    # the corrector and an output's synchronisation run once a call or an
+    # output: they call the drift and the perturbation step, compiled once,
+    # instead of inlining a copy at each of their call sites
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
-                           drift=_plain_drift, perturbation=perturbation)
+                           drift=called(_plain_drift, nrt), perturbation=called(perturbation, nrt))
     # an output's synchronisation drifts every planet by the owed half step:
     # in lanes, bit for bit, where the loop drifts in lanes (the outer solar
     # system, an output each step, no monitors: 0.56 us an output against
     # 0.60, within this machine's scatter)
     sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
-                      cache=cache, nrt=nrt, drift=_lanes_drift if lanes else _plain_drift,
+                      cache=cache, nrt=nrt,
+                      drift=called(_lanes_drift if lanes else _plain_drift, nrt),
                       from_internal=from_internal, apply_corrector=corrector)
     return to_internal, perturbation, corrector, sync
 
@@ -862,12 +866,14 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
             resident_drift=specialize(_resident_drift, key, cache=cache, inline=True, nrt=nrt),
             resident_perturbation=specialize(COORDINATE_SYSTEMS[coordinates][4], key,
                                              cache=cache, inline=True, nrt=nrt),
-            lanes_in=specialize(_resident_in, key, cache=cache, inline=True, nrt=nrt),
-            lanes_out=specialize(_resident_out, key, cache=cache, inline=True, nrt=nrt),
+            lanes_in=called(specialize(_resident_in, key, cache=cache, inline=True, nrt=nrt),
+                            nrt),
+            lanes_out=called(specialize(_resident_out, key, cache=cache, inline=True, nrt=nrt),
+                             nrt),
             lanes_check=specialize(_resident_check, key, cache=cache, inline=True, nrt=nrt),
             output_pending=specialize(_lanes_pending, key, cache=cache, inline=True, nrt=nrt),
-            output_drift=specialize(_resident_output_drift, key, cache=cache, inline=True,
-                                    nrt=nrt),
+            output_drift=called(specialize(_resident_output_drift, key, cache=cache,
+                                           inline=True, nrt=nrt), nrt),
             make_output=specialize(_lanes_output, key, cache=cache, nrt=nrt,
                                    synchronize=sync, _record=record))
     else:
@@ -881,8 +887,9 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
         outputs["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
-                      COEFS=tuple(float(c) for c in coefs), to_internal=to_internal,
-                      drift=drift, perturbation=perturbation, apply_corrector=corrector,
+                      COEFS=tuple(float(c) for c in coefs), to_internal=called(to_internal, nrt),
+                      drift=drift, owed_drift=called(drift, nrt), perturbation=perturbation,
+                      apply_corrector=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
                       **outputs)
 
