@@ -61,7 +61,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit, specialize
+from ._jit import called, njit, specialize
 from .coordinates import from_democratic_heliocentric, to_democratic_heliocentric
 from .gravity import pair_accelerations
 from .status import Status
@@ -545,6 +545,13 @@ def trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v,
     return n
 
 
+# the loop's rare paths (a call's start, a step redone, the step an encounter
+# begins) call these, compiled once, instead of inlining a copy each
+_criterion_call = called(criterion)
+_pair_accelerations_call = called(pair_accelerations)
+_jump_call = called(jump)
+
+
 def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active, acc, xs, vs,
                 w1, w2, state, owed_box, checked, enc, enc_new, params, inner, tabs, mon, step0,
                 mon_t, mon_out, check_every, sargs, targs):
@@ -573,7 +580,7 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
         state[0] = 1
         state[2] = 0
         owed_box[0] = 0.0
-        npairs, peri = criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed,
+        npairs, peri = _criterion_call(xh, vb, gm, hill, r2, n_active, k_hill, k_speed,
                                  dt, r_peri, enc)
         state[3] = peri
         state[4] = 1 if npairs > 0 else 0
@@ -636,12 +643,12 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                     if flagged:
                         _kick_unflagged(xh, vb, acc, gm, n_active, enc, owed)
                     else:
-                        pair_accelerations(xh, gm, n_active, 0.0, acc, 1, False)
+                        _pair_accelerations_call(xh, gm, n_active, 0.0, acc, 1, False)
                         for i in range(n):
                             vb[i, 0] += owed * acc[i, 0]
                             vb[i, 1] += owed * acc[i, 1]
                             vb[i, 2] += owed * acc[i, 2]
-                    jump(xh, vb, gm, n_active, owed)
+                    _jump_call(xh, vb, gm, n_active, owed)
                 continue
             break
         if not ok:
@@ -698,7 +705,7 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                 if new_flagged:
                     _kick_unflagged(xh, vb, acc, gm, n_active, enc, half)
                 else:
-                    pair_accelerations(xh, gm, n_active, 0.0, acc, 1, False)
+                    _pair_accelerations_call(xh, gm, n_active, 0.0, acc, 1, False)
                     for i in range(n):
                         vb[i, 0] += half * acc[i, 0]
                         vb[i, 1] += half * acc[i, 1]
