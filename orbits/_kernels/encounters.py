@@ -41,6 +41,8 @@ References
 
 import math
 
+import numpy as np
+
 from ._jit import njit
 from .kepler import bracketed_anomaly, short_step_anomaly, stumpff
 
@@ -240,11 +242,14 @@ def _unit_roots(c, A):
     d3 = _derivative(d2)
     d4 = _derivative(d3)
     crit = (_NAN, _NAN, _NAN, _NAN, _NAN)
-    crit, m = _roots_between(d4, A, False, crit, 0)
-    crit, m = _roots_between(d3, A, False, crit, m)
-    crit, m = _roots_between(d2, A, False, crit, m)
-    crit, m = _roots_between(d1, A, False, crit, m)
-    return _roots_between(c, A, True, crit, m)
+    # from the fourth derivative down to the quintic, in a loop so that the
+    # count and the flag are variables: passed as constants, numba would
+    # compile _roots_between (and _root_in) once for each value
+    pieces = (d4, d3, d2, d1, c)
+    m = np.int64(0)
+    for k in range(5):
+        crit, m = _roots_between(pieces[k], A, k == 4, crit, m)
+    return crit, m
 
 
 # --------------------------------------------------------------------------

@@ -80,9 +80,11 @@ FAC_MAX = 6.0       # an accepted inner step grows by at most 6
 #: adds at least one pair; the criterion rarely changes twice)
 MAX_REDO = 8
 #: the inner integrator's force: a group of flagged bodies about the star
-#: (relative to the group's first body), or every body and every pull
-MODE_GROUP = 0
-MODE_ALL = 1
+#: (relative to the group's first body), or every body and every pull.
+#: Floats: numba would compile the inner integrator once for each integer
+#: constant passed (a literal type), and it is compiled once for both
+MODE_GROUP = 0.0
+MODE_ALL = 1.0
 _CBRT2 = 1.2599210498948732
 _TINY = 1e-300
 _EPS = 2.220446049250313e-16
@@ -448,7 +450,7 @@ def inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol):
     kepler_drift_all(xh, vb, eta, h, w1, w2)
     ok = True
     for g in range(groups):
-        ns = 0
+        ns = np.int64(0)   # not a constant: _dop853 is compiled for one type of it
         for i in range(1, n):
             if label[i] == g:
                 idx[ns] = i
