@@ -14,7 +14,10 @@ time is not in the figure.
 
 Printed with PASS/MISS: every loop's estimate is within a factor of two of
 the measurement (the notice's "about"); a loop missing from the table says
-"a few seconds", which passes below 10 s.
+"a few seconds", which passes below 10 s.  Beside it, the CPU seconds of the
+whole first run (making the simulation, its monitors' kernels included, and
+running it; the import excluded) against the goals of the issue "Start in
+seconds": ``leapfrog`` <= 2 s, ``ias15`` <= 3 s, every other loop <= 6 s.
 
 Run ``python benchmarks/bench_first_compile.py`` (several minutes: each
 process compiles from nothing), or name loops: ``... leapfrog wh``.
@@ -35,17 +38,24 @@ _CHILD = textwrap.dedent("""
     from orbits._compiling import loop_label
     name, _, coords = sys.argv[1].partition(":")
     integ = orbits.integrators.get(name, **({"coordinates": coords} if coords else {}))
+    import time
     dt = None if integ.adaptive else 10 * u.day
+    cpu = time.process_time()
     sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integ, dt=dt)
     result = sim.run(until=100 * u.day, outputs=3, progress=False)
+    cpu = time.process_time() - cpu
     print(json.dumps({"label": loop_label(integ), "compile": result.compile_time,
-                      "wall": result.wall_time}))
+                      "wall": result.wall_time, "cpu": cpu}))
 """)
 
 #: an estimate is "about" the measurement within this factor
 FACTOR = 2.0
 #: what "a few seconds" covers
 FEW = 10.0
+#: the first run's CPU seconds the issue "Start in seconds" asks for, by integrator
+GOALS = {"leapfrog": 2.0, "ias15": 3.0}
+#: every other loop's
+GOAL_OTHER = 6.0
 
 
 def _loops():
@@ -78,8 +88,10 @@ def main(argv=None):
     from orbits._compiling import FIRST_COMPILE_SECONDS
     print("outer solar system, first run (10 steps) on an empty numba cache: seconds "
           "compiling inside the run")
-    print(f"{'loop':30s} {'measured s':>10s} {'table s':>8s} {'ratio':>6s}")
+    print(f"{'loop':30s} {'measured s':>10s} {'table s':>8s} {'ratio':>6s} "
+          f"{'first run CPU s':>16s} {'goal':>5s}")
     worst = 1.0
+    missed = []
     table = {}
     for spec in args.loops or _loops():
         row = _first_run(spec)
@@ -93,9 +105,14 @@ def main(argv=None):
             ratio = max(seconds / quoted, quoted / seconds) if seconds > 0 else float("inf")
             shown = f"{quoted:.0f}"
         worst = max(worst, ratio)
-        print(f"{label:30s} {seconds:10.1f} {shown:>8s} {ratio:6.2f}", flush=True)
+        goal = GOALS.get(spec, GOAL_OTHER)
+        if row["cpu"] > goal:
+            missed.append(label)
+        print(f"{label:30s} {seconds:10.1f} {shown:>8s} {ratio:6.2f} {row['cpu']:16.1f} "
+              f"{goal:5.0f} {'PASS' if row['cpu'] <= goal else 'MISS'}", flush=True)
     print(f"estimates within {FACTOR:g}x of the measurement: worst {worst:.2f}x  "
           f"{'PASS' if worst <= FACTOR else 'MISS'}")
+    print(f"first runs within their goals: {'PASS' if not missed else 'MISS: ' + ', '.join(missed)}")
     print("measured, as a table: " + json.dumps(table))
 
 

@@ -56,7 +56,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from ._jit import njit, specialize
+from ._jit import called, njit, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
                       accelerate_pairwise_parallel, accelerate_pairwise_rebound,
                       accelerate_pairwise_small)
@@ -223,7 +223,8 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
             until_record = int(mon_t[n_mon + 1]) - (k + 1)
         else:
             until_record = -1
-        _record(x, v, t, mon, n_mon, mon_t, mon_out)
+        # n_mon as a variable: a constant 0 would compile the recorder once more
+        _record(x, v, t, mon, np.int64(n_mon), mon_t, mon_out)
         work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
         n_mon += 1
     stop = stop_check(x, v, t, sargs)  # noqa: F821 - bound by specialize
@@ -662,6 +663,25 @@ def _implicit_kick(x, v, t, h, fargs, acc, vm):
             v[i, d] += h * acc[i, d]
 
 
+@njit(inline="always")
+def _no_implicit_kick(x, v, t, h, fargs, acc, vm):
+    pass
+
+
+def _implicit_kick_for(force):
+    # Gravity alone never reads velocities: its loops leave the implicit kick
+    # out.  For other forces (whose loops serve velocity-dependent ones and
+    # others alike) the kick is a call: it iterates the force a few times, so
+    # a call costs nothing beside it, and an inlined copy of the force cost
+    # its compilation again in every loop
+    if force.jit and force.terms is None and force.inner is None and not force.opaque \
+            and not force.velocity_dependent:
+        return _no_implicit_kick
+    kick = specialize(_implicit_kick, force.key, jit=force.jit, cache=force.cache,
+                      inline=True, force=force.kernel)
+    return called(kick, nrt=force.runtime) if force.jit else kick
+
+
 def splitting_loop(force, name, kinds, coefs, stop=False):
     """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
 
@@ -671,9 +691,7 @@ def splitting_loop(force, name, kinds, coefs, stop=False):
     return specialize(_splitting_loop, f"{name}_{force.key}{'_stop' if stop else ''}",
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force, stop),
-                      implicit_kick=specialize(_implicit_kick, force.key, jit=force.jit,
-                                               cache=force.cache, inline=True,
-                                               force=force.kernel),
+                      implicit_kick=_implicit_kick_for(force),
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), **work_kernels(force))
 
