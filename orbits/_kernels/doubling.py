@@ -26,6 +26,12 @@ __all__ = ["doubling_loop"]
 
 
 
+#: ``track`` of :func:`_rk4_step`: floats, not booleans, so that numba compiles
+#: the step once for both (a constant True or False is a type of its own)
+UNTRACKED = 0.0
+TRACKED = 1.0
+
+
 def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
     # classic RK4 from (x, v) with its first stage (k0x, k0v) given; result in
     # (xo, vo).  kx, kv hold stages 1..3.  Returns RK4's mean of the work rate
@@ -102,9 +108,9 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         if t + 1.01 * h >= target:
             h = target - t
             shortened = True
-        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, False)  # noqa: F821
+        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, UNTRACKED)  # noqa: F821
         pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,  # noqa: F821
-                      fargs, p0, True)
+                      fargs, p0, TRACKED)
         for i in range(n):
             for d in range(3):
                 kmx[i, d] = vh[i, d]
@@ -113,7 +119,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         if HAS_WORK:  # noqa: F821
             pm = work_rate(xh, vh, t + 0.5 * h, fargs)  # noqa: F821
         pb = rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs,  # noqa: F821
-                      x2, v2, fargs, pm, True)
+                      x2, v2, fargs, pm, TRACKED)
         fev += 10
         err = 0.0
         for i in range(ne):
