@@ -649,7 +649,7 @@ def _dissipative_sim(integrator="ias15", dt=None):
 
 @pytest.mark.parametrize("integrator, dt", [
     ("ias15", None),
-    pytest.param("leapfrog", 0.5 * u.day, marks=pytest.mark.slow)])  # 22 s compiling
+    ("leapfrog", 0.5 * u.day)])
 def test_restart_with_dissipative_terms_is_bit_identical(tmp_path, integrator, dt):
     # a run stopped half-way and continued from its file: the same floats as one
     # run straight through, the terms rebuilt from the file and the work W

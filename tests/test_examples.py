@@ -25,7 +25,6 @@ def test_sun_jupiter_probe_example(capsys):
     assert "Jupiter at the end: a = 5.2" in capsys.readouterr().out
 
 
-@pytest.mark.slow  # ~65 s compiling three GR terms into two methods; the docs' build runs it too
 def test_mercury_perihelion_example(capsys):
     # 20 years keep the test short; the fit's error then grows as T^-3/2
     # from the 100-year run's 1e-4 relative, to about 1e-3

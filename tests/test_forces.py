@@ -810,7 +810,6 @@ print(after.alloc - before.alloc, after.free - before.free)
 """
 
 
-@pytest.mark.slow  # a new process compiles a user term's loops: 20-60 s
 def test_a_user_term_that_allocates_is_freed_in_the_wisdom_holman_loop():
     # the Wisdom-Holman loop runs without numba's runtime when its kernels
     # allocate nothing; a user's term returns a new array every kick, which
