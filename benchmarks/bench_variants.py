@@ -19,11 +19,19 @@ a new process (loaded), then each stopping condition, collision mode,
 Goals (issue "Start in seconds"): a combination of built-in terms after the
 first, a user force in a new process, and each of the later rows cost <= 1 s.
 
+The stopping conditions are data for one loop per integrator, checked
+through one compiled pointer (:mod:`orbits._kernels.stopping`), which the
+first condition on an empty cache compiles, once for every integrator.
+``--shared-cache`` keeps one cache for all the integrators named, so that
+the rows of the second show what a condition costs an integrator with that
+pointer already in the cache.
+
 Run ``python benchmarks/bench_variants.py [INTEGRATOR ...]`` (default
 ``leapfrog ias15``; a minute or two each).
 """
 
 import argparse
+import contextlib
 import json
 import os
 import subprocess
@@ -94,12 +102,18 @@ def main(argv=None):
     parser.add_argument("integrators", nargs="*", default=["leapfrog", "ias15"])
     parser.add_argument("--rows", help="comma-separated rows to run after 'none' "
                         f"(default: all of {', '.join(ROWS[1:])})")
+    parser.add_argument("--shared-cache", action="store_true",
+                        help="one numba cache for all the integrators, not one each")
     args = parser.parse_args(argv)
-    print("outer solar system, 10 steps; one new numba cache, one new process a row; "
+    print(f"outer solar system, 10 steps; one new numba cache "
+          f"{'for all' if args.shared_cache else 'an integrator'}, one new process a row; "
           "CPU s of making and running (import excluded)")
     ok = True
+    shared = tempfile.TemporaryDirectory() if args.shared_cache else None
     for integrator in args.integrators:
-        with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as mod:
+        own = tempfile.TemporaryDirectory() if shared is None else contextlib.nullcontext(
+            shared.name)
+        with own as cache, tempfile.TemporaryDirectory() as mod:
             with open(os.path.join(mod, "benchuser.py"), "w") as f:
                 f.write(_USER_MODULE)
             env = dict(os.environ, NUMBA_CACHE_DIR=cache,
@@ -119,6 +133,8 @@ def main(argv=None):
                     verdict = f"goal <= {goal:.0f} s: {'PASS' if cpu <= goal else 'MISS'}"
                     ok = ok and cpu <= goal
                 print(f"{integrator:10s} {row:26s} {cpu:7.2f} s  {verdict}", flush=True)
+    if shared is not None:
+        shared.cleanup()
     print("all goals met" if ok else "some goals missed")
 
 

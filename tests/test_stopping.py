@@ -222,3 +222,26 @@ def test_an_encounter_between_step_ends_stops_a_fixed_step_run(integrator):
     # the message names the pass: when it was closest and how close
     found = re.search(r"closest at t = ([-+.e0-9]+) .*separation ([-+.e0-9]+)", str(exc))
     assert found and 10 < float(found[1]) < 11 and float(found[2]) < 0.02
+
+
+def test_conditions_are_data_of_one_type():
+    # a loop is compiled for the numba types of its arguments: a stopping
+    # record of one type for every simulation, with conditions or without,
+    # is one compiled loop serving them all
+    import numba
+    from orbits._kernels import stopping as ks
+    b = orbits.scenes.outer_solar_system()
+    sized = orbits.BodySet.from_arrays(b.masses, b.positions, b.velocities, names=b.names,
+                                       units=b.units, radii=[1e-3] * len(b) * u.au)
+    none = ks.stop_record(None)
+    assert numba.typeof(none[0]) == ks.SARGS
+    cases = [(b, dict(encounter_distance=0.01 * u.au)),
+             (b, dict(encounter_hill=1.0, escape_distance=1e3 * u.au, escape_unbound=True)),
+             (sized, dict(collisions="merge")),
+             (b, dict(encounter_log=0.1 * u.au)),
+             (b, dict(encounter_log=3.0, monitors=("energy", "megno")))]
+    for bodies, kw in cases:
+        sim = orbits.Simulation(bodies.copy(), "ias15", **kw)
+        record = ks.stop_record(sim._stop)
+        assert record[0] is sim._stop, kw
+        assert numba.typeof(record) == numba.typeof(none), kw

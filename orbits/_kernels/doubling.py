@@ -65,7 +65,7 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
 
 
 def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
-                   dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
+                   dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, stopping, max_steps,
                    rtol, atol, marks, mark_steps):
     # marks: outputs recorded in the loop, as in orbits._kernels.embedded
     n = x.shape[0]
@@ -150,10 +150,10 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                 p0 = work_rate(x, v, t, fargs)  # noqa: F821
             stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-                sargs, fargs)
+                stopping, fargs)
             if stop != GO:
-                info[0] = sargs[6][0]       # the bodies the condition names
-                info[1] = sargs[6][1]
+                info[0] = stopping[0][6][0]     # the bodies the condition names
+                info[1] = stopping[0][6][1]
                 status = stop
                 break
             if has_marks and t == target:
@@ -176,13 +176,13 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
     return status, t, steps, rejected, fev, n_mon
 
 
-def doubling_loop(force, stop=False):
+def doubling_loop(force):
     """The RK4 step-doubling loop compiled for a force."""
-    key = f"{force.key}{'_stop' if stop else ''}"
+    key = force.key
     work = work_kernels(force)
     step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel,
                       HAS_WORK=work["HAS_WORK"], work_rate=work["work_rate"])
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, rk4_step=step,
-                      step_end=step_epilogue(force, stop), rows=measured_rows(force),
+                      step_end=step_epilogue(force), rows=measured_rows(force),
                       record_row=force.recorder, **work)

@@ -74,7 +74,7 @@ def step_underflow(h, t, t_end):
 
 
 def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
-                   info, fargs, mon, step0, mon_t, mon_out, sargs, max_steps, rtol, atol,
+                   info, fargs, mon, step0, mon_t, mon_out, stopping, max_steps, rtol, atol,
                    marks, mark_steps):
     # marks (outputs recorded in the loop): the loop lands on each of these
     # times in turn, as it lands on t_end, and records there a row of
@@ -191,10 +191,10 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
                 p0 = work_rate(x, v, t, fargs)  # noqa: F821
             stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-                sargs, fargs)
+                stopping, fargs)
             if stop != GO:
-                info[0] = sargs[6][0]       # the bodies the condition names
-                info[1] = sargs[6][1]
+                info[0] = stopping[0][6][0]     # the bodies the condition names
+                info[1] = stopping[0][6][1]
                 status = stop
                 break
             if has_marks and t == target:
@@ -218,10 +218,10 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     return status, t, steps, rejected, fev, n_mon
 
 
-def embedded_loop(force, has_e3, stop=False):
+def embedded_loop(force, has_e3):
     """The adaptive embedded Runge-Kutta loop compiled for a force and an estimator."""
-    key = f"{force.key}{'_e3' if has_e3 else ''}{'_stop' if stop else ''}"
+    key = f"{force.key}{'_e3' if has_e3 else ''}"
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),
-                      step_end=step_epilogue(force, stop), rows=measured_rows(force),
+                      step_end=step_epilogue(force), rows=measured_rows(force),
                       record_row=force.recorder, **work_kernels(force))

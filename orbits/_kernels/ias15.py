@@ -304,7 +304,7 @@ def _b6_rounding(x, xs, a0, acc, n):
 
 
 def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, dtp, ref,
-                tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
+                tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, stopping, max_steps,
                 epsilon, min_dt, mode, marks, mark_steps):
     # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
     # ref = (length of the reference step, time from its start to now).
@@ -586,10 +586,10 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
             ref[1] += dt
 
         stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
-            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out, sargs,
-            fargs)
+            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
+            stopping, fargs)
         if stop != GO:
-            stop_info(sargs, info)
+            stop_info(stopping, info)
             return stop, t, n_mon
         if abs(proposed) < min_dt:
             info[0] = worst
@@ -639,26 +639,25 @@ _JITTED = {"_predict": njit(_predict), "_g_from_b": njit(_g_from_b),
            "_b_from_g": njit(_b_from_g), "_first_step": njit(_first_step)}
 
 
-def ias15_loop(force, stop=False):
+def ias15_loop(force):
     """The IAS15 loop compiled for a :class:`~orbits._kernels.stepping.ForceKernel`.
 
-    ``stop`` compiles in the stopping conditions of :mod:`.stopping`.
     Velocities are predicted at the substeps only for forces that read them
     (gravity does not), and for forces whose non-conservative terms' work it
     integrates.
 
     The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
-    dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs,
-    max_steps, epsilon, min_dt, mode, marks, mark_steps)`` with the arrays of
+    dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, stopping,
+    max_steps, epsilon, min_dt, mode, marks, mark_steps)`` (``stopping`` a stopping
+    record, :func:`~orbits._kernels.stopping.stop_record`) with the arrays of
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
     # the work rate P = sum m a . v needs the velocities at the nodes
     predict_v = force.velocity_dependent or force.opaque or force.work is not None
     helpers = _JITTED if force.jit else {}
-    suffix = f"{force.key}{'_stop' if stop else ''}"
-    return specialize(_ias15_loop, suffix, jit=force.jit, cache=force.cache,
+    return specialize(_ias15_loop, force.key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,
-                      step_end=step_epilogue(force, stop), PREDICT_V=predict_v,
+                      step_end=step_epilogue(force), PREDICT_V=predict_v,
                       record_row=force.recorder,
                       rows=measured_rows(force), **work_kernels(force), **helpers)

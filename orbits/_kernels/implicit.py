@@ -309,7 +309,7 @@ def jacobian_for(force, velocity_dependent):
 # -- the loop ---------------------------------------------------------------------------
 
 def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, piv, newton,
-                   fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every, sargs):
+                   fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every, stopping):
     # theta bound by specialize: 1.0 implicit Euler, 0.5 implicit midpoint.
     # w: the unknown velocity increment W; dw: residual, then Newton update;
     # xs, vs: stage point; acc: accelerations there (kept for the next
@@ -394,7 +394,7 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
         cache[0] = 1
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, mon, n_mon, mon_t, mon_out, sargs, fargs)
+            every, mon, n_mon, mon_t, mon_out, stopping, fargs)
         if status != GO:
             if status == Status.NON_FINITE:
                 cache[0] = 0
@@ -402,17 +402,17 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
     return Status.OK, nsteps, n_mon
 
 
-def implicit_loop(force, name, theta, velocity_dependent, stop=False):
+def implicit_loop(force, name, theta, velocity_dependent):
     """The Newton loop of a one-leg theta-method compiled for a :class:`~.stepping.ForceKernel`.
 
     ``theta`` is 1.0 (implicit Euler) or 0.5 (implicit midpoint); ``name``
-    names the method; the Jacobian is :func:`jacobian_for`'s; ``stop``
-    compiles in the stopping conditions of :mod:`.stopping`.
+    names the method; the Jacobian is :func:`jacobian_for`'s; the loop's last
+    argument is a stopping record (:func:`~.stopping.stop_record`).
     """
     jac, jkey = jacobian_for(force, velocity_dependent)
     if jkey == "fd" and velocity_dependent:
         jkey = "fd_v"
-    return specialize(_implicit_loop, f"{name}_{force.key}_{jkey}{'_stop' if stop else ''}",
+    return specialize(_implicit_loop, f"{name}_{force.key}_{jkey}",
                       jit=force.jit, cache=force.cache and not jkey.startswith("own"),
-                      force=force.kernel, jacobian=jac, step_end=step_epilogue(force, stop),
+                      force=force.kernel, jacobian=jac, step_end=step_epilogue(force),
                       THETA=float(theta), **work_kernels(force))

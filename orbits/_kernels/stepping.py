@@ -20,10 +20,11 @@ exact failing step and recomputes the last good state from it
 (:func:`orbits._driver.advance_checked`), so the loop pays for neither a
 copy nor a check every step.
 
-After every step a loop calls its stopping check (:mod:`.stopping`); a
-check that fires ends the loop with its status and ``steps_done`` counting
-the step that triggered it.  Loops compiled without conditions call
-:func:`~.stopping.no_stop`, which compiles to nothing.
+After every step a loop checks the stopping conditions of its stopping
+record ``stopping = (sargs, check)`` (:mod:`.stopping`: a pointer and the
+conditions as data, so one loop serves a run with or without them; without,
+the check is a branch); a check that fires ends the loop with its status and
+``steps_done`` counting the step that triggered it.
 
 Monitors (energy, angular momentum, ...) are recorded every ``every`` steps,
 counted from the start of the simulation (``step0``), into ``mon_t`` and
@@ -62,16 +63,13 @@ from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
                       accelerate_pairwise_small)
 from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, monitor_row
 from .status import Status
-from .stopping import check_stop, no_stop
+from .stopping import call_check
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
-           "user_force", "state_is_finite", "ForceKernel", "NO_STOP_ARGS", "with_terms",
+           "user_force", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
            "clock_step", "add_compensated", "stop_info"]
-
-#: the stopping arguments of a loop compiled without conditions
-NO_STOP_ARGS = (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64))
 
 #: operator codes of a splitting table
 DRIFT = 0
@@ -157,10 +155,10 @@ def add_compensated(x, dx, cs):
 
 
 @njit(inline="always")
-def stop_info(sargs, info):
-    """The bodies behind a stopping condition (the stop arguments' last
-    entry) into an adaptive loop's ``info``."""
-    sinfo = sargs[6]
+def stop_info(stopping, info):
+    """The bodies behind a stopping condition (``sargs[6]`` of the stopping
+    record ``stopping``) into an adaptive loop's ``info``."""
+    sinfo = stopping[0][6]
     info[0] = sinfo[0]
     info[1] = sinfo[1]
 
@@ -195,7 +193,7 @@ def first_record(every, step0, mon_t):
 
 
 def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record, every,
-              mon, n_mon, mon_t, mon_out, sargs, fargs):
+              mon, n_mon, mon_t, mon_out, stopping, fargs):
     # The epilogue of every loop's step, at time t after step k (of nsteps):
     # the finite check (fixed-step loops, check=True: every check_every
     # steps and after the last; adaptive loops test their error estimate
@@ -227,11 +225,11 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
         _record(x, v, t, mon, np.int64(n_mon), mon_t, mon_out)
         work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
         n_mon += 1
-    stop = stop_check(x, v, t, sargs)  # noqa: F821 - bound by specialize
-    if stop != 0:
+    status = stop_check(x, v, t, stopping)  # noqa: F821 - bound by specialize
+    if status != 0:
         if check and not state_is_finite(x, v):
             return Status.NON_FINITE, k, until_check, until_record, n_mon
-        return stop, k + 1, until_check, until_record, n_mon
+        return status, k + 1, until_check, until_record, n_mon
     if renormalise:
         # the chaos indicators' tangent vector has grown large: the driver
         # scales it back between calls (orbits._kernels.variational)
@@ -239,26 +237,26 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
     return GO, k + 1, until_check, until_record, n_mon
 
 
-def step_epilogue(force, stop=False):
-    """The step epilogue of the loops compiled for a :class:`ForceKernel`
-    (``stop``: with the stopping conditions of :mod:`.stopping`)."""
+def step_epilogue(force):
+    """The step epilogue of the loops compiled for a :class:`ForceKernel`,
+    which take a stopping record (:func:`~.stopping.stop_record`)."""
     from .variational import tangent_kernels
-    return epilogue(force.recorder, f"{force.key}{'_stop' if stop else ''}", jit=force.jit,
-                    cache=force.cache, runtime=force.runtime, stop=stop,
-                    work_note=work_kernels(force)["work_note"],
+    return epilogue(force.recorder, force.key, jit=force.jit, cache=force.cache,
+                    runtime=force.runtime, work_note=work_kernels(force)["work_note"],
                     tangent_step=tangent_kernels(force)["tangent_step"])
 
 
-def epilogue(record, key, jit=True, cache=True, runtime=False, stop=False, work_note=None,
+def epilogue(record, key, jit=True, cache=True, runtime=False, stop=None, work_note=None,
              tangent_step=None):
     """The step epilogue with monitor recorder ``record``, compiled under ``key``
-    (``runtime``: for loops that need numba's runtime; ``stop``: True for the
-    stopping conditions of :mod:`.stopping`, or a check of the same signature
-    that a loop binds instead; ``work_note``: what writes the work of
-    non-conservative terms into a monitor row, see :func:`work_kernels`; none
-    by default; ``tangent_step``: the chaos indicators' update after a step,
-    see :mod:`.variational`; none by default)."""
-    stop_check = stop if callable(stop) else check_stop if stop else no_stop
+    (``runtime``: for loops that need numba's runtime; ``stop``: the
+    stopping check ``stop(x, v, t, stop_args) -> status`` that a loop binds,
+    by default :func:`~.stopping.call_check` of a stopping record;
+    ``work_note``: what writes the work of non-conservative terms into a
+    monitor row, see :func:`work_kernels`; none by default;
+    ``tangent_step``: the chaos indicators' update after a step, see
+    :mod:`.variational`; none by default)."""
+    stop_check = call_check if stop is None else stop
     return specialize(_step_end, key, jit=jit, inline=True, nrt=runtime, cache=cache,
                       _record=record, stop_check=stop_check,
                       work_note=_no_work_note if work_note is None else work_note,
@@ -567,7 +565,7 @@ def add_scaled(a, aF, h, b, bF, flat):
 
 
 def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_dependent, mon,
-                    step0, mon_t, mon_out, check_every, sargs):
+                    step0, mon_t, mon_out, check_every, stopping):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
     # (v += c dt a(x)), the table KINDS/COEFS bound by specialize as constant
     # tuples, so that the compiler unrolls it.  The acceleration depends only
@@ -622,7 +620,7 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
                     work_add(fargs, -h * work_rate(x, vm, tx, fargs))  # noqa: F821
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, mon, n_mon, mon_t, mon_out, sargs, fargs)
+            every, mon, n_mon, mon_t, mon_out, stopping, fargs)
         if status != GO:
             cache[0] = 1 if fresh and status != Status.NON_FINITE else 0
             return status, done, n_mon
@@ -682,15 +680,15 @@ def _implicit_kick_for(force):
     return called(kick, nrt=force.runtime) if force.jit else kick
 
 
-def splitting_loop(force, name, kinds, coefs, stop=False):
+def splitting_loop(force, name, kinds, coefs):
     """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
 
-    ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method;
-    ``stop`` compiles in the stopping conditions of :mod:`.stopping`.
+    ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method.
+    The loop's last argument is a stopping record (:func:`~.stopping.stop_record`).
     """
-    return specialize(_splitting_loop, f"{name}_{force.key}{'_stop' if stop else ''}",
+    return specialize(_splitting_loop, f"{name}_{force.key}",
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
-                      step_end=step_epilogue(force, stop),
+                      step_end=step_epilogue(force),
                       implicit_kick=_implicit_kick_for(force),
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), **work_kernels(force))
@@ -736,7 +734,7 @@ def rk_sums(sx, sv, kxF, kvF, b, count):
 
 
 def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, step0,
-                      mon_t, mon_out, check_every, sargs):
+                      mon_t, mon_out, check_every, stopping):
     # y = (x, v), y' = (v, a(x, v, t)); stage s has state
     # y + dt sum_j A[s, j] k_j and derivative k_s.  kx[s] = stage velocity,
     # kv[s] = stage acceleration.  The work is the same method applied to
@@ -772,15 +770,15 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
             work_add(fargs, -dt * pw)  # noqa: F821
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
-            every, mon, n_mon, mon_t, mon_out, sargs, fargs)
+            every, mon, n_mon, mon_t, mon_out, stopping, fargs)
         if status != GO:
             return status, done, n_mon
     return Status.OK, nsteps, n_mon
 
 
-def runge_kutta_loop(force, stop=False):
-    """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`
-    (``stop``: with the stopping conditions of :mod:`.stopping`)."""
-    return specialize(_runge_kutta_loop, f"{force.key}{'_stop' if stop else ''}",
+def runge_kutta_loop(force):
+    """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`; its
+    last argument is a stopping record (:func:`~.stopping.stop_record`)."""
+    return specialize(_runge_kutta_loop, force.key,
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
-                      step_end=step_epilogue(force, stop), **work_kernels(force))
+                      step_end=step_epilogue(force), **work_kernels(force))

@@ -3,9 +3,18 @@
 A check has the signature ``check(x, v, t, sargs) -> status`` (``t`` the
 time of the state) and, when it fires, writes the bodies concerned into
 ``sargs[6]`` (an int64 array of two: the pair for an encounter or a
-collision; the body and -1 for an escape).  Loops are compiled
-with :func:`no_stop` when a simulation asks for no condition, which inlines to
-nothing, so such a scene pays nothing for the feature.
+collision; the body and -1 for an escape).
+
+The conditions are data: a loop takes the stopping record ``(sargs, check)``
+(:func:`stop_record`), ``check`` a pointer to :func:`check_stop` compiled as
+a C callable of the signature :data:`CHECK` (numba's first-class functions),
+and calls it after a step only where ``sargs[0]`` (the mask) is not 0
+(:func:`call_check`): one loop serves every combination of conditions, and a
+run without any pays a branch a step.  The pointer is compiled once, on
+first use, and cached; every simulation's ``sargs`` has the type
+:data:`SARGS`, a run without conditions :func:`no_conditions`.  A C callable
+cannot raise into its caller; :func:`check_stop` raises nothing (numpy's
+error model, no allocation).
 
 ``sargs = (mask, distance2, hill_k, escape2, gm, central, info, radii, prev,
 clock, work, hit, log_hill, log_distance, log, log_n)``:
@@ -51,11 +60,15 @@ clock, work, hit, log_hill, log_distance, log, log_n)``:
 
 import math
 
-from ._jit import njit
+import numpy as np
+from numba.core import types as nbtypes
+
+from ._jit import cfunc, njit
 from .encounters import closest_approach, kepler_contact
 from .status import Status
 
-__all__ = ["no_stop", "check_stop", "collision_check", "collision_pairs", "keep_state",
+__all__ = ["no_stop", "check_stop", "SARGS", "CHECK", "AHEAD", "no_conditions",
+           "stop_record", "call_check", "check_pointer", "ahead_pointer", "collision_check", "collision_pairs", "keep_state",
            "encounter_log", "encounter_check", "collision_ahead", "ENCOUNTER_DISTANCE",
            "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG",
            "LOOKS_INSIDE"]
@@ -526,3 +539,93 @@ def check_stop(x, v, t, sargs):
                 info[1] = -1
                 return Status.ESCAPE
     return Status.LOG_FULL if full else 0
+
+
+# -- the conditions as data: the stopping record of the loops ----------------------
+
+_F1 = nbtypes.float64[::1]
+_I1 = nbtypes.int64[::1]
+_F2 = nbtypes.float64[:, ::1]
+#: the numba type of ``sargs`` (see the module notes), the same for every simulation
+SARGS = nbtypes.Tuple((nbtypes.int64, nbtypes.float64, nbtypes.float64, nbtypes.float64, _F1,
+                       nbtypes.int64, _I1, _F1, nbtypes.float64[:, :, ::1], _F1, _F2, _F1,
+                       nbtypes.float64, nbtypes.float64, _F2, _I1))
+#: the signature of a check's pointer: ``check(x, v, t, sargs) -> status``
+CHECK = nbtypes.int64(_F2, _F2, nbtypes.float64, SARGS)
+#: the signature of :func:`ahead_pointer`'s pointer: ``ahead(x, v, t, h, sargs) -> bool``
+AHEAD = nbtypes.boolean(_F2, _F2, nbtypes.float64, nbtypes.float64, SARGS)
+
+
+def _check(x, v, t, sargs):
+    return check_stop(x, v, t, sargs)
+
+
+def _no_check(x, v, t, sargs):
+    return 0
+
+
+def _ahead(x, v, t, h, sargs):
+    keep_state(x, v, t, sargs)
+    return collision_ahead(x, v, t, h, sargs)
+
+
+def _no_ahead(x, v, t, h, sargs):
+    return False
+
+
+_POINTERS = {}
+
+
+def check_pointer(conditions=True):
+    """The pointer of :func:`check_stop` (``conditions``), or of a check that
+    carries on, as a C callable of :data:`CHECK`: compiled on first use and
+    cached on disk."""
+    key = bool(conditions)
+    if key not in _POINTERS:
+        _POINTERS[key] = cfunc(CHECK, _check if key else _no_check)
+    return _POINTERS[key]
+
+
+def ahead_pointer(conditions=True):
+    """For a loop whose step may not finish (``trace``'s inner integration):
+    the pointer of :data:`AHEAD` that keeps ``x``, ``v`` at ``t`` as the
+    state of the last check (:func:`keep_state`) and answers
+    :func:`collision_ahead` within ``h`` (``conditions``), or that does
+    nothing; compiled on first use and cached on disk."""
+    key = ("ahead", bool(conditions))
+    if key not in _POINTERS:
+        _POINTERS[key] = cfunc(AHEAD, _ahead if conditions else _no_ahead)
+    return _POINTERS[key]
+
+
+def no_conditions():
+    """``sargs`` without conditions (mask 0), of the type :data:`SARGS`."""
+    return (0, 0.0, 0.0, 0.0, np.zeros(1), 0, np.zeros(2, dtype=np.int64), np.zeros(1),
+            np.zeros((2, 1, 3)), np.zeros(2), np.zeros((4, 3)), np.zeros(3), 0.0, 0.0,
+            np.zeros((0, 5)), np.zeros(3, dtype=np.int64))
+
+
+_NONE = None
+
+
+def stop_record(sargs=None):
+    """The stopping record ``(sargs, check)`` the loops take for a simulation's
+    ``sargs`` (None: no conditions, and a check never called).  The pointer
+    comes second: numba takes a tuple that starts with a function for a
+    sequence of functions (and warns that this is experimental)."""
+    global _NONE
+    if sargs is None:
+        if _NONE is None:
+            _NONE = (no_conditions(), check_pointer(False))
+        return _NONE
+    return (sargs, check_pointer(sargs[0] != 0))
+
+
+@njit(inline="always")
+def call_check(x, v, t, stop):
+    """The conditions of the stopping record ``stop`` after a step: 0 to carry
+    on.  Without conditions, a branch."""
+    sargs = stop[0]
+    if sargs[0] == 0:
+        return 0
+    return stop[1](x, v, t, sargs)

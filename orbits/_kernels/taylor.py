@@ -249,7 +249,7 @@ def radius_step(X, order):
 
 
 def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp, tc, info,
-                 counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps, order, min_dt,
+                 counts, fargs, mon, step0, mon_t, mon_out, stopping, max_steps, order, min_dt,
                  marks, mark_steps):
     # counts: (accepted steps, 0, series expanded x order) of this call; tc:
     # (time reached, the part of it t + dt rounded away), as in the IAS15
@@ -309,10 +309,10 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
         counts[0] += 1
         dtp[0] = proposed
         stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
-            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out, sargs,
-            fargs)
+            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
+            stopping, fargs)
         if stop != GO:
-            stop_info(sargs, info)
+            stop_info(stopping, info)
             return stop, t, n_mon
         if t == target:
             if not has_marks:
@@ -328,17 +328,15 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
             target = marks[k_mark]
 
 
-def taylor_loop(force, stop=False):
-    """The Taylor loop compiled for gravity's :class:`~orbits._kernels.stepping.ForceKernel`
-    (``stop``: with the stopping conditions of :mod:`.stopping`).
+def taylor_loop(force):
+    """The Taylor loop compiled for gravity's :class:`~orbits._kernels.stepping.ForceKernel`.
 
     The loop is ``loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv,
-    dt, tc, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, max_steps,
+    dt, tc, info, counts, fargs, mon, step0, mon_t, mon_out, stopping, max_steps,
     order, min_dt, marks, mark_steps)`` with the arrays of
     :meth:`orbits.integrators.taylor.Taylor.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the counts in ``counts``.
     """
-    suffix = f"{force.key}{'_stop' if stop else ''}"
-    return specialize(_taylor_loop, suffix, jit=force.jit, cache=force.cache,
-                      nrt=force.runtime, step_end=step_epilogue(force, stop),
+    return specialize(_taylor_loop, force.key, jit=force.jit, cache=force.cache,
+                      nrt=force.runtime, step_end=step_epilogue(force),
                       record_row=force.recorder, **work_kernels(force))

@@ -66,7 +66,6 @@ from .coordinates import from_democratic_heliocentric, to_democratic_heliocentri
 from .gravity import pair_accelerations
 from .status import Status
 from .stepping import GO, _record, epilogue, first_record
-from .stopping import collision_ahead, keep_state
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 __all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
@@ -556,7 +555,7 @@ _jump_call = called(jump)
 
 def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active, acc, xs, vs,
                 w1, w2, state, owed_box, checked, enc, enc_new, params, inner, tabs, mon, step0,
-                mon_t, mon_out, check_every, sargs, targs):
+                mon_t, mon_out, check_every, stopping, targs):
     # state: [0] internal state current, [1] system checked, [2] the segment
     # started at a criterion point (else at a synchronised state: no opening
     # kick), [3] the segment integrates everything (a close pericentre),
@@ -568,8 +567,11 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
     # params: (k_hill, k_speed, k_peri, rtol); inner: the inner integrator's
     # arrays, whose counts (segments with flags, redos, inner steps) add up.
     # targs: the added terms' arguments (kicked with gravity's interaction,
-    # HAS_TERMS and term_kick bound by specialize).
+    # HAS_TERMS and term_kick bound by specialize).  stopping: the stopping
+    # record (orbits._kernels.stopping.stop_record) and the pointer of
+    # ahead_pointer after it.
     k_hill, k_speed, k_peri, rtol = params
+    checks = stopping[0][0] != 0
     counts = inner[11]
     n = xh.shape[0]
     every = mon[0]
@@ -665,10 +667,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             from_democratic_heliocentric(xc, vc, gm, x, v)
             state[0] = 0
             checked[1] = 0.0
-            if STOP:  # noqa: F821 - bound by specialize
-                keep_state(x, v, t_start, sargs)
-                if collision_ahead(x, v, t_start, seg, sargs):
-                    return Status.COLLISION, k, n_mon
+            if checks and stopping[2](x, v, t_start, seg, stopping[0]):
+                return Status.COLLISION, k, n_mon
             return Status.STEP_UNDERFLOW, k, n_mon
         if flagged or peri:
             counts[0] += 1
@@ -726,12 +726,12 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
         # encounter, every step); else the epilogue sees the internal state
         # (the finite check)
         seen_x, seen_v, t_seen = xh, vb, t + (k + 1) * dt
-        if until_record == 1 or (STOP and k + 1 == nsteps):  # noqa: F821 - by specialize
+        if until_record == 1 or (checks and k + 1 == nsteps):
             trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v, w1,
                               w2, inner, tabs, rtol)
             checked[1] = 0.0
             seen_x, seen_v = x, v
-        elif STOP:  # noqa: F821
+        elif checks:
             from_democratic_heliocentric(xc, vc, gm, x, v)
             t_seen -= owed
             checked[0] = t_seen
@@ -739,7 +739,7 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             seen_x, seen_v = x, v
         status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
             seen_x, seen_v, t_seen, k, nsteps, True, until_check, check_every, until_record,
-            every, mon, n_mon, mon_t, mon_out, sargs, ())
+            every, mon, n_mon, mon_t, mon_out, stopping, ())
         if status != GO:
             return status, done, n_mon
     return Status.OK, nsteps, n_mon
@@ -750,12 +750,13 @@ def _no_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
     pass
 
 
-def trace_loop(stop=False, record=_record, terms=None):
-    """The ``trace`` loop, compiled with (``stop``) or without the stopping
-    conditions of :mod:`.stopping`, ``record`` recording the monitors, and
-    ``terms`` (a :class:`~orbits._kernels.terms.TermKernel` of position-only
-    terms, or None) kicked with the interaction, as ``wh`` kicks them."""
-    key = "trace_stop" if stop else "trace"
+def trace_loop(record=_record, terms=None):
+    """The ``trace`` loop, ``record`` recording the monitors, and ``terms`` (a
+    :class:`~orbits._kernels.terms.TermKernel` of position-only terms, or
+    None) kicked with the interaction, as ``wh`` kicks them.  It takes a
+    stopping record (:func:`~.stopping.stop_record`) with
+    :func:`~.stopping.ahead_pointer`'s pointer added."""
+    key = "trace"
     if terms is None:
         kick, cache = _no_term_kick, True
     else:
@@ -763,10 +764,9 @@ def trace_loop(stop=False, record=_record, terms=None):
         cache = terms.cache
         kick = specialize(_heliocentric_term_kick, f"trace_{terms.key}", cache=cache,
                           inline=True, nrt=not cache, extra=terms.accel)
-    return specialize(_trace_loop, key, cache=cache, nrt=not cache, STOP=bool(stop),
+    return specialize(_trace_loop, key, cache=cache, nrt=not cache,
                       HAS_TERMS=terms is not None, term_kick=kick,
-                      step_end=epilogue(record, key, cache=cache, runtime=not cache,
-                                        stop=stop))
+                      step_end=epilogue(record, key, cache=cache, runtime=not cache))
 
 
 def inner_arrays(n, stages):

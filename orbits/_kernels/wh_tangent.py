@@ -811,16 +811,16 @@ def tangent_synchronizer(coordinates, terms, force):
     return _kernels(coordinates, terms, _key(coordinates, force), force.cache)[3]
 
 
-def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force, escape=False):
+def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
     """The Wisdom-Holman loop of :func:`orbits._kernels.wisdom_holman.wh_loop`
     compiled with the tangent of every operator, for a force with variations
     ``force`` (its ``inner`` the gravity, with ``terms``); with the chaos
     indicators after every step if ``force.chaos``, and with the escape check
-    of :func:`~orbits._kernels.wisdom_holman.escape_kernels` on the bodies if
-    ``escape``.  Called with ``targs = (terms' args, tp)`` (see the module
-    notes), ``gm`` and ``eta`` of the bodies alone (``n`` entries), the state
-    arrays of ``n (1 + K)`` rows and the stopping arguments (``()`` without
-    ``escape``)."""
+    of :func:`~orbits._kernels.wisdom_holman.escape_kernels` on the bodies.
+    Called with ``targs = (terms' args, tp)`` (see the module notes), ``gm``
+    and ``eta`` of the bodies alone (``n`` entries), the state arrays of
+    ``n (1 + K)`` rows and a stopping record
+    (:func:`~orbits._kernels.stopping.stop_record`)."""
     from .stepping import epilogue, work_kernels
     from .variational import chaos_update, renormalise
     key = _key(coordinates, force)
@@ -837,12 +837,9 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force, escape=False)
                           renormalise=renormalise)
     note = specialize(_chaos_note, key, cache=cache, inline=True, nrt=nrt,
                       note=work_kernels(force)["work_note"])
-    stop, stopping = False, {}
-    if escape:
-        key = f"{key}_escape"
-        bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,
-                            synchronize=sync)
-        stopping["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
+    bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,
+                        synchronize=sync)
+    stop_args, stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=called(to_internal, nrt),
@@ -850,4 +847,4 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force, escape=False)
                       apply_corrector=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache,
                                         work_note=note, tangent_step=step, stop=stop),
-                      **stopping)
+                      stop_args=stop_args)

@@ -106,7 +106,7 @@ from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
-from .stopping import check_stop
+from .stopping import no_stop
 from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, resident_drift_twice,
                        resident_finite, resident_jump_kick, resident_kick, resident_load,
                        resident_store)
@@ -462,11 +462,11 @@ def _lanes_note(xj, vj, t, mon, n_mon, mon_t, mon_out):
 
 
 def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
-             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs, sargs):
+             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs, stopping):
     # xj, vj: the internal (Jacobi or democratic heliocentric) state;
-    # eta: G times the mass each row's Kepler drift orbits; sargs: the
-    # stopping arguments of a loop compiled with the escape check (see
-    # escape_kernels), () for the others.
+    # eta: G times the mass each row's Kepler drift orbits; stopping: the
+    # stopping record (orbits._kernels.stopping.stop_record), whose escape
+    # conditions the loops without lanes check (see escape_kernels).
     # state[0]: xj, vj hold the current state (else start from x, v);
     # owed_box[0]: the drift the internal state still owes, deferred from the
     # last step's closing drift; cdt[0]: the step the mapping state's
@@ -532,7 +532,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
             status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
                 xj, vj, t + (k + 1) * dt, k, nsteps, not RESIDENT, until_check, check_every,
                 until_record, every, (mon, sync), n_mon, mon_t, mon_out,
-                stop_args(sargs, sync), sync)
+                stop_args(stopping, sync), sync)
         else:
             status, done = Status.NON_FINITE, k
         if status != GO:
@@ -552,8 +552,9 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
 
 
 @njit(inline="always")
-def stop_args(sargs, sync):
-    # what the epilogue's stopping check takes: nothing in a loop without one
+def stop_args(stopping, sync):
+    # what the epilogue's stopping check takes: nothing in the lanes' loop,
+    # which checks no conditions
     return ()
 
 
@@ -609,20 +610,28 @@ def may_escape(xj, vj, gm, eta, owed, corr, esc2):
     return not reach * reach <= esc2
 
 
-def _escape_args(sargs, sync):
-    return (sargs, sync)
+def _escape_args(stopping, sync):
+    return (stopping, sync)
+
+
+def _escape_gate(xj, vj, t, args):
+    # without conditions, a branch
+    if args[0][0][0] == 0:
+        return 0
+    return escape_check(xj, vj, t, args)  # noqa: F821 - bound by specialize
 
 
 def _escape_check(xj, vj, t, args):
     # the escape conditions of orbits._kernels.stopping (ESCAPE, UNBOUND) on
     # the inertial state at the end of the step, which is synchronised into
     # x, v (as for an output) only where a body may be beyond the distance
-    sargs, sync = args
+    stopping, sync = args
+    sargs = stopping[0]
     gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
     if not may_escape(xj, vj, gm, eta, owed, corr, sargs[3]):
         return 0
     synchronize_bodies(xj, vj, sync)  # noqa: F821 - bound by specialize
-    return check_stop(x, v, t, sargs)
+    return stopping[1](x, v, t, sargs)
 
 
 def _synchronize_bodies(xj, vj, sync):
@@ -634,14 +643,17 @@ def _synchronize_bodies(xj, vj, sync):
 def escape_kernels(key, synchronize_bodies, cache=True, nrt=False):
     """The bindings of :func:`_wh_loop` and of its step epilogue's stopping
     check for a loop that checks escapes (``escape_distance``, and
-    ``escape_unbound``, of :class:`orbits.Simulation`), compiled under
-    ``key``: ``(stop_args, check)``.  ``synchronize_bodies(xj, vj, sync)``
-    writes the bodies' inertial state into ``x``, ``v`` of ``sync`` (the
-    synchronisation's arguments, as the loop hands them to its epilogue)."""
+    ``escape_unbound``, of :class:`orbits.Simulation`) where its stopping
+    record has conditions, compiled under ``key``: ``(stop_args, check)``.
+    ``synchronize_bodies(xj, vj, sync)`` writes the bodies' inertial state
+    into ``x``, ``v`` of ``sync`` (the synchronisation's arguments, as the
+    loop hands them to its epilogue)."""
     check = specialize(_escape_check, key, cache=cache, nrt=nrt,
                        synchronize_bodies=synchronize_bodies)
+    gate = specialize(_escape_gate, key, cache=cache, inline=True, nrt=nrt,
+                      escape_check=check)
     args = specialize(_escape_args, key, cache=cache, inline=True, nrt=nrt)
-    return args, check
+    return args, gate
 
 
 def _wh_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
@@ -831,7 +843,7 @@ def synchronizer(coordinates, terms=None, lanes=False):
 
 
 def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record,
-            lanes=False, escape=False):
+            lanes=False):
     """The Wisdom-Holman loop compiled for one table of Kepler drifts (DRIFT) and
     perturbation steps (KICK) in ``coordinates`` (a key of
     :data:`COORDINATE_SYSTEMS`); ``name`` names the table.  ``terms`` (a
@@ -841,14 +853,13 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     lanes (:mod:`orbits._kernels.wh_lanes`), bit for bit the same results;
     the loop's ``targs`` are then ``(wh_lanes.lanes_scratch(N),)``.  The
     corrector and the synchronisation stay scalar (they run once a call or
-    an output).  ``escape`` (not with ``lanes``): the loop checks the escape
-    conditions of :mod:`orbits._kernels.stopping` after every step on the
-    synchronised state (:func:`escape_kernels`) and takes their ``sargs``
-    (a loop without takes ``()``)."""
+    an output).  The loop takes a stopping record
+    (:func:`~orbits._kernels.stopping.stop_record`); without ``lanes`` it
+    checks the escape conditions of :mod:`orbits._kernels.stopping` after
+    every step on the synchronised state where the record has conditions
+    (:func:`escape_kernels`); the lanes' loop checks none."""
     if lanes and terms is not None:
         raise ValueError("wh_loop: the lanes' loop takes no added terms")
-    if lanes and escape:
-        raise ValueError("wh_loop: the lanes' loop checks no escapes")
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, lanes)
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
@@ -879,9 +890,8 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     else:
         recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, synchronize=sync,
                               _record=record)
-    stop = False
-    if escape:
-        key = f"{key}_escape"
+    stop = no_stop
+    if not lanes:
         bodies = specialize(_synchronize_bodies, key, cache=cache, inline=True, nrt=nrt,
                             synchronize=sync)
         outputs["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)

@@ -22,8 +22,7 @@ def loop_for(factory, force, *args, **options):
     >>> from orbits._kernels import ias15, stepping
     >>> from orbits.integrators._loops import loop_for
     >>> force = stepping.gravity_force("small")
-    >>> loop_for(ias15.ias15_loop, force, stop=False) is loop_for(ias15.ias15_loop, force,
-    ...                                                            stop=False)
+    >>> loop_for(ias15.ias15_loop, force) is loop_for(ias15.ias15_loop, force)
     True
     """
     key = (factory, force.key, force.jit, force.cache, force.runtime, args,

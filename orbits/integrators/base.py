@@ -49,6 +49,7 @@ import numpy as np
 
 from .._kernels.status import with_status
 from .._kernels import stepping
+from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError, OrbitsWarning
 
 __all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
@@ -410,13 +411,12 @@ class SplittingMethod(Integrator):
         >>> status.name, np.round(x[1], 6)
         ('OK', array([ 1., -0.,  0.]))
         """
-        loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs,
-                                       stop=stop is not None)
+        loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs)
         fargs = stepping.work_bound(force, fargs, ws)
         return with_status(*loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
                     velocity_dependent or force.velocity_dependent,
                     mon, step0, mon_t, mon_out, check_every,
-                    stepping.NO_STOP_ARGS if stop is None else stop))
+                    stop_record(stop)))
 
     def invalidate(self, ws):
         """Drop the cached force: the next kick evaluates it again.
@@ -509,11 +509,11 @@ class ExplicitRungeKutta(Integrator):
         >>> status.name, steps
         ('OK', 1000)
         """
-        loop = stepping.runge_kutta_loop(force, stop=stop is not None)
+        loop = stepping.runge_kutta_loop(force)
         fargs = stepping.work_bound(force, fargs, ws)
         return with_status(*loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
                     ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every,
-                    stepping.NO_STOP_ARGS if stop is None else stop))
+                    stop_record(stop)))
 
 
 class AdaptiveIntegrator(Integrator):

@@ -5,6 +5,7 @@ import numpy as np
 from .._kernels.status import with_status
 from .._kernels import doubling as _doubling
 from .._kernels import stepping as _stepping
+from .._kernels.stopping import stop_record
 from ._loops import loop_for
 from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
 
@@ -63,12 +64,12 @@ class RK4Doubling(AdaptiveIntegrator):
         """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
-        loop = loop_for(_doubling.doubling_loop, force, stop=stop is not None)
+        loop = loop_for(_doubling.doubling_loop, force)
         fargs = _stepping.work_bound(force, fargs, ws)
         w = ws
         args = (x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
                 w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
                 w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
-                _stepping.NO_STOP_ARGS if stop is None else stop, int(max_steps),
+                stop_record(stop), int(max_steps),
                 float(self.config["rtol"]), float(self.config["atol"]))
         return with_status(*loop(*args, marks, mark_steps))

@@ -5,6 +5,7 @@ import numpy as np
 from .._kernels.status import with_status
 from .._kernels import embedded as _embedded
 from .._kernels import stepping as _stepping
+from .._kernels.stopping import stop_record
 from . import dop853_coefficients as _dop853
 from . import tableaux
 from ._loops import loop_for
@@ -53,13 +54,12 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
-        loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None,
-                        stop=stop is not None)
+        loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None)
         fargs = _stepping.work_bound(force, fargs, ws)
         args = (x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
                 float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],
                 ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
-                mon_t, mon_out, _stepping.NO_STOP_ARGS if stop is None else stop,
+                mon_t, mon_out, stop_record(stop),
                 int(max_steps), float(self.config["rtol"]), float(self.config["atol"]))
         return with_status(*loop(*args, marks, mark_steps))
 

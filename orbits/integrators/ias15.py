@@ -4,7 +4,8 @@ import numpy as np
 
 from .._kernels.status import Status
 from .._kernels import ias15 as _k
-from .._kernels.stepping import NO_STOP_ARGS, work_bound
+from .._kernels.stepping import work_bound
+from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
 from ._loops import loop_for
 from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
@@ -138,12 +139,12 @@ class IAS15(AdaptiveIntegrator):
         """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
         on each and record there a row of ``mon_out`` (monitors and state),
         its time in ``mon_t`` and its step count in ``mark_steps``."""
-        loop = loop_for(_k.ias15_loop, force, stop=stop is not None)
+        loop = loop_for(_k.ias15_loop, force)
         fargs = work_bound(force, fargs, ws)
         args = (x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
                 ws["er"], ws["csx"], ws["csv"], ws["xs"], ws["vs"], ws["acc"], ws["P"],
                 ws["dt"], ws["ref"], ws["tc"], ws["flags"], ws["info"], ws["counts"], fargs,
-                mon, int(step0), mon_t, mon_out, NO_STOP_ARGS if stop is None else stop,
+                mon, int(step0), mon_t, mon_out, stop_record(stop),
                 int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
                 ADAPTIVE_MODES[self.config["adaptive_mode"]])
         status, t_reached, n_mon = loop(*args, marks, mark_steps)

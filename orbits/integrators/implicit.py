@@ -16,6 +16,7 @@ import numpy as np
 
 from .._kernels.status import Status
 from .._kernels import implicit, stepping
+from .._kernels.stopping import stop_record
 from .base import Integrator
 
 __all__ = ["ImplicitOneLeg", "ImplicitEuler", "ImplicitMidpoint"]
@@ -53,14 +54,13 @@ class ImplicitOneLeg(Integrator):
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         velocity_dependent = bool(velocity_dependent or force.velocity_dependent)
-        loop = implicit.implicit_loop(force, self.name, self.theta, velocity_dependent,
-                                      stop=stop is not None)
+        loop = implicit.implicit_loop(force, self.name, self.theta, velocity_dependent)
         fargs = stepping.work_bound(force, fargs, ws)
         status, done, n_mon = loop(
             x, v, t, dt, nsteps, ws["w"], ws["dw"], ws["xs"], ws["vs"], ws["acc"],
             ws["cache"], ws["jx"], ws["jv"], ws["lu"], ws["piv"], ws["newton_iterations"],
             fargs, bool(velocity_dependent), mon, step0, mon_t, mon_out, check_every,
-            stepping.NO_STOP_ARGS if stop is None else stop)
+            stop_record(stop))
         return Status(status), done, n_mon
 
     def invalidate(self, ws):

@@ -5,7 +5,7 @@ import numbers
 import numpy as np
 
 from .._kernels import taylor as _k
-from .._kernels.stepping import NO_STOP_ARGS
+from .._kernels.stopping import stop_record
 from .._kernels.status import Status
 from ..errors import IntegratorOptionError
 from ._loops import loop_for
@@ -157,11 +157,11 @@ class Taylor(AdaptiveIntegrator):
             # a workspace not bound yet, or bound for other bodies (the kernel
             # writes as many pairs as the massive bodies make)
             self.bind(ws, force, fargs)
-        loop = loop_for(_k.taylor_loop, force, stop=stop is not None)
+        loop = loop_for(_k.taylor_loop, force)
         status, t_reached, n_mon = loop(
             x, v, float(t), float(t_end), *ws["series"], ws["csx"], ws["csv"], ws["dt"],
             ws["tc"], ws["info"], ws["counts"], fargs, mon, int(step0), mon_t, mon_out,
-            NO_STOP_ARGS if stop is None else stop, int(max_steps), self.order_used,
+            stop_record(stop), int(max_steps), self.order_used,
             float(self.config["min_dt"]), marks, mark_steps)
         c = ws["counts"]
         return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon

@@ -9,7 +9,7 @@ import numpy as np
 from .._kernels import trace as _trace
 from .._kernels.coordinates import from_democratic_heliocentric
 from .._kernels.status import with_status
-from .._kernels.stepping import NO_STOP_ARGS
+from .._kernels.stopping import ahead_pointer, stop_record
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
 from .base import RTOL_FLOOR, Integrator
@@ -287,7 +287,7 @@ class Trace(Integrator):
             self.bind(ws, force, fargs)
             terms, targs = ws["terms"]
         c = self.config
-        loop = _trace.trace_loop(stop=stop is not None, record=force.recorder, terms=terms)
+        loop = _trace.trace_loop(record=force.recorder, terms=terms)
         params = (c["hill"], c["speed"], c["pericentre"], c["rtol"])
         return with_status(*loop(
             x, v, ws["xh"], ws["vb"], ws["xc"], ws["vc"], float(t), float(dt), int(nsteps),
@@ -295,7 +295,7 @@ class Trace(Integrator):
             ws["xs"], ws["vs"], ws["w1"], ws["w2"], ws["state"], ws["owed"], ws["checked"],
             ws["enc"],
             ws["enc_new"], params, self._inner(ws), self._tabs, mon, step0, mon_t, mon_out,
-            check_every, NO_STOP_ARGS if stop is None else stop, targs))
+            check_every, stop_record(stop) + (ahead_pointer(stop is not None),), targs))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v`` (the owed part of the

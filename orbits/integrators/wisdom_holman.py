@@ -22,6 +22,7 @@ from .._kernels import wisdom_holman as _wh
 from .._kernels import wh_lanes as _lanes
 from .._kernels import wh_tangent as _wht
 from .._kernels.stepping import DRIFT, KICK, work_bound
+from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
 from . import tableaux
 from .base import Integrator
@@ -401,9 +402,9 @@ class WisdomHolman(Integrator):
                 velocity_dependent=False, check_every=1, stop=None):
         """Advance by ``nsteps`` steps in the compiled loop (see
         :meth:`Integrator.advance`); with ``stop`` (the stopping arguments of
-        :mod:`orbits._kernels.stopping`, escapes only), the loop compiled with
-        the escape check, which looks at the synchronised state after every
-        step where a body may be beyond the escape distance
+        :mod:`orbits._kernels.stopping`, escapes only), the loop checks
+        escapes: it looks at the synchronised state after every step where a
+        body may be beyond the escape distance
         (:func:`orbits._kernels.wisdom_holman.may_escape`), and drifts its
         planets without the vector lanes."""
         if force.inner is not None:
@@ -419,11 +420,11 @@ class WisdomHolman(Integrator):
         gravity = fargs if terms is None else fargs[0]
         gm, n_active = gravity[0], gravity[1]
         loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"],
-                           terms, force.recorder, lanes, escape=stop is not None)
+                           terms, force.recorder, lanes)
         return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
                     ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
                     ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs,
-                    () if stop is None else stop))
+                    stop_record(stop)))
 
     @staticmethod
     def _loop_terms(ws, n):
@@ -463,13 +464,12 @@ class WisdomHolman(Integrator):
         gravity = fargs[0] if terms is None else fargs[0][0]
         gm, n_active = gravity[0], gravity[1]
         loop = _wht.wh_tangent_loop(self.name, self._kinds, self._coefs,
-                                    self.config["coordinates"], terms, force,
-                                    escape=stop is not None)
+                                    self.config["coordinates"], terms, force)
         return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"][:n],
                                  n_active, ws["acc"], ws["xs"], ws["vs"], ws["state"],
                                  ws["owed"], self._corr, ws["cdt"], mon, step0, mon_t,
                                  mon_out, check_every, (targs, tp),
-                                 () if stop is None else stop))
+                                 stop_record(stop)))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
