@@ -195,7 +195,7 @@ class ForceTerm:
         >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
         ...               b.positions.value, b.velocities.value)
         >>> bound = orbits.forces.GR("Star").bind(ctx)
-        >>> bound.args[0], round(1 / bound.args[2] ** 0.5, 1)   # source index; c in au/day
+        >>> bound.args[0], round(1 / bound.args[1] ** 0.5, 1)   # source index; c in au/day
         (0, 173.1)
         """
         raise NotImplementedError
@@ -697,7 +697,7 @@ class GRFull(ForceTerm):
         >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
         ...               b.positions.value, b.velocities.value)
         >>> bound = orbits.forces.GRFull().bind(ctx)
-        >>> bound.args[1]    # massive bodies
+        >>> bound.args[0]    # massive bodies
         2
         """
         ic2 = _inv_c2(self, self.c, ctx)
@@ -829,7 +829,7 @@ class ZonalHarmonics(ForceTerm):
         >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
         ...               b.positions.value, b.velocities.value)
         >>> bound = orbits.forces.ZonalHarmonics("Star", 0.005 * u.au, J2=1e-6).bind(ctx)
-        >>> bound.args[0], f"{bound.args[2] / b.units.G:.2e}"   # index; m J2 R^2 [Msun au^2]
+        >>> bound.args[0], f"{bound.args[1] / b.units.G:.2e}"   # index; m J2 R^2 [Msun au^2]
         (0, '2.50e-11')
         """
         b = ctx.index(self.body, repr(self), "body")
@@ -1253,7 +1253,7 @@ class TidesConstantTimeLag(ForceTerm):
         ...               b.positions.value, b.velocities.value)
         >>> bound = orbits.forces.TidesConstantTimeLag("Planet", k2=0.3, time_lag=1 * u.day,
         ...                                            radius=0.001 * u.au).bind(ctx)
-        >>> bound.args[0], f"{bound.args[2]:.1e}", bound.args[3]   # body, 3 k2 R^5, tau
+        >>> bound.args[0], f"{bound.args[1]:.1e}", bound.args[2]   # body, 3 k2 R^5, tau
         (1, '9.0e-16', 1.0)
         """
         term = repr(self)
@@ -1415,7 +1415,7 @@ class RadiationPressure(ForceTerm):
         >>> ctx = Context(b.names, m, b.units.G * m, 2, b.units, False, np.arange(2),
         ...               b.positions.value, b.velocities.value)
         >>> bound = orbits.forces.RadiationPressure("Star", beta=0.1).bind(ctx)
-        >>> bound.args[0], bound.args[2]     # the source; beta of each body
+        >>> bound.args[0], bound.args[3]     # the source; beta of each body
         (0, array([0. , 0.1]))
         """
         term = repr(self)
