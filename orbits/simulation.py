@@ -1999,7 +1999,7 @@ def _user_function_failed(fargs):
     wrong shape (see :mod:`orbits._user_functions`)."""
     from ._kernels.terms import TermTable
     if isinstance(fargs, TermTable):
-        return bool(fargs.user.flag[0])
+        return fargs.user is not None and bool(fargs.user.flag[0])
     if isinstance(fargs, tuple):
         return any(_user_function_failed(f) for f in fargs)
     return False

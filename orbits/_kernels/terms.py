@@ -41,7 +41,7 @@ import numpy as np
 
 from numba.core import types as nbtypes
 
-from ._jit import cfunc, njit, specialize
+from ._jit import njit, specialize
 from .invariants import _add
 
 __all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "TABLE", "table",
@@ -873,7 +873,7 @@ class TermTable(NamedTuple):
     m: np.ndarray         # masses, internal order
     an: np.ndarray        # scratch (N, 3)
     pot: np.ndarray       # scratch (N,)
-    user: UserTerms
+    user: UserTerms   # or None: no user terms
 
 
 class TermRow(NamedTuple):
@@ -885,30 +885,15 @@ class TermRow(NamedTuple):
     per_body: object = None
 
 
-def _no_user_accel(x, v, t, pos, xu, vu, mu, flag, acc):
-    pass
-
-
-def _no_user_energy(x, pos, xu, mu):
-    return 0.0
-
-
-_NO_USER = None
-
-
-def _no_user(n):
-    global _NO_USER
-    if _NO_USER is None:
-        _NO_USER = (cfunc(USER_ACCEL, _no_user_accel), cfunc(USER_ENERGY, _no_user_energy))
-    accel, energy = _NO_USER
-    return UserTerms(accel, energy, np.zeros(0, dtype=np.int64), np.zeros((0, 3)),
-                     np.zeros((0, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), False)
-
-
 def table(rows, gm, m, user=None):
     """The :class:`TermTable` of ``rows`` (:class:`TermRow`) over bodies with
     ``G m`` ``gm`` and masses ``m`` (internal order); ``user`` the
-    :class:`UserTerms` of the rows coded :data:`USER`, if any."""
+    :class:`UserTerms` of the rows coded :data:`USER`, or None without such
+    rows.  A table without user terms holds arrays and numbers alone, which
+    numba types on a call from Python in a microsecond or two; a compiled
+    pointer in it is typed element by element in Python (some 0.2 ms a call),
+    so only tables with user terms carry one (their loops are compiled apart,
+    once, for every user function)."""
     n = len(m)
     rows = list(rows)
     codes = np.array([r.code for r in rows], dtype=np.int64)
@@ -922,7 +907,28 @@ def table(rows, gm, m, user=None):
             per_body[k] = r.per_body
     return TermTable(codes, ints, reals, per_body, np.ascontiguousarray(gm, dtype=np.float64),
                      np.ascontiguousarray(m, dtype=np.float64), np.zeros((n, 3)), np.zeros(n),
-                     _no_user(n) if user is None else user)
+                     user)
+
+
+@njit
+def _user_accel(u, x, v, t, acc):
+    # the user terms' accelerations (none where the table has none: u is None)
+    if u is not None:
+        u.accel(x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc)
+
+
+@njit
+def _user_energy(u, x):
+    if u is not None:
+        return u.energy(x, u.pos, u.xu, u.mu)
+    return 0.0
+
+
+@njit
+def _user_velocity_dependent(u):
+    if u is not None:
+        return u.velocity_dependent
+    return False
 
 
 @njit
@@ -949,8 +955,7 @@ def table_accel(x, v, t, tab, acc):
         elif c == RADIATION:
             radiation_accel(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), acc)
         elif c == USER:
-            u = tab.user
-            u.accel(x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc)
+            _user_accel(tab.user, x, v, t, acc)
 
 
 @njit
@@ -972,8 +977,7 @@ def table_energy(x, v, tab):
         elif c == ZONAL:
             e += zonal_energy(x, v, (ints[0], gm, reals[0], reals[1], reals[2:5], m))
         elif c == USER:
-            u = tab.user
-            e += u.energy(x, u.pos, u.xu, u.mu)
+            e += _user_energy(tab.user, x)
     return e
 
 
@@ -985,8 +989,7 @@ def _row_accel(x, v, t, tab, k, acc):
         gr_full_accel(x, v, t, (tab.gm, tab.ints[k, 0], tab.reals[k, 0], tab.an, tab.pot),
                       acc)
     elif c == USER:
-        u = tab.user
-        u.accel(x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc)
+        _user_accel(tab.user, x, v, t, acc)
 
 
 @njit
@@ -1047,7 +1050,8 @@ def table_jacobian(x, v, t, tab, jx, jv):
         elif c == RADIATION:
             radiation_jacobian(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), jx, jv)
         elif c == USER:
-            _row_difference_jacobian(x, v, t, tab, k, tab.user.velocity_dependent, jx, jv)
+            _row_difference_jacobian(x, v, t, tab, k, _user_velocity_dependent(tab.user),
+                                     jx, jv)
 
 
 #: the kernels of every table of terms: one key, so one loop for any combination
