@@ -42,8 +42,8 @@ from numba.extending import intrinsic
 
 from . import _inlining  # noqa: F401 - installs itself
 
-__all__ = ["njit", "njit_parallel", "specialize", "called", "cfunc", "fma", "KERNEL_STAMP",
-           "NUMBA_OPTIONS"]
+__all__ = ["njit", "njit_parallel", "specialize", "called", "cfunc", "pointer", "fma",
+           "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -92,6 +92,21 @@ def cfunc(signature, func):
         return numba.cfunc(signature, **options)(func)
     finally:
         func.__qualname__ = qualname
+
+
+def pointer(kernel, signature):
+    """``kernel`` (a compiled function) compiled as a C callable of
+    ``signature`` (:func:`cfunc`), cached under the kernel's name: its own
+    code, not a function that calls it, so that a call through the pointer
+    hands the arguments over once (a wrapper hands them on again: some 30 ns
+    for the stopping conditions' 16 arguments, nine of them arrays)."""
+    py = kernel.py_func
+    name = f"{py.__name__}__pointer"
+    func = types.FunctionType(py.__code__, py.__globals__, name, py.__defaults__,
+                              py.__closure__)
+    func.__qualname__ = name
+    func.__module__ = py.__module__
+    return cfunc(signature, func)
 
 
 @intrinsic

@@ -63,15 +63,15 @@ import math
 import numpy as np
 from numba.core import types as nbtypes
 
-from ._jit import cfunc, njit
+from ._jit import cfunc, njit, pointer
 from .encounters import closest_approach, kepler_contact
 from .status import Status
 
 __all__ = ["no_stop", "check_stop", "SARGS", "CHECK", "AHEAD", "no_conditions",
-           "stop_record", "call_check", "check_pointer", "ahead_pointer", "collision_check", "collision_pairs", "keep_state",
-           "encounter_log", "encounter_check", "collision_ahead", "ENCOUNTER_DISTANCE",
-           "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG",
-           "LOOKS_INSIDE"]
+           "stop_record", "call_check", "check_pointer", "ahead_pointer", "collision_check",
+           "collision_pairs", "keep_state", "encounter_log", "encounter_check",
+           "collision_ahead", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE", "UNBOUND",
+           "COLLISION", "ENCOUNTER_LOG", "LOOKS_INSIDE"]
 
 ENCOUNTER_DISTANCE = 1
 ENCOUNTER_HILL = 2
@@ -556,10 +556,6 @@ CHECK = nbtypes.int64(_F2, _F2, nbtypes.float64, SARGS)
 AHEAD = nbtypes.boolean(_F2, _F2, nbtypes.float64, nbtypes.float64, SARGS)
 
 
-def _check(x, v, t, sargs):
-    return check_stop(x, v, t, sargs)
-
-
 def _no_check(x, v, t, sargs):
     return 0
 
@@ -582,7 +578,7 @@ def check_pointer(conditions=True):
     cached on disk."""
     key = bool(conditions)
     if key not in _POINTERS:
-        _POINTERS[key] = cfunc(CHECK, _check if key else _no_check)
+        _POINTERS[key] = pointer(check_stop, CHECK) if key else cfunc(CHECK, _no_check)
     return _POINTERS[key]
 
 
