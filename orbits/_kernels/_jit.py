@@ -42,8 +42,8 @@ from numba.extending import intrinsic
 
 from . import _inlining  # noqa: F401 - installs itself
 
-__all__ = ["njit", "njit_parallel", "specialize", "called", "cfunc", "fma", "KERNEL_STAMP",
-           "NUMBA_OPTIONS"]
+__all__ = ["njit", "njit_parallel", "specialize", "called", "cfunc", "pointer", "Pointer",
+           "fma", "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -92,6 +92,53 @@ def cfunc(signature, func):
         return numba.cfunc(signature, **options)(func)
     finally:
         func.__qualname__ = qualname
+
+
+class Pointer:
+    """A C callable (:func:`cfunc`) to hand compiled code as an argument,
+    typed at once: numba types a ``CFunc`` argument by building its function
+    type anew, some 50 µs a call, and an argument that is a tuple holding one
+    is typed element by element in Python (200 µs for the stopping
+    conditions' record), where a tuple of arrays and numbers alone takes
+    numba's compiled path (1 µs).  So a pointer travels as an argument of
+    its own, as this object: its type is ready (numba reads
+    ``_numba_type_``), and numba takes its address through the wrapper
+    address protocol (``__wrapper_address__``, as for any first-class
+    function).  Called from Python, it runs the function as Python."""
+
+    __slots__ = ("cfunc", "_numba_type_", "_address")
+
+    def __init__(self, compiled):
+        self.cfunc = compiled
+        self._numba_type_ = numba.typeof(compiled)
+        self._address = compiled.address
+
+    def __wrapper_address__(self):
+        return self._address
+
+    def signature(self):
+        return self.cfunc._sig
+
+    def __call__(self, *args):
+        return self.cfunc(*args)
+
+
+def pointer(kernel, signature):
+    """``kernel`` (a compiled function, or a plain one) compiled as a C
+    callable of ``signature`` (:func:`cfunc`), as a :class:`Pointer`.  A
+    compiled kernel's own code is compiled, cached under its name, not a
+    function that calls it, so that a call through the pointer hands the
+    arguments over once (a wrapper hands them on again: some 30 ns for the
+    stopping conditions' 16 arguments, nine of them arrays)."""
+    py = getattr(kernel, "py_func", None)
+    if py is None:
+        return Pointer(cfunc(signature, kernel))
+    name = f"{py.__name__}__pointer"
+    func = types.FunctionType(py.__code__, py.__globals__, name, py.__defaults__,
+                              py.__closure__)
+    func.__qualname__ = name
+    func.__module__ = py.__module__
+    return Pointer(cfunc(signature, func))
 
 
 @intrinsic

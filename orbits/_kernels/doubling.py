@@ -65,9 +65,10 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
 
 
 def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
-                   dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, stopping, max_steps,
+                   dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps,
                    rtol, atol, marks, mark_steps):
     # marks: outputs recorded in the loop, as in orbits._kernels.embedded
+    stopping = (sargs, check)
     n = x.shape[0]
     every = mon[0]
     n_mon = 0

@@ -74,7 +74,7 @@ def step_underflow(h, t, t_end):
 
 
 def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
-                   info, fargs, mon, step0, mon_t, mon_out, stopping, max_steps, rtol, atol,
+                   info, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps, rtol, atol,
                    marks, mark_steps):
     # marks (outputs recorded in the loop): the loop lands on each of these
     # times in turn, as it lands on t_end, and records there a row of
@@ -83,6 +83,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     # loop is landing on it at the end of a call: the same steps, bit for
     # bit.  Empty marks: the loop lands on t_end alone (the same compiled
     # loop for both uses).
+    stopping = (sargs, check)
     n = x.shape[0]
     s = b.shape[0]
     # flat views of the (N, 3) arrays: the stages run over every component in

@@ -304,7 +304,7 @@ def _b6_rounding(x, xs, a0, acc, n):
 
 
 def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, dtp, ref,
-                tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, stopping, max_steps,
+                tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps,
                 epsilon, min_dt, mode, marks, mark_steps):
     # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
     # ref = (length of the reference step, time from its start to now).
@@ -320,6 +320,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     # last mark.  The rows count in n_mon.  Empty marks: the loop lands on
     # t_end alone (the same compiled loop: a loop compiled for each use cost
     # every new force two compilations).
+    stopping = (sargs, check)
     n = x.shape[0]
     # the predictor's and the corrector's loops run over every component of
     # these flat views (loops that LLVM turns into vector instructions, not N
@@ -647,9 +648,9 @@ def ias15_loop(force):
     integrates.
 
     The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
-    dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, stopping,
-    max_steps, epsilon, min_dt, mode, marks, mark_steps)`` (``stopping`` a stopping
-    record, :func:`~orbits._kernels.stopping.stop_record`) with the arrays of
+    dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, check,
+    max_steps, epsilon, min_dt, mode, marks, mark_steps)`` (``sargs, check`` a
+    stopping record, :func:`~orbits._kernels.stopping.stop_record`) with the arrays of
     :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """

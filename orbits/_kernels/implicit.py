@@ -309,11 +309,13 @@ def jacobian_for(force, velocity_dependent):
 # -- the loop ---------------------------------------------------------------------------
 
 def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, piv, newton,
-                   fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every, stopping):
+                   fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every, sargs,
+                   check):
     # theta bound by specialize: 1.0 implicit Euler, 0.5 implicit midpoint.
     # w: the unknown velocity increment W; dw: residual, then Newton update;
     # xs, vs: stage point; acc: accelerations there (kept for the next
     # prediction, valid when cache[0] == 1); newton[0] counts iterations.
+    stopping = (sargs, check)
     n = x.shape[0]
     m = 3 * n
     th = THETA  # noqa: F821 - bound by specialize
@@ -407,7 +409,7 @@ def implicit_loop(force, name, theta, velocity_dependent):
 
     ``theta`` is 1.0 (implicit Euler) or 0.5 (implicit midpoint); ``name``
     names the method; the Jacobian is :func:`jacobian_for`'s; the loop's last
-    argument is a stopping record (:func:`~.stopping.stop_record`).
+    arguments are a stopping record (:func:`~.stopping.stop_record`).
     """
     jac, jkey = jacobian_for(force, velocity_dependent)
     if jkey == "fd" and velocity_dependent:

@@ -565,7 +565,7 @@ def add_scaled(a, aF, h, b, bF, flat):
 
 
 def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_dependent, mon,
-                    step0, mon_t, mon_out, check_every, stopping):
+                    step0, mon_t, mon_out, check_every, sargs, check):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
     # (v += c dt a(x)), the table KINDS/COEFS bound by specialize as constant
     # tuples, so that the compiler unrolls it.  The acceleration depends only
@@ -577,6 +577,7 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
     # the kick stays symmetric; vm is its scratch.  A kick v' = v + h a changes
     # the kinetic energy by exactly h sum m a . (v + v') / 2: the
     # non-conservative terms' part of it is their work (HAS_WORK).
+    stopping = (sargs, check)
     n = x.shape[0]
     # flat views of the (N, 3) arrays: the drifts and kicks as loops LLVM
     # turns into vector instructions, each component's operation as before
@@ -684,7 +685,7 @@ def splitting_loop(force, name, kinds, coefs):
     """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
 
     ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method.
-    The loop's last argument is a stopping record (:func:`~.stopping.stop_record`).
+    The loop's last two arguments are a stopping record (:func:`~.stopping.stop_record`).
     """
     return specialize(_splitting_loop, f"{name}_{force.key}",
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
@@ -734,11 +735,12 @@ def rk_sums(sx, sv, kxF, kvF, b, count):
 
 
 def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, step0,
-                      mon_t, mon_out, check_every, stopping):
+                      mon_t, mon_out, check_every, sargs, check):
     # y = (x, v), y' = (v, a(x, v, t)); stage s has state
     # y + dt sum_j A[s, j] k_j and derivative k_s.  kx[s] = stage velocity,
     # kv[s] = stage acceleration.  The work is the same method applied to
     # W' = -P(x, v, t): W += -dt sum_s b_s P(stage s).
+    stopping = (sargs, check)
     n = x.shape[0]
     n_stages = b.shape[0]
     # flat views of the (N, 3) arrays, for loops LLVM turns into vector instructions
@@ -778,7 +780,7 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
 
 def runge_kutta_loop(force):
     """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`; its
-    last argument is a stopping record (:func:`~.stopping.stop_record`)."""
+    last two arguments are a stopping record (:func:`~.stopping.stop_record`)."""
     return specialize(_runge_kutta_loop, force.key,
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force), **work_kernels(force))

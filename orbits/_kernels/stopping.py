@@ -5,12 +5,13 @@ time of the state) and, when it fires, writes the bodies concerned into
 ``sargs[6]`` (an int64 array of two: the pair for an encounter or a
 collision; the body and -1 for an escape).
 
-The conditions are data: a loop takes the stopping record ``(sargs, check)``
+The conditions are data: a loop takes the stopping record ``sargs, check``
 (:func:`stop_record`), ``check`` a pointer to :func:`check_stop` compiled as
-a C callable of the signature :data:`CHECK` (numba's first-class functions),
-and calls it after a step only where ``sargs[0]`` (the mask) is not 0
-(:func:`call_check`): one loop serves every combination of conditions, and a
-run without any pays a branch a step.  The pointer is compiled once, on
+a C callable of the signature :data:`CHECK` (numba's first-class functions,
+:class:`~._jit.Pointer`), and calls it after a step only where ``sargs[0]``
+(the mask) is not 0 (:func:`call_check`, on the pair ``(sargs, check)``): one
+loop serves every combination of conditions, and a run without any pays a
+branch a step.  The pointer is compiled once, on
 first use, and cached; every simulation's ``sargs`` has the type
 :data:`SARGS`, a run without conditions :func:`no_conditions`.  A C callable
 cannot raise into its caller; :func:`check_stop` raises nothing (numpy's
@@ -63,15 +64,15 @@ import math
 import numpy as np
 from numba.core import types as nbtypes
 
-from ._jit import cfunc, njit
+from ._jit import njit, pointer
 from .encounters import closest_approach, kepler_contact
 from .status import Status
 
 __all__ = ["no_stop", "check_stop", "SARGS", "CHECK", "AHEAD", "no_conditions",
-           "stop_record", "call_check", "check_pointer", "ahead_pointer", "collision_check", "collision_pairs", "keep_state",
-           "encounter_log", "encounter_check", "collision_ahead", "ENCOUNTER_DISTANCE",
-           "ENCOUNTER_HILL", "ESCAPE", "UNBOUND", "COLLISION", "ENCOUNTER_LOG",
-           "LOOKS_INSIDE"]
+           "stop_record", "call_check", "check_pointer", "ahead_pointer", "collision_check",
+           "collision_pairs", "keep_state", "encounter_log", "encounter_check",
+           "collision_ahead", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE", "UNBOUND",
+           "COLLISION", "ENCOUNTER_LOG", "LOOKS_INSIDE"]
 
 ENCOUNTER_DISTANCE = 1
 ENCOUNTER_HILL = 2
@@ -556,10 +557,6 @@ CHECK = nbtypes.int64(_F2, _F2, nbtypes.float64, SARGS)
 AHEAD = nbtypes.boolean(_F2, _F2, nbtypes.float64, nbtypes.float64, SARGS)
 
 
-def _check(x, v, t, sargs):
-    return check_stop(x, v, t, sargs)
-
-
 def _no_check(x, v, t, sargs):
     return 0
 
@@ -582,7 +579,7 @@ def check_pointer(conditions=True):
     cached on disk."""
     key = bool(conditions)
     if key not in _POINTERS:
-        _POINTERS[key] = cfunc(CHECK, _check if key else _no_check)
+        _POINTERS[key] = pointer(check_stop if key else _no_check, CHECK)
     return _POINTERS[key]
 
 
@@ -594,7 +591,7 @@ def ahead_pointer(conditions=True):
     nothing; compiled on first use and cached on disk."""
     key = ("ahead", bool(conditions))
     if key not in _POINTERS:
-        _POINTERS[key] = cfunc(AHEAD, _ahead if conditions else _no_ahead)
+        _POINTERS[key] = pointer(_ahead if conditions else _no_ahead, AHEAD)
     return _POINTERS[key]
 
 
@@ -609,10 +606,11 @@ _NONE = None
 
 
 def stop_record(sargs=None):
-    """The stopping record ``(sargs, check)`` the loops take for a simulation's
-    ``sargs`` (None: no conditions, and a check never called).  The pointer
-    comes second: numba takes a tuple that starts with a function for a
-    sequence of functions (and warns that this is experimental)."""
+    """The stopping record ``(sargs, check)`` the loops take, as two arguments,
+    for a simulation's ``sargs`` (None: no conditions, and a check never
+    called).  Inside a loop the pair is one value, ``(sargs, check)``: the
+    pointer second, for numba takes a tuple that starts with a function for
+    a sequence of functions (and warns that this is experimental)."""
     global _NONE
     if sargs is None:
         if _NONE is None:
@@ -623,8 +621,8 @@ def stop_record(sargs=None):
 
 @njit(inline="always")
 def call_check(x, v, t, stop):
-    """The conditions of the stopping record ``stop`` after a step: 0 to carry
-    on.  Without conditions, a branch."""
+    """The conditions of the stopping record ``stop = (sargs, check)`` after a
+    step: 0 to carry on.  Without conditions, a branch."""
     sargs = stop[0]
     if sargs[0] == 0:
         return 0

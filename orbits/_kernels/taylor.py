@@ -249,11 +249,12 @@ def radius_step(X, order):
 
 
 def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp, tc, info,
-                 counts, fargs, mon, step0, mon_t, mon_out, stopping, max_steps, order, min_dt,
+                 counts, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps, order, min_dt,
                  marks, mark_steps):
     # counts: (accepted steps, 0, series expanded x order) of this call; tc:
     # (time reached, the part of it t + dt rounded away), as in the IAS15
     # loop (orbits._kernels.ias15), and marks, mark_steps as there
+    stopping = (sargs, check)
     n = x.shape[0]
     gm = fargs[0]
     n_active = fargs[1]
@@ -332,8 +333,9 @@ def taylor_loop(force):
     """The Taylor loop compiled for gravity's :class:`~orbits._kernels.stepping.ForceKernel`.
 
     The loop is ``loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv,
-    dt, tc, info, counts, fargs, mon, step0, mon_t, mon_out, stopping, max_steps,
-    order, min_dt, marks, mark_steps)`` with the arrays of
+    dt, tc, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps,
+    order, min_dt, marks, mark_steps)`` (``sargs, check`` a stopping record,
+    :func:`~orbits._kernels.stopping.stop_record`) with the arrays of
     :meth:`orbits.integrators.taylor.Taylor.workspace`; it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the counts in ``counts``.
     """

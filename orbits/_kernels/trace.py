@@ -555,7 +555,7 @@ _jump_call = called(jump)
 
 def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active, acc, xs, vs,
                 w1, w2, state, owed_box, checked, enc, enc_new, params, inner, tabs, mon, step0,
-                mon_t, mon_out, check_every, stopping, targs):
+                mon_t, mon_out, check_every, sargs, check, ahead, targs):
     # state: [0] internal state current, [1] system checked, [2] the segment
     # started at a criterion point (else at a synchronised state: no opening
     # kick), [3] the segment integrates everything (a close pericentre),
@@ -567,11 +567,12 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
     # params: (k_hill, k_speed, k_peri, rtol); inner: the inner integrator's
     # arrays, whose counts (segments with flags, redos, inner steps) add up.
     # targs: the added terms' arguments (kicked with gravity's interaction,
-    # HAS_TERMS and term_kick bound by specialize).  stopping: the stopping
-    # record (orbits._kernels.stopping.stop_record) and the pointer of
-    # ahead_pointer after it.
+    # HAS_TERMS and term_kick bound by specialize).  sargs, check: the
+    # stopping record (orbits._kernels.stopping.stop_record); ahead: the
+    # pointer of orbits._kernels.stopping.ahead_pointer.
+    stopping = (sargs, check)
     k_hill, k_speed, k_peri, rtol = params
-    checks = stopping[0][0] != 0
+    checks = sargs[0] != 0
     counts = inner[11]
     n = xh.shape[0]
     every = mon[0]
@@ -667,7 +668,7 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             from_democratic_heliocentric(xc, vc, gm, x, v)
             state[0] = 0
             checked[1] = 0.0
-            if checks and stopping[2](x, v, t_start, seg, stopping[0]):
+            if checks and ahead(x, v, t_start, seg, sargs):
                 return Status.COLLISION, k, n_mon
             return Status.STEP_UNDERFLOW, k, n_mon
         if flagged or peri:

@@ -462,7 +462,7 @@ def _lanes_note(xj, vj, t, mon, n_mon, mon_t, mon_out):
 
 
 def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
-             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs, stopping):
+             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs, sargs, check):
     # xj, vj: the internal (Jacobi or democratic heliocentric) state;
     # eta: G times the mass each row's Kepler drift orbits; stopping: the
     # stopping record (orbits._kernels.stopping.stop_record), whose escape
@@ -471,6 +471,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
     # owed_box[0]: the drift the internal state still owes, deferred from the
     # last step's closing drift; cdt[0]: the step the mapping state's
     # corrector belongs to (corr has no rows without corrector).
+    stopping = (sargs, check)
     every = mon[0]
     n_mon = 0
     corrected = corr.shape[0] > 0

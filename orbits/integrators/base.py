@@ -416,7 +416,7 @@ class SplittingMethod(Integrator):
         return with_status(*loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
                     velocity_dependent or force.velocity_dependent,
                     mon, step0, mon_t, mon_out, check_every,
-                    stop_record(stop)))
+                    *stop_record(stop)))
 
     def invalidate(self, ws):
         """Drop the cached force: the next kick evaluates it again.
@@ -513,7 +513,7 @@ class ExplicitRungeKutta(Integrator):
         fargs = stepping.work_bound(force, fargs, ws)
         return with_status(*loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
                     ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every,
-                    stop_record(stop)))
+                    *stop_record(stop)))
 
 
 class AdaptiveIntegrator(Integrator):

@@ -70,6 +70,6 @@ class RK4Doubling(AdaptiveIntegrator):
         args = (x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
                 w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
                 w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
-                stop_record(stop), int(max_steps),
+                *stop_record(stop), int(max_steps),
                 float(self.config["rtol"]), float(self.config["atol"]))
         return with_status(*loop(*args, marks, mark_steps))

@@ -59,7 +59,7 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
         args = (x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
                 float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],
                 ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
-                mon_t, mon_out, stop_record(stop),
+                mon_t, mon_out, *stop_record(stop),
                 int(max_steps), float(self.config["rtol"]), float(self.config["atol"]))
         return with_status(*loop(*args, marks, mark_steps))
 

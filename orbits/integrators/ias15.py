@@ -144,7 +144,7 @@ class IAS15(AdaptiveIntegrator):
         args = (x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
                 ws["er"], ws["csx"], ws["csv"], ws["xs"], ws["vs"], ws["acc"], ws["P"],
                 ws["dt"], ws["ref"], ws["tc"], ws["flags"], ws["info"], ws["counts"], fargs,
-                mon, int(step0), mon_t, mon_out, stop_record(stop),
+                mon, int(step0), mon_t, mon_out, *stop_record(stop),
                 int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
                 ADAPTIVE_MODES[self.config["adaptive_mode"]])
         status, t_reached, n_mon = loop(*args, marks, mark_steps)

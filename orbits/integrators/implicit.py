@@ -60,7 +60,7 @@ class ImplicitOneLeg(Integrator):
             x, v, t, dt, nsteps, ws["w"], ws["dw"], ws["xs"], ws["vs"], ws["acc"],
             ws["cache"], ws["jx"], ws["jv"], ws["lu"], ws["piv"], ws["newton_iterations"],
             fargs, bool(velocity_dependent), mon, step0, mon_t, mon_out, check_every,
-            stop_record(stop))
+            *stop_record(stop))
         return Status(status), done, n_mon
 
     def invalidate(self, ws):

@@ -161,7 +161,7 @@ class Taylor(AdaptiveIntegrator):
         status, t_reached, n_mon = loop(
             x, v, float(t), float(t_end), *ws["series"], ws["csx"], ws["csv"], ws["dt"],
             ws["tc"], ws["info"], ws["counts"], fargs, mon, int(step0), mon_t, mon_out,
-            stop_record(stop), int(max_steps), self.order_used,
+            *stop_record(stop), int(max_steps), self.order_used,
             float(self.config["min_dt"]), marks, mark_steps)
         c = ws["counts"]
         return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon

@@ -295,7 +295,7 @@ class Trace(Integrator):
             ws["xs"], ws["vs"], ws["w1"], ws["w2"], ws["state"], ws["owed"], ws["checked"],
             ws["enc"],
             ws["enc_new"], params, self._inner(ws), self._tabs, mon, step0, mon_t, mon_out,
-            check_every, stop_record(stop) + (ahead_pointer(stop is not None),), targs))
+            check_every, *stop_record(stop), ahead_pointer(stop is not None), targs))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v`` (the owed part of the

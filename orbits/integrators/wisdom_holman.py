@@ -424,7 +424,7 @@ class WisdomHolman(Integrator):
         return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
                     ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
                     ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs,
-                    stop_record(stop)))
+                    *stop_record(stop)))
 
     @staticmethod
     def _loop_terms(ws, n):
@@ -469,7 +469,7 @@ class WisdomHolman(Integrator):
                                  n_active, ws["acc"], ws["xs"], ws["vs"], ws["state"],
                                  ws["owed"], self._corr, ws["cdt"], mon, step0, mon_t,
                                  mon_out, check_every, (targs, tp),
-                                 stop_record(stop)))
+                                 *stop_record(stop)))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
