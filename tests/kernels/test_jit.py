@@ -1,5 +1,8 @@
 """The package's numba options (orbits._kernels._jit)."""
 
+import numba
+from numba.core import types as nbtypes
+
 from orbits._kernels import _jit, wh_batch
 
 
@@ -28,3 +31,40 @@ def test_fma_rounds_once():
     fused, plain = _fused_and_not(a, b, -1.0)
     assert fused == -2.0 ** -60
     assert plain == 0.0
+
+
+_UNARY = nbtypes.float64(nbtypes.float64)
+
+
+@_jit.njit
+def _halve(a):
+    return 0.5 * a
+
+
+def _triple(a):
+    return 3.0 * a
+
+
+@_jit.njit(cache=False)
+def _call(f, a):
+    return f(a)
+
+
+def test_a_pointer_is_an_argument_typed_by_its_signature():
+    # numba types a Pointer from _numba_type_ and takes its address through
+    # the wrapper address protocol; a numba that read neither would fail here
+    for kernel, expected in ((_halve, 1.5), (_triple, 9.0)):
+        p = _jit.pointer(kernel, _UNARY)
+        assert numba.typeof(p) == numba.typeof(p.cfunc)
+        assert _call(p, 3.0) == expected
+        assert p(3.0) == expected           # from Python: the function as Python
+    assert len(_call.signatures) == 1       # one compilation for every such pointer
+
+
+def test_a_kernel_pointer_is_its_own_code_cached_under_the_stamp():
+    # the C callable of a compiled kernel is the kernel's code (not a function
+    # calling it), cached as a kernel is (see the test above)
+    p = _jit.pointer(_halve, _UNARY)
+    assert p.cfunc._pyfunc.__code__ is _halve.py_func.__code__
+    index = p.cfunc._cache._cache_file._index_name
+    assert index.startswith(f"test_jit._halve__pointer__{_jit.KERNEL_STAMP}")
