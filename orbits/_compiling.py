@@ -32,14 +32,14 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "lo
 #: recorded in benchmarks/RESULTS.md).  Keyed by :func:`loop_label`; only the
 #: notice's estimate reads it.
 FIRST_COMPILE_SECONDS = {
-    "euler": 4.0, "symplectic-euler": 5.0, "verlet": 4.0, "leapfrog": 4.0,
+    "euler": 4.0, "symplectic-euler": 5.0, "verlet": 4.0, "leapfrog": 2.0,
     "rk2": 3.0, "rk4": 4.0, "yoshida4": 4.0, "yoshida6": 4.0, "yoshida8": 4.0,
-    "wh": 45.0, "wh democratic-heliocentric": 35.0,
+    "wh": 31.0, "wh democratic-heliocentric": 31.0,
     "saba2": 35.0, "saba2 democratic-heliocentric": 40.0,
     "saba3": 45.0, "saba3 democratic-heliocentric": 35.0,
     "saba4": 35.0, "saba4 democratic-heliocentric": 45.0,
-    "dopri5": 5.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 8.0, "taylor": 6.0,
-    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 35.0,
+    "dopri5": 5.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 9.0, "taylor": 6.0,
+    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 28.0,
 }
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
