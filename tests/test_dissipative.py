@@ -130,6 +130,27 @@ def test_radiation_source_takes_no_reaction():
     assert np.all(a[0] == 0) and np.all(a[2] == 0) and np.abs(a[1]).max() > 0
 
 
+def _table_of(which, args):
+    # the term of _cases() as the one row of a table of terms
+    m = random_state(5, seed=3)[2]
+    if which == "migration":
+        row = kt.TermRow(kt.MIGRATION, args[:2], args[2:])
+        return kt.table([row], 0.3 * m, m)
+    if which == "tides":
+        row = kt.TermRow(kt.TIDES, (args[0],), (args[2], args[3]) + tuple(args[4]))
+        return kt.table([row], args[1], m)
+    row = kt.TermRow(kt.RADIATION, (args[0],), (args[1], args[3]), args[2])
+    return kt.table([row], 0.3 * m, m)
+
+
+def test_a_table_row_is_its_terms_kernel():
+    # the table's dispatch hands each term the arguments its kernel takes
+    for which, (x, v, accel, _, args, _) in _cases().items():
+        a = np.zeros_like(x)
+        kt.table_accel(x, v, 0.0, _table_of(which, args), a)
+        np.testing.assert_array_equal(a, _accel(accel, x, v, args))
+
+
 @pytest.mark.parametrize("which", ["migration", "tides", "radiation"])
 def test_analytic_jacobians_match_differences(which):
     # the package's own central differences (relative step 6e-6, orbits._kernels.terms
@@ -140,9 +161,8 @@ def test_analytic_jacobians_match_differences(which):
     n = 3 * x.shape[0]
     jx, jv = np.zeros((n, n)), np.zeros((n, n))
     jac(x, v, 0.0, args, jx, jv)
-    fd = kt.difference_jacobian(accel, f"test_{which}", True, cache=False)
     fx, fv = np.zeros((n, n)), np.zeros((n, n))
-    fd(x, v, 0.0, args, fx, fv)
+    kt.row_difference_jacobian(x, v, 0.0, _table_of(which, args), 0, True, fx, fv)
     scale = max(np.abs(fx).max(), np.abs(fv).max())
     np.testing.assert_allclose(jx, fx, rtol=0, atol=1e-7 * scale)
     np.testing.assert_allclose(jv, fv, rtol=0, atol=1e-7 * scale)

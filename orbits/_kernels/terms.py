@@ -41,7 +41,7 @@ import numpy as np
 
 from numba.core import types as nbtypes
 
-from ._jit import njit, specialize
+from ._jit import njit
 from .invariants import _add
 
 __all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "TABLE", "table",
@@ -50,7 +50,7 @@ __all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "TABLE", "table",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
            "migration_accel", "migration_jacobian", "tides_accel", "tides_jacobian",
            "radiation_accel", "radiation_jacobian", "dissipative_energy",
-           "difference_jacobian"]
+           "rows_accel", "row_difference_jacobian"]
 
 
 class TermKernel(NamedTuple):
@@ -767,39 +767,9 @@ def radiation_jacobian(x, v, t, args, jx, jv):
 
 # -- central differences of one term, for terms without an analytic Jacobian -----------
 
-#: relative step of :func:`difference_jacobian` (about the cube root of the
+#: relative step of :func:`row_difference_jacobian` (about the cube root of the
 #: machine epsilon, which balances truncation and rounding in a central difference)
 FD_STEP = 6.0e-6
-
-
-def _difference_jacobian(x, v, t, args, jx, jv):
-    # column by column: the term's accelerations at x +- delta e_q (and v +- ..)
-    n = x.shape[0]
-    m = 3 * n
-    xp = x.copy()
-    vp = v.copy()
-    ap = np.zeros((n, 3))
-    am = np.zeros((n, 3))
-    for half in range(2 if VELOCITY else 1):  # noqa: F821 - bound by specialize
-        src = x if half == 0 else v
-        dst = xp if half == 0 else vp
-        out = jx if half == 0 else jv
-        for q in range(m):
-            i = q // 3
-            d = q % 3
-            delta = FD_STEP * max(abs(src[i, d]), 1e-3 * _scale(src))
-            hi = src[i, d] + delta
-            lo = src[i, d] - delta
-            ap[...] = 0.0
-            am[...] = 0.0
-            dst[i, d] = hi
-            term(xp, vp, t, args, ap)  # noqa: F821 - bound by specialize
-            dst[i, d] = lo
-            term(xp, vp, t, args, am)  # noqa: F821
-            dst[i, d] = src[i, d]
-            inv = 1.0 / (hi - lo)
-            for p in range(m):
-                out[p, q] += (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
 
 
 @njit
@@ -809,12 +779,6 @@ def _scale(a):
         for d in range(3):
             s = max(s, abs(a[i, d]))
     return s if s > 0.0 else 1.0
-
-
-def difference_jacobian(accel, key, velocity_dependent, cache=True):
-    """A central-difference Jacobian of one term's ``accel`` (6N or 12N calls)."""
-    return specialize(_difference_jacobian, f"fdterm_{key}", cache=cache, term=accel,
-                      VELOCITY=bool(velocity_dependent))
 
 
 # -- several terms as one table ------------------------------------------------------------
@@ -934,8 +898,14 @@ def _user_velocity_dependent(u):
 @njit
 def table_accel(x, v, t, tab, acc):
     """Adds the accelerations of every term of the table ``tab`` to ``acc``."""
+    rows_accel(x, v, t, tab, 0, tab.codes.shape[0], acc)
+
+
+@njit
+def rows_accel(x, v, t, tab, first, end, acc):
+    """Adds the accelerations of the rows ``first`` to ``end - 1`` of ``tab`` to ``acc``."""
     gm = tab.gm
-    for k in range(tab.codes.shape[0]):
+    for k in range(first, end):
         c = tab.codes[k]
         ints = tab.ints[k]
         reals = tab.reals[k]
@@ -982,19 +952,12 @@ def table_energy(x, v, tab):
 
 
 @njit
-def _row_accel(x, v, t, tab, k, acc):
-    # the accelerations of row k alone, for the central differences below
-    c = tab.codes[k]
-    if c == GR_FULL:
-        gr_full_accel(x, v, t, (tab.gm, tab.ints[k, 0], tab.reals[k, 0], tab.an, tab.pot),
-                      acc)
-    elif c == USER:
-        _user_accel(tab.user, x, v, t, acc)
-
-
-@njit
-def _row_difference_jacobian(x, v, t, tab, k, velocity, jx, jv):
-    # central differences of row k, column by column (as _difference_jacobian)
+def row_difference_jacobian(x, v, t, tab, k, velocity, jx, jv):
+    """Adds the central-difference ``da/dx`` (and with ``velocity`` ``da/dv``)
+    of row ``k`` of ``tab`` to ``jx`` (``jv``), column by column: the
+    accelerations at ``x +- delta e_q`` with ``delta`` :data:`FD_STEP` of the
+    component (at least 1e-3 of the largest), for terms without an analytic
+    Jacobian (6N or 12N evaluations of the row)."""
     n = x.shape[0]
     m = 3 * n
     xp = x.copy()
@@ -1014,9 +977,9 @@ def _row_difference_jacobian(x, v, t, tab, k, velocity, jx, jv):
             ap[...] = 0.0
             am[...] = 0.0
             dst[i, d] = hi
-            _row_accel(xp, vp, t, tab, k, ap)
+            rows_accel(xp, vp, t, tab, k, k + 1, ap)
             dst[i, d] = lo
-            _row_accel(xp, vp, t, tab, k, am)
+            rows_accel(xp, vp, t, tab, k, k + 1, am)
             dst[i, d] = src[i, d]
             inv = 1.0 / (hi - lo)
             for p in range(m):
@@ -1038,7 +1001,7 @@ def table_jacobian(x, v, t, tab, jx, jv):
         elif c == GR_POTENTIAL:
             gr_potential_jacobian(x, v, t, (ints[0], gm, reals[0]), jx, jv)
         elif c == GR_FULL:
-            _row_difference_jacobian(x, v, t, tab, k, True, jx, jv)
+            row_difference_jacobian(x, v, t, tab, k, True, jx, jv)
         elif c == ZONAL:
             zonal_jacobian(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]), jx, jv)
         elif c == MIGRATION:
@@ -1050,7 +1013,7 @@ def table_jacobian(x, v, t, tab, jx, jv):
         elif c == RADIATION:
             radiation_jacobian(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), jx, jv)
         elif c == USER:
-            _row_difference_jacobian(x, v, t, tab, k, _user_velocity_dependent(tab.user),
+            row_difference_jacobian(x, v, t, tab, k, _user_velocity_dependent(tab.user),
                                      jx, jv)
 
 
