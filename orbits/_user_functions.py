@@ -22,8 +22,12 @@ import types
 import numpy as np
 from numba.core import types as nbtypes
 
-from ._kernels._jit import KERNEL_STAMP, cfunc, specialize
+from ._kernels._jit import KERNEL_STAMP, bound_globals, cfunc, slots, specialize
 from ._kernels import terms as _kterms
+
+# the names the templates below are written against, bound by specialize
+adder, head, tail, user, user_accel, user_potential = slots(
+    "adder", "head", "tail", "user", "user_accel", "user_potential")
 
 __all__ = ["code_key", "term_pointers", "force_pointer", "force_args", "FORCE_SIZE"]
 
@@ -95,8 +99,7 @@ def code_key(func, _seen=None):
 
 def _cfunc(template, signature, suffix, **bindings):
     # a copy of template with bindings as its globals, compiled as a cached C callable
-    glob = dict(template.__globals__)
-    glob.update(bindings)
+    glob = bound_globals(template, bindings)
     name = f"{template.__name__}__{suffix}__{KERNEL_STAMP}"
     func = types.FunctionType(template.__code__, glob, name, template.__defaults__,
                               template.__closure__)
@@ -114,7 +117,7 @@ def _term_add(x, v, t, pos, xu, vu, mu, flag, acc):
         for d in range(3):
             xu[k, d] = x[pos[k], d]
             vu[k, d] = v[pos[k], d]
-    a = user(xu, vu, t, mu)  # noqa: F821 - bound by specialize
+    a = user(xu, vu, t, mu)
     if a.shape[0] != n or a.shape[1] != 3:
         flag[0] = FORCE_SIZE
         for k in range(n):
@@ -127,8 +130,8 @@ def _term_add(x, v, t, pos, xu, vu, mu, flag, acc):
 
 
 def _term_chain(x, v, t, pos, xu, vu, mu, flag, acc):
-    head(x, v, t, pos, xu, vu, mu, flag, acc)  # noqa: F821 - bound by specialize
-    tail(x, v, t, pos, xu, vu, mu, flag, acc)  # noqa: F821
+    head(x, v, t, pos, xu, vu, mu, flag, acc)
+    tail(x, v, t, pos, xu, vu, mu, flag, acc)
 
 
 def _term_none(x, v, t, pos, xu, vu, mu, flag, acc):
@@ -136,18 +139,18 @@ def _term_none(x, v, t, pos, xu, vu, mu, flag, acc):
 
 
 def _term_pointer(x, v, t, pos, xu, vu, mu, flag, acc):
-    adder(x, v, t, pos, xu, vu, mu, flag, acc)  # noqa: F821 - bound by specialize
+    adder(x, v, t, pos, xu, vu, mu, flag, acc)
 
 
 def _potential_one(x, pos, xu, mu):
     for k in range(pos.shape[0]):
         for d in range(3):
             xu[k, d] = x[pos[k], d]
-    return user_potential(xu, mu)  # noqa: F821 - bound by specialize
+    return user_potential(xu, mu)
 
 
 def _potential_chain(x, pos, xu, mu):
-    return head(x, pos, xu, mu) + tail(x, pos, xu, mu)  # noqa: F821 - bound by specialize
+    return head(x, pos, xu, mu) + tail(x, pos, xu, mu)
 
 
 def _potential_none(x, pos, xu, mu):
@@ -155,7 +158,7 @@ def _potential_none(x, pos, xu, mu):
 
 
 def _potential_pointer(x, pos, xu, mu):
-    return adder(x, pos, xu, mu)  # noqa: F821 - bound by specialize
+    return adder(x, pos, xu, mu)
 
 
 _POINTERS = {}
@@ -175,7 +178,7 @@ def term_pointers(terms):
     akey = "none"
     pkey = "none"
     for term, (fk, pk) in reversed(list(zip(terms, keys))):
-        one = specialize(_term_add, fk, user=term.func, FORCE_SIZE=FORCE_SIZE)
+        one = specialize(_term_add, fk, user=term.func)
         akey = f"{fk}_{akey}" if akey != "none" else fk
         add = specialize(_term_chain, hashlib.sha1(akey.encode()).hexdigest()[:16],
                          head=one, tail=add)
@@ -208,7 +211,7 @@ def _force_pointer(x, v, t, size, shape, flag, acc):
     # arrays in order; the padding stays zero
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
-    a = np.asarray(user_accel(xu, vu, t)).ravel()  # noqa: F821 - bound by specialize
+    a = np.asarray(user_accel(xu, vu, t)).ravel()
     flat = acc.ravel()
     if a.size != size:
         flag[0] = FORCE_SIZE

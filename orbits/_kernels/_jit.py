@@ -42,8 +42,8 @@ from numba.extending import intrinsic
 
 from . import _inlining  # noqa: F401 - installs itself
 
-__all__ = ["njit", "njit_parallel", "specialize", "called", "cfunc", "pointer", "Pointer",
-           "fma", "KERNEL_STAMP", "NUMBA_OPTIONS"]
+__all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
+           "cfunc", "pointer", "Pointer", "fma", "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -173,12 +173,72 @@ KERNEL_STAMP = _stamp()
 _SPECIALISED = {}
 
 
+class Slot:
+    """A global name that templates are written against and :func:`specialize`
+    binds: a kernel (the force, the step's epilogue) or a constant (whether
+    the loop integrates work).  Declared at module level with :func:`slots`;
+    ``default`` is what an unbound slot takes (None: it must be bound)."""
+
+    __slots__ = ("name", "default")
+
+    def __init__(self, name, default=None):
+        self.name = name
+        self.default = default
+
+    def __repr__(self):
+        return f"Slot({self.name!r})"
+
+    def __call__(self, *args, **kwargs):
+        raise TypeError(f"slot {self.name!r} is not bound: only the copies that "
+                        f"specialize makes can run")
+
+
+def slots(*names, **defaults):
+    """Declare the slots of a module's templates: ``force, rows = slots("force",
+    "rows")``; a keyword declares a slot with its default,
+    ``record, = slots(record=_record)``.  Returns the :class:`Slot` objects in
+    the order given, names first."""
+    return tuple([Slot(n) for n in names] + [Slot(n, d) for n, d in defaults.items()])
+
+
+def _used_names(code):
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= _used_names(const)
+    return names
+
+
+def bound_globals(template, bindings):
+    """The template's globals with its slots bound; an unknown binding and a
+    slot left unbound without a default are errors that name them."""
+    glob = template.__globals__
+    declared = {k for k, v in glob.items() if isinstance(v, Slot)}
+    unknown = sorted(set(bindings) - declared)
+    if unknown:
+        raise TypeError(f"{template.__module__}.{template.__name__} has no slot "
+                        f"{', '.join(map(repr, unknown))}; its module declares "
+                        f"{', '.join(map(repr, sorted(declared))) or 'none'}")
+    used = _used_names(template.__code__) & declared
+    bound = dict(glob)
+    for name in used:
+        if name in bindings:
+            continue
+        default = glob[name].default
+        if default is None:
+            raise TypeError(f"{template.__module__}.{template.__name__} needs its slot "
+                            f"{name!r} bound")
+        bound[name] = default
+    bound.update(bindings)
+    return bound
+
+
 def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, **bindings):
     """Compile a copy of ``template`` whose global names are bound to ``bindings``.
 
     A stepping loop is written once, with the force (or another kernel) as a
-    global name.  Each scene's loop is a copy of that code with the name bound
-    to the kernel it needs, compiled and cached under its own name, so a scene
+    global name, a :class:`Slot` its module declares.  Each scene's loop is
+    a copy of that code with the name bound to the kernel it needs, compiled and cached under its own name, so a scene
     compiles only the kernels it uses.  (Passing the kernel as an argument
     would defeat numba's on-disk cache; closures do too.)
 
@@ -199,13 +259,15 @@ def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, *
         False compiles without numba's runtime, so without reference counts
         (see the module notes); only for code that allocates nothing.
     **bindings
-        Global names to replace, typically jitted kernels.
+        The template's slots (:func:`slots`) to bind, typically to jitted
+        kernels; a name that is not a slot of the template's module is an
+        error, as is a slot the template uses that is left unbound without
+        a default.
     """
     key = (template, suffix, jit, cache, inline, nrt)
     if key in _SPECIALISED:
         return _SPECIALISED[key]
-    glob = dict(template.__globals__)
-    glob.update(bindings)
+    glob = bound_globals(template, bindings)
     safe = "".join(ch if ch.isalnum() else "_" for ch in suffix)
     name = f"{template.__name__}__{safe}__{KERNEL_STAMP}"
     func = types.FunctionType(template.__code__, glob, name,

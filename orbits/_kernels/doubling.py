@@ -16,11 +16,16 @@ when the step is accepted.
 
 import math
 
-from ._jit import specialize
+from ._jit import slots, specialize
 from .embedded import initial_step, next_step, step_underflow
 from .status import Status
-from .stepping import GO, first_record, step_epilogue, work_kernels
+from .stepping import GO, WORK_SLOTS, first_record, step_epilogue, work_kernels
 from .variational import measured_rows
+
+# the names the templates below are written against, bound by specialize
+force, record_row, rk4_step, rows, step_end = slots(
+    "force", "record_row", "rk4_step", "rows", "step_end")
+HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["doubling_loop"]
 
@@ -51,9 +56,9 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
                 xs[i, d] = x[i, d] + a * gx
                 vs[i, d] = v[i, d] + a * gv
                 kx[st, i, d] = vs[i, d]
-        force(xs, vs, t + (0.5 * h if st < 2 else h), fargs, kv[st])  # noqa: F821
-        if HAS_WORK and track:  # noqa: F821 - bound by specialize
-            pw += (2.0 if st < 2 else 1.0) / 6.0 * work_rate(  # noqa: F821
+        force(xs, vs, t + (0.5 * h if st < 2 else h), fargs, kv[st])
+        if HAS_WORK and track:
+            pw += (2.0 if st < 2 else 1.0) / 6.0 * work_rate(
                 xs, vs, t + (0.5 * h if st < 2 else h), fargs)
     for i in range(n):
         for d in range(3):
@@ -61,7 +66,7 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
                                             + 2.0 * kx[1, i, d] + kx[2, i, d])
             vo[i, d] = v[i, d] + h / 6.0 * (k0v[i, d] + 2.0 * kv[0, i, d]
                                             + 2.0 * kv[1, i, d] + kv[2, i, d])
-    return pw if HAS_WORK and track else 0.0  # noqa: F821
+    return pw if HAS_WORK and track else 0.0
 
 
 def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
@@ -79,10 +84,10 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
     info[0] = -1
     info[1] = -1
     # the error measures the bodies' rows (not the tangent rows of variations)
-    ne = rows(x, fargs)  # noqa: F821 - bound by specialize
+    ne = rows(x, fargs)
     ncomp = 6 * ne
     if fsal[0] == 0:
-        force(x, v, t, fargs, k0v)  # noqa: F821
+        force(x, v, t, fargs, k0v)
         fev += 1
         for i in range(n):
             for d in range(3):
@@ -93,8 +98,8 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         h_prop = initial_step(x[:ne], v[:ne], k0x[:ne], k0v[:ne], rtol, atol, t_end - t)
     status = Status.OK
     p0 = 0.0
-    if HAS_WORK:  # noqa: F821 - bound by specialize
-        p0 = work_rate(x, v, t, fargs)  # noqa: F821
+    if HAS_WORK:
+        p0 = work_rate(x, v, t, fargs)
     target = t_end
     k_mark = 0
     # an empty marks array: none (one compiled loop for both uses)
@@ -109,17 +114,17 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         if t + 1.01 * h >= target:
             h = target - t
             shortened = True
-        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, UNTRACKED)  # noqa: F821
-        pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,  # noqa: F821
+        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, UNTRACKED)
+        pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,
                       fargs, p0, TRACKED)
         for i in range(n):
             for d in range(3):
                 kmx[i, d] = vh[i, d]
-        force(xh, vh, t + 0.5 * h, fargs, kmv)  # noqa: F821
+        force(xh, vh, t + 0.5 * h, fargs, kmv)
         pm = 0.0
-        if HAS_WORK:  # noqa: F821
-            pm = work_rate(xh, vh, t + 0.5 * h, fargs)  # noqa: F821
-        pb = rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs,  # noqa: F821
+        if HAS_WORK:
+            pm = work_rate(xh, vh, t + 0.5 * h, fargs)
+        pb = rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs,
                       x2, v2, fargs, pm, TRACKED)
         fev += 10
         err = 0.0
@@ -138,7 +143,7 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                     x[i, d] = x2[i, d]
                     v[i, d] = v2[i, d]
             t = target if shortened else t + h
-            force(x, v, t, fargs, k0v)  # noqa: F821
+            force(x, v, t, fargs, k0v)
             fev += 1
             for i in range(n):
                 for d in range(3):
@@ -146,10 +151,10 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
             steps += 1
             if not shortened:
                 h_prop = next_step(h, err, 4.0)
-            if HAS_WORK:  # noqa: F821
-                work_add(fargs, -0.5 * h * (pa + pb))  # noqa: F821
-                p0 = work_rate(x, v, t, fargs)  # noqa: F821
-            stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
+            if HAS_WORK:
+                work_add(fargs, -0.5 * h * (pa + pb))
+                p0 = work_rate(x, v, t, fargs)
+            stop, _, _, until_record, n_mon = step_end(
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
                 stopping, fargs)
             if stop != GO:
@@ -159,8 +164,8 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
                 break
             if has_marks and t == target:
                 mon_t[n_mon] = t
-                record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - by specialize
-                work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+                record_row(x, v, t, mon, n_mon, mon_t, mon_out)
+                work_note(fargs, mon_out, n_mon)
                 mark_steps[n_mon] = step0 + steps
                 n_mon += 1
                 k_mark += 1

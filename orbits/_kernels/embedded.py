@@ -22,10 +22,15 @@ P(stage j)``, and committed only when the step is accepted.
 
 import math
 
-from ._jit import njit, specialize
+from ._jit import njit, slots, specialize
 from .status import Status
-from .stepping import GO, first_record, rk_stage, rk_sums, step_epilogue, work_kernels
+from .stepping import GO, WORK_SLOTS, first_record, rk_stage, rk_sums, step_epilogue, work_kernels
 from .variational import measured_rows
+
+# the names the templates below are written against, bound by specialize
+force, has_e3, record_row, rows, step_end = slots(
+    "force", "has_e3", "record_row", "rows", "step_end")
+HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
            "FAC_MIN", "FAC_MAX"]
@@ -106,10 +111,10 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     info[0] = -1
     info[1] = -1
     # the error measures the bodies' rows (not the tangent rows of variations)
-    ne = rows(x, fargs)  # noqa: F821 - bound by specialize
+    ne = rows(x, fargs)
     ncomp = 6 * ne
     if fsal[0] == 0:
-        force(x, v, t, fargs, kv[0])  # noqa: F821 - bound by specialize
+        force(x, v, t, fargs, kv[0])
         fev += 1
         for i in range(n):
             for d in range(3):
@@ -120,8 +125,8 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
         h_prop = initial_step(x[:ne], v[:ne], kx[0, :ne], kv[0, :ne], rtol, atol, t_end - t)
     status = Status.OK
     p0 = 0.0
-    if HAS_WORK:  # noqa: F821 - bound by specialize
-        p0 = work_rate(x, v, t, fargs)  # noqa: F821
+    if HAS_WORK:
+        p0 = work_rate(x, v, t, fargs)
     target = t_end
     k_mark = 0
     # an empty marks array: none (one compiled loop for both uses)
@@ -140,9 +145,9 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
         pw = b[0] * p0
         for st in range(1, s):
             rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, st, h)
-            force(xs, vs, t + c[st] * h, fargs, kv[st])  # noqa: F821
-            if HAS_WORK and b[st] != 0.0:  # noqa: F821
-                pw += b[st] * work_rate(xs, vs, t + c[st] * h, fargs)  # noqa: F821
+            force(xs, vs, t + c[st] * h, fargs, kv[st])
+            if HAS_WORK and b[st] != 0.0:
+                pw += b[st] * work_rate(xs, vs, t + c[st] * h, fargs)
         fev += s - 1
         # the step's sums b . k, gathered in x1, v1, then the new state
         rk_sums(x1F, v1F, kxF, kvF, b, s)
@@ -150,7 +155,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             x1F[k] = xF[k] + h * x1F[k]
             v1F[k] = vF[k] + h * v1F[k]
             kxF[s, k] = v1F[k]
-        force(x1, v1, t + h, fargs, kv[s])  # noqa: F821
+        force(x1, v1, t + h, fargs, kv[s])
         fev += 1
         err5 = 0.0
         err3 = 0.0
@@ -169,7 +174,7 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
                 sv = atol + rtol * max(abs(v[i, d]), abs(v1[i, d]))
                 err5 += (ex / sx) ** 2 + (ev / sv) ** 2
                 err3 += (fx / sx) ** 2 + (fv / sv) ** 2
-        if has_e3:  # noqa: F821 - bound by specialize
+        if has_e3:
             denom = err5 + 0.01 * err3
             err = 0.0 if denom == 0.0 else abs(h) * err5 / math.sqrt(denom * ncomp)
         else:
@@ -187,10 +192,10 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             steps += 1
             if not shortened:
                 h_prop = next_step(h, err, q)
-            if HAS_WORK:  # noqa: F821
-                work_add(fargs, -h * pw)  # noqa: F821
-                p0 = work_rate(x, v, t, fargs)  # noqa: F821
-            stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
+            if HAS_WORK:
+                work_add(fargs, -h * pw)
+                p0 = work_rate(x, v, t, fargs)
+            stop, _, _, until_record, n_mon = step_end(
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
                 stopping, fargs)
             if stop != GO:
@@ -201,8 +206,8 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             if has_marks and t == target:
                 # an output: recorded as the driver would record it on return
                 mon_t[n_mon] = t
-                record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - by specialize
-                work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+                record_row(x, v, t, mon, n_mon, mon_t, mon_out)
+                work_note(fargs, mon_out, n_mon)
                 mark_steps[n_mon] = step0 + steps
                 n_mon += 1
                 k_mark += 1

@@ -60,10 +60,10 @@ from fractions import Fraction
 
 import numpy as np
 
-from ._jit import njit, specialize
+from ._jit import njit, slots, specialize
 from .status import Status
-from .stepping import (GO, adaptive_start, add_compensated, clock_step, first_record,
-                       must_return, step_epilogue, stop_info, work_kernels)
+from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
+                       first_record, must_return, step_epilogue, stop_info, work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -337,7 +337,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     g1 = g.reshape((7, m3))
     acc1 = acc.reshape(m3)
     # the step control measures the bodies' rows (not the tangent rows of variations)
-    ne = rows(x, fargs)  # noqa: F821 - bound by specialize
+    ne = rows(x, fargs)
     every = mon[0]
     cap = mon_t.shape[0]
     n_mon = 0
@@ -354,7 +354,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         if must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap):
             return Status.OK, t, n_mon
         if flags[0] == 0:
-            force(x, v, t, fargs, a0)  # noqa: F821 - bound by specialize
+            force(x, v, t, fargs, a0)
             counts[2] += 1
             flags[0] = 1
             s = 0.0
@@ -365,7 +365,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 return Status.NON_FINITE, t, n_mon
         proposed = dtp[0]
         if proposed == 0.0 or not math.isfinite(proposed):
-            proposed = _first_step(x[:ne], a0[:ne], target - t)
+            proposed = first_step(x[:ne], a0[:ne], target - t)
         proposed = abs(proposed) * direction
         remaining = (target - t) - ct
         trimmed = abs(proposed) >= abs(remaining)
@@ -377,16 +377,16 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         # first guess of b
         predicted = flags[1] != 0
         if predicted:
-            _predict(b, e, br, er, ref[1] / ref[0], dt / ref[0], P)
+            predict(b, e, br, er, ref[1] / ref[0], dt / ref[0], P)
         else:
             b[...] = 0.0
             e[...] = 0.0
-        _g_from_b(b, g)
+        g_from_b(b, g)
 
         # the work rate at the start of the step, the Radau rule's node h = 0
         p0 = 0.0
-        if HAS_WORK:  # noqa: F821 - bound by specialize
-            p0 = work_rate(x, v, t, fargs)  # noqa: F821
+        if HAS_WORK:
+            p0 = work_rate(x, v, t, fargs)
 
         # predictor-corrector
         err_last = 2.0
@@ -404,15 +404,15 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                             b1[1, k] * _X1 + h * (b1[2, k] * _X2 + h * (
                                 b1[3, k] * _X3 + h * (b1[4, k] * _X4 + h * (
                                     b1[5, k] * _X5 + h * b1[6, k] * _X6)))))))))
-                    if PREDICT_V:  # noqa: F821 - bound by specialize
+                    if PREDICT_V:
                         vs1[k] = v1[k] + (csv1[k] + hdt * (a01[k] + h * (
                             b1[0, k] * _V0 + h * (b1[1, k] * _V1 + h * (
                                 b1[2, k] * _V2 + h * (b1[3, k] * _V3 + h * (
                                     b1[4, k] * _V4 + h * (b1[5, k] * _V5 + h * (
                                         b1[6, k] * _V6)))))))))
-                force(xs, vs, t + (ct + hdt), fargs, acc)  # noqa: F821
-                if HAS_WORK:  # noqa: F821
-                    pw += _WR[sub] * work_rate(xs, vs, t + (ct + hdt), fargs)  # noqa: F821
+                force(xs, vs, t + (ct + hdt), fargs, acc)
+                if HAS_WORK:
+                    pw += _WR[sub] * work_rate(xs, vs, t + (ct + hdt), fargs)
                 # the corrector, a pass over every component at a time (each
                 # a loop LLVM vectorises; each component's operations in the
                 # order of the nested form): the new divided difference r
@@ -458,7 +458,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         # much as the random walk itself.  The g are divided differences of
         # this step's forces alone; b = C g taken afresh from them carry no
         # memory of the prediction, and the drift is gone (validation/brouwer.py).
-        _b_from_g(g, b)
+        b_from_g(g, b)
 
         # step control: the global criterion always, the per-body timescale on top
         worst = -1
@@ -561,8 +561,8 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         add_compensated(x, xs, csx)
         add_compensated(v, vs, csv)
         flags[0] = 0
-        if HAS_WORK:  # noqa: F821
-            work_add(fargs, -dt * pw)  # noqa: F821
+        if HAS_WORK:
+            work_add(fargs, -dt * pw)
         t, ct = clock_step(t, ct, dt, trimmed, target)
         tc[0] = t
         tc[1] = ct
@@ -586,7 +586,7 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
         else:
             ref[1] += dt
 
-        stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
+        stop, _, _, until_record, n_mon = step_end(
             x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
             stopping, fargs)
         if stop != GO:
@@ -600,8 +600,8 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
                 return Status.OK, t, n_mon
             # an output: recorded as the driver would record it on return
             mon_t[n_mon] = t
-            record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
-            work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+            record_row(x, v, t, mon, n_mon, mon_t, mon_out)
+            work_note(fargs, mon_out, n_mon)
             mark_steps[n_mon] = step0 + counts[0]
             n_mon += 1
             k_mark += 1
@@ -636,8 +636,15 @@ def _first_step(x, a0, span):
     return abs(span)
 
 
-_JITTED = {"_predict": njit(_predict), "_g_from_b": njit(_g_from_b),
-           "_b_from_g": njit(_b_from_g), "_first_step": njit(_first_step)}
+# the names _ias15_loop is written against, bound by ias15_loop (specialize);
+# the helpers default to their Python form, for a loop that runs as Python
+force, rows, step_end, record_row, PREDICT_V = slots(
+    "force", "rows", "step_end", "record_row", "PREDICT_V")
+HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+predict, g_from_b, b_from_g, first_step = slots(
+    predict=_predict, g_from_b=_g_from_b, b_from_g=_b_from_g, first_step=_first_step)
+_JITTED = {"predict": njit(_predict), "g_from_b": njit(_g_from_b),
+           "b_from_g": njit(_b_from_g), "first_step": njit(_first_step)}
 
 
 def ias15_loop(force):

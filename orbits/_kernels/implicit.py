@@ -57,9 +57,14 @@ import math
 
 import numpy as np
 
-from ._jit import njit, specialize
+from ._jit import njit, slots, specialize
 from .status import Status
-from .stepping import GO, first_record, state_is_finite, step_epilogue, work_kernels
+from .stepping import WORK_SLOTS, GO, first_record, state_is_finite, step_epilogue, work_kernels
+
+# the names the templates below are written against, bound by specialize
+THETA, VELOCITY, base_jacobian, extra, force, jacobian, step_end, user_jac = slots(
+    "THETA", "VELOCITY", "base_jacobian", "extra", "force", "jacobian", "step_end", "user_jac")
+HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["implicit_loop", "gravity_jacobian", "user_jacobian",
            "finite_difference_jacobian", "jacobian_for", "lu_factor", "lu_solve",
@@ -196,7 +201,7 @@ def _user_jacobian(x, v, t, fargs, jx, jv):
     size, shape = fargs
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
-    dadx, dadv = user_jac(xu, vu, t)  # noqa: F821 - bound by specialize
+    dadx, dadv = user_jac(xu, vu, t)
     jxu = np.asarray(dadx)
     jvu = np.asarray(dadv)
     for p in range(size):
@@ -234,14 +239,14 @@ def _finite_difference_jacobian(x, v, t, fargs, jx, jv):
         hi = x[i, d] + delta
         lo = x[i, d] - delta
         xp[i, d] = hi
-        force(xp, v, t, fargs, ap)  # noqa: F821 - bound by specialize
+        force(xp, v, t, fargs, ap)
         xp[i, d] = lo
-        force(xp, v, t, fargs, am)  # noqa: F821
+        force(xp, v, t, fargs, am)
         xp[i, d] = x[i, d]
         inv = 1.0 / (hi - lo)
         for p in range(m):
             jx[p, q] = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
-    if VELOCITY:  # noqa: F821 - bound by specialize
+    if VELOCITY:
         for q in range(m):
             i = q // 3
             d = q % 3
@@ -249,9 +254,9 @@ def _finite_difference_jacobian(x, v, t, fargs, jx, jv):
             hi = v[i, d] + delta
             lo = v[i, d] - delta
             vp[i, d] = hi
-            force(x, vp, t, fargs, ap)  # noqa: F821
+            force(x, vp, t, fargs, ap)
             vp[i, d] = lo
-            force(x, vp, t, fargs, am)  # noqa: F821
+            force(x, vp, t, fargs, am)
             vp[i, d] = v[i, d]
             inv = 1.0 / (hi - lo)
             for p in range(m):
@@ -277,12 +282,12 @@ _GRAVITY_KEYS = ("gravity_small", "gravity_serial", "gravity_parallel")
 
 
 def _jacobian_with_terms(x, v, t, fargs, jx, jv):
-    base_jacobian(x, v, t, fargs[0], jx, jv)  # noqa: F821 - bound by specialize
-    if VELOCITY:  # noqa: F821 - bound by specialize
+    base_jacobian(x, v, t, fargs[0], jx, jv)
+    if VELOCITY:
         for p in range(jv.shape[0]):
             for q in range(jv.shape[1]):
                 jv[p, q] = 0.0
-    extra(x, v, t, fargs[1], jx, jv)  # noqa: F821
+    extra(x, v, t, fargs[1], jx, jv)
 
 
 def jacobian_for(force, velocity_dependent):
@@ -318,7 +323,7 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
     stopping = (sargs, check)
     n = x.shape[0]
     m = 3 * n
-    th = THETA  # noqa: F821 - bound by specialize
+    th = THETA
     cx = th * th * dt * dt
     cv = th * dt
     dwf = dw.reshape(m)
@@ -341,12 +346,12 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
                     vsid = v[i, d] + th * w[i, d]
                     vs[i, d] = vsid
                     xs[i, d] = x[i, d] + th * dt * vsid
-            force(xs, vs, ts, fargs, acc)  # noqa: F821 - bound by specialize
+            force(xs, vs, ts, fargs, acc)
             for i in range(n):
                 for d in range(3):
                     dw[i, d] = dt * acc[i, d] - w[i, d]
             if refresh:
-                jacobian(xs, vs, ts, fargs, jx, jv)  # noqa: F821 - bound by specialize
+                jacobian(xs, vs, ts, fargs, jx, jv)
                 for p in range(m):
                     for q in range(m):
                         lu[p, q] = -cx * jx[p, q]
@@ -385,8 +390,8 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
         if not converged:
             cache[0] = 0
             return Status.NO_CONVERGENCE, k, n_mon
-        if HAS_WORK:  # noqa: F821 - bound by specialize
-            work_add(fargs, -dt * work_rate(xs, vs, ts, fargs))  # noqa: F821
+        if HAS_WORK:
+            work_add(fargs, -dt * work_rate(xs, vs, ts, fargs))
         # the step, with the accelerations at the last stage point
         for i in range(n):
             for d in range(3):
@@ -394,7 +399,7 @@ def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, p
                 x[i, d] += dt * (v[i, d] + th * hv)
                 v[i, d] += hv
         cache[0] = 1
-        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+        status, done, until_check, until_record, n_mon = step_end(
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
             every, mon, n_mon, mon_t, mon_out, stopping, fargs)
         if status != GO:

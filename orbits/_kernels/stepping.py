@@ -57,13 +57,23 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from ._jit import called, njit, specialize
+from ._jit import called, njit, slots, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
                       accelerate_pairwise_parallel, accelerate_pairwise_rebound,
                       accelerate_pairwise_small)
 from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, monitor_row
 from .status import Status
 from .stopping import call_check
+
+# the names the templates below are written against, bound by specialize
+#: the slots that :func:`work_kernels` binds, which every loop that integrates
+#: the work of non-conservative terms declares (:func:`~._jit.slots`)
+WORK_SLOTS = ("HAS_WORK", "work_rate", "work_add", "work_note")
+HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+(force, step_end, implicit_kick, KINDS, COEFS, pair_kernel, base, extra, extra_energy,
+ nc_accel, user_accel, stop_check, tangent_step, record) = slots(
+    "force", "step_end", "implicit_kick", "KINDS", "COEFS", "pair_kernel", "base", "extra",
+    "extra_energy", "nc_accel", "user_accel", "stop_check", "tangent_step", "record")
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
            "user_force", "state_is_finite", "ForceKernel", "with_terms",
@@ -209,7 +219,7 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
             until_check = check_every
             if not state_is_finite(x, v):
                 return Status.NON_FINITE, k, until_check, until_record, n_mon
-    renormalise = tangent_step(x, v, t, fargs)  # noqa: F821 - bound by specialize
+    renormalise = tangent_step(x, v, t, fargs)
     until_record -= 1
     if until_record == 0:
         if every > 0:
@@ -222,10 +232,10 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
         else:
             until_record = -1
         # n_mon as a variable: a constant 0 would compile the recorder once more
-        _record(x, v, t, mon, np.int64(n_mon), mon_t, mon_out)
-        work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+        record(x, v, t, mon, np.int64(n_mon), mon_t, mon_out)
+        work_note(fargs, mon_out, n_mon)
         n_mon += 1
-    status = stop_check(x, v, t, stopping)  # noqa: F821 - bound by specialize
+    status = stop_check(x, v, t, stopping)
     if status != 0:
         if check and not state_is_finite(x, v):
             return Status.NON_FINITE, k, until_check, until_record, n_mon
@@ -258,7 +268,7 @@ def epilogue(record, key, jit=True, cache=True, runtime=False, stop=None, work_n
     :mod:`.variational`; none by default)."""
     stop_check = call_check if stop is None else stop
     return specialize(_step_end, key, jit=jit, inline=True, nrt=runtime, cache=cache,
-                      _record=record, stop_check=stop_check,
+                      record=record, stop_check=stop_check,
                       work_note=_no_work_note if work_note is None else work_note,
                       tangent_step=_no_tangent_step if tangent_step is None else tangent_step)
 
@@ -267,7 +277,7 @@ def epilogue(record, key, jit=True, cache=True, runtime=False, stop=None, work_n
 
 def _gravity_force(x, v, t, fargs, acc):
     gm, n_active, eps2, work, G, m = fargs
-    pair_kernel(x, gm, n_active, eps2, acc, work)  # noqa: F821 - bound by specialize
+    pair_kernel(x, gm, n_active, eps2, acc, work)
 
 
 def _gravity_force_exact(x, v, t, fargs, acc):
@@ -292,7 +302,7 @@ def _user_python_force(x, v, t, fargs, acc):
     size, shape = fargs[0], fargs[1]
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
-    a = np.asarray(user_accel(xu, vu, t)).ravel()  # noqa: F821 - bound by specialize
+    a = np.asarray(user_accel(xu, vu, t)).ravel()
     if a.size != size:
         # checked before the run too (orbits.custom); here for a size that varies
         raise ValueError(USER_FORCE_SIZE)
@@ -374,8 +384,8 @@ def gravity_force(kind):
 
 
 def _forced(x, v, t, fargs, acc):
-    base(x, v, t, fargs[0], acc)  # noqa: F821 - bound by specialize
-    extra(x, v, t, fargs[1], acc)  # noqa: F821
+    base(x, v, t, fargs[0], acc)
+    extra(x, v, t, fargs[1], acc)
 
 
 def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
@@ -385,7 +395,7 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
     row = mon_out[n_mon]
     monitor_row(x, v, m, G, n_active, eps2, which, row)
     if which & ENERGY:
-        row[0] += extra_energy(x, v, eargs)  # noqa: F821 - bound by specialize
+        row[0] += extra_energy(x, v, eargs)
     record_state(x, v, m, row)
 
 
@@ -424,7 +434,7 @@ def _work_rate(x, v, t, fargs):
         scratch[i, 0] = 0.0
         scratch[i, 1] = 0.0
         scratch[i, 2] = 0.0
-    nc_accel(x, v, t, nargs, scratch)  # noqa: F821 - bound by specialize
+    nc_accel(x, v, t, nargs, scratch)
     s = 0.0
     for i in range(n):
         s += m[i] * (scratch[i, 0] * v[i, 0] + scratch[i, 1] * v[i, 1]
@@ -597,29 +607,29 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
     until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         tx = t + k * dt
-        for op in range(len(KINDS)):  # noqa: F821 - bound by specialize
-            h = COEFS[op] * dt  # noqa: F821
-            if KINDS[op] == DRIFT:  # noqa: F821
+        for op in range(len(KINDS)):
+            h = COEFS[op] * dt
+            if KINDS[op] == DRIFT:
                 add_scaled(x, xF, h, v, vF, flat)
                 tx += h
                 fresh = False
             elif velocity_dependent:
                 implicit_kick(x, v, tx, h, fargs, acc, vm)
                 fresh = False
-                if HAS_WORK:  # noqa: F821 - bound by specialize
+                if HAS_WORK:
                     # vm is the kick's midpoint velocity (v + v') / 2
-                    work_add(fargs, -h * work_rate(x, vm, tx, fargs))  # noqa: F821
+                    work_add(fargs, -h * work_rate(x, vm, tx, fargs))
             else:
                 if not fresh:
-                    force(x, v, tx, fargs, acc)  # noqa: F821 - bound by specialize
+                    force(x, v, tx, fargs, acc)
                     fresh = True
                 add_scaled(v, vF, h, acc, aF, flat)
-                if HAS_WORK:  # noqa: F821
+                if HAS_WORK:
                     for i in range(n):
                         for d in range(3):
                             vm[i, d] = v[i, d] - 0.5 * h * acc[i, d]
-                    work_add(fargs, -h * work_rate(x, vm, tx, fargs))  # noqa: F821
-        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+                    work_add(fargs, -h * work_rate(x, vm, tx, fargs))
+        status, done, until_check, until_record, n_mon = step_end(
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
             every, mon, n_mon, mon_t, mon_out, stopping, fargs)
         if status != GO:
@@ -645,7 +655,7 @@ def _implicit_kick(x, v, t, h, fargs, acc, vm):
             vm[i, d] = v[i, d]
     prev = math.inf
     for it in range(KICK_MAX_ITER):
-        force(x, vm, t, fargs, acc)  # noqa: F821 - bound by specialize
+        force(x, vm, t, fargs, acc)
         change = 0.0
         scale = 0.0
         for i in range(n):
@@ -760,17 +770,17 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
         pw = 0.0
         for s in range(n_stages):
             rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, s, dt)
-            force(xs, vs, tk + c[s] * dt, fargs, kv[s])  # noqa: F821 - bound by specialize
-            if HAS_WORK and b[s] != 0.0:  # noqa: F821
-                pw += b[s] * work_rate(xs, vs, tk + c[s] * dt, fargs)  # noqa: F821
+            force(xs, vs, tk + c[s] * dt, fargs, kv[s])
+            if HAS_WORK and b[s] != 0.0:
+                pw += b[s] * work_rate(xs, vs, tk + c[s] * dt, fargs)
         # the step's sums b . k, gathered in xs, vs (free until the next step)
         rk_sums(xsF, vsF, kxF, kvF, b, n_stages)
         for q in range(m3):
             xF[q] += dt * xsF[q]
             vF[q] += dt * vsF[q]
-        if HAS_WORK:  # noqa: F821
-            work_add(fargs, -dt * pw)  # noqa: F821
-        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+        if HAS_WORK:
+            work_add(fargs, -dt * pw)
+        status, done, until_check, until_record, n_mon = step_end(
             x, v, t + (k + 1) * dt, k, nsteps, True, until_check, check_every, until_record,
             every, mon, n_mon, mon_t, mon_out, stopping, fargs)
         if status != GO:

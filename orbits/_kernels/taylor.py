@@ -48,10 +48,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._jit import njit, specialize
+from ._jit import njit, slots, specialize
 from .status import Status
-from .stepping import (GO, adaptive_start, add_compensated, clock_step, first_record,
-                       must_return, step_epilogue, stop_info, work_kernels)
+from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
+                       first_record, must_return, step_epilogue, stop_info, work_kernels)
+
+# the names the templates below are written against, bound by specialize
+record_row, step_end = slots("record_row", "step_end")
+HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["order_for", "pair_count", "padded_pairs", "Series", "series_arrays", "taylor_loop",
            "expand", "PAD"]
@@ -309,7 +313,7 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
         tc[1] = ct
         counts[0] += 1
         dtp[0] = proposed
-        stop, _, _, until_record, n_mon = step_end(  # noqa: F821 - bound by specialize
+        stop, _, _, until_record, n_mon = step_end(
             x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
             stopping, fargs)
         if stop != GO:
@@ -319,8 +323,8 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
             if not has_marks:
                 return Status.OK, t, n_mon
             mon_t[n_mon] = t
-            record_row(x, v, t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
-            work_note(fargs, mon_out, n_mon)  # noqa: F821 - bound by specialize
+            record_row(x, v, t, mon, n_mon, mon_t, mon_out)
+            work_note(fargs, mon_out, n_mon)
             mark_steps[n_mon] = step0 + counts[0]
             n_mon += 1
             k_mark += 1

@@ -61,12 +61,15 @@ import math
 
 import numpy as np
 
-from ._jit import called, njit, specialize
+from ._jit import called, njit, slots, specialize
 from .coordinates import from_democratic_heliocentric, to_democratic_heliocentric
 from .gravity import pair_accelerations
 from .status import Status
 from .stepping import GO, _record, epilogue, first_record
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
+
+# the names the templates below are written against, bound by specialize
+HAS_TERMS, step_end, term_kick = slots("HAS_TERMS", "step_end", "term_kick")
 
 __all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
            "inner_arrays",
@@ -613,8 +616,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                 # the exact flow of gravity ends on the criterion point, less
                 # the added terms' half kick
                 _copy(vb, vs)
-                if HAS_TERMS:  # noqa: F821 - bound by specialize
-                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+                if HAS_TERMS:
+                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
             else:
                 jump(xh, vb, gm, n_active, half)
                 if flagged:
@@ -626,8 +629,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                         vs[i, 0] = vb[i, 0] + half * acc[i, 0]
                         vs[i, 1] = vb[i, 1] + half * acc[i, 1]
                         vs[i, 2] = vb[i, 2] + half * acc[i, 2]
-                if HAS_TERMS:  # noqa: F821
-                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+                if HAS_TERMS:
+                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
             npairs, peri_end = criterion(xh, vs, gm, hill, r2, n_active, k_hill,
                                          k_speed, dt, r_peri, enc_new)
             grew = npairs > 0 and _new_flags(enc, enc_new, n, n_active)
@@ -642,8 +645,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                     peri = True
                 _copy(xc, xh)
                 _copy(vc, vb)
-                if state[2] and HAS_TERMS:  # noqa: F821
-                    term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)  # noqa: F821
+                if state[2] and HAS_TERMS:
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)
                 if state[2] and not peri:
                     if flagged:
                         _kick_unflagged(xh, vb, acc, gm, n_active, enc, owed)
@@ -692,8 +695,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             # the next segment integrates gravity whole from the criterion
             # point, after the added terms' half kick
             _copy(vs, vb)
-            if HAS_TERMS:  # noqa: F821
-                term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+            if HAS_TERMS:
+                term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
         else:
             if not flagged and not peri and not new_flagged:
                 # no flags either side: the Wisdom-Holman kick I(h), its arithmetic
@@ -701,8 +704,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                     vb[i, 0] += dt * acc[i, 0]
                     vb[i, 1] += dt * acc[i, 1]
                     vb[i, 2] += dt * acc[i, 2]
-                if HAS_TERMS:  # noqa: F821
-                    term_kick(xh, vb, w1, w2, gm, eta, n_active, dt, targs)  # noqa: F821
+                if HAS_TERMS:
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, dt, targs)
             else:
                 _copy(vs, vb)
                 if new_flagged:
@@ -713,8 +716,8 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
                         vb[i, 0] += half * acc[i, 0]
                         vb[i, 1] += half * acc[i, 1]
                         vb[i, 2] += half * acc[i, 2]
-                if HAS_TERMS:  # noqa: F821
-                    term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)  # noqa: F821
+                if HAS_TERMS:
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
             jump(xh, vb, gm, n_active, half)
         owed = half
         owed_box[0] = owed
@@ -738,7 +741,7 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             checked[0] = t_seen
             checked[1] = 1.0
             seen_x, seen_v = x, v
-        status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+        status, done, until_check, until_record, n_mon = step_end(
             seen_x, seen_v, t_seen, k, nsteps, True, until_check, check_every, until_record,
             every, mon, n_mon, mon_t, mon_out, stopping, ())
         if status != GO:

@@ -51,8 +51,14 @@ import math
 
 import numpy as np
 
-from ._jit import njit, specialize
+from ._jit import njit, slots, specialize
 from .implicit import jacobian_for
+
+# the names the templates below are written against, bound by specialize
+(CHAOS_ON, MASSES, MEGNO_COLUMN, VELOCITY, inner, inner_add, inner_note, inner_rate,
+ inner_record, jacobian) = slots(
+    "CHAOS_ON", "MASSES", "MEGNO_COLUMN", "VELOCITY", "inner", "inner_add", "inner_note",
+    "inner_rate", "inner_record", "jacobian")
 
 __all__ = ["with_variations", "variation_args", "chaos_update", "chaos_rescaled",
            "chaos_values", "chaos_box", "measured_rows", "CHAOS", "RENORMALISE_EXPONENT",
@@ -146,13 +152,13 @@ def chaos_values(box):
 def _varied(x, v, t, fargs, acc):
     inner_args, vargs = fargs[0], fargs[1]
     n, dm, jx, jv = vargs[0], vargs[1], vargs[2], vargs[3]
-    inner(x[:n], v[:n], t, inner_args, acc[:n])  # noqa: F821 - bound by specialize
+    inner(x[:n], v[:n], t, inner_args, acc[:n])
     for p in range(3 * n):
         for q in range(3 * n):
             jx[p, q] = 0.0
-            if VELOCITY:  # noqa: F821 - bound by specialize
+            if VELOCITY:
                 jv[p, q] = 0.0
-    jacobian(x[:n], v[:n], t, inner_args, jx, jv)  # noqa: F821 - bound by specialize
+    jacobian(x[:n], v[:n], t, inner_args, jx, jv)
     k = dm.shape[0]
     for j in range(k):
         o = n * (j + 1)
@@ -163,11 +169,11 @@ def _varied(x, v, t, fargs, acc):
                 for c in range(n):
                     s += (jx[r, 3 * c] * x[o + c, 0] + jx[r, 3 * c + 1] * x[o + c, 1]
                           + jx[r, 3 * c + 2] * x[o + c, 2])
-                    if VELOCITY:  # noqa: F821
+                    if VELOCITY:
                         s += (jv[r, 3 * c] * v[o + c, 0] + jv[r, 3 * c + 1] * v[o + c, 1]
                               + jv[r, 3 * c + 2] * v[o + c, 2])
                 acc[o + i, d] = s
-        if MASSES:  # noqa: F821 - bound by specialize
+        if MASSES:
             G, eps2 = vargs[5]
             for l in range(n):
                 g = G * dm[j, l]
@@ -201,7 +207,7 @@ def _varied_jacobian(x, v, t, fargs, jx, jv):
         for q in range(3 * n):
             sx[p, q] = 0.0
             sv[p, q] = 0.0
-    jacobian(x[:n], v[:n], t, inner_args, sx, sv)  # noqa: F821 - bound by specialize
+    jacobian(x[:n], v[:n], t, inner_args, sx, sv)
     blocks = m // (3 * n)
     for b in range(blocks):
         o = 3 * n * b
@@ -214,34 +220,34 @@ def _varied_jacobian(x, v, t, fargs, jx, jv):
 def _varied_record(x, v, t, mon, n_mon, mon_t, mon_out):
     # the bodies' monitors: the masses in mon say how many rows are bodies
     n = mon[2].shape[0]
-    inner_record(x[:n], v[:n], t, mon, n_mon, mon_t, mon_out)  # noqa: F821 - bound
+    inner_record(x[:n], v[:n], t, mon, n_mon, mon_t, mon_out)
 
 
 def _varied_work_rate(x, v, t, fargs):
     n = fargs[1][0]
-    return inner_rate(x[:n], v[:n], t, fargs[0])  # noqa: F821 - bound by specialize
+    return inner_rate(x[:n], v[:n], t, fargs[0])
 
 
 def _varied_work_add(fargs, dw):
-    inner_add(fargs[0], dw)  # noqa: F821 - bound by specialize
+    inner_add(fargs[0], dw)
 
 
 def _varied_note(fargs, mon_out, row):
     # the work, then the chaos indicators, into the monitor row just recorded
-    inner_note(fargs[0], mon_out, row)  # noqa: F821 - bound by specialize
-    if CHAOS_ON:  # noqa: F821 - bound by specialize
+    inner_note(fargs[0], mon_out, row)
+    if CHAOS_ON:
         box = fargs[1][4]
         span = box[1] - box[0]
         if span != 0.0:
-            mon_out[row, MEGNO_COLUMN] = box[5] / span  # noqa: F821
-            mon_out[row, MEGNO_COLUMN + 1] = box[8] / span  # noqa: F821
-            mon_out[row, MEGNO_COLUMN + 2] = box[7]  # noqa: F821
+            mon_out[row, MEGNO_COLUMN] = box[5] / span
+            mon_out[row, MEGNO_COLUMN + 1] = box[8] / span
+            mon_out[row, MEGNO_COLUMN + 2] = box[7]
 
 
 def _tangent_step(x, v, t, fargs):
     # after every step: the chaos accumulators (tangent vector 0); True asks
     # the loop to stop for a renormalisation
-    if CHAOS_ON:  # noqa: F821 - bound by specialize
+    if CHAOS_ON:
         vargs = fargs[1]
         n = vargs[0]
         return chaos_update(x[n:2 * n], v[n:2 * n], t, vargs[4])
@@ -277,8 +283,7 @@ def tangent_kernels(force):
     if force.inner is None or not force.chaos:
         return dict(tangent_step=_no_tangent_step)
     return dict(tangent_step=specialize(_tangent_step, force.key, cache=force.cache,
-                                        inline=True, chaos_update=chaos_update,
-                                        CHAOS_ON=True))
+                                        inline=True, CHAOS_ON=True))
 
 
 def variational_work_kernels(force, inner_kernels):

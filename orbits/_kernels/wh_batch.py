@@ -93,7 +93,7 @@ import tempfile
 
 import numpy as np
 
-from ._jit import KERNEL_STAMP, njit, specialize
+from ._jit import KERNEL_STAMP, njit, slots, specialize
 from .coordinates import interior_gm, to_jacobi
 from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
@@ -105,6 +105,9 @@ from .invariants import MONITOR_WIDTH, monitor_row
 from .status import Status
 from .wh_lanes import column_start, drift_columns
 from .wisdom_holman import synchronize
+
+# the names the templates below are written against, bound by specialize
+kick, flat_kick, KICK_SYSTEMS, lane_step = slots("kick", "flat_kick", "KICK_SYSTEMS", "lane_step")
 
 __all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "lanes_workspace", "kepler_drift_lanes",
            "interaction_kick_lanes", "advance_lanes", "advance_loop", "unrolled_kick",
@@ -551,7 +554,7 @@ def _step(X, V, GM, MU, n_active, dt, owed, LF, nb, XI, ACC, d, fl, s3, a3, t4, 
     # returns the drift now owed.  kick: bound by specialize (_any_size_kick
     # or an unrolled_kick)
     _drift_lanes(X, V, MU, 0.5 * dt + owed, LF, nb, d, fl, one_x, one_v)
-    kick(X, V, XI, ACC, GM, MU, n_active, 1.0 * dt, LF, nb, d, s3, a3, t4)  # noqa: F821
+    kick(X, V, XI, ACC, GM, MU, n_active, 1.0 * dt, LF, nb, d, s3, a3, t4)
     return 0.5 * dt
 
 
@@ -562,7 +565,7 @@ def _any_size_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4):
 
 #: the step of advance_lanes, for systems of any size; advance_loop binds
 #: the step with an unrolled_kick instead
-lane_step = specialize(_step, "any_size", inline=True, kick=_any_size_kick)
+_any_size_step = specialize(_step, "any_size", inline=True, kick=_any_size_kick)
 
 
 @njit(inline="always")
@@ -575,8 +578,7 @@ def _lane_finite(X, V, nb, b):
     return math.isfinite(s)
 
 
-@njit
-def advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, good, X, V, XI,
+def _advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, good, X, V, XI,
                   ACC, GM, MU, LF, d, fl, s3, a3, t4, ckx, ckv, px, pv, one_x, one_v, lf1):
     """Advance every live system ``nsteps`` steps of the Wisdom-Holman map.
 
@@ -722,6 +724,10 @@ def advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, goo
             owed[b] = ow
             good[b] = nsteps
     return failed
+
+
+#: the batch loop for systems of any size (see :func:`_advance_lanes`)
+advance_lanes = specialize(_advance_lanes, "any_size", lane_step=_any_size_step)
 
 
 # -- the kick unrolled for one size of system ---------------------------------------
@@ -881,13 +887,13 @@ def _unrolled_step_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t
     F = d[_KLF]
     for k in range(np.uint64(m)):
         F[k] = LF[k]
-    if nb != KICK_SYSTEMS:  # noqa: F821 - bound by specialize
+    if nb != KICK_SYSTEMS:
         raise ValueError("wh_batch: a loop of advance_loop takes the number of systems "
                          "it was made for")
     # the number of systems as a value known only when the kick runs: a loop
     # of a trip count below 16 known when it compiles is never vectorised
     # (at 4 and 8 systems the kick would stay scalar)
-    flat_kick(d.ravel(), V.ravel(), h, nb)  # noqa: F821 - bound by specialize
+    flat_kick(d.ravel(), V.ravel(), h, nb)
 
 
 def advance_loop(n, n_active, nb):
@@ -906,7 +912,7 @@ def advance_loop(n, n_active, nb):
     kick_ = specialize(_unrolled_step_kick, key, inline=True, flat_kick=flat,
                        KICK_SYSTEMS=nb)
     step_ = specialize(_step, f"unrolled_{key}", inline=True, kick=kick_)
-    return specialize(advance_lanes.py_func, f"unrolled_{key}", lane_step=step_)
+    return specialize(_advance_lanes, f"unrolled_{key}", lane_step=step_)
 
 
 def to_lanes(x, v, gm):

@@ -108,13 +108,16 @@ import math
 
 import numpy as np
 
-from ._jit import njit, specialize
+from ._jit import njit, slots, specialize
 # the planets' columns, padded to a multiple of the lane width (shared with the
 # gravity kernels' lanes)
 from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pull_rows,
                       pull_rows_factored)
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, advanced_state, f_and_g,
                      kepler_drift, quartic_step, short_start, stumpff_lane)
+
+# the names the templates below are written against, bound by specialize
+step_of, = slots("step_of")
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
            "lanes_scratch", "kepler_drift_lanes",
@@ -299,9 +302,9 @@ def _pass_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, H,
     # Returns how many columns are not right.
     for k in range(k0, P):
         _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k,
-                      step_of(H, k, h0))  # noqa: F821 - bound by specialize
+                      step_of(H, k, h0))
     for k in range(k0, P):
-        _iterate_column(T, t, k, step_of(H, k, h0))  # noqa: F821
+        _iterate_column(T, t, k, step_of(H, k, h0))
     rejected = 0
     for k in range(k0, P):
         rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,

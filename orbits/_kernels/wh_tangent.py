@@ -92,13 +92,19 @@ References
 
 import math
 
-from ._jit import called, njit, specialize
+from ._jit import called, njit, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democratic_heliocentric,
                           to_jacobi)
 from .kepler import advance_tangent_by_anomaly, kepler_drift_tangent, short_step_anomaly
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels,
                             heliocentric_interaction_kick, interaction_kick, jump)
+
+# the names the templates below are written against, bound by specialize
+(TERMS, record, chaos_update, inertial_tangent, jacobian, note, renormalise, synchronize,
+ term_jacobian, term_kick, term_tangent) = slots(
+    "TERMS", "record", "chaos_update", "inertial_tangent", "jacobian", "note", "renormalise",
+    "synchronize", "term_jacobian", "term_kick", "term_tangent")
 
 __all__ = ["drift_tangent", "interaction_kick_and_tangent",
            "jump_tangent",
@@ -587,7 +593,7 @@ def _terms_jacobian(x, targs):
             jv[p, q] = 0.0
     n = n3 // 3
     # position-only terms: the kick passes the positions as velocities too
-    term_jacobian(x[:n], x[:n], 0.0, targs[0], jx, jv)  # noqa: F821 - bound by specialize
+    term_jacobian(x[:n], x[:n], 0.0, targs[0], jx, jv)
 
 
 def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
@@ -597,7 +603,7 @@ def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
     tp = targs[1]
     n = gm.shape[0]
     k = tp[2]
-    jacobian(x, targs)  # noqa: F821 - bound by specialize
+    jacobian(x, targs)
     for j in range(k):
         o = n * (1 + j)
         _from_jacobi_block(xj, x, gm, eta, tp[0], tp[1], j, False)
@@ -631,7 +637,7 @@ def _heliocentric_term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs):
     mt = 0.0
     for i in range(n_active):
         mt += gm[i]
-    jacobian(x, targs)  # noqa: F821 - bound by specialize
+    jacobian(x, targs)
     for j in range(k):
         o = n * (1 + j)
         for d in range(3):
@@ -659,10 +665,10 @@ def _jacobi_perturbation(xj, vj, x, acc, gm, eta, n_active, h, targs):
     n = gm.shape[0]
     tp = targs[1]
     interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp)
-    if TERMS:  # noqa: F821 - bound by specialize
-        term_kick(xj[:n], vj[:n], x[:n], acc[:n], gm, eta, n_active, h,  # noqa: F821
+    if TERMS:
+        term_kick(xj[:n], vj[:n], x[:n], acc[:n], gm, eta, n_active, h,
                   targs[0])
-        term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+        term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs)
 
 
 def _heliocentric_perturbation(xh, vb, x, acc, gm, eta, n_active, h, targs):
@@ -673,10 +679,10 @@ def _heliocentric_perturbation(xh, vb, x, acc, gm, eta, n_active, h, targs):
     jump(xh[:n], vb[:n], gm, n_active, 0.5 * h)
     heliocentric_interaction_kick(xh[:n], vb[:n], acc[:n], gm, n_active, h)
     heliocentric_kick_tangent(xh, vb, acc, gm, n_active, h, tp)
-    if TERMS:  # noqa: F821 - bound by specialize
-        term_kick(xh[:n], vb[:n], x[:n], acc[:n], gm, eta, n_active, h,  # noqa: F821
+    if TERMS:
+        term_kick(xh[:n], vb[:n], x[:n], acc[:n], gm, eta, n_active, h,
                   targs[0])
-        term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+        term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs)
     jump_tangent(xh, vb, gm, n_active, 0.5 * h, tp)
     jump(xh[:n], vb[:n], gm, n_active, 0.5 * h)
 
@@ -718,15 +724,15 @@ def _carrying(targs, k):
 def _tangent_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
     # the monitors' recorder: the bodies alone synchronised, then recorded
     mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs) = mon
-    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
                 _carrying(targs, 0))
-    _record(x, v, t, mon_args, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
+    record(x, v, t, mon_args, n_mon, mon_t, mon_out)
 
 
 def _tangent_bodies(xj, vj, sync):
     # the bodies alone synchronised into x, v (for the escape check)
     gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
-    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
                 _carrying(targs, 0))
 
 
@@ -738,17 +744,17 @@ def _chaos_step(xj, vj, t, sync):
     gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
     n = gm.shape[0]
     tp = targs[1]
-    inertial_tangent(xj, vj, gm, eta, xs, vs, tp)  # noqa: F821 - bound by specialize
+    inertial_tangent(xj, vj, gm, eta, xs, vs, tp)
     box = tp[6]
-    if chaos_update(xs[n:2 * n], vs[n:2 * n], t, box):  # noqa: F821 - bound by specialize
-        renormalise(xj, vj, n, box)  # noqa: F821 - bound by specialize
+    if chaos_update(xs[n:2 * n], vs[n:2 * n], t, box):
+        renormalise(xj, vj, n, box)
     return False
 
 
 def _chaos_note(sync, mon_out, row):
     # the chaos indicators into the monitor row just recorded, by the
     # variational force's own note (its fargs[1][4] is the box)
-    note(((), (0, 0, 0, 0, sync[11][1][6])), mon_out, row)  # noqa: F821 - bound
+    note(((), (0, 0, 0, 0, sync[11][1][6])), mon_out, row)
 
 
 _INERTIAL_TANGENT = {"jacobi": jacobi_inertial_tangent,
@@ -786,7 +792,7 @@ def _kernels(coordinates, terms, key, cache):
                            drift=called(_drift, nrt), perturbation=perturbation)
     sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt,
                       drift=called(_drift, nrt), from_internal=from_internal,
-                      apply_corrector=corrector)
+                      corrector_kernel=corrector)
     return to_internal, perturbation, corrector, sync
 
 
@@ -828,7 +834,7 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
     nrt = _runtime(terms, cache)
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, key, cache)
     recorder = specialize(_tangent_record, key, cache=cache, nrt=nrt, synchronize=sync,
-                          _record=force.recorder)
+                          record=force.recorder)
     step = None   # the epilogue's default: nothing after a step
     if force.chaos:
         step = specialize(_chaos_step, key, cache=cache, inline=True, nrt=nrt,
@@ -844,7 +850,7 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=called(to_internal, nrt),
                       drift=_drift, owed_drift=called(_drift, nrt), perturbation=perturbation,
-                      apply_corrector=corrector,
+                      corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache,
                                         work_note=note, tangent_step=step, stop=stop),
                       stop_args=stop_args)

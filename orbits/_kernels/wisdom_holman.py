@@ -99,7 +99,7 @@ References
 
 import math
 
-from ._jit import called, njit, specialize
+from ._jit import called, njit, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
                           to_democratic_heliocentric, to_jacobi)
 from .gravity import pair_accelerations
@@ -111,6 +111,14 @@ from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, resident_drift_
                        resident_finite, resident_jump_kick, resident_kick, resident_load,
                        resident_store)
 from .wh_lanes import resident_drift as resident_drift_rows
+
+# the names the templates below are written against, bound by specialize
+(COEFS, HELIOCENTRIC, KINDS, convert, drift, escape_check, extra, from_internal, owed_drift,
+ perturbation, step, step_end, synchronize_bodies, term_kick, to_internal, sync_kernel,
+ corrector_kernel, record) = slots(
+    "COEFS", "HELIOCENTRIC", "KINDS", "convert", "drift", "escape_check", "extra",
+    "from_internal", "owed_drift", "perturbation", "step", "step_end", "synchronize_bodies",
+    "term_kick", "to_internal", "sync_kernel", "corrector_kernel", "record")
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
@@ -288,11 +296,11 @@ def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
         else:
             a = corr[m - 1 - k, 0] * h
             b = corr[m - 1 - k, 1] * h
-        drift(xj, vj, eta, a, x, acc, targs)  # noqa: F821 - bound by specialize
-        perturbation(xj, vj, x, acc, gm, eta, n_active, -b, targs)  # noqa: F821 - bound
-        drift(xj, vj, eta, -2.0 * a, x, acc, targs)  # noqa: F821
-        perturbation(xj, vj, x, acc, gm, eta, n_active, b, targs)  # noqa: F821
-        drift(xj, vj, eta, a, x, acc, targs)  # noqa: F821
+        drift(xj, vj, eta, a, x, acc, targs)
+        perturbation(xj, vj, x, acc, gm, eta, n_active, -b, targs)
+        drift(xj, vj, eta, -2.0 * a, x, acc, targs)
+        perturbation(xj, vj, x, acc, gm, eta, n_active, b, targs)
+        drift(xj, vj, eta, a, x, acc, targs)
 
 
 def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs):
@@ -305,10 +313,10 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, ta
             xs[i, d] = xj[i, d]
             vs[i, d] = vj[i, d]
     if owed != 0.0:
-        drift(xs, vs, eta, owed, x, acc, targs)  # noqa: F821 - bound by specialize
+        drift(xs, vs, eta, owed, x, acc, targs)
     if corr.shape[0] > 0:
-        apply_corrector(xs, vs, x, acc, gm, eta, n_active, corr, h, FORWARD, targs)
-    from_internal(xs, vs, gm, eta, x, v, targs)  # noqa: F821 - bound by specialize
+        corrector_kernel(xs, vs, x, acc, gm, eta, n_active, corr, h, FORWARD, targs)
+    from_internal(xs, vs, gm, eta, x, v, targs)
 
 
 # An output of the lanes' loop (no added terms, four bodies or more) is noted
@@ -325,17 +333,17 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, ta
 # none of this: the defaults below do nothing.
 
 @njit(inline="always")
-def output_pending(targs):
+def _no_output_pending(targs):
     return False
 
 
 @njit(inline="always")
-def output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
+def _no_output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
     pass
 
 
 @njit(inline="always")
-def make_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
+def _no_make_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
                 corr, h, targs):
     pass
 
@@ -348,32 +356,40 @@ def make_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n
 # own check is then off) and writes the state back where it is not finite.
 # An output drifts its copy from the lanes (_resident_output_drift).  The
 # defaults below do nothing.
-RESIDENT = False
 
 
 @njit(inline="always")
-def resident_drift(xj, vj, eta, h, targs):
+def _no_resident_drift(xj, vj, eta, h, targs):
     pass
 
 
 @njit(inline="always")
-def resident_perturbation(xj, vj, gm, eta, n_active, h, targs):
+def _no_resident_perturbation(xj, vj, gm, eta, n_active, h, targs):
     pass
 
 
 @njit(inline="always")
-def lanes_in(xj, vj, gm, eta, targs):
+def _no_lanes_in(xj, vj, gm, eta, targs):
     pass
 
 
 @njit(inline="always")
-def lanes_out(xj, vj, targs):
+def _no_lanes_out(xj, vj, targs):
     pass
 
 
 @njit(inline="always")
-def lanes_check(xj, vj, k, nsteps, until_check, check_every, until_record, targs):
+def _no_lanes_check(xj, vj, k, nsteps, until_check, check_every, until_record, targs):
     return True, until_check
+
+
+# the lanes' slots, which other loops leave at these defaults
+(RESIDENT, output_pending, output_drift, make_output, resident_drift, resident_perturbation,
+ lanes_in, lanes_out, lanes_check) = slots(
+    RESIDENT=False, output_pending=_no_output_pending, output_drift=_no_output_drift,
+    make_output=_no_make_output, resident_drift=_no_resident_drift,
+    resident_perturbation=_no_resident_perturbation, lanes_in=_no_lanes_in,
+    lanes_out=_no_lanes_out, lanes_check=_no_lanes_check)
 
 
 def _resident_drift(xj, vj, eta, h, targs):
@@ -447,9 +463,9 @@ def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
     # that output_drift already drifted (owed 0; xa, va are then xs, vs)
     S = targs[0]
     S[PENDING, 0] = 0.0
-    synchronize(xa, va, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+    sync_kernel(xa, va, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
                 targs)
-    _record(x, v, S[PENDING, 2], mon, int(S[PENDING, 1]), mon_t, mon_out)  # noqa: F821
+    record(x, v, S[PENDING, 2], mon, int(S[PENDING, 1]), mon_t, mon_out)
 
 
 def _lanes_note(xj, vj, t, mon, n_mon, mon_t, mon_out):
@@ -476,31 +492,31 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
     n_mon = 0
     corrected = corr.shape[0] > 0
     if state[0] == 0:
-        to_internal(x, v, gm, eta, xj, vj, targs)  # noqa: F821 - bound by specialize
+        to_internal(x, v, gm, eta, xj, vj, targs)
         state[0] = 1
         owed_box[0] = 0.0
         if corrected:
-            apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
+            corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
             cdt[0] = abs(dt)
     elif corrected and cdt[0] != abs(dt):
         # a new step size (a shorter last step): through the true state to the
         # mapping state of the new step's corrector
         if owed_box[0] != 0.0:
-            owed_drift(xj, vj, eta, owed_box[0], xs, vs, targs)  # noqa: F821 - bound
+            owed_drift(xj, vj, eta, owed_box[0], xs, vs, targs)
             owed_box[0] = 0.0
-        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], FORWARD, targs)
-        apply_corrector(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
+        corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], FORWARD, targs)
+        corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
         cdt[0] = abs(dt)
     owed = owed_box[0]
     lanes_in(xj, vj, gm, eta, targs)
-    n_ops = len(KINDS)  # noqa: F821 - bound by specialize
-    defer = KINDS[n_ops - 1] == DRIFT  # noqa: F821
+    n_ops = len(KINDS)
+    defer = KINDS[n_ops - 1] == DRIFT
     until_check = check_every
     until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         for op in range(n_ops):
-            h = COEFS[op] * dt  # noqa: F821
-            if KINDS[op] == DRIFT:  # noqa: F821
+            h = COEFS[op] * dt
+            if KINDS[op] == DRIFT:
                 if op == 0:
                     if output_pending(targs):
                         # the output noted at the end of the last step
@@ -517,11 +533,11 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
                 elif RESIDENT:
                     resident_drift(xj, vj, eta, h, targs)
                 else:
-                    drift(xj, vj, eta, h, xs, vs, targs)  # noqa: F821 - bound
+                    drift(xj, vj, eta, h, xs, vs, targs)
             elif RESIDENT:
                 resident_perturbation(xj, vj, gm, eta, n_active, h, targs)
             else:
-                perturbation(xj, vj, xs, acc, gm, eta, n_active, h, targs)  # noqa: F821
+                perturbation(xj, vj, xs, acc, gm, eta, n_active, h, targs)
         # the shared epilogue checks the internal state; its recorder
         # synchronises first, so the monitors see the inertial state at the
         # time; the synchronisation's arguments are also its fargs, for the
@@ -530,7 +546,7 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         finite, until_check = lanes_check(xj, vj, k, nsteps, until_check, check_every,
                                           until_record, targs)
         if finite:
-            status, done, until_check, until_record, n_mon = step_end(  # noqa: F821
+            status, done, until_check, until_record, n_mon = step_end(
                 xj, vj, t + (k + 1) * dt, k, nsteps, not RESIDENT, until_check, check_every,
                 until_record, every, (mon, sync), n_mon, mon_t, mon_out,
                 stop_args(stopping, sync), sync)
@@ -553,10 +569,13 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
 
 
 @njit(inline="always")
-def stop_args(stopping, sync):
+def _no_stop_args(stopping, sync):
     # what the epilogue's stopping check takes: nothing in the lanes' loop,
     # which checks no conditions
     return ()
+
+
+stop_args, = slots(stop_args=_no_stop_args)
 
 
 #: Relative margin of :func:`may_escape`'s bound, for the rounding of the
@@ -619,7 +638,7 @@ def _escape_gate(xj, vj, t, args):
     # without conditions, a branch
     if args[0][0][0] == 0:
         return 0
-    return escape_check(xj, vj, t, args)  # noqa: F821 - bound by specialize
+    return escape_check(xj, vj, t, args)
 
 
 def _escape_check(xj, vj, t, args):
@@ -631,13 +650,13 @@ def _escape_check(xj, vj, t, args):
     gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
     if not may_escape(xj, vj, gm, eta, owed, corr, sargs[3]):
         return 0
-    synchronize_bodies(xj, vj, sync)  # noqa: F821 - bound by specialize
+    synchronize_bodies(xj, vj, sync)
     return stopping[1](x, v, t, sargs)
 
 
 def _synchronize_bodies(xj, vj, sync):
     gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
-    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,  # noqa: F821
+    sync_kernel(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
                 targs)
 
 
@@ -661,8 +680,8 @@ def _wh_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
     # the recorder the Wisdom-Holman loop hands the shared step epilogue:
     # mon is (the monitors' arguments, the synchronisation's)
     mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs) = mon
-    synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs)  # noqa: F821
-    _record(x, v, t, mon_args, n_mon, mon_t, mon_out)  # noqa: F821 - bound by specialize
+    sync_kernel(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs)
+    record(x, v, t, mon_args, n_mon, mon_t, mon_out)
 
 
 def _jacobi_term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs):
@@ -677,7 +696,7 @@ def _jacobi_term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs):
         acc[i, 0] = 0.0
         acc[i, 1] = 0.0
         acc[i, 2] = 0.0
-    extra(x, x, 0.0, targs, acc)  # noqa: F821 - bound by specialize
+    extra(x, x, 0.0, targs, acc)
     sx, sy, sz = jacobi_velocity_kick(xj, vj, acc, gm, eta, h, False)
     vj[0, 0] += h * sx
     vj[0, 1] += h * sy
@@ -710,7 +729,7 @@ def _heliocentric_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
         acc[i, 0] = 0.0
         acc[i, 1] = 0.0
         acc[i, 2] = 0.0
-    extra(x, x, 0.0, targs, acc)  # noqa: F821 - bound by specialize
+    extra(x, x, 0.0, targs, acc)
     fx = 0.0
     fy = 0.0
     fz = 0.0
@@ -760,25 +779,25 @@ def _lanes_drift(xj, vj, eta, h, w1, w2, targs):
 
 
 def _plain_convert(a, b, gm, eta, c, d, targs):
-    convert(a, b, gm, eta, c, d)  # noqa: F821 - bound by specialize
+    convert(a, b, gm, eta, c, d)
 
 
 def _plain_perturbation(xj, vj, x, acc, gm, eta, n_active, h, targs):
-    step(xj, vj, x, acc, gm, eta, n_active, h)  # noqa: F821 - bound by specialize
+    step(xj, vj, x, acc, gm, eta, n_active, h)
 
 
 def _perturbation_with_terms(xj, vj, x, acc, gm, eta, n_active, h, targs):
     # gravity's perturbation step, then the terms' kick: both depend on
     # positions only, so the kicks commute (in democratic heliocentric
     # coordinates the terms kick between the two half jumps)
-    if HELIOCENTRIC:  # noqa: F821 - bound by specialize
+    if HELIOCENTRIC:
         jump(xj, vj, gm, n_active, 0.5 * h)
         heliocentric_interaction_kick(xj, vj, acc, gm, n_active, h)
-        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)
         jump(xj, vj, gm, n_active, 0.5 * h)
     else:
         interaction_kick(xj, vj, x, acc, gm, eta, n_active, h)
-        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)  # noqa: F821
+        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)
 
 
 #: coordinate system -> (to internal, from internal, perturbation step, the
@@ -833,7 +852,7 @@ def _kernels(coordinates, terms=None, lanes=False):
     sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
                       cache=cache, nrt=nrt,
                       drift=called(_lanes_drift if lanes else _plain_drift, nrt),
-                      from_internal=from_internal, apply_corrector=corrector)
+                      from_internal=from_internal, corrector_kernel=corrector)
     return to_internal, perturbation, corrector, sync
 
 
@@ -887,20 +906,20 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
             output_drift=called(specialize(_resident_output_drift, key, cache=cache,
                                            inline=True, nrt=nrt), nrt),
             make_output=specialize(_lanes_output, key, cache=cache, nrt=nrt,
-                                   synchronize=sync, _record=record))
+                                   sync_kernel=sync, record=record))
     else:
-        recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, synchronize=sync,
-                              _record=record)
+        recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, sync_kernel=sync,
+                              record=record)
     stop = no_stop
     if not lanes:
         bodies = specialize(_synchronize_bodies, key, cache=cache, inline=True, nrt=nrt,
-                            synchronize=sync)
+                            sync_kernel=sync)
         outputs["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
                       KINDS=tuple(int(k) for k in kinds),
                       COEFS=tuple(float(c) for c in coefs), to_internal=called(to_internal, nrt),
                       drift=drift, owed_drift=called(drift, nrt), perturbation=perturbation,
-                      apply_corrector=corrector,
+                      corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
                       **outputs)
 

@@ -1,21 +1,26 @@
 """The package's numba options (orbits._kernels._jit)."""
 
 import numba
+import pytest
 from numba.core import types as nbtypes
 
 from orbits._kernels import _jit, wh_batch
 
 
 def test_a_cached_kernel_is_cached_under_the_stamp_of_every_kernel_source():
-    # numba keys a cached function by its own file only; the batch loop
-    # inlines the lanes' drift of another file, and loaded its old
-    # compilation after that file changed until the cache's name carried the
+    # numba keys a cached function by its own file only; a kernel that
+    # inlines another file's kernel (the monitor row inlines nothing, but
+    # the batch loop inlines the lanes' drift) would load its old
+    # compilation after that file changed, so the cache's name carries the
     # hash of every kernel source (as specialize's copies do).  The function
     # keeps its own name.
-    loop = wh_batch.advance_lanes
-    assert loop.__qualname__ == loop.py_func.__qualname__ == "advance_lanes"
-    index = loop._cache._cache_file._index_name     # numba's own name of the cache
-    assert index.startswith(f"wh_batch.advance_lanes__{_jit.KERNEL_STAMP}")
+    from orbits._kernels import invariants
+    kernel = invariants.monitor_row
+    assert kernel.__qualname__ == kernel.py_func.__qualname__ == "monitor_row"
+    index = kernel._cache._cache_file._index_name     # numba's own name of the cache
+    assert index.startswith(f"invariants.monitor_row__{_jit.KERNEL_STAMP}")
+    batch = wh_batch.advance_lanes._cache._cache_file._index_name
+    assert _jit.KERNEL_STAMP in batch
 
 
 @_jit.njit(cache=False)
@@ -68,3 +73,60 @@ def test_a_kernel_pointer_is_its_own_code_cached_under_the_stamp():
     assert p.cfunc._pyfunc.__code__ is _halve.py_func.__code__
     index = p.cfunc._cache._cache_file._index_name
     assert index.startswith(f"test_jit._halve__pointer__{_jit.KERNEL_STAMP}")
+
+
+# -- templates and their slots (specialize) ---------------------------------------
+
+_kernel, _scale = _jit.slots("_kernel", _scale=2.0)
+
+
+def _template(x):
+    return _scale * _kernel(x)
+
+
+def test_specialize_binds_a_declared_slot_and_a_default():
+    double = _jit.specialize(_template, "test_double", jit=False, _kernel=lambda x: x + 1.0)
+    assert double(1.0) == 4.0              # (1 + 1) * the default scale 2
+    triple = _jit.specialize(_template, "test_triple", jit=False, _kernel=abs, _scale=3.0)
+    assert triple(-2.0) == 6.0
+
+
+def test_specialize_refuses_a_name_that_is_not_a_slot():
+    with pytest.raises(TypeError, match="has no slot 'kernel'.*'_kernel', '_scale'"):
+        _jit.specialize(_template, "test_typo", jit=False, kernel=abs)
+
+
+def test_specialize_refuses_a_slot_left_unbound():
+    with pytest.raises(TypeError, match="needs its slot '_kernel' bound"):
+        _jit.specialize(_template, "test_unbound", jit=False)
+
+
+def test_an_unbound_slot_cannot_run():
+    with pytest.raises(TypeError, match="slot '_kernel' is not bound"):
+        _template(1.0)
+
+
+def test_every_template_module_declares_its_slots():
+    # the kernels' templates name no global their module leaves undefined:
+    # each such name is a declared slot (compile's bookkeeping of names used
+    # by functions, against the module's own names and the builtins)
+    import builtins
+    import pathlib
+    import symtable
+    root = pathlib.Path(_jit.__file__).parents[1]
+    paths = sorted((root / "_kernels").glob("*.py")) + [root / "_user_functions.py"]
+    missing = []
+    for path in paths:
+        top = symtable.symtable(path.read_text(), str(path), "exec")
+        defined = {s.get_name() for s in top.get_symbols() if s.is_assigned() or s.is_imported()}
+        defined |= {"__file__", "__name__", "__doc__", "__spec__", "__package__"}
+        stack = list(top.get_children())
+        while stack:
+            tab = stack.pop()
+            stack.extend(tab.get_children())
+            for sym in tab.get_symbols():
+                name = sym.get_name()
+                if (sym.is_global() and sym.is_referenced() and name not in defined
+                        and not hasattr(builtins, name)):
+                    missing.append(f"{path.name}: {name} in {tab.get_name()}")
+    assert not missing, missing
