@@ -159,8 +159,9 @@ def invariable_plane_rotation(L):
 def angle_between(a, b):
     """The angle between vectors, in [0, pi].
 
-    From ``atan2(|a x b|, a . b)``: accurate near 0 and pi, where ``acos`` of the normalised dot product
-    loses half the digits; NaN where either vector is NaN.
+    From ``atan2(|a x b|, a . b)``: accurate near 0 and pi, where ``acos`` of
+    the normalised dot product loses half the digits; NaN where either vector
+    is NaN.
 
     Parameters
     ----------
