@@ -19,7 +19,9 @@ import math
 import astropy.units as u
 import numpy as np
 
+from . import geometry as _geometry
 from ._kernels import kepler as _kepler
+from .body import Body, _position, unknown_body
 from .errors import (BodyError, CoincidentBodiesError, DuplicateBodyError,
                      ElementsError, NoMassiveBodyError, UnknownBodyError)
 from .units import UnitSystem
@@ -371,7 +373,54 @@ class BodySet:
         return len(self._names)
 
     def __contains__(self, name):
+        """Whether a body of this name (or a :class:`~orbits.body.Body` view's
+        name) is in the set."""
+        if isinstance(name, Body):
+            name = name.name
         return name in self._names
+
+    def __getitem__(self, key):
+        """A read-only view of one body, by name or by index.
+
+        Parameters
+        ----------
+        key : str or int
+            The body's name, or its place in the set (from 0; negative counts
+            from the end).
+
+        Returns
+        -------
+        orbits.body.Body
+            Its ``name``, ``mass``, ``radius``, ``position``, ``velocity``,
+            ``elements(primary=...)`` and ``orbit(primary=...)``, read from
+            this set when read.
+
+        Raises
+        ------
+        UnknownBodyError
+            No body of that name; the message suggests the nearest name.
+        IndexError
+            An index past either end.
+
+        Examples
+        --------
+        >>> import orbits
+        >>> bodies = orbits.scenes.outer_solar_system()
+        >>> bodies["Jupiter"].mass
+        <Quantity 0.00095479 solMass>
+        >>> bodies[-1].name
+        'Pluto'
+        >>> try:
+        ...     bodies["Jupyter"]
+        ... except orbits.errors.UnknownBodyError as exc:
+        ...     print(str(exc).split(";")[0])
+        body 'Jupyter': no such body (did you mean 'Jupiter'?)
+        """
+        return Body(self, _position(self._names, key))
+
+    def __iter__(self):
+        """The bodies in order, each as a :class:`~orbits.body.Body` view."""
+        return (Body(self, i) for i in range(len(self._names)))
 
     def __repr__(self):
         """The bodies with their masses, their radii where any is non-zero, and, for
@@ -513,8 +562,7 @@ class BodySet:
         try:
             return self._names.index(name)
         except ValueError:
-            raise UnknownBodyError(f"no such body; known: {', '.join(self._names)}",
-                                   body=name) from None
+            raise unknown_body(name, self._names) from None
 
     @property
     def total_mass(self):
@@ -571,7 +619,12 @@ class BodySet:
         ----------
         name : str
         primary : str, optional
-            Default: the centre of mass of the bodies before ``name`` in the set.
+            A body's name; ``"barycentre"`` (or ``"barycenter"``): the centre of
+            mass of all bodies, ``name`` included, with ``mu = G (M + m)`` for
+            the total mass ``M`` and the body's mass ``m``, as REBOUND's
+            ``particle.orbit(primary=sim.com())``.  Default: the centre of mass
+            of the bodies before ``name`` in the set (Jacobi-like, REBOUND's
+            default in ``particle.orbit()``).
 
         Returns
         -------
@@ -596,12 +649,112 @@ class BodySet:
     def _element_values(self, name, primary):
         # (a, e, inc, Omega, omega, f, M) in internal units and rad, and the
         # kernel's status
-        i = self.index(name)
-        mp, xp, vp = self._primary_state(name, primary, before=i)
-        mu = self.units.G * (mp + self._m[i])
+        mu, r, v = self._relative(name, primary)
         out = np.empty(7)
-        status = _kepler.state_to_elements(mu, self._x[i] - xp, self._v[i] - vp, out)
+        status = _kepler.state_to_elements(mu, r, v, out)
         return out, status
+
+    def _relative(self, name, primary):
+        # mu = G (m_primary + m_body) and the state relative to the primary
+        # (internal units): of a named body, of the bodies before ``name``
+        # (None), or of the barycentre of all bodies, ``name`` included
+        i = self.index(name)
+        if _geometry.is_barycentre(primary):
+            self._require_mass()
+            mp = self._m.sum()
+            xp, vp = self._com()
+        else:
+            if primary == name:
+                raise BodyError("a body has no orbit about itself; name another primary",
+                                body=name, field="primary")
+            mp, xp, vp = self._primary_state(name, primary, before=i)
+        mu = self.units.G * (mp + self._m[i])
+        return mu, self._x[i] - xp, self._v[i] - vp
+
+    def mutual_inclination(self, a, b, primary=None):
+        """The angle between the orbital planes of two bodies.
+
+        Parameters
+        ----------
+        a, b : str
+            The bodies' names.
+        primary : str, optional
+            The primary of both orbits, as for :meth:`elements`: a body's name,
+            ``"barycentre"``, or None for each body's default (the centre of
+            mass of the bodies before it, so that in a hierarchical system each
+            orbit is about what it goes around).
+
+        Returns
+        -------
+        Quantity, scalar, rad
+            In [0, pi]: the angle between the orbits' angular momentum vectors
+            ``r x v`` (relative to their primaries), which for two orbits about
+            one primary is ``cos I = cos i_a cos i_b + sin i_a sin i_b
+            cos(Omega_a - Omega_b)``.
+
+        Raises
+        ------
+        UnknownBodyError, BodyError
+            As :meth:`elements` raises them.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> bodies = orbits.BodySet()
+        >>> bodies.add("Sun", mass=1 * u.Msun)
+        >>> bodies.add("b", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, inc=10 * u.deg)
+        >>> bodies.add("c", mass=1 * u.Mearth, primary="Sun", a=2 * u.au, inc=10 * u.deg,
+        ...            Omega=180 * u.deg)
+        >>> bodies.mutual_inclination("b", "c", primary="Sun").to(u.deg).round(10)
+        <Quantity 20. deg>
+        """
+        _, ra, va = self._relative(a, primary)
+        _, rb, vb = self._relative(b, primary)
+        return float(_geometry.angle_between(np.cross(ra, va), np.cross(rb, vb))) << u.rad
+
+    def to_invariable_plane(self):
+        """Rotate the set so that its total angular momentum points along +z.
+
+        In place, as :meth:`move_to_com`: positions and velocities are rotated
+        about the origin, so distances, speeds, the energy and ``|L|`` are
+        unchanged.  The angular momentum is the one about the centre of mass
+        (the same in any frame moving uniformly); in a set moved to its
+        centre of mass, the total angular momentum.  The new x axis points
+        along the ascending node of the invariable plane on the old x-y plane
+        (``z x L``), as REBOUND's
+        ``sim.rotate(rebound.Rotation.to_new_axes(newz=sim.angular_momentum()))``
+        chooses it; where ``L`` is already along z to within rounding, x is
+        kept.
+
+        Raises
+        ------
+        NoMassiveBodyError
+            Every body is massless.
+        BodyError
+            The set has no angular momentum about its centre of mass (field
+            ``angular_momentum``), so no plane is defined.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import orbits
+        >>> bodies = orbits.scenes.outer_solar_system(com=True)
+        >>> bodies.to_invariable_plane()
+        >>> m = bodies.masses.value
+        >>> L = (m[:, None] * np.cross(bodies.positions.value, bodies.velocities.value)).sum(0)
+        >>> bool(np.hypot(L[0], L[1]) < 1e-15 * L[2])
+        True
+        """
+        self._require_mass()
+        L = _geometry.angular_momentum(self._m, self._x, self._v)
+        if not np.any(L):
+            raise BodyError("the set has no angular momentum about its centre of mass; "
+                            "no invariable plane is defined", field="angular_momentum")
+        R = _geometry.invariable_plane_rotation(L)
+        self._x = self._x @ R.T
+        self._v = self._v @ R.T
+        self.history.append({"from": "to_invariable_plane"})
 
     def plot_orbits(self, primary=None, plane="xy", ax=None, path=None):
         """A sketch of the set: each body on its osculating Keplerian orbit.
@@ -739,9 +892,8 @@ class BodySet:
             raise BodyError(f"primary must be a body's name, got {primary!r}",
                             body=name, field="primary")
         if primary not in self._names:
-            raise UnknownBodyError(
-                f"unknown primary {primary!r}; known bodies: {', '.join(self._names)}",
-                body=name, field="primary")
+            raise unknown_body(primary, self._names, field="primary", body=name,
+                               what=f"unknown primary {primary!r}", label="known bodies")
         j = self._names.index(primary)
         return self._m[j], self._x[j], self._v[j]
 

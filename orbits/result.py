@@ -16,7 +16,9 @@ import astropy.units as u
 import numpy as np
 
 from ._kernels import kepler as _kepler
+from .body import Track, unknown_body
 from .errors import BodyError, ElementsError, NoMassiveBodyError, UnknownBodyError
+from .geometry import angle_between, barycentre, is_barycentre
 from .monitors import massless_energy_errors
 from .units import UnitSystem
 
@@ -240,6 +242,48 @@ class Result:
     def __len__(self):
         return len(self.times)
 
+    def __getitem__(self, name):
+        """One body's track through the outputs, by name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        orbits.body.Track
+            ``times``, ``positions`` and ``velocities`` (shape (n, 3), NaN once
+            a collision merged the body away), ``masses``, ``elements()`` and
+            ``mutual_inclination()``.
+
+        Raises
+        ------
+        UnknownBodyError
+            No body of that name; the message suggests the nearest name.
+        TypeError
+            ``name`` is not a string (an index would be ambiguous between
+            outputs and bodies: ``result.positions[k]`` is output ``k``).
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+        >>> result = sim.run(until=1 * u.yr, outputs=5, progress=False)
+        >>> result["Planet"].positions.shape
+        (5, 3)
+        """
+        if not isinstance(name, str):
+            raise TypeError(f"a result's bodies are looked up by name (str), got "
+                            f"{type(name).__name__}; result.positions[k] is output k")
+        return Track(self, self._index(name))
+
+    def __contains__(self, name):
+        """Whether a body of this name is in the result."""
+        return isinstance(name, str) and name in self.names
+
+    __iter__ = None     # not a sequence of outputs or bodies: iterate over result.names
+
     def __repr__(self):
         return (f"<Result: {len(self)} outputs of {len(self.names)} bodies, "
                 f"{self.integrator['name']}, {self.status}>")
@@ -448,8 +492,12 @@ class Result:
         body : str
             The body's name.
         primary : str, optional
-            The body the orbit is about.  Default: the centre of mass of the
-            bodies before ``body`` in the set (Jacobi-like, as in
+            The body the orbit is about, by name; or ``"barycentre"`` (or
+            ``"barycenter"``): the centre of mass of all bodies at each output,
+            ``body`` included, with ``mu = G (M + m)`` (REBOUND's
+            ``particle.orbit(primary=sim.com())``; bodies merged away by a
+            collision left out).  Default: the centre of mass of the bodies
+            before ``body`` in the set (Jacobi-like, as in
             :meth:`~orbits.BodySet.elements` and REBOUND's ``Particle.orbit()``).
 
         Returns
@@ -495,53 +543,19 @@ class Result:
         >>> print(el["a"][0].round(2), el["P"][0].to(u.yr).round(1))
         5.2 AU 11.9 yr
         """
-        i = self._index(body)
-        U, x, v, m = self._internal()
-        n = x.shape[0]
-        # masses at each output where collisions changed them (NaN: merged
-        # away), else the masses at the start for every output
-        mh = (np.nan_to_num(self.masses_at_outputs.to_value(U.unit("mass")))
-              if self.masses_at_outputs is not None else np.broadcast_to(m, (n, len(m))))
-        if primary is None:
-            interior = m[:i]
-            if i == 0 or not np.any(interior > 0):
-                raise BodyError("orbital elements need a primary: no massive body comes "
-                                "before this one in the set; name one with primary=",
-                                body=body, field="primary")
-            w = mh[:, :i]
-            mp = w.sum(axis=1)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                xp = np.einsum("kj,kjd->kd", w, np.nan_to_num(x[:, :i])) / mp[:, None]
-                vp = np.einsum("kj,kjd->kd", w, np.nan_to_num(v[:, :i])) / mp[:, None]
-        else:
-            if not isinstance(primary, str) or primary not in self.names:
-                raise UnknownBodyError(f"unknown primary {primary!r}; known bodies: "
-                                       f"{', '.join(self.names)}", body=body,
-                                       field="primary")
-            j = self.names.index(primary)
-            if j == i:
-                raise BodyError("a body has no orbit about itself; name another primary",
-                                body=body, field="primary")
-            mp, xp, vp = mh[:, j], x[:, j], v[:, j]
-        mu = U.G * (mp + mh[:, i])
-        if not np.any(mu > 0):
-            raise ElementsError("the primary and the body are both massless; an orbit "
-                                "needs mass", body=body, field="primary")
-        # outputs after a collision merged the body (or its primary) away: NaN
-        here = np.isfinite(x[:, i, 0]) & np.isfinite(xp[:, 0])
+        U = self.units
+        mu, dx, dv, here = self._relative_states(body, primary)
+        n = len(mu)
         out = np.full((n, 7), np.nan)
         status = np.zeros(n, dtype=np.int64)
         if here.all():
-            _kepler.state_to_elements_many(np.ascontiguousarray(mu, dtype=float),
-                                           np.ascontiguousarray(x[:, i] - xp),
-                                           np.ascontiguousarray(v[:, i] - vp), out, status)
+            _kepler.state_to_elements_many(mu, dx, dv, out, status)
         elif here.any():
             part = np.empty((int(here.sum()), 7))
             st = np.zeros(len(part), dtype=np.int64)
-            _kepler.state_to_elements_many(np.ascontiguousarray(mu[here], dtype=float),
-                                           np.ascontiguousarray(x[here, i] - xp[here]),
-                                           np.ascontiguousarray(v[here, i] - vp[here]),
-                                           part, st)
+            _kepler.state_to_elements_many(np.ascontiguousarray(mu[here]),
+                                           np.ascontiguousarray(dx[here]),
+                                           np.ascontiguousarray(dv[here]), part, st)
             out[here], status[here] = part, st
         bad = np.flatnonzero(status)
         if bad.size:
@@ -560,6 +574,96 @@ class Result:
             elements[key] = out[:, k] << u.rad
         elements["P"] = q(period, "time")
         return elements
+
+    def _relative_states(self, body, primary):
+        """``mu`` (n,), the body's position and velocity relative to its
+        primary (n, 3) each, in the run's internal units, and where both are
+        present (n,) (False once a collision merged either away)."""
+        i = self._index(body)
+        U, x, v, m = self._internal()
+        n = x.shape[0]
+        # masses at each output where collisions changed them (NaN: merged
+        # away), else the masses at the start for every output
+        mh = (np.nan_to_num(self.masses_at_outputs.to_value(U.unit("mass")))
+              if self.masses_at_outputs is not None else np.broadcast_to(m, (n, len(m))))
+        if is_barycentre(primary):
+            if not np.any(m > 0):
+                raise NoMassiveBodyError("the barycentre needs a body with positive mass")
+            mp, xp, vp = barycentre(mh, x, v)
+        elif primary is None:
+            interior = m[:i]
+            if i == 0 or not np.any(interior > 0):
+                raise BodyError("orbital elements need a primary: no massive body comes "
+                                "before this one in the set; name one with primary=",
+                                body=body, field="primary")
+            w = mh[:, :i]
+            mp = w.sum(axis=1)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                xp = np.einsum("kj,kjd->kd", w, np.nan_to_num(x[:, :i])) / mp[:, None]
+                vp = np.einsum("kj,kjd->kd", w, np.nan_to_num(v[:, :i])) / mp[:, None]
+        else:
+            if not isinstance(primary, str) or primary not in self.names:
+                raise unknown_body(primary, self.names, field="primary", body=body,
+                                   what=f"unknown primary {primary!r}",
+                                   label="known bodies")
+            j = self.names.index(primary)
+            if j == i:
+                raise BodyError("a body has no orbit about itself; name another primary",
+                                body=body, field="primary")
+            mp, xp, vp = mh[:, j], x[:, j], v[:, j]
+        mu = np.ascontiguousarray(U.G * (mp + mh[:, i]), dtype=float)
+        if not np.any(mu > 0):
+            raise ElementsError("the primary and the body are both massless; an orbit "
+                                "needs mass", body=body, field="primary")
+        # outputs after a collision merged the body (or its primary) away: NaN
+        here = np.isfinite(x[:, i, 0]) & np.isfinite(xp[:, 0])
+        return (mu, np.ascontiguousarray(x[:, i] - xp), np.ascontiguousarray(v[:, i] - vp),
+                here)
+
+    def mutual_inclination(self, a, b, primary=None):
+        """The angle between the orbital planes of two bodies at every output.
+
+        Parameters
+        ----------
+        a, b : str
+            The bodies' names.
+        primary : str, optional
+            The primary of both orbits, as for :meth:`elements`: a body's name,
+            ``"barycentre"``, or None for each body's default (the centre of
+            mass of the bodies before it, so that in a hierarchical system each
+            orbit is about what it goes around).
+
+        Returns
+        -------
+        Quantity, shape (n,), rad
+            In [0, pi]: the angle between the orbits' angular momentum vectors
+            ``r x v`` (relative to their primaries); for two orbits about one
+            primary, ``cos I = cos i_a cos i_b + sin i_a sin i_b
+            cos(Omega_a - Omega_b)``.  NaN at outputs after a collision merged
+            either body (or its primary) away.
+
+        Raises
+        ------
+        UnknownBodyError, BodyError
+            As :meth:`elements` raises them.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "leapfrog",
+        ...                         dt=10 * u.day)
+        >>> result = sim.run(until=1000 * u.yr, outputs=3, progress=False)
+        >>> result.mutual_inclination("Jupiter", "Saturn", primary="Sun").to(u.deg).round(3)
+        <Quantity [1.251, 1.257, 1.25 ] deg>
+        """
+        normals = []
+        for name in (a, b):
+            _, dx, dv, here = self._relative_states(name, primary)
+            h = np.cross(dx, dv)
+            h[~here] = np.nan
+            normals.append(h)
+        return angle_between(*normals) << u.rad
 
     def elements_table(self, body, primary=None):
         """:meth:`elements` at every output as a plain table for people and files.
@@ -913,8 +1017,7 @@ class Result:
     def _index(self, name, field="body"):
         if isinstance(name, str) and name in self.names:
             return list(self.names).index(name)
-        raise UnknownBodyError(f"no such body; known: {', '.join(self.names)}",
-                               body=name, field=field)
+        raise unknown_body(name, self.names, field=field)
 
     def _internal(self):
         """The unit system and plain arrays of positions, velocities and masses in it."""

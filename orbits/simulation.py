@@ -1277,6 +1277,12 @@ class Simulation(Driven):
     def bodies(self):
         """The current state as a new :class:`BodySet`.
 
+        A snapshot made each time it is read: ``sim.bodies["Planet"].position``
+        is the body's position now, but a set or a body view
+        (:class:`~orbits.body.Body`) kept from before a run still holds the
+        state it was read at.  Changing it changes a copy, not the
+        simulation: make a new :class:`Simulation` from it for that.
+
         Examples
         --------
         >>> import astropy.units as u
@@ -1286,6 +1292,8 @@ class Simulation(Driven):
         >>> b = sim.bodies
         >>> b.names, b.positions.unit, b.radii.unit
         (['Star', 'Planet'], Unit("AU"), Unit("AU"))
+        >>> sim.bodies["Planet"].position.shape
+        (3,)
         """
         self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
         inv = np.argsort(self._order)
