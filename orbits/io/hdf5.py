@@ -177,6 +177,7 @@ from .._kernels import invariants as _inv
 from ..errors import OrbitsError
 from ..monitors import CHAOS_MONITORS, _work_column, monitor_fields
 from ..records import RunPlan, SimulationState
+from ..units import format_time, time_unit
 
 __all__ = ["FileRecorder", "load", "describe", "read_checkpoint", "Checkpoint", "truncate",
            "ResumePoint",
@@ -2825,6 +2826,7 @@ def describe(path):
     >>> [line.split()[0] for line in text.splitlines()[1:4]]
     ['bodies', 'integrator', 'units']
     """
+    import astropy.units as u
     with _open_read(path) as f:
         b = f["particles/bodies"]
         par = f["parameters"]
@@ -2832,18 +2834,22 @@ def describe(path):
         monitors = json.loads(par.attrs["monitors"])
         n_out = _read_ends(f, monitors)
         t = b["position/time"]
-        tu = t.attrs["unit"]
+        tu = u.Unit(t.attrs["unit"])
         units = json.loads(par.attrs["units"])
+        # times in the unit of the larger end of the outputs', so that they read alike
+        ends = (t[0], t[n_out - 1]) if n_out else (0.0,)
+        shown = time_unit(max(abs(v) for v in ends) * tu)
         lines = [
             f"{path}: orbits output (layout {FORMAT} v{FORMAT_VERSION}), written by "
             f"orbits {par.attrs['orbits_version']} on {par.attrs['written']}",
             f"bodies          {len(names)}: {', '.join(names[:8])}"
             + (", ..." if len(names) > 8 else ""),
             f"integrator      {par.attrs['integrator']} {par.attrs['integrator_options']}, "
-            f"dt = {par.attrs['dt']:g} {par.attrs['dt_unit']}",
+            f"dt = {format_time(par.attrs['dt'] * u.Unit(par.attrs['dt_unit']))}",
             f"units           {units['name']}, G = {units['G']!r} ({units['G_source']})",
             f"outputs         {n_out}"
-            + (f", t = {t[0]:g} .. {t[n_out - 1]:g} {tu}" if n_out else ""),
+            + (f", t = {(t[0] * tu).to_value(shown):.6g} .. "
+               f"{format_time(t[n_out - 1] * tu, shown)}" if n_out else ""),
             f"monitors        {', '.join(monitors) or 'none'}",
             f"forces          {_describe_forces(par, path)}",
         ]
@@ -2862,7 +2868,7 @@ def describe(path):
             tb = f["restart/t_base"][slot]
             t_ck = tb + clock[1] * par.attrs["dt"]
             lines.append(f"checkpoint      {count} written; the last at step {clock[0]}, "
-                         f"t = {t_ck:g} {tu}")
+                         f"t = {format_time(t_ck * tu, shown)}")
         totals = _totals(f)
         if totals is not None:
             lines.append(f"work            {totals[0]} steps, {totals[1]} force evaluations, "
