@@ -180,7 +180,7 @@ from ..records import RunPlan, SimulationState
 from ..units import format_time, time_unit
 
 __all__ = ["FileRecorder", "load", "describe", "read_checkpoint", "Checkpoint", "truncate",
-           "ResumePoint",
+           "ResumePoint", "whole_run",
            "OrbitsFileError", "FileInUse", "TangentShapeError",
            "FORMAT", "FORMAT_VERSION", "CHECKPOINT_SECONDS", "BUFFER_ROWS",
            "SWMR_READ_ATTEMPTS"]
@@ -2558,6 +2558,87 @@ def _totals(f):
     start = par["start_clock"][()]
     return (int(clock[0] - start[0]), int(clock[2] - start[1]), int(clock[4] - start[2]),
             float(r["wall"][slot]))
+
+
+@_damaged
+def whole_run(path):
+    """What a summary of every run that wrote a file needs, without its outputs:
+    the fields of :class:`~orbits.Result` that :func:`load` gives for the
+    whole file, for a result that holds only a last output (from
+    :meth:`orbits.Simulation.resume` or a run continued into the file).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    dict
+        ``steps``, ``force_evaluations``, ``steps_rejected`` and ``wall_time``
+        (totals at the last checkpoint, as :func:`load` reads them),
+        ``start_time`` (the first output's time, a Quantity), and
+        ``largest_errors`` (the largest relative errors of the monitored
+        invariants at every output and in-loop row); ``collisions`` and
+        ``encounters`` where the file logs them.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> last = sim.run(until=20 * u.day, outputs=3, output=path, progress=False)
+    >>> whole = hdf5.whole_run(path)
+    >>> last.steps, last.start_time, whole["steps"], whole["start_time"]
+    (10, <Quantity 10. d>, 20, <Quantity 0. d>)
+    """
+    import astropy.units as u
+    from ..monitors import relative_error, vector_relative_error
+
+    with _open_read(path) as f:
+        b, par, obs = f["particles/bodies"], f["parameters"], f["observables"]
+        monitors = json.loads(par.attrs["monitors"])
+        n = _rows(f, monitors)
+        totals = _totals(f)
+        if totals is None:
+            step = b["position/step"]
+            totals = (int(step[n - 1] - step[0]) if n else 0, None, 0, None)
+        t = b["position/time"]
+        fields = dict(zip(("steps", "force_evaluations", "steps_rejected", "wall_time"),
+                          totals))
+        if n:
+            fields["start_time"] = float(t[0]) << u.Unit(t.attrs["unit"])
+        ref = par["reference"][()]
+        scales = par["scales"][()]
+        work = "energy" in monitors and "work" in obs
+        m = _rows(f, monitors, in_loop=True)
+        largest = {}
+        for name in ("energy", "angular_momentum"):
+            if name not in monitors:
+                continue
+            errors = []
+            for group, rows in ((obs, n), (obs["in_loop"], m)):
+                if not rows:
+                    continue
+                values = group[name]["value"][:rows]
+                if name == "energy":
+                    if work:
+                        values = values + group["work"]["value"][:rows]
+                    errors.append(relative_error(values, ref[0] + float(_work_column(ref)),
+                                                 scale=scales[0]))
+                else:
+                    errors.append(vector_relative_error(values, ref[1:4], scales[1]))
+            if errors:
+                largest[name] = float(max(np.max(e) for e in errors))
+        fields["largest_errors"] = largest
+        if "encounters" in f:
+            fields["encounters"] = _encounters(f["encounters"])
+        if "masses" in f["restart"]:
+            fields["collisions"] = _collisions(f.get("collisions"), par)
+    return fields
 
 
 @_damaged
