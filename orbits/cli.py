@@ -13,6 +13,7 @@ and ``benchmarks/bench_startup.py`` times it.
 """
 
 import argparse
+import copy
 import math
 import re
 import signal
@@ -445,6 +446,7 @@ def main(argv=None):
     import astropy.units as u
     import orbits
     from orbits.errors import OrbitsError, RunError, RunInterrupted, SimulationStopped
+    from orbits.units import format_time
 
     path = getattr(args, "out", None) or (args.file if args.command == "resume" else None)
     previous = None
@@ -457,7 +459,8 @@ def main(argv=None):
         return _main(args, orbits)
     except RunInterrupted as exc:
         name = signal.Signals(exc.signal or signal.SIGINT).name
-        where = "" if exc.time is None else f" at t = {exc.time:.10g} (step {exc.step})"
+        where = ("" if exc.time is None
+                 else f" at t = {format_time(exc.time, digits=10)} (step {exc.step})")
         print(f"orbits: stopped by {name}{where}"
               + (f"; a checkpoint is in {path}: 'orbits resume {path}' finishes the run"
                  if path else "; nothing was written (no --out)"), file=sys.stderr)
@@ -664,13 +667,14 @@ def _resume(args, orbits):
 
 
 def _check_continues(path, point, sim, until):
-    """An ``--until`` at or before the end of the run in the file (after it, for a
-    run backwards) is an error, raised before any work."""
+    """An ``--until`` at or before the end of the run in the file (at or after it,
+    for a run backwards) is an error, raised before any work."""
     from orbits.units import format_time
     if point.finished:
         end, what = sim.time, "the end of the run"
     else:
-        end, what = sim.units.quantity(point.plan.until, "time"), "the end of the interrupted run"
+        end = sim.units.quantity(point.plan.until, "time")
+        what = "the end of the interrupted run"
     forward = point.plan.until >= point.plan.start_time
     if (until > end) if forward else (until < end):
         return
@@ -678,13 +682,12 @@ def _check_continues(path, point, sim, until):
         f"--until {format_time(until, digits=10)} is not {'after' if forward else 'before'} "
         f"{what} in {path} (t = {format_time(end, digits=10)}); give a "
         f"{'later' if forward else 'earlier'} time"
-        + ("" if point.finished else f", or none to only finish the run"))
+        + ("" if point.finished else ", or none to only finish the run"))
 
 
 def _whole_run(result, path, orbits):
     """``result`` (the last output of a run written into ``path``) with the steps,
     time span, work and largest errors of every run in the file."""
-    import copy
     whole = copy.copy(result)
     vars(whole).update(orbits.io.hdf5.whole_run(path))
     return whole

@@ -2,6 +2,7 @@
 
 import pathlib
 import re
+import signal
 
 import astropy.units as u
 import numpy as np
@@ -251,3 +252,15 @@ def test_resume_until_before_the_end_is_refused_before_any_work(interrupted, cap
     # a plain number is in the file's unit of time, days
     assert main(["resume", str(interrupted), "--until", "0.5", "--no-progress"]) == 3
     assert ("--until 43200 s is not after the end of the run in" in capsys.readouterr().err)
+
+
+def test_an_interrupted_run_says_when_it_stopped_in_readable_units(monkeypatch, capsys):
+    from orbits.errors import RunInterrupted
+
+    def interrupted(self, *args, **kwargs):
+        raise RunInterrupted("interrupted", signal=signal.SIGINT, time=4.383e9 * u.day,
+                             step=43830000)
+    monkeypatch.setattr(orbits.Simulation, "run", interrupted)
+    assert main(["run", "kepler", "-i", "leapfrog", "--dt", "100d", "--until", "20Myr",
+                 "--no-progress"]) == 128 + signal.SIGINT
+    assert "stopped by SIGINT at t = 12 Myr (step 43830000)" in capsys.readouterr().err
