@@ -13,6 +13,8 @@ and ``benchmarks/bench_startup.py`` times it.
 """
 
 import argparse
+import copy
+import math
 import re
 import signal
 import sys
@@ -107,6 +109,27 @@ OPTION_TAKEN_BY = {
     "coordinates": ("wh", "saba2", "saba3", "saba4"),
 }
 
+#: Outputs of a run when ``--outputs`` is not given (orbits.simulation.DEFAULT_OUTPUTS,
+#: written out here so that the help is built without importing the library;
+#: tests/test_cli_run.py checks that the two agree).
+DEFAULT_OUTPUTS = 500
+
+#: The fewest and most intervals between outputs that :func:`default_outputs`
+#: chooses for a fixed-step run of more steps than ``DEFAULT_OUTPUTS - 1``:
+#: within a factor of five below and two above the default, so that a run keeps
+#: enough outputs to plot and a file stays near its usual size.
+OUTPUT_INTERVALS = (100, 1000)
+
+OUTPUTS_HELP = (
+    f"number of outputs, the start and the end included; default: for a fixed-step "
+    f"integrator, one per step in a run of up to {DEFAULT_OUTPUTS - 1} steps, else the "
+    f"count nearest {DEFAULT_OUTPUTS} (from {OUTPUT_INTERVALS[0] + 1} to "
+    f"{OUTPUT_INTERVALS[1] + 1}) that puts the outputs a whole number of steps apart "
+    f"(--dt 100d --until 1e5yr: 365250 steps, 488 outputs 750 steps apart), or "
+    f"{DEFAULT_OUTPUTS} at "
+    f"the nearest steps where the steps have no such divisor; {DEFAULT_OUTPUTS} for an "
+    f"adaptive one")
+
 RUN_EXAMPLES = """\
 examples:
   orbits run outer-solar-system -i wh --dt 100d --until 1e5yr --com --out run.h5
@@ -187,8 +210,7 @@ def _parser():
     run.add_argument("--until", type=parse_quantity, default=None,
                      help="end time, e.g. 1000yr, or a plain number in the scene's units; "
                           "needed unless the file's [run] table gives it")
-    run.add_argument("--outputs", type=int, default=None,
-                     help="number of outputs (500, or one per step for a shorter run)")
+    run.add_argument("--outputs", type=int, default=None, help=OUTPUTS_HELP)
     run.add_argument("--gr", choices=sorted(GR_TERMS),
                      help="general relativity: 'sun' (1PN correction from the most massive "
                           "body, velocity-dependent), 'potential' (its potential form, which "
@@ -229,9 +251,13 @@ def _parser():
                                         "one, from its HDF5 file")
     res.add_argument("file")
     res.add_argument("--until", type=parse_quantity,
-                     help="continue to this time after the interrupted run is finished")
+                     help="continue to this time after the interrupted run is finished; "
+                          "it must be after the run's end (an --until the run has passed "
+                          "is refused before anything is done, exit status "
+                          f"{EXIT_INPUT})")
     res.add_argument("--outputs", type=int, default=None,
-                     help="outputs of the --until run (500)")
+                     help="outputs of the --until run; default as for 'orbits run': a "
+                          "whole number of steps apart for a fixed-step integrator")
     res.add_argument("--no-progress", action="store_true")
     res.add_argument("--checkpoint-interval", type=float, default=None)
 
@@ -250,7 +276,11 @@ def _parser():
     elements = sub.add_parser("elements", help="the osculating orbital elements of a body "
                                                "at every output of a file, as a table")
     elements.add_argument("file")
-    elements.add_argument("--body", required=True, help="the body's name")
+    elements.add_argument("body", nargs="?", default=None, metavar="BODY",
+                          help="the body's name")
+    elements.add_argument("--body", dest="body_option", default=None, metavar="BODY",
+                          help="the same, as an option (for scripts written before BODY "
+                               "was positional)")
     elements.add_argument("--primary", default=None,
                           help="the body the orbit is about (default: the centre of mass "
                                "of the bodies before it in the set, as REBOUND's orbit())")
@@ -334,6 +364,62 @@ _TIME_OPTIONS = ("--dt", "--until", "--epsilon", "--tol", "--rtol", "--atol", "-
                  "--encounter-distance", "--encounter-hill", "--escape-distance")
 
 
+def default_outputs(steps):
+    """The number of outputs of a fixed-step run of ``steps`` steps when none is
+    asked for: outputs a whole number of steps apart.
+
+    Parameters
+    ----------
+    steps : float
+        The run's length in steps of dt, ``(until - start) / dt`` (a fraction
+        where a shortened last step ends it).
+
+    Returns
+    -------
+    int or None
+        ``n + 1`` for the divisor ``n`` of the steps (rounded to a whole
+        number) nearest ``DEFAULT_OUTPUTS - 1`` by ratio, from
+        :data:`OUTPUT_INTERVALS`; every step for a run of at most
+        ``DEFAULT_OUTPUTS - 1`` steps; None (the library's default, spread
+        over the nearest steps) where there is no such divisor or no whole
+        step.  Output ``k`` then falls after ``k * steps / n`` steps: the run's
+        plan puts it at the nearest step, which is exact, and only the last,
+        at the end, follows a shortened step.
+
+    Examples
+    --------
+    >>> from orbits.cli import default_outputs
+    >>> default_outputs(365250.0)      # 1e5 yr at 100 d: 488 outputs, 750 steps apart
+    488
+    >>> default_outputs(3652.5)        # 100 yr at 10 d: 3652 steps (and a half one)
+    333
+    >>> default_outputs(73.05), default_outputs(1009.0), default_outputs(0.3)
+    (74, None, None)
+    """
+    whole = int(round(steps))
+    if whole < 1:
+        return None
+    wanted = DEFAULT_OUTPUTS - 1
+    if whole <= wanted:
+        return whole + 1
+    lo, hi = OUTPUT_INTERVALS
+    found = [n for n in range(lo, min(hi, whole) + 1) if whole % n == 0]
+    if not found:
+        return None
+    # nearest by ratio; between two as near, the more outputs
+    best = min(found, key=lambda n: (abs(math.log(n / wanted)), -n))
+    return best + 1
+
+
+def _outputs_for(sim, until, outputs):
+    """``outputs`` as given, else :func:`default_outputs` for a fixed-step run from
+    ``sim``'s time to ``until`` (None for an adaptive one: the library's default)."""
+    if outputs is not None or sim.integrator.adaptive:
+        return outputs
+    steps = float(((until - sim.time) / sim.dt).decompose())
+    return default_outputs(abs(steps)) if math.isfinite(steps) else None
+
+
 def _in_scene_units(value, bodies, kind="time"):
     """A plain number is read in the scene's unit of time (or ``kind``), as the help says."""
     import astropy.units as u
@@ -355,9 +441,12 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if args.command == "compile" and args.all and args.integrators:
         parser.error("compile: give integrator names or --all, not both")
+    if args.command == "elements":
+        _elements_body(parser, args)
     import astropy.units as u
     import orbits
     from orbits.errors import OrbitsError, RunError, RunInterrupted, SimulationStopped
+    from orbits.units import format_time
 
     path = getattr(args, "out", None) or (args.file if args.command == "resume" else None)
     previous = None
@@ -370,7 +459,8 @@ def main(argv=None):
         return _main(args, orbits)
     except RunInterrupted as exc:
         name = signal.Signals(exc.signal or signal.SIGINT).name
-        where = "" if exc.time is None else f" at t = {exc.time:.10g} (step {exc.step})"
+        where = ("" if exc.time is None
+                 else f" at t = {format_time(exc.time, digits=10)} (step {exc.step})")
         print(f"orbits: stopped by {name}{where}"
               + (f"; a checkpoint is in {path}: 'orbits resume {path}' finishes the run"
                  if path else "; nothing was written (no --out)"), file=sys.stderr)
@@ -418,21 +508,7 @@ def _main(args, orbits):
     elif args.command == "run":
         return _run(args, orbits)
     elif args.command == "resume":
-        sim = orbits.Simulation.from_file(args.file)
-        progress = False if args.no_progress else None
-        result = None
-        if not sim.resume_point.finished:
-            result = sim.resume(progress=progress,
-                                checkpoint_interval=args.checkpoint_interval)
-            print(f"finished the interrupted run in {args.file}")
-        if args.until is not None:
-            result = sim.run(until=_in_scene_units(args.until, sim.bodies),
-                             outputs=args.outputs, progress=progress, output=args.file,
-                             checkpoint_interval=args.checkpoint_interval)
-        if result is None:
-            print(f"{args.file}: its run is complete; give --until to continue it")
-            return 0
-        print(result.summary())
+        return _resume(args, orbits)
     elif args.command == "info":
         print(orbits.io.describe(args.file))
     elif args.command == "validate":
@@ -471,6 +547,17 @@ def _compile(args, orbits):
     compiling = sum(seconds for _, seconds in loops)
     print(f"{len(loops)} loop{'' if len(loops) == 1 else 's'} ready in {wall:.1f} s "
           f"({compiling:.1f} s compiling); numba's cache: {_compiling.cache_dir()}")
+
+
+def _elements_body(parser, args):
+    """``orbits elements FILE BODY``, or ``FILE --body BODY`` as before; not both."""
+    if args.body is not None and args.body_option is not None:
+        parser.error(f"elements: give the body once, as BODY or --body, not both "
+                     f"({args.body!r} and {args.body_option!r})")
+    if args.body is None:
+        args.body = args.body_option
+    if args.body is None:
+        parser.error("elements: give the body, as in 'orbits elements FILE Jupiter'")
 
 
 def _elements(args, orbits):
@@ -531,7 +618,8 @@ def _run(args, orbits):
                             dt=_in_scene_units(dt, bodies), forces=forces,
                             **{k: v for k, v in stops.items() if v is not None})
     print(f"scene           {args.scene}")
-    result = sim.run(until=_in_scene_units(until, bodies), outputs=given("outputs"),
+    until = _in_scene_units(until, bodies)
+    result = sim.run(until=until, outputs=_outputs_for(sim, until, given("outputs")),
                      progress=False if args.no_progress else None,
                      output=args.out, overwrite=args.force,
                      checkpoint_interval=args.checkpoint_interval)
@@ -539,6 +627,70 @@ def _run(args, orbits):
     if args.out:
         print(f"written         {args.out}")
     return 0
+
+
+def _resume(args, orbits):
+    """``orbits resume``: finish the interrupted run, then continue to ``--until``;
+    the summary covers every run in the file.  An ``--until`` that the run has
+    already passed is refused before anything is done."""
+    from orbits.errors import RunError
+    from orbits.units import format_time
+    sim = orbits.Simulation.from_file(args.file)
+    point = sim.resume_point
+    until = None
+    if args.until is not None:
+        until = _in_scene_units(args.until, sim.bodies)
+        _check_continues(args.file, point, sim, until)
+    elif point.finished:
+        print(f"{args.file}: its run is complete; give --until to continue it")
+        return 0
+    progress = False if args.no_progress else None
+    time0, steps0 = sim.time, sim.steps
+    try:
+        if not point.finished:
+            result = sim.resume(progress=progress,
+                                checkpoint_interval=args.checkpoint_interval)
+            print(f"finished the interrupted run in {args.file}")
+        if until is not None:
+            result = sim.run(until=until, outputs=_outputs_for(sim, until, args.outputs),
+                             progress=progress, output=args.file,
+                             checkpoint_interval=args.checkpoint_interval)
+    except RunError as exc:
+        # a stop or a failure: main() prints its result's summary, of the whole run too
+        if exc.result is not None:
+            exc.result = _whole_run(exc.result, args.file, orbits)
+        raise
+    print(_whole_run(result, args.file, orbits).summary())
+    print(f"this command    {sim.steps - steps0} of these steps, from t = "
+          f"{format_time(time0, digits=10)}")
+    return 0
+
+
+def _check_continues(path, point, sim, until):
+    """An ``--until`` at or before the end of the run in the file (at or after it,
+    for a run backwards) is an error, raised before any work."""
+    from orbits.units import format_time
+    if point.finished:
+        end, what = sim.time, "the end of the run"
+    else:
+        end = sim.units.quantity(point.plan.until, "time")
+        what = "the end of the interrupted run"
+    forward = point.plan.until >= point.plan.start_time
+    if (until > end) if forward else (until < end):
+        return
+    raise ValueError(
+        f"--until {format_time(until, digits=10)} is not {'after' if forward else 'before'} "
+        f"{what} in {path} (t = {format_time(end, digits=10)}); give a "
+        f"{'later' if forward else 'earlier'} time"
+        + ("" if point.finished else ", or none to only finish the run"))
+
+
+def _whole_run(result, path, orbits):
+    """``result`` (the last output of a run written into ``path``) with the steps,
+    time span, work and largest errors of every run in the file."""
+    whole = copy.copy(result)
+    vars(whole).update(orbits.io.hdf5.whole_run(path))
+    return whole
 
 
 def _bodies(scene, orbits):

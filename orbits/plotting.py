@@ -11,8 +11,9 @@
 Figures are :class:`matplotlib.figure.Figure` objects made without pyplot, so
 making one changes no global state (no backend switch, no figure left open);
 a notebook shows one returned as the last value of a cell, and
-``fig.savefig`` writes it.  Time axes are in days, years, kyr or Myr as the
-span of the run asks (:func:`time_unit`).
+``fig.savefig`` writes it.  Time axes are in seconds, days, years, kyr, Myr
+or Gyr as the span of the run asks (:func:`time_unit`, the chooser of
+:mod:`orbits.units` that the run summary uses too).
 """
 
 import math
@@ -23,14 +24,16 @@ import numpy as np
 
 from ._kernels import kepler as _kepler
 from .errors import ElementsError
+from .units import TIME_UNITS, time_unit
 
 __all__ = ["plot_result", "plot_elements", "plot_orbits", "plot_file", "time_unit",
            "TIME_AXIS_UNITS", "MAX_BODIES_DRAWN", "MAX_BODIES_IN_LEGEND",
            "ORBIT_POINTS", "SPARSE_STEP"]
 
-#: Units of a time axis: the first whose bound (in years) is above the span.
-#: A run of 1e5 years is drawn in kyr, one of a month in days.
-TIME_AXIS_UNITS = ((1.0, u.day), (1e4, u.yr), (1e7, u.kyr), (math.inf, u.Myr))
+#: Units of a time axis: those of the run summary (:data:`orbits.units.TIME_UNITS`),
+#: chosen by :func:`time_unit`.  A run of 1e5 years is drawn in kyr, one of a
+#: month in days.
+TIME_AXIS_UNITS = TIME_UNITS
 
 #: Trajectories drawn at most (the first bodies of the set): a cluster of
 #: thousands of stars would be one black blot and take seconds.
@@ -55,37 +58,6 @@ SPARSE_STEP = 0.5
 _HYPERBOLA_REACH = (4.0, 2.0)
 
 _PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
-
-
-def time_unit(span):
-    """The unit in which a time axis of this length reads best.
-
-    Parameters
-    ----------
-    span : Quantity, scalar, time (or dimensionless)
-        Length of the axis.
-
-    Returns
-    -------
-    astropy.units.Unit
-        ``d`` below a year, ``yr`` below 1e4 years, ``kyr`` below 1e7 years,
-        else ``Myr`` (:data:`TIME_AXIS_UNITS`); dimensionless for N-body units.
-
-    Examples
-    --------
-    >>> import astropy.units as u
-    >>> from orbits.plotting import time_unit
-    >>> time_unit(1e5 * u.yr), time_unit(30 * u.day), time_unit(3e7 * u.day)
-    (Unit("kyr"), Unit("d"), Unit("kyr"))
-    """
-    span = u.Quantity(span)
-    if span.unit.physical_type != "time":
-        return span.unit
-    years = abs(span.to_value(u.yr))
-    for bound, unit in TIME_AXIS_UNITS:
-        if years < bound:
-            return unit
-    return TIME_AXIS_UNITS[-1][1]
 
 
 def plot_result(result, path=None, frame=None, fig=None):

@@ -20,7 +20,7 @@ from .body import Track, unknown_body
 from .errors import BodyError, ElementsError, NoMassiveBodyError, UnknownBodyError
 from .geometry import angle_between, barycentre, is_barycentre
 from .monitors import massless_energy_errors
-from .units import UnitSystem
+from .units import UnitSystem, format_time, time_unit
 
 __all__ = ["Result", "FRAMES", "DOMINANT_MASS_FRACTION"]
 
@@ -434,7 +434,10 @@ class Result:
                   else f"{self.force_evaluations} force evaluations")
         if len(self.times):
             start = self.times[0] if self.start_time is None else self.start_time
-            span = f"{start:.6g} -> {self.times[-1]:.6g}"
+            end = self.times[-1]
+            # both ends in the unit of the larger, so that they read alike
+            unit = time_unit(max(abs(start), abs(end)))
+            span = f"{start.to_value(unit):.6g} -> {format_time(end, unit)}"
         else:
             span = "no outputs"
         lines = [
@@ -444,7 +447,8 @@ class Result:
             f"bodies          {len(self.names)}: {', '.join(self.names[:6])}"
             + (", ..." if len(self.names) > 6 else ""),
             f"time            {span}, "
-            + ("adaptive steps" if self.integrator.get("adaptive") else f"dt = {self.dt:.6g}"),
+            + ("adaptive steps" if self.integrator.get("adaptive")
+               else f"dt = {format_time(self.dt)}"),
             f"steps           {self.steps} "
             + (f"(+{self.steps_rejected} rejected) " if self.integrator.get("adaptive") else "")
             + f"({forces}), {wall_text}",

@@ -15,7 +15,8 @@ import numpy as np
 
 from .errors import BodyUnitsError
 
-__all__ = ["UnitSystem", "GAUSSIAN_GRAVITATIONAL_CONSTANT"]
+__all__ = ["UnitSystem", "GAUSSIAN_GRAVITATIONAL_CONSTANT", "time_unit", "format_time",
+           "TIME_UNITS"]
 
 #: Gauss's constant k in au^(3/2) / (day Msun^(1/2)) (IAU 1976).  k**2 is the
 #: G that REBOUND's unit table and the Hairer-Lubich-Wanner data set use for
@@ -36,6 +37,13 @@ _REBOUND_NAMES = {
     "mass": {u.Msun: "Msun", u.kg: "kg", u.g: "g", u.Mearth: "Mearth", u.Mjup: "Mjupiter"},
     "time": {u.day: "day", u.s: "s", u.yr: "yr", u.hour: "hr"},
 }
+
+#: Units in which a person reads a time: the first whose bound (in years) is
+#: above the span, so that a span reads as a number from 1 to 999 of its unit
+#: (a day and a year excepted): 1e5 years in kyr, a month in days, an hour in
+#: seconds.  The run summary, ``orbits info`` and the plots' time axes use it.
+TIME_UNITS = ((1 / 365.25, u.s), (1.0, u.day), (1e3, u.yr), (1e6, u.kyr), (1e9, u.Myr),
+              (math.inf, u.Gyr))
 
 _KINDS = ("length", "mass", "time", "velocity", "acceleration", "energy",
           "angular_momentum", "momentum", "dimensionless", "angle")
@@ -337,3 +345,70 @@ class UnitSystem:
         if self._dimensionless:
             return "nbody"
         return f"{self.length}-{self.mass}-{self.time}"
+
+
+def time_unit(span):
+    """The unit in which a time of this size reads best.
+
+    Parameters
+    ----------
+    span : Quantity, scalar, time (or dimensionless)
+        The time, or the span of times, to be shown; its sign is ignored.
+
+    Returns
+    -------
+    astropy.units.Unit
+        ``s`` below a day, ``d`` below a (Julian) year, ``yr`` below 1000
+        years, ``kyr`` below a million, ``Myr`` below a billion, else ``Gyr``
+        (:data:`TIME_UNITS`); the span's own unit where it is not a time
+        (N-body units).
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> from orbits.units import time_unit
+    >>> time_unit(1e5 * u.yr), time_unit(30 * u.day), time_unit(4.383e9 * u.day)
+    (Unit("kyr"), Unit("d"), Unit("Myr"))
+    """
+    span = u.Quantity(span)
+    if span.unit.physical_type != "time":
+        return span.unit
+    years = abs(span.to_value(u.yr))
+    for bound, unit in TIME_UNITS:
+        if years < bound:
+            return unit
+    return TIME_UNITS[-1][1]
+
+
+def format_time(time, unit=None, digits=6):
+    """A time as a person reads it: ``"100 kyr"``, ``"12 Myr"``, ``"30 d"``.
+
+    Parameters
+    ----------
+    time : Quantity, time (or dimensionless), or float
+        A float is shown as it is, without a unit.
+    unit : astropy.units.Unit, optional
+        The unit to show it in; default :func:`time_unit` of ``time``.  Give
+        the unit of the largest of several times to show them alike.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> from orbits.units import format_time, time_unit
+    >>> format_time(4.383e9 * u.day), format_time(3652.5 * u.day), format_time(0.5 * u.day)
+    ('12 Myr', '10 yr', '43200 s')
+    >>> format_time(0 * u.day, time_unit(1e5 * u.yr)), format_time(12.5 * u.one)
+    ('0 kyr', '12.5')
+    """
+    if not isinstance(time, u.Quantity):
+        return f"{float(time):.{digits}g}"
+    unit = time_unit(time) if unit is None else u.Unit(unit)
+    text = f"{time.to_value(unit):.{digits}g}"
+    name = unit.to_string()
+    return f"{text} {name}" if name else text

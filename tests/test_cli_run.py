@@ -58,7 +58,7 @@ def test_run_table_gives_defaults_and_options_override_them(system, capsys):
                                'outputs = 3\n[run.options]\nrtol = 1e-8\n')
     assert main(["run", str(system), "--no-progress"]) == 0
     out = capsys.readouterr().out
-    assert "dop853" in out and "rtol=1e-08" in out and "365.25 d" in out
+    assert "dop853" in out and "rtol=1e-08" in out and "-> 1 yr" in out
     assert main(["run", str(system), "--rtol", "1e-6", "--until", "10d", "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert "rtol=1e-06" in out and "-> 10 d" in out
@@ -195,3 +195,62 @@ def test_file_and_scene_errors(tmp_path, capsys):
     assert ".toml or .csv" in capsys.readouterr().err
     assert main(["run", "kepler", "-i", "ias15"]) == 3
     assert "--until is needed" in capsys.readouterr().err
+
+
+# -- the default number of outputs ------------------------------------------------------------
+
+def test_the_default_outputs_are_the_librarys():
+    from orbits import simulation
+    assert cli.DEFAULT_OUTPUTS == simulation.DEFAULT_OUTPUTS
+
+
+@pytest.mark.parametrize("steps, outputs", [
+    (365250.0, 488),       # 1e5 yr at 100 d = 2 3 5^3 487: 487 intervals of 750 steps
+    (3652.5, 333),         # 100 yr at 10 d: 3652 = 4 11 83 steps and a half; 332 of 11
+    (36525.0, 488),        # 1000 yr at 10 d = 3 5^2 487
+    (10000.0, 501),        # 500 intervals of 20 steps: the default itself where it fits
+    (499.0, 500),          # one per step up to the default
+    (73.05, 74),           # and a shortened last step
+    (600.0, 601),          # 600 is a divisor of itself, nearer 499 than 300
+    (1009.0, None),        # a prime: the library's default, at the nearest steps
+    (2 * 2609.0, None),    # divisors 2 and 2609 only: outside 100 to 1000
+    (0.3, None),           # less than a step
+])
+def test_default_outputs_fall_a_whole_number_of_steps_apart(steps, outputs):
+    chosen = cli.default_outputs(steps)
+    assert chosen == outputs
+    if chosen is not None:
+        assert round(steps) % (chosen - 1) == 0
+        assert cli.OUTPUT_INTERVALS[0] <= chosen - 1 <= cli.OUTPUT_INTERVALS[1] or steps < 500
+
+
+@pytest.mark.parametrize("until, end, count, apart", [
+    ("3652.5d", 3652.5, 333, 11),    # 3652 steps and a half one
+    ("3651.7d", 3651.7, 333, 11),    # 3651 and most of one: 3652 in all
+    ("3652.3d", 3652.3, 333, 11),
+    ("1yr", 365.25, 366, 1),         # one per step
+])
+def test_run_outputs_fall_whole_steps_apart(tmp_path, until, end, count, apart, capsys):
+    path = tmp_path / "run.h5"
+    assert main(["run", "kepler", "-i", "leapfrog", "--dt", "1d", "--until", until,
+                 "--out", str(path), "--no-progress"]) == 0
+    times = orbits.load(path).times.to_value("day")
+    assert len(times) == count
+    # every output but the last (at until, after a shortened step) a whole number
+    # of steps after the one before; the times are sums of whole steps of 1 d, exact
+    assert np.all(np.diff(times[:-1]) == apart)
+    assert times[-1] == pytest.approx(end, rel=1e-15)      # float64 rounding of until
+
+
+def test_adaptive_runs_keep_the_default(capsys, tmp_path):
+    path = tmp_path / "run.h5"
+    assert main(["run", "kepler", "-i", "ias15", "--until", "1000d", "--out", str(path),
+                 "--no-progress"]) == 0
+    assert len(orbits.load(path).times) == cli.DEFAULT_OUTPUTS
+
+
+def test_help_says_how_the_outputs_are_chosen(capsys):
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "a whole number of steps apart" in out and "488 outputs 750 steps apart" in out

@@ -177,9 +177,10 @@ from .._kernels import invariants as _inv
 from ..errors import OrbitsError
 from ..monitors import CHAOS_MONITORS, _work_column, monitor_fields
 from ..records import RunPlan, SimulationState
+from ..units import format_time, time_unit
 
 __all__ = ["FileRecorder", "load", "describe", "read_checkpoint", "Checkpoint", "truncate",
-           "ResumePoint",
+           "ResumePoint", "whole_run",
            "OrbitsFileError", "FileInUse", "TangentShapeError",
            "FORMAT", "FORMAT_VERSION", "CHECKPOINT_SECONDS", "BUFFER_ROWS",
            "SWMR_READ_ATTEMPTS"]
@@ -2560,6 +2561,87 @@ def _totals(f):
 
 
 @_damaged
+def whole_run(path):
+    """What a summary of every run that wrote a file needs, without its outputs:
+    the fields of :class:`~orbits.Result` that :func:`load` gives for the
+    whole file, for a result that holds only a last output (from
+    :meth:`orbits.Simulation.resume` or a run continued into the file).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    dict
+        ``steps``, ``force_evaluations``, ``steps_rejected`` and ``wall_time``
+        (totals at the last checkpoint, as :func:`load` reads them),
+        ``start_time`` (the first output's time, a Quantity), and
+        ``largest_errors`` (the largest relative errors of the monitored
+        invariants at every output and in-loop row); ``collisions`` and
+        ``encounters`` where the file logs them.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> from orbits.io import hdf5
+    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
+    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
+    >>> last = sim.run(until=20 * u.day, outputs=3, output=path, progress=False)
+    >>> whole = hdf5.whole_run(path)
+    >>> last.steps, last.start_time, whole["steps"], whole["start_time"]
+    (10, <Quantity 10. d>, 20, <Quantity 0. d>)
+    """
+    import astropy.units as u
+    from ..monitors import relative_error, vector_relative_error
+
+    with _open_read(path) as f:
+        b, par, obs = f["particles/bodies"], f["parameters"], f["observables"]
+        monitors = json.loads(par.attrs["monitors"])
+        n = _rows(f, monitors)
+        totals = _totals(f)
+        if totals is None:
+            step = b["position/step"]
+            totals = (int(step[n - 1] - step[0]) if n else 0, None, 0, None)
+        t = b["position/time"]
+        fields = dict(zip(("steps", "force_evaluations", "steps_rejected", "wall_time"),
+                          totals))
+        if n:
+            fields["start_time"] = float(t[0]) << u.Unit(t.attrs["unit"])
+        ref = par["reference"][()]
+        scales = par["scales"][()]
+        work = "energy" in monitors and "work" in obs
+        m = _rows(f, monitors, in_loop=True)
+        largest = {}
+        for name in ("energy", "angular_momentum"):
+            if name not in monitors:
+                continue
+            errors = []
+            for group, rows in ((obs, n), (obs["in_loop"], m)):
+                if not rows:
+                    continue
+                values = group[name]["value"][:rows]
+                if name == "energy":
+                    if work:
+                        values = values + group["work"]["value"][:rows]
+                    errors.append(relative_error(values, ref[0] + float(_work_column(ref)),
+                                                 scale=scales[0]))
+                else:
+                    errors.append(vector_relative_error(values, ref[1:4], scales[1]))
+            if errors:
+                largest[name] = float(max(np.max(e) for e in errors))
+        fields["largest_errors"] = largest
+        if "encounters" in f:
+            fields["encounters"] = _encounters(f["encounters"])
+        if "masses" in f["restart"]:
+            fields["collisions"] = _collisions(f.get("collisions"), par)
+    return fields
+
+
+@_damaged
 def load(path):
     """Read an output file into a :class:`~orbits.Result` with Quantities.
 
@@ -2825,6 +2907,7 @@ def describe(path):
     >>> [line.split()[0] for line in text.splitlines()[1:4]]
     ['bodies', 'integrator', 'units']
     """
+    import astropy.units as u
     with _open_read(path) as f:
         b = f["particles/bodies"]
         par = f["parameters"]
@@ -2832,18 +2915,22 @@ def describe(path):
         monitors = json.loads(par.attrs["monitors"])
         n_out = _read_ends(f, monitors)
         t = b["position/time"]
-        tu = t.attrs["unit"]
+        tu = u.Unit(t.attrs["unit"])
         units = json.loads(par.attrs["units"])
+        # times in the unit of the larger end of the outputs', so that they read alike
+        ends = (t[0], t[n_out - 1]) if n_out else (0.0,)
+        shown = time_unit(max(abs(v) for v in ends) * tu)
         lines = [
             f"{path}: orbits output (layout {FORMAT} v{FORMAT_VERSION}), written by "
             f"orbits {par.attrs['orbits_version']} on {par.attrs['written']}",
             f"bodies          {len(names)}: {', '.join(names[:8])}"
             + (", ..." if len(names) > 8 else ""),
             f"integrator      {par.attrs['integrator']} {par.attrs['integrator_options']}, "
-            f"dt = {par.attrs['dt']:g} {par.attrs['dt_unit']}",
+            f"dt = {format_time(par.attrs['dt'] * u.Unit(par.attrs['dt_unit']))}",
             f"units           {units['name']}, G = {units['G']!r} ({units['G_source']})",
             f"outputs         {n_out}"
-            + (f", t = {t[0]:g} .. {t[n_out - 1]:g} {tu}" if n_out else ""),
+            + (f", t = {(t[0] * tu).to_value(shown):.6g} .. "
+               f"{format_time(t[n_out - 1] * tu, shown)}" if n_out else ""),
             f"monitors        {', '.join(monitors) or 'none'}",
             f"forces          {_describe_forces(par, path)}",
         ]
@@ -2862,7 +2949,7 @@ def describe(path):
             tb = f["restart/t_base"][slot]
             t_ck = tb + clock[1] * par.attrs["dt"]
             lines.append(f"checkpoint      {count} written; the last at step {clock[0]}, "
-                         f"t = {t_ck:g} {tu}")
+                         f"t = {format_time(t_ck * tu, shown)}")
         totals = _totals(f)
         if totals is not None:
             lines.append(f"work            {totals[0]} steps, {totals[1]} force evaluations, "
