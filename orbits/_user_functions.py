@@ -228,7 +228,7 @@ def force_pointer(accel, ndim):
     key = (code_key(accel), ndim)
     if key not in _POINTERS:
         _POINTERS[key] = _cfunc(_force_pointer, force_signature(ndim), f"{key[0]}_{ndim}",
-                                user_accel=accel, FORCE_SIZE=FORCE_SIZE)
+                                user_accel=accel)
     return _POINTERS[key]
 
 
