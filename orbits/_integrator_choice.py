@@ -8,12 +8,7 @@ import inspect
 from . import integrators as _integrators
 from .errors import IntegratorOptionError
 
-__all__ = ["DEFAULT", "configured", "step_required"]
-
-#: The integrator of ``Simulation(bodies)``: adaptive, so that it needs no
-#: step, and accurate to round-off at its default tolerance (REBOUND's
-#: default too).
-DEFAULT = "ias15"
+__all__ = ["configured", "step_required"]
 
 
 def configured(integrator, options, signature_of):
@@ -92,4 +87,4 @@ def step_required(integ):
     return IntegratorOptionError(
         f"integrator {integ.name!r} takes fixed steps and needs dt (a time); the adaptive "
         f"integrators choose their own steps and need none: {adaptive} (the default is "
-        f"{DEFAULT!r})")
+        f"{_integrators.DEFAULT!r})")

@@ -239,7 +239,7 @@ class Simulation(Driven):
     IAS15(epsilon=1e-10, min_dt=0.0, adaptive_mode='global')
     """
 
-    def __init__(self, bodies, integrator=_choice.DEFAULT, dt=None, *, forces=(),
+    def __init__(self, bodies, integrator=_integrators.DEFAULT, dt=None, *, forces=(),
                  monitors=DEFAULT_MONITORS, monitor_every=None, softening=None, parallel=None,
                  encounter_distance=None, encounter_hill=None, escape_distance=None,
                  escape_unbound=False, collisions=None, restitution=None, encounter_log=None,

@@ -28,9 +28,14 @@ from .trace import Trace
 from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
 __all__ = ["get", "available", "aliases", "register", "adaptive_names", "Integrator",
-           "IntegratorInfo", "SplittingMethod", "ExplicitRungeKutta", "ALIASES"]
+           "IntegratorInfo", "SplittingMethod", "ExplicitRungeKutta", "ALIASES", "DEFAULT"]
 
 _REGISTRY = {}
+
+#: The integrator of ``Simulation(bodies)`` and ``orbits run``: adaptive, so
+#: that it needs no step, and accurate to round-off at its default tolerance
+#: (REBOUND's default too).
+DEFAULT = "ias15"
 
 #: Other names -> registry name, where the other name means the same method:
 #: REBOUND's ``"whfast"`` is the Wisdom-Holman map in Jacobi coordinates
