@@ -107,6 +107,9 @@ class BodySet:
             (with ``omega`` too only if the three agree).
         l, theta : Quantity, angle
             Mean longitude ``pomega + M`` and true longitude ``pomega + f``.
+            For ``inc`` above 90 degrees the three longitudes are measured
+            the other way round, as REBOUND does: ``pomega = Omega - omega``,
+            ``l = pomega - M``, ``theta = pomega - f``.
         E : Quantity, angle
             Eccentric anomaly (a bound orbit).
         T : Quantity, time

@@ -19,9 +19,13 @@ field      meaning                               in place of
 with ``mu = G (m_primary + m_body)``, the two-body ``GM`` that
 :meth:`~orbits.BodySet.add` uses for every orbit, ``n = sqrt(mu / |a|^3)`` the
 mean motion, and ``pomega = Omega + omega`` however the pericentre was given.
-``t = 0`` is the instant of the body set's states: a simulation made from the
-set starts its clock there, so ``T`` is a time on that clock (negative for a
-pericentre passed before the start).
+For a retrograde orbit (``inc`` above 90 degrees) the longitudes are measured
+the other way round, ``pomega = Omega - omega``, ``l = pomega - M``,
+``theta = pomega - f``, so that ``pomega`` stays the direction of pericentre
+for an orbit near the reference plane whichever way it goes round; REBOUND
+measures them so too.  ``t = 0`` is the instant of the body set's states: a
+simulation made from the set starts its clock there, so ``T`` is a time on
+that clock (negative for a pericentre passed before the start).
 
 One field of each group places the orbit: ``a`` or ``P``; ``omega`` or
 ``pomega`` (both only if they agree with ``Omega``); one of ``f``, ``M``,
@@ -116,17 +120,20 @@ def classical(name, mu, fields):
         raise ElementsError("orbital elements need the semi-major axis a or the period P",
                             body=name, field="a")
 
+    # +1 prograde, -1 retrograde: the sense in which the longitudes are measured
+    sense = -1.0 if given.get("inc", 0.0) > 0.5 * math.pi else 1.0
     Omega = given.get("Omega", 0.0)
     if "pomega" in given:
         if "omega" in given:
-            _check_agreement(name, given["pomega"], Omega, given["omega"],
-                             "Omega" in given)
+            _check_agreement(name, given["pomega"], Omega, sense * given["omega"],
+                             "Omega" in given, sense)
             out["omega"] = given["omega"]
         else:
-            out["omega"] = given["pomega"] - Omega
+            out["omega"] = sense * (given["pomega"] - Omega)
     else:
         out["omega"] = given.get("omega")
-    pomega = given["pomega"] if "pomega" in given else Omega + given.get("omega", 0.0)
+    pomega = (given["pomega"] if "pomega" in given
+              else Omega + sense * given.get("omega", 0.0))
 
     phase = [k for k in PHASE_FIELDS if k in given]
     if len(phase) > 1:
@@ -138,9 +145,9 @@ def classical(name, mu, fields):
     if which in ("f", "M"):
         out[which] = given[which]
     elif which == "theta":
-        out["f"] = given["theta"] - pomega
+        out["f"] = sense * (given["theta"] - pomega)
     elif which == "l":
-        out["M"] = given["l"] - pomega
+        out["M"] = sense * (given["l"] - pomega)
     elif which == "E":
         out["f"] = _true_from_eccentric(name, given["E"], e)
     elif which == "T":
@@ -162,13 +169,15 @@ def _axis_from_period(name, mu, P, e):
     return (mu * (P / _TWO_PI) ** 2) ** (1.0 / 3.0)
 
 
-def _check_agreement(name, pomega, Omega, omega, Omega_given):
-    """``pomega = Omega + omega`` to rounding, modulo a whole turn."""
+def _check_agreement(name, pomega, Omega, omega, Omega_given, sense):
+    """``pomega = Omega + omega`` to rounding, modulo a whole turn (``omega``
+    signed by the sense of the orbit)."""
     off = math.remainder(pomega - (Omega + omega), _TWO_PI)
     scale = abs(pomega) + abs(Omega) + abs(omega) + _TWO_PI
     if abs(off) > AGREEMENT_ULPS * 2.220446049250313e-16 * scale:
         which = "Omega, omega and pomega" if Omega_given else "omega and pomega (Omega = 0)"
-        raise ElementsError(f"{which} disagree: pomega must be Omega + omega, and differs "
+        rule = "Omega + omega" if sense > 0 else "Omega - omega (a retrograde orbit)"
+        raise ElementsError(f"{which} disagree: pomega must be {rule}, and differs "
                             f"from it by {off:.3g} rad; give omega or pomega, not both",
                             body=name, field="pomega")
 
