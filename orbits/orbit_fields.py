@@ -4,17 +4,17 @@ Besides the semi-major axis ``a`` and the angles ``omega`` (argument of
 pericentre) and ``f`` or ``M`` (true or mean anomaly), an orbit may be given
 as REBOUND's ``Particle`` takes it (Murray & Dermott 1999, ch. 2):
 
-=========  ====================================  ==================================
-field      meaning                               in place of
-=========  ====================================  ==================================
-``P``      orbital period                        ``a = (mu P^2 / 4 pi^2)^(1/3)``
-``pomega`` longitude of pericentre               ``omega = pomega - Omega``
-``l``      mean longitude                        ``M = l - pomega``
-``theta``  true longitude                        ``f = theta - pomega``
-``E``      eccentric anomaly                     ``f``, from ``tan(f/2) =
-                                                 sqrt((1+e)/(1-e)) tan(E/2)``
-``T``      time of pericentre passage            ``M = n (t - T)``, ``t = 0``
-=========  ====================================  ==================================
+==========  ====================================  ==================================
+field       meaning                               in place of
+==========  ====================================  ==================================
+``P``       orbital period                        ``a = (mu P^2 / 4 pi^2)^(1/3)``
+``pomega``  longitude of pericentre               ``omega = pomega - Omega``
+``l``       mean longitude                        ``M = l - pomega``
+``theta``   true longitude                        ``f = theta - pomega``
+``E``       eccentric anomaly                     ``f``, from ``tan(f/2) =
+                                                  sqrt((1+e)/(1-e)) tan(E/2)``
+``T``       time of pericentre passage            ``M = n (t - T)``, ``t = 0``
+==========  ====================================  ==================================
 
 with ``mu = G (m_primary + m_body)``, the two-body ``GM`` that
 :meth:`~orbits.BodySet.add` uses for every orbit, ``n = sqrt(mu / |a|^3)`` the
