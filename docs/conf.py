@@ -130,9 +130,11 @@ def _integrator_table():
         integ = orbits.integrators.get(info.name)
         cls = type(integ)
         options = ", ".join(f"``{k}={v!r}``" for k, v in integ.config.items()) or "none"
+        also = (" (also called " + ", ".join(f"``{a}``" for a in info.aliases) + ")"
+                if info.aliases else "")
         rows.append((f":class:`{info.name} <{cls.__module__}.{cls.__name__}>`",
                      str(info.order), "yes" if info.symplectic else "no",
-                     "yes" if info.adaptive else "no", options, info.summary))
+                     "yes" if info.adaptive else "no", options, info.summary + also))
     lines = [".. list-table::", "   :header-rows: 1", "   :widths: 12 6 9 8 25 40", "",
              "   * - name", "     - order", "     - symplectic", "     - adaptive",
              "     - options (defaults)", "     - what it is"]

@@ -20,6 +20,7 @@ import astropy.units as u
 import numpy as np
 
 from . import geometry as _geometry
+from . import orbit_fields as _orbit_fields
 from ._kernels import kepler as _kepler
 from .body import Body, _position, unknown_body
 from .errors import (BodyError, CoincidentBodiesError, DuplicateBodyError,
@@ -29,6 +30,10 @@ from .units import UnitSystem
 __all__ = ["BodySet"]
 
 _ELEMENT_NAMES = ("a", "e", "inc", "Omega", "omega", "f", "M")
+#: what each field of :meth:`BodySet.add`'s orbit is
+_FIELD_KINDS = {"a": "length", "e": "dimensionless", "inc": "angle", "Omega": "angle",
+                "omega": "angle", "f": "angle", "M": "angle",
+                **_orbit_fields.ALTERNATIVE_FIELDS}
 _REPR_ROWS = 5  # rows a repr shows at each end of a long set
 
 
@@ -69,7 +74,8 @@ class BodySet:
 
     # -- construction -----------------------------------------------------------
     def add(self, name, mass, *, position=None, velocity=None, primary=None, a=None,
-            e=None, inc=None, Omega=None, omega=None, f=None, M=None, radius=None):
+            e=None, inc=None, Omega=None, omega=None, f=None, M=None, radius=None,
+            P=None, pomega=None, l=None, T=None, E=None, theta=None):
         """Add one body, by Cartesian state or by orbital elements.
 
         Parameters
@@ -94,17 +100,37 @@ class BodySet:
             Inclination, longitude of the ascending node, argument of pericentre.
             Default 0.
         f, M : Quantity, angle
-            True or mean anomaly (give at most one).  Default ``f = 0``.
+            True or mean anomaly.  Default ``f = 0``.
+        P : Quantity, time
+            Orbital period, in place of ``a``: ``a = (mu P^2 / 4 pi^2)^(1/3)``
+            (a bound orbit, ``e < 1``).
+        pomega : Quantity, angle
+            Longitude of pericentre ``Omega + omega``, in place of ``omega``
+            (with ``omega`` too only if the three agree).
+        l, theta : Quantity, angle
+            Mean longitude ``pomega + M`` and true longitude ``pomega + f``.
+            For ``inc`` above 90 degrees the three longitudes are measured
+            the other way round, as REBOUND does: ``pomega = Omega - omega``,
+            ``l = pomega - M``, ``theta = pomega - f``.
+        E : Quantity, angle
+            Eccentric anomaly (a bound orbit).
+        T : Quantity, time
+            Time of pericentre passage, on the clock of a simulation made from
+            the set, which starts at t = 0: ``M = -n T``.
         radius : Quantity, scalar, length, optional
             The body's physical radius: finite and >= 0.  Default 0 (a point
             mass).  Gravity does not read it; it is kept for collision
             detection and travels with the set into simulations and files.
 
+        Give at most one of ``f``, ``M``, ``E``, ``l``, ``theta``, ``T``, and
+        ``a`` or ``P``; these are REBOUND's ``Particle`` fields, with the
+        same meanings (:mod:`orbits.orbit_fields`).
+
         Notes
         -----
         The orbit about the primary uses ``mu = G (m_primary + m_body)``, so a
         massive body on a circular orbit given this way stays circular in the
-        two-body problem.
+        two-body problem; ``P`` and ``T`` are read with the same ``mu``.
 
         Examples
         --------
@@ -122,6 +148,15 @@ class BodySet:
         0.0167
         >>> bodies.radii.to(u.km).round(1)
         <Quantity [   0. , 6378.1,    0. ] km>
+
+        REBOUND's ways to give an orbit: a period, the longitude of pericentre
+        and the mean longitude.
+
+        >>> bodies.add("Mars", mass=0.107 * u.Mearth, primary="Sun", P=686.98 * u.day,
+        ...            e=0.0934, pomega=336.04 * u.deg, l=355.45 * u.deg)
+        >>> el = bodies.elements("Mars", primary="Sun")
+        >>> round(float(el["a"].to_value(u.au)), 4), round(float(el["omega"].to(u.deg).value), 2)
+        (1.5237, 336.04)
         """
         self._check_name(name)
         m = self._scalar(mass, "mass", name, "mass")
@@ -134,7 +169,8 @@ class BodySet:
         if not (math.isfinite(r) and r >= 0):
             raise BodyError(f"radius must be finite and >= 0, got {r} {self.units.length}",
                             body=name, field="radius")
-        elements = dict(a=a, e=e, inc=inc, Omega=Omega, omega=omega, f=f, M=M)
+        elements = dict(a=a, e=e, inc=inc, Omega=Omega, omega=omega, f=f, M=M, P=P,
+                        pomega=pomega, l=l, T=T, E=E, theta=theta)
         given = [k for k, val in elements.items() if val is not None]
         if given or primary is not None:
             if position is not None or velocity is not None:
@@ -897,18 +933,14 @@ class BodySet:
         j = self._names.index(primary)
         return self._m[j], self._x[j], self._v[j]
 
-    def _state_from_elements(self, name, m, primary, a, e, inc, Omega, omega, f, M):
+    def _state_from_elements(self, name, m, primary, **fields):
         mp, xp, vp = self._primary_state(name, primary, before=len(self))
-        if a is None:
-            raise ElementsError("orbital elements need the semi-major axis a",
-                                body=name, field="a")
-        a_ = self._scalar(a, "length", name, "a")
-        e_ = 0.0 if e is None else self._scalar(e, "dimensionless", name, "e")
-        ang = {}
-        for key, val in (("inc", inc), ("Omega", Omega), ("omega", omega), ("f", f),
-                         ("M", M)):
-            ang[key] = None if val is None else self._scalar(val, "angle", name, key)
-        pos, vel = _relative_state(name, self.units, mp, m, a_, e_, **ang)
+        values = {key: None if val is None else self._scalar(val, _FIELD_KINDS[key], name, key)
+                  for key, val in fields.items()}
+        el = _orbit_fields.classical(name, self.units.G * (mp + m), values)
+        e_ = 0.0 if el["e"] is None else el["e"]
+        pos, vel = _relative_state(name, self.units, mp, m, el["a"], e_, el["inc"],
+                                   el["Omega"], el["omega"], el["f"], el["M"])
         return xp + pos, vp + vel
 
 

@@ -201,8 +201,8 @@ def _parser():
     run.add_argument("scene", help="scene name (see 'orbits scenes') or a body-set file "
                                    "ending in .toml or .csv")
     run.add_argument("--integrator", "-i", default=None,
-                     help="integrator name (see 'orbits integrators'); default: the file's "
-                          "[run] integrator, else verlet")
+                     help="integrator name or alias (see 'orbits integrators'); default: "
+                          "the file's [run] integrator, else ias15")
     run.add_argument("--dt", type=parse_quantity, default=None,
                      help="step, with a unit (10d, 1h) or a plain number in the scene's "
                           "units; for adaptive integrators (ias15, dopri5, ...) the first "
@@ -503,8 +503,9 @@ def _main(args, orbits):
     elif args.command == "integrators":
         print(f"{'name':18s} {'order':>5s}  {'symplectic':10s} {'adaptive':8s} summary")
         for info in orbits.integrators.available():
+            also = f" (also: {', '.join(info.aliases)})" if info.aliases else ""
             print(f"{info.name:18s} {info.order:5d}  {str(info.symplectic):10s} "
-                  f"{str(info.adaptive):8s} {info.summary}")
+                  f"{str(info.adaptive):8s} {info.summary}{also}")
     elif args.command == "run":
         return _run(args, orbits)
     elif args.command == "resume":
@@ -594,15 +595,16 @@ def _run(args, orbits):
         value = getattr(args, key)
         return defaults.get(key) if value is None else value
 
-    name = args.integrator or defaults.get("integrator", "verlet")
+    name = args.integrator or defaults.get("integrator", orbits.integrators.DEFAULT)
     options = dict(defaults.get("options", {}))
     options.update((k, getattr(args, k)) for k in INTEGRATOR_OPTIONS
                    if getattr(args, k) is not None)
     integrator = orbits.integrators.get(name, **options)
     dt, until = given("dt"), given("until")
     if dt is None and not integrator.adaptive:
-        raise ValueError(f"--dt is needed: {name!r} takes fixed steps "
-                         f"(adaptive integrators such as ias15 choose their own)")
+        raise ValueError(f"--dt is needed: {name!r} takes fixed steps (the adaptive "
+                         f"integrators choose their own: "
+                         f"{', '.join(orbits.integrators.adaptive_names())})")
     if until is None:
         raise ValueError("--until is needed: the end time, such as 1000yr (a body-set "
                          "file may give it as 'until' in its [run] table)")

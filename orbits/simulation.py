@@ -16,6 +16,7 @@ import astropy.units as u
 import numpy as np
 
 from . import collisions as _collisions
+from . import _integrator_choice as _choice
 from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
@@ -120,13 +121,22 @@ class Simulation(Driven):
     bodies : BodySet
         Copied; later changes to it do not affect the simulation.
     integrator : str or Integrator
-        Registry name (see :func:`orbits.integrators.available`) or a configured
-        instance from :func:`orbits.integrators.get`.
+        Registry name or alias (see :func:`orbits.integrators.available`) or
+        a configured instance from :func:`orbits.integrators.get`.  Default
+        ``"ias15"``, which needs no ``dt``.
     dt : Quantity (time) or float
         Step size; for adaptive integrators the first step to try (optional:
         by default they choose it).  A plain number is read in the body set's
         unit of time, and is accepted only when the body set was given its
-        unit system explicitly.
+        unit system explicitly.  A fixed-step integrator without it is an
+        :class:`~orbits.errors.IntegratorOptionError` that names the adaptive
+        ones.
+    **options
+        The integrator's options, given by name beside it, as
+        ``Simulation(bodies, "ias15", epsilon=1e-10)``: the same as
+        ``integrator=orbits.integrators.get("ias15", epsilon=1e-10)``.  An
+        option the integrator does not have, or options beside an instance,
+        are an :class:`~orbits.errors.IntegratorOptionError`.
     monitors : sequence of str
         Any of ``"energy"``, ``"angular_momentum"``, ``"momentum"``,
         ``"center_of_mass"``, and the chaos indicators ``"megno"`` (the running
@@ -223,13 +233,17 @@ class Simulation(Driven):
     >>> result = sim.run(until=30 * u.day, outputs=31, progress=False)
     >>> result.positions.shape
     (31, 2, 3)
+    >>> orbits.Simulation(orbits.scenes.earth_moon()).integrator.name
+    'ias15'
+    >>> orbits.Simulation(orbits.scenes.earth_moon(), "ias15", epsilon=1e-10).integrator
+    IAS15(epsilon=1e-10, min_dt=0.0, adaptive_mode='global')
     """
 
-    def __init__(self, bodies, integrator="verlet", dt=None, *, forces=(),
+    def __init__(self, bodies, integrator=_integrators.DEFAULT, dt=None, *, forces=(),
                  monitors=DEFAULT_MONITORS, monitor_every=None, softening=None, parallel=None,
                  encounter_distance=None, encounter_hill=None, escape_distance=None,
                  escape_unbound=False, collisions=None, restitution=None, encounter_log=None,
-                 rebound_arithmetic=False, variations=None, seed=None):
+                 rebound_arithmetic=False, variations=None, seed=None, **options):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
@@ -240,8 +254,10 @@ class Simulation(Driven):
         self._bare_ok = bodies._bare_ok
         self._names = bodies.names
         self._history = list(bodies.history)
-        self.integrator = _integrators.get(integrator)
+        self.integrator = _choice.configured(integrator, options, Simulation.__init__)
         adaptive = self.integrator.adaptive
+        if dt is None and not adaptive:
+            raise _choice.step_required(self.integrator)
         self._dt = 0.0 if (adaptive and dt is None) else self._time_value(dt, "dt")
         # an adaptive method's dt is only its first step; 0 lets it choose
         if not ((self._dt > 0 or (adaptive and self._dt == 0)) and math.isfinite(self._dt)):

@@ -207,10 +207,10 @@ def test_bad_files(tmp_path):
 def test_cli_run_info_resume_plot(tmp_path, capsys):
     from orbits.cli import main
     path = tmp_path / "cli.h5"
-    assert main(["run", "outer-solar-system", "--dt", "10d", "--until", "100yr",
-                 "--out", str(path), "--no-progress"]) == 0
-    assert main(["run", "outer-solar-system", "--dt", "10d", "--until", "100yr",
-                 "--out", str(path), "--no-progress"]) == 4
+    run = ["run", "outer-solar-system", "-i", "verlet", "--dt", "10d", "--until", "100yr",
+           "--out", str(path), "--no-progress"]
+    assert main(run) == 0
+    assert main(run) == 4
     assert "--force" in capsys.readouterr().err
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out

@@ -134,11 +134,11 @@ def test_non_finite_state_keeps_last_good_state():
 ])
 def test_bad_dt(dt, exc):
     with pytest.raises(exc, match="dt"):
-        orbits.Simulation(sun_jupiter_probe(), dt=dt)
+        orbits.Simulation(sun_jupiter_probe(), "verlet", dt=dt)
 
 
 def test_bad_until_and_outputs():
-    sim = orbits.Simulation(sun_jupiter_probe(), dt=5 * u.day)
+    sim = orbits.Simulation(sun_jupiter_probe(), "verlet", dt=5 * u.day)
     sim.run(until=1 * u.yr, outputs=2, progress=False)
     with pytest.raises(ValueError, match="not after the current time"):
         sim.run(until=0.5 * u.yr)
@@ -156,9 +156,11 @@ def test_unknown_integrator_and_option():
 
 
 def test_progress_bar_can_be_silenced(capsys):
-    orbits.Simulation(kepler_bodies(), dt=0.01).run(until=1.0, outputs=2, progress=False)
+    orbits.Simulation(kepler_bodies(), "verlet", dt=0.01).run(until=1.0, outputs=2,
+                                                              progress=False)
     assert capsys.readouterr().err == ""
-    orbits.Simulation(kepler_bodies(), dt=0.01).run(until=1.0, outputs=2, progress=True)
+    orbits.Simulation(kepler_bodies(), "verlet", dt=0.01).run(until=1.0, outputs=2,
+                                                              progress=True)
     assert "step" in capsys.readouterr().err
 
 

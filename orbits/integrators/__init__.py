@@ -1,12 +1,15 @@
-"""The registry of integrators: name -> class.
+"""The registry of integrators: name -> class, and REBOUND's names for the same methods.
 
 >>> import orbits
 >>> [i.name for i in orbits.integrators.available()][:3]
 ['euler', 'symplectic-euler', 'verlet']
 >>> orbits.integrators.get("rk4")
 RK4()
+>>> orbits.integrators.get("whfast").name       # REBOUND's name for the same method
+'wh'
 """
 
+import difflib
 from typing import NamedTuple
 
 from ..errors import UnknownIntegratorError
@@ -24,10 +27,37 @@ from .taylor import Taylor
 from .trace import Trace
 from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
-__all__ = ["get", "available", "register", "Integrator", "IntegratorInfo",
-           "SplittingMethod", "ExplicitRungeKutta"]
+__all__ = ["get", "available", "aliases", "register", "adaptive_names", "Integrator",
+           "IntegratorInfo", "SplittingMethod", "ExplicitRungeKutta", "ALIASES", "DEFAULT"]
 
 _REGISTRY = {}
+
+#: The integrator of ``Simulation(bodies)`` and ``orbits run``: adaptive, so
+#: that it needs no step, and accurate to round-off at its default tolerance
+#: (REBOUND's default too).
+DEFAULT = "ias15"
+
+#: Other names -> registry name, where the other name means the same method:
+#: REBOUND's ``"whfast"`` is the Wisdom-Holman map in Jacobi coordinates
+#: without a corrector by default, with the same ``corrector`` and
+#: ``coordinates`` choices as ``wh`` (its ``"wh"`` is the same map too).
+ALIASES = {"whfast": "wh"}
+
+#: REBOUND's names for methods that are not here, with what to use instead.
+#: Not aliases: the methods differ (see the integrators guide).
+_ELSEWHERE = {
+    "mercurius": ("REBOUND's MERCURIUS (a Wisdom-Holman map whose interaction is split "
+                  "by a smooth changeover function, IAS15 inside it) is not here; 'trace' "
+                  "is the hybrid method here (the same democratic heliocentric map, "
+                  "switching time-reversibly to DOP853 for close encounters)", "trace"),
+    "saba": ("REBOUND's 'saba' is SABA(10,6,4) unless its type is set; that method is not "
+             "here, but 'saba2', 'saba3' and 'saba4' are (Laskar & Robutel 2001, as "
+             "REBOUND's 'saba2' to 'saba4')", "saba2"),
+    "whfast512": ("WHFast512 is the Wisdom-Holman map in democratic heliocentric "
+                  "coordinates: 'wh' with coordinates='democratic-heliocentric'", "wh"),
+    "whc": ("REBOUND's 'whc' is WHFast with the 17th-order corrector: 'wh' with "
+            "corrector=17", "wh"),
+}
 
 
 class IntegratorInfo(NamedTuple):
@@ -46,6 +76,8 @@ class IntegratorInfo(NamedTuple):
     symplectic: bool
     adaptive: bool
     summary: str
+    #: other names that :func:`get` accepts for it (REBOUND's)
+    aliases: tuple = ()
 
 
 def register(cls):
@@ -101,7 +133,11 @@ def get(name, **options):
     Raises
     ------
     UnknownIntegratorError
-        The name is not registered; the message lists the valid ones.
+        The name is not registered; the message suggests the nearest one and
+        lists the valid ones.
+    IntegratorOptionError
+        An option the integrator does not have; the message lists the ones
+        it has.
 
     Returns
     -------
@@ -116,17 +152,72 @@ def get(name, **options):
     IAS15(epsilon=1e-10, min_dt=0.0, adaptive_mode='global')
     >>> orbits.integrators.get("dopri5").config
     {'rtol': 1e-09, 'atol': 1e-12}
+    >>> orbits.integrators.get("whfast", corrector=17)   # an alias (ALIASES)
+    WisdomHolman(coordinates='jacobi', corrector=17)
     """
     if isinstance(name, Integrator):
         if options:
             return type(name)(**{**name.config, **options})
         return name
-    try:
-        cls = _REGISTRY[name]
-    except (KeyError, TypeError):
-        raise UnknownIntegratorError(
-            f"unknown integrator {name!r}; valid names: {', '.join(_REGISTRY)}") from None
-    return cls(**options)
+    return _lookup(name)(**options)
+
+
+def _lookup(name):
+    """The class registered under ``name`` or one of its aliases."""
+    if isinstance(name, str):
+        cls = _REGISTRY.get(ALIASES.get(name.lower(), name)) or _REGISTRY.get(name.lower())
+        if cls is not None:
+            return cls
+    raise UnknownIntegratorError(_unknown_message(name))
+
+
+def _unknown_message(name):
+    text = f"unknown integrator {name!r}"
+    valid = f"valid names: {', '.join(_REGISTRY)}; aliases: " + ", ".join(
+        f"{a} -> {n}" for a, n in ALIASES.items())
+    if not isinstance(name, str):
+        return f"{text}: a name is a string; {valid}"
+    note, nearest = _ELSEWHERE.get(name.lower(), (None, None))
+    if note is None:
+        close = difflib.get_close_matches(name.lower(), [*_REGISTRY, *ALIASES], n=1, cutoff=0.6)
+        nearest = ALIASES.get(close[0], close[0]) if close else None
+    else:
+        text += f"; {note}"
+    if nearest is not None:
+        text += f"; did you mean {nearest!r}?"
+    return f"{text}; {valid}"
+
+
+def aliases():
+    """Other names :func:`get` accepts, each with the registry name it means.
+
+    Returns
+    -------
+    dict of str to str
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.aliases()
+    {'whfast': 'wh'}
+    """
+    return dict(ALIASES)
+
+
+def adaptive_names():
+    """The registry names of the adaptive integrators, which choose their own steps.
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.adaptive_names()[-2:]
+    ['ias15', 'taylor']
+    """
+    return [name for name, cls in _REGISTRY.items() if cls.adaptive]
 
 
 def available():
@@ -142,5 +233,6 @@ def available():
     >>> [(i.name, i.order) for i in orbits.integrators.available() if i.symplectic][:3]
     [('symplectic-euler', 1), ('verlet', 2), ('leapfrog', 2)]
     """
-    return [IntegratorInfo(c.name, c.order, c.symplectic, c.adaptive, c.summary)
+    return [IntegratorInfo(c.name, c.order, c.symplectic, c.adaptive, c.summary,
+                           tuple(a for a, n in ALIASES.items() if n == c.name))
             for c in _REGISTRY.values()]
