@@ -19,7 +19,9 @@ import math
 import astropy.units as u
 import numpy as np
 
-from ._kernels import kepler as _kepler
+from ._kernels import anomalies as _anomalies
+from ._kernels import elements as _elements
+from ._kernels.status import describe_status
 from .errors import (BodyError, CoincidentBodiesError, DuplicateBodyError,
                      ElementsError, NoMassiveBodyError, UnknownBodyError)
 from .units import UnitSystem
@@ -588,7 +590,7 @@ class BodySet:
         """
         out, status = self._element_values(name, primary)
         if status != 0:
-            raise ElementsError(_kepler.describe_status(status), body=name, field="elements")
+            raise ElementsError(describe_status(status), body=name, field="elements")
         q = self.units.quantity
         return {"a": q(out[0], "length"), "e": out[1] << u.dimensionless_unscaled,
                 **{k: out[j] << u.rad for j, k in enumerate(_ELEMENT_NAMES[2:], start=2)}}
@@ -600,7 +602,7 @@ class BodySet:
         mp, xp, vp = self._primary_state(name, primary, before=i)
         mu = self.units.G * (mp + self._m[i])
         out = np.empty(7)
-        status = _kepler.state_to_elements(mu, self._x[i] - xp, self._v[i] - vp, out)
+        status = _elements.state_to_elements(mu, self._x[i] - xp, self._v[i] - vp, out)
         return out, status
 
     def plot_orbits(self, primary=None, plane="xy", ax=None, path=None):
@@ -803,17 +805,17 @@ def _relative_state(name, units, mp, m, a, e, inc, Omega, omega, f, M):
         raise ElementsError("give the true anomaly f or the mean anomaly M, not both",
                             body=name, field="f")
     anomaly = ang["f"] if ang["f"] is not None else (
-        _kepler.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
+        _anomalies.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
     mu = units.G * (mp + m)
     if mu <= 0:
         raise ElementsError("the primary and the body are both massless; an orbit "
                             "needs mass", body=name, field="primary")
     pos, vel = np.empty(3), np.empty(3)
-    status = _kepler.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
+    status = _elements.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
                                        ang["Omega"] or 0.0, ang["omega"] or 0.0,
                                        anomaly, pos, vel)
     if status != 0:
-        raise ElementsError(_kepler.describe_status(status), body=name,
+        raise ElementsError(describe_status(status), body=name,
                             field="f" if ang["f"] is not None else "elements")
     return pos, vel
 
@@ -858,7 +860,7 @@ def _bound_elements(bodies, i):
         return None
     mu = bodies.units.G * (mt + bodies._m[i])
     out = np.empty(7)
-    status = _kepler.state_to_elements(mu, bodies._x[i] - (m @ bodies._x[:i]) / mt,
+    status = _elements.state_to_elements(mu, bodies._x[i] - (m @ bodies._x[:i]) / mt,
                                        bodies._v[i] - (m @ bodies._v[:i]) / mt, out)
     if status != 0 or not (0 <= out[1] < 1 and out[0] > 0):
         return None

@@ -15,7 +15,8 @@ import math
 import astropy.units as u
 import numpy as np
 
-from ._kernels import kepler as _kepler
+from ._kernels import elements as _elements
+from ._kernels.status import describe_status
 from .errors import BodyError, ElementsError, NoMassiveBodyError, UnknownBodyError
 from .monitors import massless_energy_errors
 from .units import UnitSystem
@@ -532,13 +533,13 @@ class Result:
         out = np.full((n, 7), np.nan)
         status = np.zeros(n, dtype=np.int64)
         if here.all():
-            _kepler.state_to_elements_many(np.ascontiguousarray(mu, dtype=float),
+            _elements.state_to_elements_many(np.ascontiguousarray(mu, dtype=float),
                                            np.ascontiguousarray(x[:, i] - xp),
                                            np.ascontiguousarray(v[:, i] - vp), out, status)
         elif here.any():
             part = np.empty((int(here.sum()), 7))
             st = np.zeros(len(part), dtype=np.int64)
-            _kepler.state_to_elements_many(np.ascontiguousarray(mu[here], dtype=float),
+            _elements.state_to_elements_many(np.ascontiguousarray(mu[here], dtype=float),
                                            np.ascontiguousarray(x[here, i] - xp[here]),
                                            np.ascontiguousarray(v[here, i] - vp[here]),
                                            part, st)
@@ -548,7 +549,7 @@ class Result:
             k = int(bad[0])
             more = f" (and at {bad.size - 1} later outputs)" if bad.size > 1 else ""
             raise ElementsError(f"at output {k} (t = {self.times[k]:.10g}){more}: "
-                                f"{_kepler.describe_status(status[k])}", body=body,
+                                f"{describe_status(status[k])}", body=body,
                                 field="elements")
         a = out[:, 0]
         period = np.full(n, np.nan)
