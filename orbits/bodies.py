@@ -21,7 +21,9 @@ import numpy as np
 
 from . import geometry as _geometry
 from . import orbit_fields as _orbit_fields
-from ._kernels import kepler as _kepler
+from ._kernels import anomalies as _anomalies
+from ._kernels import elements as _elements
+from ._kernels.status import describe_status
 from .body import Body, _position, unknown_body
 from .errors import (BodyError, CoincidentBodiesError, DuplicateBodyError,
                      ElementsError, NoMassiveBodyError, UnknownBodyError)
@@ -677,7 +679,7 @@ class BodySet:
         """
         out, status = self._element_values(name, primary)
         if status != 0:
-            raise ElementsError(_kepler.describe_status(status), body=name, field="elements")
+            raise ElementsError(describe_status(status), body=name, field="elements")
         q = self.units.quantity
         return {"a": q(out[0], "length"), "e": out[1] << u.dimensionless_unscaled,
                 **{k: out[j] << u.rad for j, k in enumerate(_ELEMENT_NAMES[2:], start=2)}}
@@ -687,7 +689,7 @@ class BodySet:
         # kernel's status
         mu, r, v = self._relative(name, primary)
         out = np.empty(7)
-        status = _kepler.state_to_elements(mu, r, v, out)
+        status = _elements.state_to_elements(mu, r, v, out)
         return out, status
 
     def _relative(self, name, primary):
@@ -987,17 +989,17 @@ def _relative_state(name, units, mp, m, a, e, inc, Omega, omega, f, M):
         raise ElementsError("give the true anomaly f or the mean anomaly M, not both",
                             body=name, field="f")
     anomaly = ang["f"] if ang["f"] is not None else (
-        _kepler.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
+        _anomalies.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
     mu = units.G * (mp + m)
     if mu <= 0:
         raise ElementsError("the primary and the body are both massless; an orbit "
                             "needs mass", body=name, field="primary")
     pos, vel = np.empty(3), np.empty(3)
-    status = _kepler.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
+    status = _elements.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
                                        ang["Omega"] or 0.0, ang["omega"] or 0.0,
                                        anomaly, pos, vel)
     if status != 0:
-        raise ElementsError(_kepler.describe_status(status), body=name,
+        raise ElementsError(describe_status(status), body=name,
                             field="f" if ang["f"] is not None else "elements")
     return pos, vel
 
@@ -1042,7 +1044,7 @@ def _bound_elements(bodies, i):
         return None
     mu = bodies.units.G * (mt + bodies._m[i])
     out = np.empty(7)
-    status = _kepler.state_to_elements(mu, bodies._x[i] - (m @ bodies._x[:i]) / mt,
+    status = _elements.state_to_elements(mu, bodies._x[i] - (m @ bodies._x[:i]) / mt,
                                        bodies._v[i] - (m @ bodies._v[:i]) / mt, out)
     if status != 0 or not (0 <= out[1] < 1 and out[0] > 0):
         return None

@@ -16,7 +16,7 @@ import numpy as np
 from . import _user_functions
 from . import integrators as _integrators
 from ._driver import FIRST_CHUNK, Driven
-from ._kernels import implicit as _implicit
+from ._kernels import jacobians as _jacobians
 from ._kernels import stepping as _stepping
 from ._kernels.status import Status
 from .errors import (ConvergenceFailure, ForceTermError, IntegratorOptionError,
@@ -177,7 +177,7 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
     force = _stepping.user_force(accel, jit=_is_jitted(accel))
     if jacobian is not None:
         _check_jacobian(jacobian, x0, v0, t0, size)
-        force = force._replace(jacobian=_implicit.user_jacobian(jacobian, _is_jitted(jacobian)),
+        force = force._replace(jacobian=_jacobians.user_jacobian(jacobian, _is_jitted(jacobian)),
                                key=f"{force.key}_jac{id(jacobian)}")
     if velocity_dependent:
         force = force._replace(velocity_dependent=True)

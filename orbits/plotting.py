@@ -22,7 +22,7 @@ import pathlib
 import astropy.units as u
 import numpy as np
 
-from ._kernels import kepler as _kepler
+from ._kernels import elements as _elements
 from .errors import ElementsError
 from .units import TIME_UNITS, time_unit
 
@@ -281,7 +281,7 @@ def plot_orbits(bodies, primary=None, plane="xy", ax=None, path=None):
 
     Notes
     -----
-    A point at true anomaly ``f`` is :func:`orbits._kernels.kepler.elements_to_state`
+    A point at true anomaly ``f`` is :func:`orbits._kernels.elements.elements_to_state`
     of ``(a, e, inc, Omega, omega, f)`` with ``mu = G (m_primary + m)``, plus the
     primary's position: ``f`` over a full turn for an ellipse, and for a
     hyperbola over ``|f| <= arccos((p / R - 1) / e)``, ``p = a (1 - e^2)``, out
@@ -446,6 +446,6 @@ def _orbit_curve(mu, el, units, reach):
     pos = np.empty((f.size, 3))
     vel = np.empty((f.size, 3))
     status = np.zeros(f.size, dtype=np.int64)
-    _kepler.elements_to_state_many(np.full(f.size, mu), elems, pos, vel, status)
+    _elements.elements_to_state_many(np.full(f.size, mu), elems, pos, vel, status)
     pos[status != 0] = np.nan
     return pos

@@ -15,7 +15,8 @@ import math
 import astropy.units as u
 import numpy as np
 
-from ._kernels import kepler as _kepler
+from ._kernels import elements as _elements
+from ._kernels.status import describe_status
 from .body import Track, unknown_body
 from .errors import BodyError, ElementsError, NoMassiveBodyError, UnknownBodyError
 from .geometry import angle_between, barycentre, is_barycentre
@@ -553,20 +554,20 @@ class Result:
         out = np.full((n, 7), np.nan)
         status = np.zeros(n, dtype=np.int64)
         if here.all():
-            _kepler.state_to_elements_many(mu, dx, dv, out, status)
+            _elements.state_to_elements_many(mu, dx, dv, out, status)
         elif here.any():
             part = np.empty((int(here.sum()), 7))
             st = np.zeros(len(part), dtype=np.int64)
-            _kepler.state_to_elements_many(np.ascontiguousarray(mu[here]),
-                                           np.ascontiguousarray(dx[here]),
-                                           np.ascontiguousarray(dv[here]), part, st)
+            _elements.state_to_elements_many(np.ascontiguousarray(mu[here]),
+                                             np.ascontiguousarray(dx[here]),
+                                             np.ascontiguousarray(dv[here]), part, st)
             out[here], status[here] = part, st
         bad = np.flatnonzero(status)
         if bad.size:
             k = int(bad[0])
             more = f" (and at {bad.size - 1} later outputs)" if bad.size > 1 else ""
             raise ElementsError(f"at output {k} (t = {self.times[k]:.10g}){more}: "
-                                f"{_kepler.describe_status(status[k])}", body=body,
+                                f"{describe_status(status[k])}", body=body,
                                 field="elements")
         a = out[:, 0]
         period = np.full(n, np.nan)

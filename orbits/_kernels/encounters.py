@@ -44,7 +44,8 @@ import math
 import numpy as np
 
 from ._jit import njit
-from .kepler import bracketed_anomaly, short_step_anomaly, stumpff
+from .kepler import bracketed_anomaly, short_step_anomaly
+from .stumpff import stumpff
 
 __all__ = [
     "ROOT_MAX_ITER",

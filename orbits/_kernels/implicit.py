@@ -41,11 +41,8 @@ flag in ``cache`` says whether they belong to the current state (a
 restart keeps both; ``invalidate`` clears the flag and the prediction falls
 back to ``W = 0``).
 
-Jacobians have the signature ``jacobian(x, v, t, fargs, jx, jv)`` and write
-``da/dx`` and ``da/dv`` over the flattened (N, 3) state into the (3N, 3N)
-arrays ``jx`` and ``jv``: :func:`gravity_jacobian` for pairwise gravity, a
-user's function through :func:`user_jacobian`, and central differences of the
-force otherwise (:func:`finite_difference_jacobian`).
+The Jacobian is the force's (:func:`~.jacobians.jacobian_for`): analytic for
+gravity and the package's terms, a user's, or central differences.
 
 The work of non-conservative force terms (:mod:`.stepping`) is the method
 applied to ``W' = -P``: ``W += -h P(x*, v*, t0 + theta h)`` at the last stage
@@ -55,20 +52,17 @@ kinetic-energy change ``h sum m a* . (v0 + v1) / 2`` of the step.
 
 import math
 
-import numpy as np
-
 from ._jit import njit, slots, specialize
+from .jacobians import jacobian_for
 from .status import Status
-from .stepping import WORK_SLOTS, GO, first_record, state_is_finite, step_epilogue, work_kernels
+from .stepping import GO, WORK_SLOTS, first_record, state_is_finite, step_epilogue, work_kernels
 
 # the names the templates below are written against, bound by specialize
-THETA, VELOCITY, base_jacobian, extra, force, jacobian, step_end, user_jac = slots(
-    "THETA", "VELOCITY", "base_jacobian", "extra", "force", "jacobian", "step_end", "user_jac")
+THETA, force, jacobian, step_end = slots("THETA", "force", "jacobian", "step_end")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
-__all__ = ["implicit_loop", "gravity_jacobian", "user_jacobian",
-           "finite_difference_jacobian", "jacobian_for", "lu_factor", "lu_solve",
-           "NEWTON_MAX_ITER", "NEWTON_ULPS", "ROUNDOFF_ULPS", "REFRESH", "FD_STEP"]
+__all__ = ["implicit_loop", "lu_factor", "lu_solve", "NEWTON_MAX_ITER", "NEWTON_ULPS",
+           "ROUNDOFF_ULPS", "REFRESH"]
 
 _EPS = 2.220446049250313e-16
 _TINY = 2.2250738585072014e-308  # smallest normal number: below it no ulps to count
@@ -83,10 +77,6 @@ NEWTON_ULPS = 4.0
 ROUNDOFF_ULPS = 1024.0
 #: recompute the Jacobian when an update shrinks by less than this factor
 REFRESH = 0.25
-#: relative step of the central differences, eps^(1/3): it balances the
-#: truncation error (~ step^2) against round-off (~ eps / step), as in
-#: scipy.optimize.approx_derivative's 3-point rule
-FD_STEP = _EPS ** (1.0 / 3.0)
 
 
 # -- linear algebra ---------------------------------------------------------------------
@@ -145,170 +135,6 @@ def lu_solve(a, piv, b):
         for j in range(i + 1, m):
             s -= a[i, j] * b[j]
         b[i] = s / a[i, i]
-
-
-# -- Jacobians ---------------------------------------------------------------------------
-
-@njit
-def gravity_jacobian(x, v, t, fargs, jx, jv):
-    """``da/dx`` of pairwise gravity (``fargs`` as the gravity force's); ``jv`` untouched.
-
-    Notes
-    -----
-    With ``r = x_i - x_j`` and ``s^2 = |r|^2 + eps2``, the block of body i's
-    acceleration against body j's position is, for ``j != i``,
-
-        dA_i/dx_j = G m_j (I / s^3 - 3 r r^T / s^5),
-
-    and the diagonal block is minus the sum of the others in its row (the
-    acceleration depends on differences of positions only).  Each pair is
-    visited once, as in the force kernels: the block is symmetric in ``r``.
-    Test particles (``i >= n_active``, zero mass) pair with the massive
-    bodies only.
-    """
-    gm, n_active, eps2 = fargs[0], fargs[1], fargs[2]
-    n = x.shape[0]
-    m = 3 * n
-    for p in range(m):
-        for q in range(m):
-            jx[p, q] = 0.0
-    d = np.empty(3)
-    for i in range(1, n):
-        for j in range(min(i, n_active)):
-            d[0] = x[i, 0] - x[j, 0]
-            d[1] = x[i, 1] - x[j, 1]
-            d[2] = x[i, 2] - x[j, 2]
-            r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2
-            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
-            inv_r5 = inv_r3 / r2
-            gj = gm[j]
-            gi = gm[i] if i < n_active else 0.0
-            for a in range(3):
-                for b in range(3):
-                    mab = -3.0 * d[a] * d[b] * inv_r5
-                    if a == b:
-                        mab += inv_r3
-                    jx[3 * i + a, 3 * j + b] += gj * mab
-                    jx[3 * i + a, 3 * i + b] -= gj * mab
-                    if gi != 0.0:
-                        jx[3 * j + a, 3 * i + b] += gi * mab
-                        jx[3 * j + a, 3 * j + b] -= gi * mab
-
-
-def _user_jacobian(x, v, t, fargs, jx, jv):
-    # the user's (size, size) matrices fill the top-left of the (3N, 3N)
-    # arrays; rows and columns of the padding stay zero
-    size, shape = fargs
-    xu = x.ravel()[:size].reshape(shape)
-    vu = v.ravel()[:size].reshape(shape)
-    dadx, dadv = user_jac(xu, vu, t)
-    jxu = np.asarray(dadx)
-    jvu = np.asarray(dadv)
-    for p in range(size):
-        for q in range(size):
-            jx[p, q] = jxu[p, q]
-            jv[p, q] = jvu[p, q]
-
-
-def user_jacobian(jac, jit):
-    """A Jacobian kernel from a user's ``jac(x, v, t) -> (da/dx, da/dv)``.
-
-    ``jac`` takes and returns arrays as the user's ``accel`` does: ``x`` and
-    ``v`` of the shape of ``x0``, and two (size, size) matrices over the
-    flattened (C-order) state.  Compiled if ``jac`` is a numba function.
-    """
-    return specialize(_user_jacobian, f"userjac{id(jac)}", jit=jit, cache=False,
-                      user_jac=jac)
-
-
-def _finite_difference_jacobian(x, v, t, fargs, jx, jv):
-    # central differences, column by column: component q of the state moves by
-    # +-delta with delta = FD_STEP * max(|y_q|, 1); the difference of the two
-    # perturbed values (exact in binary) is the divisor
-    n = x.shape[0]
-    m = 3 * n
-    xp = x.copy()
-    vp = v.copy()
-    # zeros: a user's force writes only its own components, not the padding
-    ap = np.zeros((n, 3))
-    am = np.zeros((n, 3))
-    for q in range(m):
-        i = q // 3
-        d = q % 3
-        delta = FD_STEP * max(abs(x[i, d]), 1.0)
-        hi = x[i, d] + delta
-        lo = x[i, d] - delta
-        xp[i, d] = hi
-        force(xp, v, t, fargs, ap)
-        xp[i, d] = lo
-        force(xp, v, t, fargs, am)
-        xp[i, d] = x[i, d]
-        inv = 1.0 / (hi - lo)
-        for p in range(m):
-            jx[p, q] = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
-    if VELOCITY:
-        for q in range(m):
-            i = q // 3
-            d = q % 3
-            delta = FD_STEP * max(abs(v[i, d]), 1.0)
-            hi = v[i, d] + delta
-            lo = v[i, d] - delta
-            vp[i, d] = hi
-            force(x, vp, t, fargs, ap)
-            vp[i, d] = lo
-            force(x, vp, t, fargs, am)
-            vp[i, d] = v[i, d]
-            inv = 1.0 / (hi - lo)
-            for p in range(m):
-                jv[p, q] = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
-
-
-def finite_difference_jacobian(force, velocity_dependent):
-    """Central-difference Jacobian of a :class:`~.stepping.ForceKernel`'s force.
-
-    Costs ``6N`` force evaluations (``12N`` with ``velocity_dependent``, which
-    also differentiates in ``v``); the relative step is :data:`FD_STEP` times
-    ``max(|y_q|, 1)`` for each state component ``y_q``.  Its error, about
-    ``FD_STEP^2`` relative, only slows Newton's convergence: the converged
-    solution does not depend on it.
-    """
-    key = f"fd_{force.key}{'_v' if velocity_dependent else ''}"
-    return specialize(_finite_difference_jacobian, key, jit=force.jit, cache=force.cache,
-                      force=force.kernel, VELOCITY=bool(velocity_dependent))
-
-
-#: keys of the gravity forces (stepping.gravity_force)
-_GRAVITY_KEYS = ("gravity_small", "gravity_serial", "gravity_parallel")
-
-
-def _jacobian_with_terms(x, v, t, fargs, jx, jv):
-    base_jacobian(x, v, t, fargs[0], jx, jv)
-    if VELOCITY:
-        for p in range(jv.shape[0]):
-            for q in range(jv.shape[1]):
-                jv[p, q] = 0.0
-    extra(x, v, t, fargs[1], jx, jv)
-
-
-def jacobian_for(force, velocity_dependent):
-    """The Jacobian kernel of a force and the key naming it.
-
-    The force's own (``force.jacobian``, a user's) if it has one, the analytic
-    one of gravity for the gravity forces, gravity's plus each added term's
-    for gravity with terms, central differences otherwise.
-    """
-    if force.terms is not None:
-        base, bkey = jacobian_for(force.base, False)
-        key = f"{bkey}+{force.terms.key}"
-        return specialize(_jacobian_with_terms, key, cache=force.cache, base_jacobian=base,
-                          extra=force.terms.jacobian,
-                          VELOCITY=bool(velocity_dependent)), key
-    own = getattr(force, "jacobian", None)
-    if own is not None:
-        return own, f"own{id(own)}"
-    if force.key in _GRAVITY_KEYS:
-        return gravity_jacobian, "gravity"
-    return finite_difference_jacobian(force, velocity_dependent), "fd"
 
 
 # -- the loop ---------------------------------------------------------------------------
@@ -413,7 +239,7 @@ def implicit_loop(force, name, theta, velocity_dependent):
     """The Newton loop of a one-leg theta-method compiled for a :class:`~.stepping.ForceKernel`.
 
     ``theta`` is 1.0 (implicit Euler) or 0.5 (implicit midpoint); ``name``
-    names the method; the Jacobian is :func:`jacobian_for`'s; the loop's last
+    names the method; the Jacobian is :func:`~.jacobians.jacobian_for`'s; the loop's last
     arguments are a stopping record (:func:`~.stopping.stop_record`).
     """
     jac, jkey = jacobian_for(force, velocity_dependent)

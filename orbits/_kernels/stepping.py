@@ -64,6 +64,7 @@ from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
 from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, monitor_row
 from .status import Status
 from .stopping import call_check
+from .variational import tangent_kernels, variational_work_kernels
 
 # the names the templates below are written against, bound by specialize
 #: the slots that :func:`work_kernels` binds, which every loop that integrates
@@ -250,7 +251,6 @@ def _step_end(x, v, t, k, nsteps, check, until_check, check_every, until_record,
 def step_epilogue(force):
     """The step epilogue of the loops compiled for a :class:`ForceKernel`,
     which take a stopping record (:func:`~.stopping.stop_record`)."""
-    from .variational import tangent_kernels
     return epilogue(force.recorder, force.key, jit=force.jit, cache=force.cache,
                     runtime=force.runtime, work_note=work_kernels(force)["work_note"],
                     tangent_step=tangent_kernels(force)["tangent_step"])
@@ -492,7 +492,6 @@ def work_kernels(force):
     they are no-ops, which compile to nothing.  A force with variations
     (``force.inner``) gets its inner force's, on the bodies' rows."""
     if force.inner is not None:
-        from .variational import variational_work_kernels
         return variational_work_kernels(force, work_kernels(force.inner))
     if force.work is None:
         return dict(HAS_WORK=False, work_rate=_no_work_rate, work_add=_no_work_add,

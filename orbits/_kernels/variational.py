@@ -15,7 +15,7 @@ augmented system gives, in the tangent rows, the exact derivative of the
 method's own map (the discrete tangent map), because each of these methods
 commutes with linearisation (Hairer, Lubich & Wanner 2006, section VI.4).
 ``da/dx`` and ``da/dv`` are the force's Jacobian
-(:func:`orbits._kernels.implicit.jacobian_for`: analytic for gravity and the
+(:func:`orbits._kernels.jacobians.jacobian_for`: analytic for gravity and the
 package's terms); ``da/dm`` is gravity's, ``G (x_l - x_i) / s^3`` for the pull
 of body ``l`` on body ``i``.  The Wisdom-Holman family propagates the tangent
 through its own Kepler drifts and kicks (:mod:`.wh_tangent`; Rein & Tamayo
@@ -52,7 +52,8 @@ import math
 import numpy as np
 
 from ._jit import njit, slots, specialize
-from .implicit import jacobian_for
+from .invariants import MONITOR_COLUMNS
+from .jacobians import jacobian_for
 
 # the names the templates below are written against, bound by specialize
 (CHAOS_ON, MASSES, MEGNO_COLUMN, VELOCITY, inner, inner_add, inner_note, inner_rate,
@@ -290,7 +291,6 @@ def variational_work_kernels(force, inner_kernels):
     """The work and note kernels (see :func:`orbits._kernels.stepping.work_kernels`)
     of a force with variations, from its inner force's ``inner_kernels``: on
     the bodies' rows, and the note also writes the chaos indicators."""
-    from .invariants import MONITOR_COLUMNS
     key = force.key
     cache = force.cache
     return dict(
@@ -311,7 +311,6 @@ def with_variations(force, masses, chaos):
     ``(fargs, vargs)`` (:func:`variation_args`).  ``masses``: some tangent
     vectors vary masses (gravity's ``da/dm`` is added); ``chaos``: tangent
     vector 0 carries the chaos indicators."""
-    from .stepping import ForceKernel
     vd = bool(force.velocity_dependent)
     jac, jkey = jacobian_for(force, vd)
     key = f"var{'m' if masses else ''}{'c' if chaos else ''}({force.key};{jkey})"
@@ -321,7 +320,9 @@ def with_variations(force, masses, chaos):
                           jacobian=jac)
     record = specialize(_varied_record, key, jit=force.jit, cache=force.cache,
                         inner_record=force.recorder)
-    return ForceKernel(kernel, key, force.jit, force.cache, jacobian=jacobian,
+    # the record of force's own type (stepping.ForceKernel, whose loops' module
+    # imports this one for the epilogue's tangent step and the work kernels)
+    return type(force)(kernel, key, force.jit, force.cache, jacobian=jacobian,
                        velocity_dependent=vd, record=record, allocates=True,
                        work=force.work, inner=force, chaos=bool(chaos))
 

@@ -97,10 +97,10 @@ from ._jit import KERNEL_STAMP, njit, slots, specialize
 from .coordinates import interior_gm, to_jacobi
 from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
-                     _STUMPFF_SHORT_Z, advanced_state, dot3, f_and_g, kepler_drift, quartic_step,
-                     short_start)
+                     advanced_state, dot3, f_and_g, kepler_drift, quartic_step, short_start)
+from .stumpff import _STUMPFF_SHORT_Z
 # the Stumpff functions without a branch (shared with orbits._kernels.wh_lanes)
-from .kepler import stumpff_lane as _stumpff_lane
+from .stumpff import stumpff_lane as _stumpff_lane
 from .invariants import MONITOR_WIDTH, monitor_row
 from .status import Status
 from .wh_lanes import column_start, drift_columns

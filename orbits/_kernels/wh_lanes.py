@@ -17,7 +17,7 @@ passes over the columns (:func:`drift_columns`): the scalar drift's
 short-step path (:func:`~orbits._kernels.kepler.kepler_drift`: the
 third-order starter of the universal anomaly, one of Danby's quartic
 iterations, the f and g functions) with the four-term Stumpff series
-(:func:`~orbits._kernels.kepler.stumpff_lane`).  This is the whole drift of
+(:func:`~orbits._kernels.stumpff.stumpff_lane`).  This is the whole drift of
 a planetary step (a few hundredths of a radian of anomaly, where the
 starter is good to 1e-6 and one iteration converges), and passes over all
 the planets let the processor overlap their long chains of dependent
@@ -113,8 +113,9 @@ from ._jit import njit, slots, specialize
 # gravity kernels' lanes)
 from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pull_rows,
                       pull_rows_factored)
-from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, _STUMPFF_SHORT_Z, advanced_state, f_and_g,
-                     kepler_drift, quartic_step, short_start, stumpff_lane)
+from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, advanced_state, f_and_g, kepler_drift,
+                     quartic_step, short_start)
+from .stumpff import _STUMPFF_SHORT_Z, stumpff_lane
 
 # the names the templates below are written against, bound by specialize
 step_of, = slots("step_of")

@@ -26,7 +26,7 @@ G dm`` (mass variations may be zero):
   linear map to ``delta`` plus its derivative in the masses applied to the
   state (``w_i = m_i / eta_i`` gives ``dw_i = (dm_i - w_i deta_i) / eta_i``;
   the centre of mass ``X = sum m x / M`` gives ``dX = (sum dm x + m dx - X dM) / M``);
-* Kepler drift: :func:`~orbits._kernels.kepler.kepler_drift_tangent`, exact
+* Kepler drift: :func:`~orbits._kernels.kepler_tangent.kepler_drift_tangent`, exact
   derivative in the state and in ``G eta_i`` (Jacobi) or ``G m_0`` (democratic
   heliocentric), whose variation is ``G`` times the cumulative ``dm`` or ``dm_0``;
 * interaction kick: the Jacobian of the pair accelerations it contains,
@@ -95,7 +95,10 @@ import math
 from ._jit import called, njit, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democratic_heliocentric,
                           to_jacobi)
-from .kepler import advance_tangent_by_anomaly, kepler_drift_tangent, short_step_anomaly
+from .kepler import short_step_anomaly
+from .kepler_tangent import advance_tangent_by_anomaly, kepler_drift_tangent
+from .stepping import epilogue, work_kernels
+from .variational import chaos_update, renormalise
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels,
                             heliocentric_interaction_kick, interaction_kick, jump)
@@ -312,7 +315,7 @@ def drift_tangent(xj, vj, eta, h, tp, w1, w2):
     As in ``kepler_drift_all``, the short steps' anomalies of all the bodies
     come first, then each body's state and tangent rows from its anomaly
     and the same universal functions (1.6 times faster than each body
-    through :func:`~orbits._kernels.kepler.kepler_drift_tangent` on the
+    through :func:`~orbits._kernels.kepler_tangent.kepler_drift_tangent` on the
     Sun, Jupiter, Saturn and a test planet); the other steps go through
     that function's bracketed solver."""
     n = eta.shape[0]
@@ -827,8 +830,6 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
     and ``eta`` of the bodies alone (``n`` entries), the state arrays of
     ``n (1 + K)`` rows and a stopping record
     (:func:`~orbits._kernels.stopping.stop_record`)."""
-    from .stepping import epilogue, work_kernels
-    from .variational import chaos_update, renormalise
     key = _key(coordinates, force)
     cache = force.cache
     nrt = _runtime(terms, cache)

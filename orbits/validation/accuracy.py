@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 
+from .._kernels import anomalies as _anomalies
+from .._kernels import elements as _elements
 from . import cases
 from ._format import fmt_count, fmt_err, fmt_time, outcome_cell
 from ._measure import run_orbits, run_rebound
@@ -64,21 +66,19 @@ def exact_two_body(body_set, t):
     orbit: the mean anomaly advances by ``n t`` (reduced modulo 2 pi in two
     parts, so its rounding is that of one orbit's, ~1e-15 rad) and the centre
     of mass moves uniformly."""
-    from .._kernels import kepler
-
     m = body_set._m
     x, v = body_set._x, body_set._v
     mu = body_set.units.G * (m[0] + m[1])
     el = np.zeros(7)
-    kepler.state_to_elements(mu, x[1] - x[0], v[1] - v[0], el)
+    _elements.state_to_elements(mu, x[1] - x[0], v[1] - v[0], el)
     a, e, inc, node, peri, _, mean0 = el
     n = math.sqrt(mu / a ** 3)
     period = 2 * math.pi / n
     whole = math.floor(t / period)
     mean = mean0 + n * (t - whole * period)
-    f = kepler.true_from_mean(math.fmod(mean, 2 * math.pi), e)
+    f = _anomalies.true_from_mean(math.fmod(mean, 2 * math.pi), e)
     pos, vel = np.zeros(3), np.zeros(3)
-    kepler.elements_to_state(mu, a, e, inc, node, peri, f, pos, vel)
+    _elements.elements_to_state(mu, a, e, inc, node, peri, f, pos, vel)
     com = (m[:, None] * x).sum(0) / m.sum() + (m[:, None] * v).sum(0) / m.sum() * t
     return np.array([com - m[1] / m.sum() * pos, com + m[0] / m.sum() * pos])
 

@@ -4,7 +4,7 @@ Six sweeps push every integrator of the registry towards the edge of what it
 can do, one parameter at a time:
 
 * **eccentricity** of a Kepler orbit, 0 to 0.9999, against the analytic orbit
-  (Kepler's equation, :mod:`orbits._kernels.kepler`: an oracle that shares no
+  (Kepler's equation, :mod:`orbits._kernels.anomalies`: an oracle that shares no
   code with any integrator);
 * **step size** on the outer solar system, against REBOUND's IAS15: the step
   for fixed-step methods, the tolerance for adaptive ones (they have no step
@@ -49,7 +49,9 @@ from ..bodies import BodySet
 from ..custom import integrate
 from ..errors import IntegratorOptionError, RunError, WallTimeExceeded
 from ..units import UnitSystem
-from .._kernels import kepler as _kepler
+from .._kernels import anomalies as _anomalies
+from .._kernels import elements as _elements
+from .._kernels.status import Status, describe_status
 from . import _measure, cases
 from ._runner import Task
 
@@ -263,15 +265,15 @@ def kepler_reference(mu, r0, v0, t):
     gives the true anomaly; no integrator is involved.
     """
     el = np.zeros(7)
-    status = _kepler.state_to_elements(mu, np.ascontiguousarray(r0, dtype=float),
+    status = _elements.state_to_elements(mu, np.ascontiguousarray(r0, dtype=float),
                                        np.ascontiguousarray(v0, dtype=float), el)
-    if status not in (_kepler.STATUS_OK, _kepler.STATUS_PARABOLIC_ORBIT):
-        raise ValueError(_kepler.describe_status(status))
+    if status not in (Status.OK, Status.PARABOLIC_ORBIT):
+        raise ValueError(describe_status(status))
     a, e, inc, node, peri, _, mean0 = el
     n = math.sqrt(mu / abs(a) ** 3)
-    f = _kepler.true_from_mean(mean0 + n * t, e)
+    f = _anomalies.true_from_mean(mean0 + n * t, e)
     pos, vel = np.zeros(3), np.zeros(3)
-    _kepler.elements_to_state(mu, a, e, inc, node, peri, f, pos, vel)
+    _elements.elements_to_state(mu, a, e, inc, node, peri, f, pos, vel)
     return pos
 
 
@@ -804,7 +806,7 @@ A Sun-mass star and a Jupiter-mass planet (1e-3 Msun), a = 1 au, from true
 anomaly 1 rad, for {orbits:g} orbits, so that the run ends away from
 pericentre.  Fixed-step methods take dt = P/{kn}.  Error: the final planet-star
 vector against the analytic orbit (Kepler's equation solved by
-`orbits._kernels.kepler`, no integrator involved), in units of a.""",
+`orbits._kernels.anomalies`, no integrator involved), in units of a.""",
     "step": """\
 The outer solar system (Hairer, Lubich & Wanner: Sun, four giant planets,
 Pluto) for {jorb} periods of Jupiter (P_J = {pj:g} days; {years:.0f} years).

@@ -13,7 +13,7 @@ import pytest
 
 import orbits
 from orbits import integrators
-from orbits._kernels import gravity, implicit, stepping
+from orbits._kernels import gravity, jacobians, stepping
 from orbits.integrators.implicit import ImplicitOneLeg
 
 from helpers import kepler_bodies
@@ -159,7 +159,7 @@ def test_gravity_jacobian_against_central_differences():
     fargs = (gm, n_active, eps2, np.zeros((4, 8)))
     jx = np.zeros((3 * n, 3 * n))
     jv = np.zeros((3 * n, 3 * n))
-    implicit.gravity_jacobian(x, np.zeros_like(x), 0.0, fargs, jx, jv)
+    jacobians.gravity_jacobian(x, np.zeros_like(x), 0.0, fargs, jx, jv)
     h = 1e-5
     fd = np.zeros_like(jx)
     for q in range(3 * n):

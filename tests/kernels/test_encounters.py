@@ -2,7 +2,7 @@
 
 Layers: (a) the Hermite estimate against closed forms (a straight line) and
 against brute-force minimisation of random cubics; (b) the two-body
-estimate against orbital elements (kepler.state_to_elements and the mean or
+estimate against orbital elements (elements.state_to_elements and the mean or
 hyperbolic anomaly), against Barker's equation and the free-fall times, and
 against the two-body orbit sampled across its window; (c) the step estimate
 on pure two-body data, under time reversal, and on a three-body encounter
@@ -18,6 +18,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 from orbits._kernels import encounters as C
 from orbits._kernels import kepler as K
+from orbits._kernels.elements import elements_to_state, state_to_elements
+from orbits._kernels.status import Status
 
 EPS = np.finfo(float).eps
 TWO_PI = 2.0 * math.pi
@@ -27,7 +29,7 @@ def drift(mu, x, v, dt):
     """The two-body state ``dt`` after ``(x, v)`` (kepler.kepler_drift)."""
     xs = np.array([x], dtype=float)
     vs = np.array([v], dtype=float)
-    assert K.kepler_drift(mu, xs, vs, 0, dt) == K.STATUS_OK
+    assert K.kepler_drift(mu, xs, vs, 0, dt) == Status.OK
     return xs[0], vs[0]
 
 
@@ -201,7 +203,7 @@ def _elements_reference(mu, pos, vel):
     """q, the time to the (nearest) pericentre passage and the period (inf
     for a hyperbola), from kepler.state_to_elements."""
     out = np.empty(7)
-    assert K.state_to_elements(mu, pos, vel, out) == K.STATUS_OK
+    assert state_to_elements(mu, pos, vel, out) == Status.OK
     a, e, M = out[0], out[1], out[6]
     n = math.sqrt(mu / abs(a) ** 3)
     period = TWO_PI / n if e < 1.0 else math.inf
@@ -227,7 +229,7 @@ ELLIPSES = [
 def _state(mu, a, e, inc, Omega, omega, f):
     pos = np.empty(3)
     vel = np.empty(3)
-    assert K.elements_to_state(mu, a, e, inc, Omega, omega, f, pos, vel) == K.STATUS_OK
+    assert elements_to_state(mu, a, e, inc, Omega, omega, f, pos, vel) == Status.OK
     return pos, vel
 
 
@@ -594,7 +596,7 @@ def test_closest_approach_stays_inside_the_step(rng):
             v1 = rng.normal(size=3)
         elif mu > 0.0:
             xs, vs = np.array([x0]), np.array([v0])
-            if K.kepler_drift(mu, xs, vs, 0, h) != K.STATUS_OK:
+            if K.kepler_drift(mu, xs, vs, 0, h) != Status.OK:
                 # a drift the solver refuses (2 draws in 120,000 of this
                 # loop): no two-body ends to test
                 continue

@@ -8,6 +8,9 @@ import numpy as np
 import pytest
 
 from orbits._kernels import kepler as K
+from orbits._kernels.elements import elements_to_state
+from orbits._kernels.status import Status
+from orbits._kernels.stumpff import stumpff
 
 mpmath = pytest.importorskip("mpmath")
 
@@ -72,9 +75,9 @@ def test_stumpff_against_mpmath():
     for z in np.r_[np.linspace(-40, 40, 401), np.logspace(-14, 1, 30),
                    -np.logspace(-14, 1, 30)]:
         if z == 0:
-            assert K.stumpff(0.0) == (1.0, 1.0, 0.5, 1.0 / 6.0)
+            assert stumpff(0.0) == (1.0, 1.0, 0.5, 1.0 / 6.0)
             continue
-        got = K.stumpff(z)
+        got = stumpff(z)
         ref = mp_stumpff(z)
         for g, r in zip(got, ref):
             scale = max(1.0, abs(float(r)))
@@ -97,7 +100,7 @@ def cases():
             f = rng.uniform(-2, 2)
             if e > 1:
                 f = rng.uniform(-0.8, 0.8) * math.acos(-1 / e)
-            assert K.elements_to_state(1.0, a, e, 0.4, 1.0, 2.0, f, x, v) == 0
+            assert elements_to_state(1.0, a, e, 0.4, 1.0, 2.0, f, x, v) == 0
             dt = 10 ** rng.uniform(-3, 2.5) * rng.choice([-1, 1])
             out.append((label, x, v, dt))
     return out
@@ -107,7 +110,7 @@ def cases():
 def test_drift_against_mpmath(case):
     label, x, v, dt = case
     xs, vs = x[None].copy(), v[None].copy()
-    assert K.kepler_drift(1.0, xs, vs, 0, dt) == K.STATUS_OK
+    assert K.kepler_drift(1.0, xs, vs, 0, dt) == Status.OK
     xr, vr = mp_drift(1.0, x, v, dt)
     # a step that ends near pericentre cancels |f| x0 + g v0 to |x|: the
     # error is ~eps times the largest term over the result (measured below
@@ -123,7 +126,7 @@ def test_drift_against_mpmath(case):
 def test_long_elliptic_step_costs_no_accuracy():
     # 1e4 periods in one call equals the same drift reduced modulo the period
     x, v = np.zeros((1, 3)), np.zeros((1, 3))
-    K.elements_to_state(1.0, 1.0, 0.3, 0.1, 0.2, 0.3, 0.4, x[0], v[0])
+    elements_to_state(1.0, 1.0, 0.3, 0.1, 0.2, 0.3, 0.4, x[0], v[0])
     period = 2 * math.pi
     a, b = (x.copy(), v.copy()), (x.copy(), v.copy())
     K.kepler_drift(1.0, *a, 0, 1e4 * period + 0.5)
@@ -135,7 +138,7 @@ def test_long_elliptic_step_costs_no_accuracy():
 
 def test_drift_composes_and_reverses():
     x, v = np.zeros((1, 3)), np.zeros((1, 3))
-    K.elements_to_state(1.0, 2.0, 0.9, 0.1, 0.2, 0.3, 2.5, x[0], v[0])
+    elements_to_state(1.0, 2.0, 0.9, 0.1, 0.2, 0.3, 2.5, x[0], v[0])
     a = (x.copy(), v.copy())
     b = (x.copy(), v.copy())
     K.kepler_drift(1.0, *a, 0, 0.7)
@@ -152,7 +155,7 @@ def test_drift_conserves_energy_and_angular_momentum():
     for e in (0.1, 0.7, 1.5):
         a = 1.0 if e < 1 else -1.0
         x, v = np.zeros((1, 3)), np.zeros((1, 3))
-        K.elements_to_state(1.0, a, e, 0.5, 0.6, 0.7, 0.3, x[0], v[0])
+        elements_to_state(1.0, a, e, 0.5, 0.6, 0.7, 0.3, x[0], v[0])
         E0 = 0.5 * v[0] @ v[0] - 1 / np.linalg.norm(x[0])
         L0 = np.cross(x[0], v[0])
         for dt in rng.uniform(-3, 3, 50):
@@ -165,10 +168,10 @@ def test_drift_conserves_energy_and_angular_momentum():
 
 def test_invalid_input_gives_status_and_nan():
     x, v = np.zeros((1, 3)), np.ones((1, 3))
-    assert K.kepler_drift(1.0, x, v, 0, 0.1) == K.STATUS_INVALID_STATE
+    assert K.kepler_drift(1.0, x, v, 0, 0.1) == Status.INVALID_STATE
     assert np.all(np.isnan(x)) and np.all(np.isnan(v))
     x, v = np.ones((1, 3)), np.ones((1, 3))
-    assert K.kepler_drift(-1.0, x, v, 0, 0.1) == K.STATUS_INVALID_STATE
+    assert K.kepler_drift(-1.0, x, v, 0, 0.1) == Status.INVALID_STATE
 
 
 def short_cases():
@@ -185,7 +188,7 @@ def short_cases():
             if e > 1:
                 f = rng.uniform(-0.9, 0.9) * math.acos(-1 / e)
             x, v = np.zeros(3), np.zeros(3)
-            assert K.elements_to_state(1.0, a, e, 0.4, 1.0, 2.0, f, x, v) == 0
+            assert elements_to_state(1.0, a, e, 0.4, 1.0, 2.0, f, x, v) == 0
             dt = 10 ** rng.uniform(-4, math.log10(0.45)) * np.linalg.norm(x) \
                 / np.linalg.norm(v) * rng.choice([-1, 1])
             out.append((f"e={e:g}", x, v, dt))
@@ -196,7 +199,7 @@ def short_cases():
 def test_short_step_path_against_mpmath_and_the_bracketed_solver(case):
     label, x, v, dt = case
     xs, vs = x[None].copy(), v[None].copy()
-    assert K.kepler_drift(1.0, xs, vs, 0, dt) == K.STATUS_OK
+    assert K.kepler_drift(1.0, xs, vs, 0, dt) == Status.OK
     xr, vr = mp_drift(1.0, x, v, dt)
     # as in test_drift_against_mpmath (a single period at most here)
     tol = 1e-13 * max(1.0, np.linalg.norm(x) / np.linalg.norm(xr))
@@ -204,7 +207,7 @@ def test_short_step_path_against_mpmath_and_the_bracketed_solver(case):
     assert np.linalg.norm(vs[0] - vr) <= tol * max(np.linalg.norm(vr), np.linalg.norm(v))
     # the two solvers find the same root: a few ulps (measured 2e-16)
     xb, vb = x[None].copy(), v[None].copy()
-    assert K._kepler_drift_bracketed(1.0, xb, vb, 0, dt) == K.STATUS_OK
+    assert K._kepler_drift_bracketed(1.0, xb, vb, 0, dt) == Status.OK
     np.testing.assert_allclose(xs, xb, rtol=0, atol=2e-15 * np.linalg.norm(xb))
     np.testing.assert_allclose(vs, vb, rtol=0, atol=2e-15 * max(np.linalg.norm(vb),
                                                                 np.linalg.norm(v)))

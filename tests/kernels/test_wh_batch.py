@@ -13,8 +13,11 @@ import pytest
 import orbits
 from orbits._kernels import kepler as K
 from orbits._kernels import wh_batch as W
+from orbits._kernels.anomalies import true_from_mean
+from orbits._kernels.elements import elements_to_state
 from orbits._kernels.invariants import MONITOR_WIDTH
 from orbits._kernels.status import Status
+from orbits._kernels.stumpff import _stumpff_short
 
 # the 50-digit drift of the scalar Kepler tests (bisection on the universal
 # Kepler equation in mpmath)
@@ -49,11 +52,11 @@ def orbit_lanes(e, ratio, lanes=LANES):
     for b in range(lanes):
         M = -math.pi + 2 * math.pi * (b + 0.5) / lanes
         if e < 1:
-            f = K.true_from_mean(M, e)
+            f = true_from_mean(M, e)
         else:
-            f = K.true_from_mean(M * 2.0, e)    # both branches of the hyperbola
+            f = true_from_mean(M * 2.0, e)    # both branches of the hyperbola
         x, v = np.zeros(3), np.zeros(3)
-        assert K.elements_to_state(1.0, a, e, 0.3, 1.1, 2.3, f, x, v) == 0
+        assert elements_to_state(1.0, a, e, 0.3, 1.1, 2.3, f, x, v) == 0
         xj[1, :, b], vj[1, :, b] = x, v
     return xj, vj, ratio * 2 * math.pi
 
@@ -152,16 +155,16 @@ ZS = [0.0, 1e-7, 1e-4, 2e-3, np.nextafter(2e-3, 1), 0.05, 0.1, np.nextafter(0.1,
 
 @pytest.mark.parametrize("sign", [1.0, -1.0])
 def test_stumpff_lanes_are_the_scalar_stumpff_functions_bit_for_bit(sign):
-    # every branch of kepler._stumpff_short and its boundaries (the series, the
+    # every branch of stumpff._stumpff_short and its boundaries (the series, the
     # quartered argument 1, 2 and 3 times), taken without a branch
     for z in ZS:
         z = sign * z
         *c, inside = W._stumpff_lane(z, True)
         assert inside
-        assert c == list(K._stumpff_short(z)), z
+        assert c == list(_stumpff_short(z)), z
         if abs(z) <= 2e-3:
             *c, _ = W._stumpff_lane(z, False)
-            assert c == list(K._stumpff_short(z)), z
+            assert c == list(_stumpff_short(z)), z
     for z in (np.nextafter(4.0, 5), 10.0, -10.0):
         assert not W._stumpff_lane(z, True)[-1]     # beyond 4: the scalar drift
 

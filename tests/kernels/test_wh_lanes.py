@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from orbits._kernels import kepler as K
+from orbits._kernels.elements import elements_to_state
 from orbits._kernels import wh_lanes as L
 from orbits._kernels import wisdom_holman as W
 
@@ -30,7 +30,7 @@ def system(orbits_, mu=1.0):
     xj[0], vj[0] = (0.1, -0.2, 0.05), (1e-3, 2e-3, -1e-3)
     for i, (a, e, f) in enumerate(orbits_, start=1):
         x, v = np.zeros(3), np.zeros(3)
-        assert K.elements_to_state(mu, a, e, 0.2 + 0.1 * i, 1.0 + i, 2.0 - 0.3 * i, f,
+        assert elements_to_state(mu, a, e, 0.2 + 0.1 * i, 1.0 + i, 2.0 - 0.3 * i, f,
                                    x, v) == 0
         xj[i], vj[i] = x, v
     return xj, vj, np.full(n, mu)

@@ -1,5 +1,5 @@
 """The tangent map of the Wisdom-Holman family (orbits._kernels.wh_tangent) and
-of its Kepler drift (kepler.kepler_drift_tangent), against central differences
+of its Kepler drift (kepler_tangent.kepler_drift_tangent), against central differences
 of the maps themselves, with the row layout a force with variations hands the
 integrators (bodies, then one block of rows per tangent vector)."""
 
@@ -10,6 +10,9 @@ import pytest
 
 from orbits import integrators
 from orbits._kernels import gravity, kepler as K, stepping, terms as T, variational as V
+from orbits._kernels.elements import elements_to_state
+from orbits._kernels.kepler_tangent import kepler_drift_tangent
+from orbits._kernels.status import Status
 from orbits.errors import IntegratorOptionError
 
 # -- central differences ------------------------------------------------------------------
@@ -49,7 +52,7 @@ def _relative_state(mu, e, f):
     a = 1.0 / (1.0 - e) if abs(e - 1.0) < 1e-3 else (1.0 if e < 1.0 else -1.0)
     x = np.zeros(3)
     v = np.zeros(3)
-    assert K.elements_to_state(mu, a, e, 0.3, 0.7, 1.1, f, x, v) == K.STATUS_OK
+    assert elements_to_state(mu, a, e, 0.3, 0.7, 1.1, f, x, v) == Status.OK
     return x, v
 
 
@@ -72,7 +75,7 @@ def _drift_tangent(mu, x0, v0, dt):
         v[4 + j, j] = 1.0
     dmu = np.zeros((k, 1))
     dmu[6, 0] = 1.0
-    status = K.kepler_drift_tangent(mu, x, v, 0, dt, dmu, k)
+    status = kepler_drift_tangent(mu, x, v, 0, dt, dmu, k)
     J = np.array([np.r_[x[1 + j], v[1 + j]] for j in range(k)]).T
     return status, np.r_[x[0], v[0]], J
 
@@ -98,7 +101,7 @@ def test_kepler_drift_tangent_against_central_differences(e, f, dt, short):
     s = K.short_step_anomaly(mu, *x0, *v0, dt)[0]
     assert math.isnan(s) != short
     status, y, J = _drift_tangent(mu, x0, v0, dt)
-    assert status == K.STATUS_OK
+    assert status == Status.OK
     z0 = np.r_[x0, v0, mu, dt]
     # the state itself is the drift's, bit for bit
     assert np.array_equal(y, _drift(z0))
@@ -116,7 +119,7 @@ def test_kepler_drift_tangent_against_central_differences(e, f, dt, short):
 def test_kepler_drift_tangent_of_no_step_is_the_identity():
     x0, v0 = _relative_state(1.0, 0.3, 1.0)
     status, y, J = _drift_tangent(1.0, x0, v0, 0.0)
-    assert status == K.STATUS_OK
+    assert status == Status.OK
     assert np.array_equal(y, np.r_[x0, v0])
     assert np.array_equal(J, np.eye(6, 7))
 
@@ -124,7 +127,7 @@ def test_kepler_drift_tangent_of_no_step_is_the_identity():
 def test_kepler_drift_tangent_of_an_invalid_state_is_nan():
     x0 = np.zeros(3)
     status, y, J = _drift_tangent(1.0, x0, np.array([0.0, 1.0, 0.0]), 0.1)
-    assert status == K.STATUS_INVALID_STATE
+    assert status == Status.INVALID_STATE
     assert np.isnan(y).all() and np.isnan(J).all()
 
 
@@ -150,7 +153,7 @@ def _system(m):
     x = np.zeros((n, 3))
     v = np.zeros((n, 3))
     for i, (a, e, inc, node, peri, f) in enumerate(PLANETS[:n - 1]):
-        K.elements_to_state(G * (m[0] + m[i + 1]), a, e, inc, node, peri, f, x[i + 1], v[i + 1])
+        elements_to_state(G * (m[0] + m[i + 1]), a, e, inc, node, peri, f, x[i + 1], v[i + 1])
     x -= (m[:, None] * x).sum(0) / m.sum()
     v -= (m[:, None] * v).sum(0) / m.sum()
     return x, v
