@@ -266,7 +266,7 @@ class Result:
         ...                         "wh", dt=1 * u.day)
         >>> result = sim.run(until=1 * u.yr, outputs=3, progress=False)
         >>> result.epochs.isot.tolist()
-        ['2000-01-01T12:00:00.000', '2000-07-02T03:00:00.000', '2000-12-31T18:00:00.000']
+        ['2000-01-01T12:00:00.000', '2000-07-02T12:00:00.000', '2000-12-31T18:00:00.000']
         """
         if self.epoch is None:
             raise NoEpochError(

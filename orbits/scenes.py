@@ -838,7 +838,7 @@ def de421(com=False, epoch=None):
     >>> bodies.epoch.isot
     '2000-01-01T12:00:00.000'
     >>> later = scenes.de421(epoch="2024-03-01T00:00:00 TDB")
-    >>> later.epoch.jd
+    >>> float(later.epoch.jd)
     2460370.5
     """
     time = _epochs.from_pair(_J2000_JD_TDB, 0.0) if epoch is None else _epochs.parse(epoch)

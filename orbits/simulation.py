@@ -1535,7 +1535,9 @@ class Simulation(Driven):
         Parameters
         ----------
         until : Quantity (time) or float
-            End time; must be later than :attr:`time`.
+            End time, later than :attr:`time` or earlier: a run backwards in
+            time takes the steps ``-dt`` (an adaptive method chooses negative
+            steps), and its outputs' times decrease.  Not :attr:`time` itself.
         outputs : int, optional
             Number of outputs, the current state first and the state at
             ``until`` last (1: only the state at ``until``).  Default
@@ -1599,6 +1601,9 @@ class Simulation(Driven):
         <Quantity [  0.  ,  91.  , 183.  , 274.  , 365.25] d>
         >>> bool(result.max_energy_error() < 1e-5)
         True
+        >>> back = sim.run(until=0 * u.day, outputs=3, progress=False)   # and back
+        >>> back.times.round(3), sim.time
+        (<Quantity [365.25, 182.25,   0.  ] d>, <Quantity 0. d>)
         """
         plan = self._plan(self._time_value(until, "until"), outputs, until)
         if wall_limit is not None and not _positive_number(wall_limit):
