@@ -1070,6 +1070,16 @@ def _check_slot(g, path, slot):
             and partial in (0.0, 1.0) and whole(start_step) and ratio >= 0):
         raise bad("plan", plan.tolist(), "a run's plan: finite times, a whole number of "
                                          "outputs >= 1, whole step counts >= 0")
+    # the checkpoint's time lies within its run: from the plan's start to its
+    # end, either way, up to a step and rounding (steps_since_base may be
+    # negative, so its sign says nothing by itself)
+    dt = float(g.file["parameters"].attrs["dt"])
+    t = t_base + clock[1] * dt
+    slack = dt + 1e-9 * max(abs(until), abs(start_time), 1.0)
+    if not min(start_time, until) - slack <= t <= max(start_time, until) + slack:
+        raise bad("clock", clock.tolist(),
+                  f"a clock whose time, t_base + steps_since_base * dt = {t:.10g}, lies "
+                  f"within its run, from {start_time:.10g} to {until:.10g}")
     done, finished, code = g["progress"][slot].tolist()
     if not (0 <= done <= outputs and finished in (0, 1) and code >= 0):
         raise bad("progress", [done, finished, code],
