@@ -88,6 +88,8 @@ def batch_key(sim, spec):
         plan = sim._plan(sim._time_value(spec.until, "until"), spec.outputs, spec.until)
     except Exception:   # alone it raises: let it
         return None
+    if plan.direction < 0:
+        return None     # the lanes' loop steps forwards only: a run backwards goes alone
     key = (len(m), n_active, float(desc.dt), float(G), desc.units.name, tuple(desc.monitors),
            float(state.t_base), int(state.steps_since_base), int(state.steps), tuple(plan))
     return key, plan, m, n_active

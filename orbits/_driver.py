@@ -239,6 +239,18 @@ class Driven:
 
     _wall_limit = None
 
+    #: +1 or -1: the direction of time of the run being carried out (its
+    #: plan's ``direction``).  ``_dt`` is the step's size, always >= 0; the
+    #: compiled loops take the signed step :attr:`_step`, and the clock
+    #: counts ``_steps_since_base`` down in a run backwards, so that
+    #: ``time = t_base + steps_since_base * dt`` holds in either direction.
+    _sign = 1
+
+    @property
+    def _step(self):
+        # the signed step the compiled loops take
+        return self._sign * self._dt
+
     @property
     def _X(self):
         # the arrays the compiled loops advance: the state, and after it the
@@ -277,6 +289,7 @@ class Driven:
         (:class:`~orbits._compiling.CompileClock`).
         """
         adaptive = self.integrator.adaptive
+        self._sign = getattr(plan, "direction", 1)
         if adaptive:
             bar = _ProgressBar(plan.outputs - 1, progress, unit="output")
             bar.update(first_mark)
@@ -455,7 +468,7 @@ class Driven:
     def _advance_adaptive(self, t_end, rec, wall0):
         integ = self.integrator
         every = self.monitor_every or 0
-        while self._t_base < t_end:
+        while (t_end - self._t_base) * self._sign > 0:
             n = self._chunk
             size = n // every + 1 if every else 0
             mon_t = np.empty(size)
@@ -570,7 +583,7 @@ class Driven:
             f"simulation was left there", time=self.time, step=self.steps, result=result)
 
     def _advance(self, n, rec, wall0, dt=None):
-        dt = self._dt if dt is None else dt
+        dt = self._step if dt is None else dt
         if self._in_loop:
             every, origin, plan = self._in_loop
             width = MONITOR_WIDTH + 6 * len(self._x)
@@ -606,8 +619,8 @@ class Driven:
                 else:
                     ahead = ahead[:n_mon]
                 rec.output_rows(self, self.steps + ahead,
-                                self._t_base + (self._steps_since_base + ahead) * self._dt,
-                                mon_out[:n_mon])
+                                self._t_base + (self._steps_since_base + self._sign * ahead)
+                                * self._dt, mon_out[:n_mon])
             elif n_mon:
                 rec.monitor_rows(mon_t[:n_mon], self._offset_rows(mon_out[:n_mon]))
             resolve = status == Status.COLLISION and self._resolves_collisions
@@ -657,8 +670,8 @@ class Driven:
     def _count(self, n, dt):
         if n == 0:
             return
-        if dt == self._dt:
-            self._steps_since_base += n
+        if dt == self._step:
+            self._steps_since_base += self._sign * n
         else:
             self._t_base = self._now() + dt
             self._steps_since_base = 0

@@ -19,6 +19,7 @@ import math
 import astropy.units as u
 import numpy as np
 
+from . import epochs as _epochs
 from . import geometry as _geometry
 from . import orbit_fields as _orbit_fields
 from ._kernels import anomalies as _anomalies
@@ -72,6 +73,7 @@ class BodySet:
         self._r = np.zeros(0)   # physical radii; 0 for a point mass
         self._x = np.zeros((0, 3))
         self._v = np.zeros((0, 3))
+        self._epoch = None      # the date the state holds at (TDB), if known
         self.history = []  # how the bodies were made, recorded with results
 
     # -- construction -----------------------------------------------------------
@@ -469,6 +471,8 @@ class BodySet:
                   for k in range(len(head))]
         lines = [f"BodySet of {len(self)} bodies ({self.units.name}; a, e, inc about the "
                  f"centre of mass of the bodies before each)"]
+        if self._epoch is not None:
+            lines.append(f"  epoch {_epochs.describe(self._epoch)}")
         for row in [head, *rows]:
             if row is None:
                 lines.append(f"  ... {len(self) - 2 * _REPR_ROWS} more ...")
@@ -517,6 +521,37 @@ class BodySet:
                          *(("", "", "") if el is None else
                            (f"{el[0]:.6g}", f"{el[1]:.4g}", f"{math.degrees(el[2]):.4g}"))])
         return head, rows
+
+    @property
+    def epoch(self):
+        """The date the positions and velocities hold at: an ``astropy.time.Time``
+        in TDB, or None (the default: a set of no particular date).
+
+        Set it to a Time of any scale; it is carried to TDB (:mod:`orbits.epochs`).
+        A :class:`~orbits.Simulation` made from the set takes it as the date of
+        its time 0, and its results give the outputs' dates (``result.epochs``).
+
+        Raises
+        ------
+        orbits.errors.EpochError
+            On setting anything but one Time (or None).
+
+        Examples
+        --------
+        >>> from astropy.time import Time
+        >>> import orbits
+        >>> bodies = orbits.scenes.kepler()
+        >>> print(bodies.epoch)
+        None
+        >>> bodies.epoch = Time("2024-01-01T00:00:00", scale="utc")
+        >>> bodies.epoch.scale, bodies.epoch.isot
+        ('tdb', '2024-01-01T00:01:09.184')
+        """
+        return self._epoch
+
+    @epoch.setter
+    def epoch(self, value):
+        self._epoch = None if value is None else _epochs.as_epoch(value)
 
     @property
     def names(self):

@@ -20,6 +20,8 @@ __all__ = [
     "IntegratorOptionError",
     "ForceTermError",
     "SystemFileError",
+    "EpochError",
+    "NoEpochError",
     "RunError",
     "SimulationStopped",
     "NonFiniteState",
@@ -226,6 +228,41 @@ class IntegratorOptionError(OrbitsError, ValueError):
     ... except orbits.OrbitsError as exc:
     ...     print(type(exc).__name__, str(exc).split(';')[0])
     IntegratorOptionError integrator 'ias15' has no option 'eps'
+    """
+
+
+class EpochError(OrbitsError, ValueError):
+    """A value given as an epoch that is not one: not an ``astropy.time.Time``
+    (where a Time is asked for), not a single date, or a date that cannot be
+    read or carried to TDB (:mod:`orbits.epochs`).
+
+    Examples
+    --------
+    >>> import orbits
+    >>> bodies = orbits.scenes.kepler()
+    >>> try:
+    ...     bodies.epoch = "2000-01-01"
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__, str(exc).split(";")[0])
+    EpochError epoch must be an astropy.time.Time, got str
+    """
+
+
+class NoEpochError(EpochError):
+    """Dates asked of a simulation or result whose bodies carry no epoch
+    (``result.epochs`` of a run without one).
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> import orbits
+    >>> result = orbits.Simulation(orbits.scenes.kepler(), "leapfrog",
+    ...                            dt=1 * u.day).run(until=2 * u.day, progress=False)
+    >>> try:
+    ...     result.epochs
+    ... except orbits.OrbitsError as exc:
+    ...     print(type(exc).__name__)
+    NoEpochError
     """
 
 

@@ -33,11 +33,24 @@ class RunPlan(NamedTuple):
 
     until: float            # end time (internal units)
     outputs: int
-    ratio: float            # (until - start) / dt
+    ratio: float            # |until - start| / dt (dt > 0: the step size)
     n_full: int             # whole steps of dt
     has_partial: bool       # one shortened last step to land on until
     start_step: int         # Simulation.steps when the run began
     start_time: float = 0.0  # time when the run began (adaptive runs' output times)
+
+    @property
+    def direction(self):
+        """+1 for a run forwards in time, -1 for one backwards (``until`` before
+        ``start_time``).
+
+        Examples
+        --------
+        >>> from orbits.records import RunPlan
+        >>> RunPlan(-10.0, 3, 10.0, 10, False, 0, start_time=0.0).direction
+        -1
+        """
+        return -1 if self.until < self.start_time else 1
 
     @property
     def total_steps(self):
@@ -297,6 +310,7 @@ class SimulationDescription(NamedTuple):
     history: list                # how the body set was made
     config: SimulationConfig     # the record that rebuilds the simulation
     forces: tuple                # the ForceTerms added to gravity
+    epoch: object = None         # astropy Time (TDB) of time 0, or None (orbits.epochs)
 
 
 #: how a plain record names a function it cannot hold (a collisions function)

@@ -15,10 +15,12 @@ import math
 import astropy.units as u
 import numpy as np
 
+from . import epochs as _epochs
 from ._kernels import elements as _elements
 from ._kernels.status import describe_status
 from .body import Track, unknown_body
-from .errors import BodyError, ElementsError, NoMassiveBodyError, UnknownBodyError
+from .errors import (BodyError, ElementsError, NoEpochError, NoMassiveBodyError,
+                     UnknownBodyError)
 from .geometry import angle_between, barycentre, is_barycentre
 from .monitors import massless_energy_errors
 from .units import UnitSystem, format_time, time_unit
@@ -50,7 +52,12 @@ class Result:
     Attributes
     ----------
     times : Quantity, shape (n,)
-        Times of the outputs (the first is the state the run started from).
+        Times of the outputs (the first is the state the run started from);
+        decreasing for a run backwards in time.
+    epoch : astropy.time.Time or None
+        The date of time 0 (TDB): the epoch of the body set the simulation
+        was made from, or None where it had none.  :attr:`epochs` gives the
+        outputs' dates.
     positions, velocities : Quantity, shape (n, N, 3)
         States at the outputs, bodies in the order of the body set.
     names : list of str
@@ -204,6 +211,7 @@ class Result:
         self.start_time = None
         self.largest_errors = None
         self.frame = None
+        self.epoch = None
         for k, v in fields.items():
             setattr(self, k, v)
         if isinstance(self.__dict__.get("units"), dict):   # as UnitSystem.to_dict() gives it
@@ -284,6 +292,35 @@ class Result:
         return isinstance(name, str) and name in self.names
 
     __iter__ = None     # not a sequence of outputs or bodies: iterate over result.names
+
+    @property
+    def epochs(self):
+        """The outputs' dates, ``epoch + times``: an ``astropy.time.Time`` array in
+        TDB, of the shape of :attr:`times`.
+
+        Raises
+        ------
+        orbits.errors.NoEpochError
+            The bodies of the run carried no epoch (:attr:`epoch` is None); a
+            run without a date has only :attr:`times`.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> import orbits
+        >>> sim = orbits.Simulation(orbits.scenes.de421(epoch="2000-01-01T12:00:00 TDB"),
+        ...                         "wh", dt=1 * u.day)
+        >>> result = sim.run(until=1 * u.yr, outputs=3, progress=False)
+        >>> result.epochs.isot.tolist()
+        ['2000-01-01T12:00:00.000', '2000-07-02T12:00:00.000', '2000-12-31T18:00:00.000']
+        """
+        if self.epoch is None:
+            raise NoEpochError(
+                "this run's bodies carried no epoch, so its outputs have times but no "
+                "dates; give the bodies one before making the simulation "
+                "(bodies.epoch = Time('2000-01-01T12:00:00', scale='tdb'), or "
+                "scenes.de421(epoch=...)), or read result.times")
+        return _epochs.at_times(self.epoch, self.times)
 
     def __repr__(self):
         return (f"<Result: {len(self)} outputs of {len(self.names)} bodies, "

@@ -28,6 +28,7 @@ import math
 import astropy.units as u
 import numpy as np
 
+from . import epochs as _epochs
 from .bodies import BodySet
 from .units import UnitSystem
 
@@ -495,11 +496,13 @@ def solar_system(epoch="2000-01-01 12:00:00", moon=True, frame="ecliptic"):
 
     Parameters
     ----------
-    epoch : str or astropy.time.Time
-        A string is read in the TDB time scale (so that no UTC leap-second or
-        IERS table is consulted); default J2000.0, ``"2000-01-01 12:00:00"``
-        TDB.  A ``Time`` in another scale is converted to TDB with IERS
-        downloads switched off for the conversion.
+    epoch : astropy.time.Time, str or float
+        The date, as :func:`orbits.epochs.parse` reads it: a ``Time`` of any
+        scale (converted to TDB with IERS downloads switched off), text (a
+        date astropy reads, in TDB unless a scale follows it:
+        ``"2024-03-01 UTC"``), or a Julian date in TDB; default J2000.0,
+        ``"2000-01-01 12:00:00"`` TDB.  The set returned carries it as its
+        :attr:`~orbits.BodySet.epoch`.
     moon : bool
         Include the Moon as its own body (the Earth is then the geocentre).
         With ``moon=False`` the body named ``"Earth"`` is the Earth-Moon
@@ -565,7 +568,7 @@ def solar_system(epoch="2000-01-01 12:00:00", moon=True, frame="ecliptic"):
 
     if frame not in _FRAMES:
         raise ValueError(f"unknown frame {frame!r}; expected one of {_FRAMES}")
-    time = _as_tdb(epoch)
+    time = _epochs.parse(epoch)
     units = UnitSystem.default()
 
     names = ["Sun", *_PLANETS[:3], "Moon", *_PLANETS[3:]]
@@ -594,6 +597,7 @@ def solar_system(epoch="2000-01-01 12:00:00", moon=True, frame="ecliptic"):
 
     bodies = BodySet.from_arrays(m, x, v, names=names, units=units)
     bodies.move_to_com()
+    bodies.epoch = time
     return _record(bodies, "solar-system", epoch=f"{time.isot} TDB", moon=bool(moon),
                    frame=frame, ephemeris="astropy builtin (ERFA epv00, plan94, moon98)",
                    gm=_DE440_REFERENCE)
@@ -751,11 +755,12 @@ def de421_states(epoch):
     return x << u.au, v << (u.au / u.day)
 
 
-def de421(com=False):
-    """The Sun, the planets, the Moon and Pluto at J2000.0 from the JPL DE421 ephemeris.
+def de421(com=False, epoch=None):
+    """The Sun, the planets, the Moon and Pluto from the JPL DE421 ephemeris, at
+    J2000.0 or another date.
 
-    Positions and velocities at JD 2451545.0 TDB (2000 January 1, 12:00 TDB)
-    in the barycentric ICRF axes of DE421 (equatorial), evaluated from the
+    Positions and velocities at ``epoch`` (default JD 2451545.0 TDB, 2000
+    January 1, 12:00 TDB) in the barycentric ICRF axes of DE421 (equatorial), evaluated from the
     Chebyshev series that the ``de421`` package installs with ``jplephem``:
     nothing is downloaded and nothing touches the network.  Masses and G are
     DE421's own GM values, so the set is the ephemeris's dynamical model
@@ -769,6 +774,14 @@ def de421(com=False):
         asteroids (about 1e-9 solar masses) that are not in this set; there
         the centre of mass of the set is 1.6e-9 au from the origin and its
         momentum is 3.6e-7 of ``sum m |v|``.
+    epoch : astropy.time.Time, str or float, optional
+        The date, as :func:`orbits.epochs.parse` reads it (a ``Time`` of any
+        scale, text such as ``"2024-03-01T00:00:00 TDB"``, or a Julian date in
+        TDB), within DE421's span, 1900 to 2200 (JD 2414992.5 to 2524624.5).
+        Default: J2000.0.  The set returned carries it as its
+        :attr:`~orbits.BodySet.epoch`, so that a run's ``result.epochs`` are
+        dates, and :func:`de421_states` at those dates is the ephemeris to
+        compare with.
 
     Returns
     -------
@@ -788,6 +801,10 @@ def de421(com=False):
     ImportError
         ``jplephem`` or ``de421`` is not installed; the message says
         ``pip install "orbits[ephemeris]"``.
+    ValueError
+        An epoch outside DE421's span.
+    orbits.errors.EpochError
+        An epoch that is no date.
 
     Notes
     -----
@@ -818,8 +835,19 @@ def de421(com=False):
     >>> r = bodies.positions[3] - bodies.positions[0]     # Earth - Sun, near perihelion
     >>> print(np.round(np.linalg.norm(r), 5))
     0.98333 AU
+    >>> bodies.epoch.isot
+    '2000-01-01T12:00:00.000'
+    >>> later = scenes.de421(epoch="2024-03-01T00:00:00 TDB")
+    >>> float(later.epoch.jd)
+    2460370.5
     """
-    x, v = _de421_arrays(_de421_ephemeris(), np.array([_J2000_JD_TDB]), 0.0)
+    time = _epochs.from_pair(_J2000_JD_TDB, 0.0) if epoch is None else _epochs.parse(epoch)
+    ephemeris = _de421_ephemeris()
+    jd1, jd2 = _epochs.to_pair(time)
+    if not ephemeris.jalpha <= jd1 + jd2 <= ephemeris.jomega:
+        raise ValueError(f"DE421 covers JD {ephemeris.jalpha} to {ephemeris.jomega} (TDB); "
+                         f"got epoch JD {jd1 + jd2!r} ({time.isot} TDB)")
+    x, v = _de421_arrays(ephemeris, np.array([jd1]), np.array([jd2]))
     gm = np.array([_de421_gm(name) for name in _DE421_BODIES])
     x, v = x[0], v[0]
 
@@ -833,7 +861,8 @@ def de421(com=False):
                                  units=units)
     if com:
         bodies.move_to_com()
-    return _record(bodies, "de421", com=bool(com), epoch="2000-01-01T12:00:00.000 TDB",
+    bodies.epoch = time
+    return _record(bodies, "de421", com=bool(com), epoch=f"{time.isot} TDB",
                    frame="icrs", ephemeris="JPL DE421 (jplephem, de421 package)",
                    gm="JPL DE421 header (Folkner, Williams & Boggs 2008)")
 

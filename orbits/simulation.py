@@ -17,6 +17,7 @@ import numpy as np
 
 from . import collisions as _collisions
 from . import _integrator_choice as _choice
+from . import epochs as _epochs
 from . import integrators as _integrators
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
@@ -254,6 +255,8 @@ class Simulation(Driven):
         self._bare_ok = bodies._bare_ok
         self._names = bodies.names
         self._history = list(bodies.history)
+        # the date of time 0: the bodies' epoch (None: a set of no date)
+        self._epoch = bodies.epoch
         self.integrator = _choice.configured(integrator, options, Simulation.__init__)
         adaptive = self.integrator.adaptive
         if dt is None and not adaptive:
@@ -1067,6 +1070,7 @@ class Simulation(Driven):
         bs._m, bs._r = m[old].copy(), r[old].copy()
         bs._x, bs._v = x[old].copy(), v[old].copy()
         bs.history = list(self._history)
+        bs._epoch = self._epoch
         prev, clock = self._stop[8], self._stop[9]   # the state before the step
         new = Simulation.__new__(Simulation)
         new._touching_ok = True
@@ -1193,6 +1197,7 @@ class Simulation(Driven):
                     f"describes keeps {np.asarray(want).dtype} values of shape "
                     f"{np.shape(want)} there")
         sim.set_state(cp.state)
+        sim._epoch = cp.epoch       # the date of time 0, as the file keeps it
         sim.output_path = cp.path
         sim._resume = cp.point
         return sim
@@ -1321,7 +1326,29 @@ class Simulation(Driven):
         bs._x = self._x[inv].copy()
         bs._v = self._v[inv].copy()
         bs.history = list(self._history)
+        if self._epoch is not None:
+            bs._epoch = self._epoch + self.time
         return bs
+
+    @property
+    def epoch(self):
+        """The date of time 0 (``astropy.time.Time``, TDB): the epoch of the body
+        set the simulation was made from, or None where it had none.  The
+        present date is ``sim.epoch + sim.time``, and :attr:`bodies` carries it.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> from astropy.time import Time
+        >>> import orbits
+        >>> bodies = orbits.scenes.kepler()
+        >>> bodies.epoch = Time("2030-01-01T00:00:00", scale="tdb")
+        >>> sim = orbits.Simulation(bodies, "leapfrog", dt=1 * u.day)
+        >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
+        >>> sim.epoch.isot, sim.bodies.epoch.isot
+        ('2030-01-01T00:00:00.000', '2030-01-11T00:00:00.000')
+        """
+        return self._epoch
 
     @property
     def state(self):
@@ -1423,7 +1450,7 @@ class Simulation(Driven):
             tuple(self._names), self._m[inv].copy(), self._r[inv].copy(), self.units,
             self.integrator, self._dt, math.sqrt(self._eps2), self.monitors,
             self.monitor_every, self.parallel, self.rebound_arithmetic,
-            stops, list(self._history), self.config, self.forces)
+            stops, list(self._history), self.config, self.forces, self._epoch)
 
     @property
     def time_value(self):
@@ -1532,7 +1559,9 @@ class Simulation(Driven):
         Parameters
         ----------
         until : Quantity (time) or float
-            End time; must be later than :attr:`time`.
+            End time, later than :attr:`time` or earlier: a run backwards in
+            time takes the steps ``-dt`` (an adaptive method chooses negative
+            steps), and its outputs' times decrease.  Not :attr:`time` itself.
         outputs : int, optional
             Number of outputs, the current state first and the state at
             ``until`` last (1: only the state at ``until``).  Default
@@ -1596,6 +1625,9 @@ class Simulation(Driven):
         <Quantity [  0.  ,  91.  , 183.  , 274.  , 365.25] d>
         >>> bool(result.max_energy_error() < 1e-5)
         True
+        >>> back = sim.run(until=0 * u.day, outputs=3, progress=False)   # and back
+        >>> back.times.round(3), sim.time
+        (<Quantity [365.25, 182.25,   0.  ] d>, <Quantity 0. d>)
         """
         plan = self._plan(self._time_value(until, "until"), outputs, until)
         if wall_limit is not None and not _positive_number(wall_limit):
@@ -1620,9 +1652,9 @@ class Simulation(Driven):
         shown = until if until is not None else until_v
         if not math.isfinite(until_v):
             raise ValueError(f"until must be a finite time, got {shown}")
-        if not until_v > now:
-            raise ValueError(f"until = {until if until is not None else until_v} is not "
-                             f"after the current time {self.time:.10g}")
+        if until_v == now:
+            raise ValueError(f"until = {shown} is the current time: there is nothing to run")
+        sign = 1 if until_v > now else -1
         default = outputs is None
         if default:
             outputs = DEFAULT_OUTPUTS
@@ -1635,7 +1667,7 @@ class Simulation(Driven):
         if self.integrator.adaptive:
             # outputs at exactly evenly spaced times, hit by shortening a step
             return RunPlan(until_v, outputs, 0.0, 0, False, self.steps, now)
-        ratio = (until_v - now) / self._dt
+        ratio = abs(until_v - now) / self._dt
         if not ratio < MAX_STEPS:
             raise ValueError(f"until = {shown} is {ratio:.3g} steps of dt = {self.dt:.6g} "
                              f"away: more than the {MAX_STEPS:.3g} steps whose times float64 "
@@ -1643,8 +1675,8 @@ class Simulation(Driven):
         n_full = int(round(ratio))
         if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
             n_full = int(math.floor(ratio))
-        partial = until_v - self._time_after(n_full)
-        has_partial = partial > 1e-12 * max(until_v - now, self._dt)
+        partial = sign * (until_v - self._time_after(n_full, sign))
+        has_partial = partial > 1e-12 * max(abs(until_v - now), self._dt)
         plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps, now)
         total = plan.total_steps
         if default and outputs > total + 1:
@@ -1664,9 +1696,10 @@ class Simulation(Driven):
                              f"smaller dt")
         return plan
 
-    def _time_after(self, n):
-        # the time after n more steps of dt, computed as every step count is
-        return self._t_base + (self._steps_since_base + n) * self._dt
+    def _time_after(self, n, sign=1):
+        # the time after n more steps of dt in the direction sign, computed as
+        # every step count is
+        return self._t_base + (self._steps_since_base + sign * n) * self._dt
 
     def _fail(self, status, rec, wall0):
         reason = {Status.NON_FINITE: "non-finite state",
@@ -1945,7 +1978,7 @@ class _Recorder:
             force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
             integrator=sim.integrator.info(), units=U, status=status,
             monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
-            forces=tuple(map(repr, sim.forces)))
+            forces=tuple(map(repr, sim.forces)), epoch=sim.epoch)
         if sim._n_tangent:
             fields["jacobian"] = sim.jacobian
             fields["tangent_vectors"] = sim.tangent_vectors

@@ -7,7 +7,10 @@ its unit, so a file says what it means without a convention to remember.
 TOML
 ----
 One ``[[body]]`` table per body, in order; an optional ``[units]`` table; an
-optional ``[run]`` table of defaults for ``orbits run``::
+optional ``[run]`` table of defaults for ``orbits run``; an optional
+``epoch``, before the tables::
+
+    epoch = "2000-01-01T12:00:00 TDB"   # optional: the date of the states
 
     [units]                     # optional; as orbits.UnitSystem takes them
     length = "au"               # default au
@@ -49,6 +52,13 @@ optional ``[run]`` table of defaults for ``orbits run``::
     [run.options]               # the integrator's options
     corrector = 17
 
+The ``epoch`` is the date the states hold at (:attr:`orbits.BodySet.epoch`):
+text that :func:`orbits.epochs.from_text` reads, a date astropy reads
+followed by its time scale (TDB when none is given: ``"2024-03-01 UTC"``,
+``"2000-01-01T12:00:00 TDB"``) or a Julian date in one or two parts
+(``"2451545.0 TDB"``, ``"2451545.0 + 0.25 TDB"``); :func:`write` writes the
+two-part Julian date in TDB, which reads back bit for bit.
+
 Body fields are those of :meth:`orbits.BodySet.add`: ``name``, ``mass``, an
 optional ``radius``, and either ``position`` and ``velocity`` (three
 components each) or ``a``, ``e``, ``inc``, ``Omega``, ``omega``, ``f`` or ``M``
@@ -62,9 +72,11 @@ CSV
 ---
 A header row names the columns with their units in brackets; a row per body;
 lines starting with ``#`` are comments, and a ``# units:`` comment before the
-header gives the unit system (plain-number columns are then read in it)::
+header gives the unit system (plain-number columns are then read in it), an
+``# epoch:`` comment the date of the states (as the TOML ``epoch``)::
 
     # units: length = au; mass = Msun; time = day
+    # epoch: 2451545.0 + 0.0 TDB
     name,mass [Msun],x [au],y [au],z [au],vx [km/s],vy [km/s],vz [km/s]
     Sun,1,0,0,0,0,0,0
     probe,0,1,0,0,0,30,0
@@ -110,9 +122,10 @@ from typing import NamedTuple
 import astropy.units as u
 import numpy as np
 
+from . import epochs as _epochs
 from ._csvcells import read_cell, safe_cell
 from .bodies import BodySet, _relative_state, _unit_string
-from .errors import BodyError, SystemFileError, _where
+from .errors import BodyError, EpochError, SystemFileError, _where
 from .units import UnitSystem
 
 try:
@@ -295,10 +308,22 @@ class _Reader:
         self.text = text
         self.source = source
         self.units = None          # the file's UnitSystem, if it gives one
+        self.epoch = None          # the file's epoch (astropy Time, TDB), if it gives one
         self.names = {}            # body name -> line where it was given
 
     def error(self, message, line, body=None, field=None):
         return SystemFileError(message, path=self.source, line=line, body=body, field=field)
+
+    def epoch_text(self, raw, line):
+        """The ``epoch`` (text, :func:`orbits.epochs.from_text`) as a TDB Time."""
+        if not isinstance(raw, str):
+            raise self.error(f"expected a date as text, such as '2000-01-01T12:00:00 TDB' "
+                             f"or '2451545.0 TDB', got {_toml_text(raw)}", line,
+                             field="epoch")
+        try:
+            return _epochs.from_text(raw)
+        except EpochError as exc:
+            raise self.error(str(exc).removeprefix("epoch: "), line, field="epoch") from None
 
     # values -----------------------------------------------------------------------
     def value(self, raw, kind, line, body=None, field=None):
@@ -491,9 +516,11 @@ class _TomlReader(_Reader):
                              _failing_line(self.text, ValueError)) from None
         lines = _TomlLines(self.text)
         for key in data:
-            if key not in ("units", "body", "run"):
-                raise self.error(_unknown("table", key, ("units", "body", "run")),
+            if key not in ("units", "body", "run", "epoch"):
+                raise self.error(_unknown("table", key, ("units", "body", "run", "epoch")),
                                  lines.find((key,)))
+        if "epoch" in data:
+            self.epoch = self.epoch_text(data["epoch"], lines.find(("epoch",)))
         if "units" in data:
             table = self.table(data["units"], "units", lines.find(("units",)))
             self.units = self.unit_system(table, lambda k: lines.find(("units", k)))
@@ -516,6 +543,7 @@ class _TomlReader(_Reader):
             self.add(bodies, table,
                      lambda k, i=i: lines.find(("body", i) if k is None else ("body", i, k)))
         bodies.history.append({"from": "file", "path": self.source})
+        bodies.epoch = self.epoch
         run = {}
         if "run" in data:
             run = self.run_table(self.table(data["run"], "run", lines.find(("run",))),
@@ -573,9 +601,10 @@ class _CsvReader(_Reader):
     def read(self):
         bodies = self.read_table()
         if bodies is None:
-            self.units, self.names = None, {}
+            self.units, self.epoch, self.names = None, None, {}
             bodies = self.read_rows()
         bodies.history.append({"from": "file", "path": self.source})
+        bodies.epoch = self.epoch
         return SystemFile(bodies, {}, self.source)
 
     def read_rows(self):
@@ -648,9 +677,10 @@ class _CsvReader(_Reader):
             return None
         later = records[k + 1:]
         rows = [r for r in later if not _comment(r)]
-        if len(rows) < len(later) and any(_comment_text(r).lower().startswith("units:")
-                                          for r in later if _comment(r)):
-            return None         # the units after the header
+        if len(rows) < len(later) and any(
+                _comment_text(r).lower().startswith(("units:", "epoch:"))
+                for r in later if _comment(r)):
+            return None         # the units or the epoch after the header
         if not rows or set(map(len, rows)) != {len(header)}:
             return None
         units = dict(header)
@@ -792,6 +822,10 @@ class _CsvReader(_Reader):
                 raise self.error("the '# units:' line must come before the header", line)
             self.units = self.unit_system(self.units_line(text[6:], line),
                                           lambda key, n=line: n)
+        elif text.lower().startswith("epoch:"):
+            if after_header:
+                raise self.error("the '# epoch:' line must come before the header", line)
+            self.epoch = self.epoch_text(text[6:].strip(), line)
 
     def units_line(self, text, line):
         table = {}
@@ -1138,8 +1172,11 @@ def _dump_toml(bodies, run):
     units = bodies.units
     out = ["# A body set for orbits: 'orbits run FILE --until 100yr' runs it,",
            "# orbits.BodySet.read(FILE) reads it.  Plain numbers are in the [units]",
-           "# below; with the G written here a run reproduces exactly.", "",
-           "[units]"]
+           "# below; with the G written here a run reproduces exactly.", ""]
+    if bodies.epoch is not None:
+        out += [f"# the date of the states: {bodies.epoch.isot} TDB",
+                f"epoch = {_toml_value(_epochs.to_text(bodies.epoch))}", ""]
+    out += ["[units]"]
     for key, value in units.to_dict().items():
         out.append(f"{key} = {_toml_value(value)}")
     for i, name in enumerate(bodies.names):
@@ -1212,6 +1249,8 @@ def _dump_csv(bodies):
     writer.writerow(["# units: " + "; ".join(f"{k} = {str(v).replace(';', ',')}"
                                              if k != "G" else f"G = {float(v)!r}"
                                              for k, v in d.items())])
+    if bodies.epoch is not None:
+        writer.writerow([f"# epoch: {_epochs.to_text(bodies.epoch)}"])
 
     def col(name, kind):
         unit = units.unit(kind).to_string()

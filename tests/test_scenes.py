@@ -16,6 +16,7 @@ from scipy.spatial.distance import pdist
 
 from orbits import scenes
 from orbits.bodies import BodySet
+from orbits.errors import EpochError
 from orbits.errors import ElementsError
 from orbits.units import UnitSystem
 
@@ -285,8 +286,11 @@ def test_solar_system_epoch_as_string_or_time(j2000):
     # TT and TDB differ by < 2 ms; the Moon moves 2 m in that time.
     tt = scenes.solar_system(Time("2000-01-01 12:00:00", scale="tt"))
     assert np.allclose(tt.positions.value, j2000.positions.value, rtol=0, atol=1e-10)
-    with pytest.raises(TypeError):
-        scenes.solar_system(2451545.0)
+    # a number is a Julian date in TDB, as de421 and de421_states read it
+    assert np.array_equal(scenes.solar_system(2451545.0).positions.value,
+                          j2000.positions.value)
+    with pytest.raises(EpochError):
+        scenes.solar_system([2451545.0])
 
 
 # Run in a fresh interpreter after this, so that nothing cached by other tests

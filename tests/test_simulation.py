@@ -140,8 +140,8 @@ def test_bad_dt(dt, exc):
 def test_bad_until_and_outputs():
     sim = orbits.Simulation(sun_jupiter_probe(), "verlet", dt=5 * u.day)
     sim.run(until=1 * u.yr, outputs=2, progress=False)
-    with pytest.raises(ValueError, match="not after the current time"):
-        sim.run(until=0.5 * u.yr)
+    with pytest.raises(ValueError, match="is the current time"):
+        sim.run(until=1 * u.yr)
     with pytest.raises(BodyUnitsError, match="until"):
         sim.run(until=2 * u.au)
     with pytest.raises(ValueError, match="at most 3 outputs"):

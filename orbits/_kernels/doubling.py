@@ -93,9 +93,12 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
             for d in range(3):
                 k0x[i, d] = v[i, d]
         fsal[0] = 1
+    # dtbox holds the step's size; the steps carry the direction of time
+    direction = 1.0 if t_end > t else -1.0
     h_prop = dtbox[0]
     if h_prop <= 0.0:
-        h_prop = initial_step(x[:ne], v[:ne], k0x[:ne], k0v[:ne], rtol, atol, t_end - t)
+        h_prop = initial_step(x[:ne], v[:ne], k0x[:ne], k0v[:ne], rtol, atol, abs(t_end - t))
+    h_prop *= direction
     status = Status.OK
     p0 = 0.0
     if HAS_WORK:
@@ -106,12 +109,12 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
     has_marks = marks.shape[0] > 0
     if has_marks:
         target = marks[0]
-    while steps < max_steps and t < t_end:
+    while steps < max_steps and (t_end - t) * direction > 0.0:
         if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
         h = h_prop
         shortened = False
-        if t + 1.01 * h >= target:
+        if (t + 1.01 * h - target) * direction >= 0.0:
             h = target - t
             shortened = True
         rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, UNTRACKED)
@@ -175,10 +178,10 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
         else:
             rejected += 1
             h_prop = next_step(h, err, 4.0)
-            if step_underflow(h_prop, t, t_end):
+            if step_underflow(abs(h_prop), t, t_end):
                 status = Status.STEP_UNDERFLOW
                 break
-    dtbox[0] = h_prop
+    dtbox[0] = abs(h_prop)
     return status, t, steps, rejected, fev, n_mon
 
 

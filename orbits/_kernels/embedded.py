@@ -120,9 +120,12 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
             for d in range(3):
                 kx[0, i, d] = v[i, d]
         fsal[0] = 1
+    # dtbox holds the step's size; the steps carry the direction of time
+    direction = 1.0 if t_end > t else -1.0
     h_prop = dtbox[0]
     if h_prop <= 0.0:
-        h_prop = initial_step(x[:ne], v[:ne], kx[0, :ne], kv[0, :ne], rtol, atol, t_end - t)
+        h_prop = initial_step(x[:ne], v[:ne], kx[0, :ne], kv[0, :ne], rtol, atol, abs(t_end - t))
+    h_prop *= direction
     status = Status.OK
     p0 = 0.0
     if HAS_WORK:
@@ -133,12 +136,12 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     has_marks = marks.shape[0] > 0
     if has_marks:
         target = marks[0]
-    while steps < max_steps and t < t_end:
+    while steps < max_steps and (t_end - t) * direction > 0.0:
         if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
         h = h_prop
         shortened = False
-        if t + 1.01 * h >= target:
+        if (t + 1.01 * h - target) * direction >= 0.0:
             # land on the target, also when only a sliver would be left (HNW's DOPRI5)
             h = target - t
             shortened = True
@@ -217,10 +220,10 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
         else:
             rejected += 1
             h_prop = next_step(h, err, q)
-            if step_underflow(h_prop, t, t_end):
+            if step_underflow(abs(h_prop), t, t_end):
                 status = Status.STEP_UNDERFLOW
                 break
-    dtbox[0] = h_prop
+    dtbox[0] = abs(h_prop)
     return status, t, steps, rejected, fev, n_mon
 
 

@@ -78,7 +78,7 @@ class ScipyIntegrator(AdaptiveIntegrator):
 
         y0 = np.concatenate([x.ravel(), v.ravel()] + ([[0.0]] if work else []))
         first = float(ws["dt"][0])
-        kw = {"first_step": min(first, t_end - t)} if first > 0 else {}
+        kw = {"first_step": min(first, abs(t_end - t))} if first > 0 else {}
         solver = getattr(integrate, self.method)(rhs, t, y0, t_end, rtol=self.config["rtol"],
                                                  atol=self.config["atol"], **kw)
         steps = 0
@@ -89,7 +89,7 @@ class ScipyIntegrator(AdaptiveIntegrator):
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
                 return Status.STEP_UNDERFLOW, t, 0, 0, int(solver.nfev), 0
             steps += 1
-            last_step = solver.t - solver.t_old
+            last_step = abs(solver.t - solver.t_old)
             if solver.status == "running" and last_step <= floor:
                 # the steps no longer move t: a collision or a singularity ahead
                 return Status.STEP_UNDERFLOW, t, 0, 0, int(solver.nfev), 0
@@ -98,7 +98,7 @@ class ScipyIntegrator(AdaptiveIntegrator):
         if work:
             _add_work(ws["work"], float(solver.y[-1]))
         if last_step > 0:
-            ws["dt"][0] = last_step
+            ws["dt"][0] = last_step     # the size; the direction is t_end's
         return Status.OK, t_end, steps, 0, int(solver.nfev), 0
 
 

@@ -36,7 +36,10 @@ adds two groups of its own::
                              integrator and its options, dt, unit system, G and its
                              source, softening, monitors, stopping conditions, when
                              written, how the body set was made, as JSON where
-                             structured)
+                             structured); epoch_tdb, where the bodies carried an
+                             epoch: (2,) float64, the Julian date of time 0 in
+                             TDB in two parts (jd1 + jd2, as astropy's Time
+                             keeps it; files without it have no date)
         reference            (14,) the monitors' values when the simulation was made
                              (the layout of orbits._kernels.invariants.MONITOR_COLUMNS;
                              older files have (10,), without the work, or (11,),
@@ -47,7 +50,9 @@ adds two groups of its own::
                              is (count - 1) % 2
         x, v                 (2, N, 3) internal order (massive bodies first)
         order                (N,) int64: internal index -> body-set index
-        clock                (2, 5) int64: steps, steps_since_base, force_evaluations,
+        clock                (2, 5) int64: steps, steps_since_base (negative in a
+                             run backwards in time: time = t_base +
+                             steps_since_base * dt, dt > 0), force_evaluations,
                              output rows written, steps rejected
         t_base               (2,) float
         plan                 (2, 7) float: the run in progress (until, outputs, ratio,
@@ -173,6 +178,7 @@ try:
 except ImportError:     # pragma: no cover - not POSIX
     resource = None
 
+from .. import epochs as _epochs
 from .._kernels import invariants as _inv
 from ..errors import OrbitsError
 from ..monitors import CHAOS_MONITORS, _work_column, monitor_fields
@@ -192,6 +198,9 @@ CHECKPOINT_SECONDS = 60.0
 #: outputs held in memory before they are written as one block
 BUFFER_ROWS = 256
 _SLOTS = 2
+#: the largest |jd1| an epoch attribute may hold: 1e9 days, 2.7 million years
+#: either side of JD 0 (a damaged attribute, not a date, beyond)
+_EPOCH_JD_LIMIT = 1e9
 _MONITOR_NAMES = ("energy", "angular_momentum", "momentum", "center_of_mass")
 #: the chaos indicators, one value per row each (orbits.monitors.CHAOS_MONITORS)
 _CHAOS = ("megno", "lyapunov", "fli")
@@ -798,6 +807,28 @@ def _attr(par, key, path, check, expected):
     return value
 
 
+def _epoch(par, path):
+    """The file's epoch (``astropy.time.Time``, TDB) from the ``epoch_tdb``
+    attribute of /parameters, or None where it has none; an
+    :class:`OrbitsFileError` where the attribute is not two finite float64
+    parts of a Julian date (``|jd2| <= 1``, as :func:`orbits.epochs.to_pair`
+    writes them)."""
+    if "epoch_tdb" not in par.attrs:
+        return None
+    value = par.attrs["epoch_tdb"]
+    arr = np.asarray(value)
+    ok = arr.shape == (2,) and arr.dtype.kind == "f"
+    if ok:
+        jd1, jd2 = (float(a) for a in arr)
+        ok = math.isfinite(jd1) and math.isfinite(jd2) and abs(jd2) <= 1.0 \
+            and abs(jd1) < _EPOCH_JD_LIMIT
+    if not ok:
+        raise OrbitsFileError(f"{path}: the 'epoch_tdb' attribute of /parameters is "
+                              f"{value!r}; expected the Julian date of the run's time 0 in "
+                              f"TDB as two float64 parts (jd1, jd2), |jd2| <= 1")
+    return _epochs.from_pair(jd1, jd2)
+
+
 def _check_units_record(units, path):
     """Raise an OrbitsFileError where the unit system a file records (a
     UnitSystem.to_dict()) does not have the fields and kinds of units it needs."""
@@ -913,6 +944,7 @@ def _check_values(f, stored, path, monitors):
                                   f"{records!r}; expected force terms' records")
     if "config" in par.attrs:
         _check_config(_json_attr(par, "config", path, dict), path, monitors)
+    _epoch(par, path)
 
     # the bodies: their count N is the length of every per-body axis
     b = "particles/bodies"
@@ -1025,7 +1057,8 @@ def _check_slot(g, path, slot):
                                f"{slot}) is {value}; expected {expected}")
 
     clock = g["clock"][slot]
-    if (clock < 0).any():
+    # every count but steps_since_base, which a run backwards counts down
+    if (np.delete(clock, 1) < 0).any():
         raise bad("clock", clock.tolist(), "counts of steps, force evaluations, rows and "
                                            "rejected steps, each >= 0")
     t_base = float(g["t_base"][slot])
@@ -1038,6 +1071,16 @@ def _check_slot(g, path, slot):
             and partial in (0.0, 1.0) and whole(start_step) and ratio >= 0):
         raise bad("plan", plan.tolist(), "a run's plan: finite times, a whole number of "
                                          "outputs >= 1, whole step counts >= 0")
+    # the checkpoint's time lies within its run: from the plan's start to its
+    # end, either way, up to a step and rounding (steps_since_base may be
+    # negative, so its sign says nothing by itself)
+    dt = float(g.file["parameters"].attrs["dt"])
+    t = t_base + clock[1] * dt
+    slack = dt + 1e-9 * max(abs(until), abs(start_time), 1.0)
+    if not min(start_time, until) - slack <= t <= max(start_time, until) + slack:
+        raise bad("clock", clock.tolist(),
+                  f"a clock whose time, t_base + steps_since_base * dt = {t:.10g}, lies "
+                  f"within its run, from {start_time:.10g} to {until:.10g}")
     done, finished, code = g["progress"][slot].tolist()
     if not (0 <= done <= outputs and finished in (0, 1) and code >= 0):
         raise bad("progress", [done, finished, code],
@@ -2095,7 +2138,7 @@ class FileRecorder:
                       dt=sim.dt, status=status, monitors=sim.monitors, path=str(self.path),
                       forces=tuple(map(repr, sim.forces)),
                       start_time=q(self.plan.start_time, "time"),
-                      largest_errors=dict(self.largest))
+                      largest_errors=dict(self.largest), epoch=self.desc.epoch)
         if sim.monitors:
             fields.update(monitor_fields(row[None], sim.monitors, self.reference, self.scales,
                                          sim.units, work=self.work))
@@ -2459,6 +2502,8 @@ def _write_layout(f, desc, state):
     }
     for k, v in meta.items():
         par.attrs[k] = v
+    if desc.epoch is not None:
+        par.attrs["epoch_tdb"] = np.array(_epochs.to_pair(desc.epoch), dtype=np.float64)
     ref = par.create_dataset("reference", data=state.reference)
     ref_units = ([unit("energy")] + [unit("angular_momentum")] * 3 + [unit("momentum")] * 3
                  + [unit("length")] * 3 + [unit("energy")]
@@ -2709,7 +2754,8 @@ def load(path):
             integrator=json.loads(par.attrs["integrator_info"]),
             units=json.loads(par.attrs["units"]),
             dt=par.attrs["dt"] * u.Unit(par.attrs["dt_unit"]), monitors=tuple(monitors),
-            status=_status(f, path), path=str(path), metadata=dict(par.attrs))
+            status=_status(f, path), path=str(path), metadata=dict(par.attrs),
+            epoch=_epoch(par, path))
         ref = par["reference"][()]
         e_scale, l_scale = par["scales"][()]
         obs = f["observables"]
@@ -2928,6 +2974,7 @@ def describe(path):
             f"integrator      {par.attrs['integrator']} {par.attrs['integrator_options']}, "
             f"dt = {format_time(par.attrs['dt'] * u.Unit(par.attrs['dt_unit']))}",
             f"units           {units['name']}, G = {units['G']!r} ({units['G_source']})",
+            f"epoch           {_describe_epoch(_epoch(par, path))}",
             f"outputs         {n_out}"
             + (f", t = {(t[0] * tu).to_value(shown):.6g} .. "
                f"{format_time(t[n_out - 1] * tu, shown)}" if n_out else ""),
@@ -2965,6 +3012,11 @@ def describe(path):
                          f"logged")
         lines.append(f"status          {_status(f, path)}")
         return "\n".join(lines)
+
+
+def _describe_epoch(epoch):
+    # the date of time 0, or that there is none
+    return "none (times only)" if epoch is None else f"{_epochs.describe(epoch)} at t = 0"
 
 
 def _describe_forces(par, path):
@@ -3005,11 +3057,12 @@ class Checkpoint(NamedTuple):
     (['Star', 'Planet'], 'leapfrog', 10)
     """
 
-    bodies: object          # the BodySet at the checkpoint
+    bodies: object          # the BodySet at the checkpoint (its epoch: the date there)
     config: dict            # SimulationConfig.to_dict() of the simulation
     state: SimulationState  # put back with Simulation.set_state
     point: object           # the ResumePoint: where the run that wrote the file stood
     path: str
+    epoch: object = None    # astropy Time (TDB) of the simulation's time 0, or None
 
 
 @_damaged
@@ -3073,6 +3126,7 @@ def read_checkpoint(path):
             raise OrbitsFileError(f"{path}: the bodies at its last checkpoint are not a body "
                                   f"set: {exc}") from None
         bodies.history = json.loads(par.attrs["bodies_history"])
+        epoch = _epoch(par, path)
         if "config" in par.attrs:
             config = json.loads(par.attrs["config"])
         else:
@@ -3096,8 +3150,10 @@ def read_checkpoint(path):
                                   f"{rows} output rows, but the file holds {held}; the "
                                   f"checkpoint does not belong to these outputs")
         t = state.t_base + state.steps_since_base * float(par.attrs["dt"])
+        if epoch is not None:
+            bodies.epoch = epoch + units.quantity(t, "time")
     return Checkpoint(bodies, config, state, ResumePoint(plan, written, bool(finished), rows, t),
-                      str(path))
+                      str(path), epoch)
 
 
 def _check_tangent_rows(ws, config, n, path):
