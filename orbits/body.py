@@ -15,7 +15,8 @@ import numbers
 import astropy.units as u
 import numpy as np
 
-from ._kernels import kepler as _kepler
+from ._kernels import elements as _elements
+from ._kernels.status import describe_status
 from .errors import ElementsError, UnknownBodyError
 
 __all__ = ["Body", "Orbit", "Track", "unknown_body"]
@@ -152,9 +153,9 @@ class Orbit:
         r = np.asarray(r, dtype=float)
         v = np.asarray(v, dtype=float)
         out = np.empty(7)
-        status = _kepler.state_to_elements(mu, r, v, out)
+        status = _elements.state_to_elements(mu, r, v, out)
         if status != 0:
-            raise ElementsError(_kepler.describe_status(status), body=body, field="elements")
+            raise ElementsError(describe_status(status), body=body, field="elements")
         a, e, inc, Omega, omega, f, M = (float(x) for x in out)
         hvec = np.cross(r, v)
         dist = float(np.linalg.norm(r))
