@@ -334,7 +334,7 @@ def test_with_a_cold_cache_each_worker_compiles_in_its_first_task_only(tmp_path,
 
 @pytest.mark.slow
 def test_the_readme_commands_for_an_existing_cluster(serial, tmp_path):
-    # the commands of the README's "Ensembles and sweeps" section, on loopback
+    # the commands of the ensembles guide for an existing cluster, on loopback
     import os
     import time
 

@@ -6,6 +6,7 @@ import pathlib
 import re
 import subprocess
 import sys
+import textwrap
 
 import astropy.units as u
 import pandas as pd
@@ -314,12 +315,12 @@ def test_ctrl_c_on_a_local_cluster_prints_one_line_and_the_same_call_continues(t
     assert resumed.drop(columns=WHERE).equals(whole.drop(columns=WHERE))
 
 
-# -- the README's example, as written --------------------------------------------------------
+# -- the ensembles guide's example, as written ------------------------------------------------
 
 def _readme_ensemble_example():
-    readme = (ROOT / "README.md").read_text()
-    section = readme.split("## Ensembles and sweeps", 1)[1]
-    return section.split("```python\n", 1)[1].split("```", 1)[0]
+    guide = (ROOT / "docs" / "guides" / "ensembles.rst").read_text()
+    block = guide.split(".. code-block:: python\n\n", 1)[1]
+    return textwrap.dedent(block.split("\n\n:meth:", 1)[0])
 
 
 @pytest.mark.slow     # about 10 s: two Python start-ups and a local cluster
