@@ -63,12 +63,17 @@ worker as in a serial loop (``client="serial"``).
 
 This module is the facade; each part of a sweep has a module of its own:
 :mod:`~orbits.ensemble.cluster` (the local Dask cluster and its workers'
-settings), :mod:`~orbits.ensemble.guard` (a script without the ``__main__``
-guard), :mod:`~orbits.ensemble.tasks` (runs cut into tasks),
+settings, :data:`~orbits.ensemble.cluster.WORKER_ENVIRONMENT` and
+:data:`~orbits.ensemble.cluster.WORKER_DASK_CONFIG`),
+:mod:`~orbits.ensemble.guard` (a script without the ``__main__`` guard),
+:mod:`~orbits.ensemble.tasks` (runs cut into tasks),
 :mod:`~orbits.ensemble.batch` (runs integrated together),
-:mod:`~orbits.ensemble.worker` (one run and its row),
+:mod:`~orbits.ensemble.worker` (one run and its row,
+:data:`~orbits.ensemble.worker.ELEMENTS_MAX_BODIES`),
 :mod:`~orbits.ensemble.compiles` (numba on a worker),
-:mod:`~orbits.ensemble.index` (the record in ``out_dir``),
+:mod:`~orbits.ensemble.index` (the record in ``out_dir``,
+:data:`~orbits.ensemble.index.INDEX_FILE` and
+:data:`~orbits.ensemble.index.SWEEP_FILE`),
 :mod:`~orbits.ensemble.perturbation` (perturbed copies),
 :mod:`~orbits.ensemble.table` (the columns) and
 :mod:`~orbits.ensemble.errors`.  Each imports only modules listed after it.
