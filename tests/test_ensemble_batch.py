@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 import orbits
-from orbits import _batch
-from orbits.ensemble import Ensemble, EnsembleOptionError, _Chunks, _Spec, local_cluster
+from orbits.ensemble import Ensemble, EnsembleOptionError, local_cluster
+from orbits.ensemble import batch as _batch
+from orbits.ensemble.tasks import _Chunks
+from orbits.ensemble.worker import _Spec
 
 cloudpickle.register_pickle_by_value(sys.modules[__name__])
 

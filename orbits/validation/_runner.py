@@ -35,7 +35,7 @@ class Task(NamedTuple):
 
 
 def _call(task):
-    from ..ensemble import _sync_numba_config
+    from ..ensemble.compiles import _sync_numba_config
     _sync_numba_config()
     module, name = task.function.split(":")
     func = getattr(importlib.import_module(module), name)

@@ -26,12 +26,16 @@ import time as _time
 
 import numpy as np
 
-from . import ensemble as _ens
-from ._kernels import wh_batch as _lanes
-from ._kernels.invariants import MONITOR_WIDTH
-from .errors import OrbitsError
-from .integrators.wisdom_holman import MASS_RATIO_LIMIT
-from .monitors import CHAOS_MONITORS, monitor_mask
+from .._kernels import wh_batch as _lanes
+from .._kernels.invariants import MONITOR_WIDTH
+from ..errors import OrbitsError
+from ..integrators.wisdom_holman import MASS_RATIO_LIMIT
+from ..io import hdf5
+from ..monitors import CHAOS_MONITORS, monitor_mask
+from ..simulation import _Recorder
+from .compiles import _cache_loads, _CompileRecorder, _sync_numba_config, _worker_fields
+from .table import _parameter_row
+from .worker import _advance, _invalid_row, _run_row
 
 __all__ = ["run_batched", "batch_key", "FLUSH_OUTPUTS"]
 
@@ -62,7 +66,7 @@ def batch_key(sim, spec):
     ----------
     sim : Simulation
         Freshly built.
-    spec : orbits.ensemble._Spec
+    spec : orbits.ensemble.worker._Spec
         The sweep's ``until`` and ``outputs``.
     """
     if not sim.integrator.batchable or sim.forces:
@@ -97,30 +101,30 @@ def batch_key(sim, spec):
 
 def run_batched(build, params, indices, spec, paths, batch):
     """Rows of the runs ``indices`` (in order) and the exception that stopped the
-    task, or None: :func:`orbits.ensemble.run_chunk` with up to ``batch`` runs
-    integrated together."""
-    _ens._sync_numba_config()
+    task, or None: :func:`orbits.ensemble.tasks.run_chunk` with up to ``batch``
+    runs integrated together."""
+    _sync_numba_config()
     rows = {}
     groups = {}
     error = None
     for pos, (p, i, path) in enumerate(zip(params, indices, paths)):
-        row = _ens._parameter_row(p, i)
-        loaded0 = _ens._cache_loads()
-        with _ens._CompileRecorder() as log:
+        row = _parameter_row(p, i)
+        loaded0 = _cache_loads()
+        with _CompileRecorder() as log:
             try:
                 sim = build(**p)
                 found = batch_key(sim, spec)
                 if found is None:
-                    outcome, exc, wall, result = _ens._advance(sim, spec, path)
+                    outcome, exc, wall, result = _advance(sim, spec, path)
             except OrbitsError as err:
-                rows[pos] = _ens._invalid_row(row, err, _ens._worker_fields(loaded0, log))
+                rows[pos] = _invalid_row(row, err, _worker_fields(loaded0, log))
                 continue
             except Exception as exc:     # build's own errors stop the sweep, as alone
                 error = exc
                 break
         if found is None:
-            rows[pos] = _ens._run_row(row, sim, spec, path, outcome, exc, wall, result,
-                                      lambda: _ens._worker_fields(loaded0, log))
+            rows[pos] = _run_row(row, sim, spec, path, outcome, exc, wall, result,
+                                      lambda: _worker_fields(loaded0, log))
             continue
         key, plan, m, n_active = found
         groups.setdefault(key, []).append(_Lane(pos, row, sim, path, plan, m, n_active))
@@ -133,17 +137,15 @@ def run_batched(build, params, indices, spec, paths, batch):
 def _recorder(sim, plan, path):
     # the recorder Simulation.run would make for this run
     if path is None:
-        from .simulation import _Recorder
         return _Recorder(sim, initial=plan.outputs > 1, capacity=plan.outputs)
-    from .io import hdf5
     return hdf5.FileRecorder(path, sim, plan, overwrite=True)
 
 
 def _run_lanes(lanes, spec):
     """Run ``lanes`` (runs of one key) together; their rows by position."""
-    loaded0 = _ens._cache_loads()
+    loaded0 = _cache_loads()
     out = {}
-    with _ens._CompileRecorder() as log:
+    with _CompileRecorder() as log:
         wall0 = _time.perf_counter()
         first = lanes[0].sim
         desc = first.description()
@@ -244,13 +246,13 @@ def _run_lanes(lanes, spec):
             out[lane.pos] = (lane, "completed", None, share, result)
         # a run that failed: alone again from its start, for its own failure's row
         for lane in again:
-            outcome, exc, wall, result = _ens._advance(lane.sim, spec, lane.path)
+            outcome, exc, wall, result = _advance(lane.sim, spec, lane.path)
             out[lane.pos] = (lane, outcome, exc, wall + share, result)
-    fields = _ens._worker_fields(loaded0, log)
+    fields = _worker_fields(loaded0, log)
     rows = {}
     for k, pos in enumerate(sorted(out)):
         lane, outcome, exc, wall, result = out[pos]
         worker = fields if k == 0 else dict(fields, kernels_compiled=0, kernels_loaded=0)
-        rows[pos] = _ens._run_row(lane.row, lane.sim, spec, lane.path, outcome, exc, wall,
+        rows[pos] = _run_row(lane.row, lane.sim, spec, lane.path, outcome, exc, wall,
                                   result, lambda w=worker: w)
     return rows
