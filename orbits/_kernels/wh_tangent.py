@@ -104,10 +104,10 @@ from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_t
                             heliocentric_interaction_kick, interaction_kick, jump)
 
 # the names the templates below are written against, bound by specialize
-(TERMS, record, chaos_update, inertial_tangent, jacobian, note, renormalise, synchronize,
- term_jacobian, term_kick, term_tangent) = slots(
-    "TERMS", "record", "chaos_update", "inertial_tangent", "jacobian", "note", "renormalise",
-    "synchronize", "term_jacobian", "term_kick", "term_tangent")
+(TERMS, record, inertial_tangent, jacobian, note, synchronize, term_jacobian, term_kick,
+ term_tangent) = slots(
+    "TERMS", "record", "inertial_tangent", "jacobian", "note", "synchronize", "term_jacobian",
+    "term_kick", "term_tangent")
 
 __all__ = ["drift_tangent", "interaction_kick_and_tangent",
            "jump_tangent",
@@ -839,9 +839,7 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
     step = None   # the epilogue's default: nothing after a step
     if force.chaos:
         step = specialize(_chaos_step, key, cache=cache, inline=True, nrt=nrt,
-                          inertial_tangent=_INERTIAL_TANGENT[coordinates],
-                          chaos_update=chaos_update,
-                          renormalise=renormalise)
+                          inertial_tangent=_INERTIAL_TANGENT[coordinates])
     note = specialize(_chaos_note, key, cache=cache, inline=True, nrt=nrt,
                       note=work_kernels(force)["work_note"])
     bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,

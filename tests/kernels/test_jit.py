@@ -130,3 +130,30 @@ def test_every_template_module_declares_its_slots():
                         and not hasattr(builtins, name)):
                     missing.append(f"{path.name}: {name} in {tab.get_name()}")
     assert not missing, missing
+
+
+def test_no_slot_shadows_a_name_its_module_imports_or_defines():
+    # a slot declared after an import of the same name replaces the function
+    # with the slot, and a binding that passes the module's name passes the slot
+    import ast
+    import pathlib
+    root = pathlib.Path(_jit.__file__).parents[1]
+    clashes = []
+    for path in sorted((root / "_kernels").glob("*.py")) + [root / "_user_functions.py"]:
+        tree = ast.parse(path.read_text())
+        slotted, other = set(), set()
+        for node in tree.body:
+            names = set()
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                names = {(a.asname or a.name).split(".")[0] for a in node.names}
+            elif isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+                names = {node.name}
+            elif isinstance(node, ast.Assign):
+                names = {n.id for t in node.targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+                call = node.value
+                if isinstance(call, ast.Call) and getattr(call.func, "id", None) == "slots":
+                    slotted |= names
+                    continue
+            other |= names
+        clashes += [f"{path.name}: {n}" for n in sorted(slotted & other)]
+    assert not clashes, clashes
