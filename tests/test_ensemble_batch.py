@@ -84,6 +84,20 @@ def test_batched_rows_equal_the_rows_of_runs_made_alone(alone, batch):
     assert df.wall_time_s.iloc[:batch].nunique() == 1
 
 
+def test_a_partial_batch_runs_in_a_power_of_two_of_lanes(alone, monkeypatch):
+    # five runs at batch=8 take eight lanes, three of them idle, so that the
+    # loop compiled for 8 serves them (a loop of five lanes would compile anew)
+    widths = []
+    made = _batch._lanes.advance_loop
+    monkeypatch.setattr(_batch._lanes, "advance_loop",
+                        lambda n, n_active, nb: widths.append(nb) or made(n, n_active, nb))
+    df = Ensemble(three_planets, SWEEP[:5]).run(UNTIL, client="serial", outputs=37,
+                                                progress=False, batch=8)
+    assert widths == [8]
+    assert_same_rows(alone.iloc[:5].reset_index(drop=True), df)
+    assert [_batch.lane_width(n, 6) for n in (1, 3, 4, 5, 6)] == [1, 4, 4, 6, 6]
+
+
 def test_runs_that_cannot_be_batched_run_alone_and_keep_their_rows():
     kinds = ["wh", "dt", "leapfrog", "wh", "corrector", "wh", "escape", "dt", "bad", "wh"]
     params = [dict(p, kind=k) for p, k in zip(SWEEP, kinds)]

@@ -130,8 +130,28 @@ def run_batched(build, params, indices, spec, paths, batch):
         groups.setdefault(key, []).append(_Lane(pos, row, sim, path, plan, m, n_active))
     for lanes in groups.values():
         for k in range(0, len(lanes), batch):
-            rows.update(_run_lanes(lanes[k:k + batch], spec))
+            part = lanes[k:k + batch]
+            rows.update(_run_lanes(part, spec, lane_width(len(part), batch)))
     return [rows[k] for k in sorted(rows)], error
+
+
+def lane_width(runs, batch):
+    """The lanes a batch of ``runs`` runs in: the smallest power of two that
+    holds them, or ``batch`` where that is smaller.  The batch loop is
+    compiled for its number of lanes, so a sweep's last, partial batch (and a
+    group of few runs) takes one of a few widths instead of a width of its
+    own; the lanes beyond the runs stay idle.
+
+    Examples
+    --------
+    >>> from orbits.ensemble.batch import lane_width
+    >>> [lane_width(n, 8) for n in (1, 2, 3, 5, 8)], lane_width(5, 6)
+    ([1, 2, 4, 8, 8], 6)
+    """
+    width = 1
+    while width < runs:
+        width *= 2
+    return min(width, batch)
 
 
 def _recorder(sim, plan, path):
@@ -141,8 +161,10 @@ def _recorder(sim, plan, path):
     return hdf5.FileRecorder(path, sim, plan, overwrite=True)
 
 
-def _run_lanes(lanes, spec):
-    """Run ``lanes`` (runs of one key) together; their rows by position."""
+def _run_lanes(lanes, spec, width):
+    """Run ``lanes`` (runs of one key) together in ``width`` lanes (at least
+    as many as runs; the others idle copies of the first run, frozen from the
+    start); their rows by position."""
     loaded0 = _cache_loads()
     out = {}
     with _CompileRecorder() as log:
@@ -150,20 +172,23 @@ def _run_lanes(lanes, spec):
         first = lanes[0].sim
         desc = first.description()
         plan = lanes[0].plan
-        nb = len(lanes)
+        nb = max(width, len(lanes))
         states = [lane.sim.state for lane in lanes]
+        filled = states + [states[0]] * (nb - len(lanes))
         n = len(states[0].order)
         n_active = lanes[0].n_active
         G = desc.units.G
         dt = float(desc.dt)
-        masses = np.ascontiguousarray(np.stack([lane.m for lane in lanes]))     # (B, N)
+        masses = np.ascontiguousarray(np.stack([lane.m for lane in lanes]
+                                               + [lanes[0].m] * (nb - len(lanes))))  # (B, N)
         gm = np.ascontiguousarray((G * masses).T)                             # (N, B)
-        x = np.stack([s.x for s in states], axis=2)
-        v = np.stack([s.v for s in states], axis=2)
+        x = np.stack([s.x for s in filled], axis=2)
+        v = np.stack([s.v for s in filled], axis=2)
         xj, vj, eta = _lanes.to_lanes(x, v, gm)
         ws = _lanes.lanes_workspace(n, nb)
         owed = np.zeros(nb)
         live = np.ones(nb)
+        live[len(lanes):] = 0.0         # the idle lanes, frozen
         status = np.zeros(nb, dtype=np.int64)
         good = np.zeros(nb, dtype=np.int64)
         recs = [_recorder(lane.sim, plan, lane.path) for lane in lanes]
