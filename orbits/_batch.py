@@ -135,8 +135,8 @@ def _recorder(sim, plan, path):
     if path is None:
         from .simulation import _Recorder
         return _Recorder(sim, initial=plan.outputs > 1, capacity=plan.outputs)
-    from .io import hdf5
-    return hdf5.FileRecorder(path, sim, plan, overwrite=True)
+    from .io.h5md import FileRecorder
+    return FileRecorder(path, sim, plan, overwrite=True)
 
 
 def _run_lanes(lanes, spec):

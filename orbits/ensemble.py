@@ -859,7 +859,7 @@ def _run_row(row, sim, spec, path, outcome, exc, wall, result, worker):
     out[_column("t_stop", units.time)] = _value(t_end, units.time)
     out["steps"] = sim.steps
     if path is not None:   # the result of a run to a file holds only its last output
-        from .io.hdf5 import load
+        from .io.h5md import load
         result = load(path)
     e = result.max_energy_error() if result is not None else None
     lerr = result.max_angular_momentum_error() if result is not None else None
