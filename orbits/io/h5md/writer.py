@@ -32,7 +32,7 @@ from ...errors import OrbitsError
 from ...monitors import _work_column, monitor_fields, relative_error, vector_relative_error
 from ...result import Result
 from .disk import (_LOG_ROW_BYTES, _METADATA_BYTES, _NoRoom, _RESERVE_BYTES, _close_written,
-                   _descriptor, _trim, _writes)
+                   _descriptor, _reserve, _trim, _writes)
 from .errors import (OrbitsFileError, TangentShapeError, _DISK_FULL, _error_number,
                      _write_error)
 from .layout import (_MONITOR_COLUMNS, _SCALAR_SERIES, _SLOTS, _append, _create, _datasets,
