@@ -26,7 +26,7 @@ _EXPORTS = {
     "integrate": ".custom",
     "compile_ahead": "._ahead",
     "Trajectory": ".custom",
-    "load": ".io.hdf5",
+    "load": ".io.h5md",
     # Ensemble needs dask and pandas when it runs; its module imports them itself
     "Ensemble": ".ensemble",
     **{name: f".{name}" for name in ("scenes", "integrators", "monitors", "analysis",

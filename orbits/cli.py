@@ -691,7 +691,7 @@ def _whole_run(result, path, orbits):
     """``result`` (the last output of a run written into ``path``) with the steps,
     time span, work and largest errors of every run in the file."""
     whole = copy.copy(result)
-    vars(whole).update(orbits.io.hdf5.whole_run(path))
+    vars(whole).update(orbits.io.h5md.whole_run(path))
     return whole
 
 

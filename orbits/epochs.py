@@ -14,7 +14,7 @@ In text (system files) an epoch is written as its Julian date in two parts,
 ``"2451545.0 + 0.0 TDB"``, which reads back bit for bit; a person may also
 write any date astropy reads, with its scale (``"2000-01-01T12:00:00 TDB"``,
 ``"2024-03-01 UTC"``; TDB when none is given).  Output files keep the two
-parts as a ``(2,)`` float64 attribute (:mod:`orbits.io.hdf5`).
+parts as a ``(2,)`` float64 attribute (:mod:`orbits.io.h5md`).
 
 ``astropy.time`` is imported only when a date is made or read (it costs
 about 50 ms, which a run without an epoch does not pay).

@@ -383,7 +383,7 @@ def plot_file(path, out=None, frame=None):
     >>> plot_file("run.h5", frame="barycentric")          # doctest: +SKIP
     PosixPath('run.png')
     """
-    from .io.hdf5 import OrbitsFileError, load
+    from .io.h5md import OrbitsFileError, load
     out = pathlib.Path(out) if out else pathlib.Path(path).with_suffix(".png")
     result = load(path)
     if not len(result.times):

@@ -1,7 +1,7 @@
 """The records a simulation is described and saved by.
 
 Plain named tuples, shared by :mod:`orbits.simulation` (which makes them) and
-:mod:`orbits.io.hdf5` and :mod:`orbits.ensemble` (which store and ship them),
+:mod:`orbits.io.h5md` and :mod:`orbits.ensemble` (which store and ship them),
 so that neither of those reads a simulation's private attributes and the
 modules do not import each other.  ``orbits.simulation`` re-exports them.
 """

@@ -65,7 +65,7 @@ def _with_callers_functions(path, config, collisions, functions):
     unless the caller gives every function of the user's that it names, and
     no other (see :meth:`Simulation.from_file`)."""
     from . import forces as _forces
-    from .io.hdf5 import OrbitsFileError
+    from .io.h5md import OrbitsFileError
     try:
         needed = _forces.functions_needed(config["forces"])
     except _forces.ForceTermError as exc:

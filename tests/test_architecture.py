@@ -50,9 +50,11 @@ def test_no_dispatch_on_integrator_names_outside_registry():
 def test_files_read_no_private_attribute_of_a_simulation():
     # the HDF5 layer goes through Simulation.description(), .state, .snapshot(),
     # .time_value and .output_path; a `sim._name` in it is a regression
-    text = (PACKAGE / "io" / "hdf5.py").read_text()
-    tree = ast.parse(text)
-    private = sorted({node.attr for node in ast.walk(tree)
-                      if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
-                      and node.value.id == "sim" and node.attr.startswith("_")})
-    assert private == []
+    files = sorted((PACKAGE / "io").rglob("*.py"))
+    assert len(files) >= 5
+    for path in files:
+        tree = ast.parse(path.read_text())
+        private = sorted({node.attr for node in ast.walk(tree)
+                          if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+                          and node.value.id == "sim" and node.attr.startswith("_")})
+        assert private == [], path.name

@@ -15,7 +15,7 @@ import pytest
 
 import orbits
 from orbits.errors import CloseEncounter, Collision
-from orbits.io.hdf5 import FileRecorder
+from orbits.io.h5md import FileRecorder
 
 from helpers import KEPLER_F0, kepler_bodies
 

@@ -11,7 +11,7 @@ import pytest
 import orbits
 from orbits import plotting
 from orbits.cli import main, parse_quantity
-from orbits.io.hdf5 import FileRecorder
+from orbits.io.h5md import FileRecorder
 from orbits.units import format_time, time_unit
 
 

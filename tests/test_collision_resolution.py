@@ -210,7 +210,7 @@ def test_a_run_interrupted_after_a_merger_resumes_bit_for_bit(tmp_path, monkeypa
     # masses at every output and the collisions; a run killed after the
     # merger resumes from its checkpoint (fewer bodies, ias15's state of
     # them) to the same file as the whole run
-    from orbits.io.hdf5 import FileRecorder
+    from orbits.io.h5md import FileRecorder
     whole, cut = tmp_path / "whole.h5", tmp_path / "cut.h5"
     kw = dict(until=10 * u.day, outputs=11, progress=False, checkpoint_interval=0)
 

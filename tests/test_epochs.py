@@ -11,7 +11,7 @@ import orbits
 from orbits import epochs, scenes, systemfile
 from orbits.cli import main
 from orbits.errors import EpochError, NoEpochError, SystemFileError
-from orbits.io.hdf5 import OrbitsFileError
+from orbits.io.h5md import OrbitsFileError
 
 J2000 = Time(2451545.0, format="jd", scale="tdb")
 

@@ -17,8 +17,7 @@ import pytest
 
 import orbits
 from orbits import _driver
-from orbits.io import hdf5
-from orbits.io.hdf5 import FileInUse, FileRecorder, OrbitsFileError
+from orbits.io.h5md import FileInUse, FileRecorder, OrbitsFileError, safety
 
 # A hang shows as a subprocess that outlives this many seconds: generous,
 # since a child spends 2-5 s importing orbits (astropy, numba) on a loaded
@@ -50,7 +49,7 @@ def python(code, *args, timeout=HANG_SECONDS):
 
 OPEN_ALL = textwrap.dedent("""
     import json, sys, orbits
-    from orbits.io import hdf5
+    from orbits.io import h5md
     calls = {"load": orbits.load, "describe": orbits.io.describe,
              "from_file": orbits.Simulation.from_file}
     for path in sys.argv[1:]:
@@ -61,7 +60,7 @@ OPEN_ALL = textwrap.dedent("""
                 row = {"error": None, "named": False, "message": "(no error)"}
             except Exception as exc:
                 row = {"error": type(exc).__name__, "message": str(exc),
-                       "named": isinstance(exc, hdf5.OrbitsFileError)}
+                       "named": isinstance(exc, h5md.OrbitsFileError)}
             print(json.dumps(dict(row, file=path, call=name)), flush=True)
 """)
 
@@ -94,8 +93,8 @@ def written(tmp_path_factory):
 def test_the_live_copy_is_marked_as_being_written(written):
     # the second kind of file opens in SWMR mode, where HDF5 retries failed reads
     done, live = written
-    assert hdf5._superblock(done).flags == 0
-    assert hdf5._superblock(live).flags & hdf5._OPEN_FOR_SWMR_WRITE
+    assert safety._superblock(done).flags == 0
+    assert safety._superblock(live).flags & safety._OPEN_FOR_SWMR_WRITE
 
 
 def test_truncated_files_fail_at_once_with_a_named_error(written, tmp_path):
@@ -105,7 +104,7 @@ def test_truncated_files_fail_at_once_with_a_named_error(written, tmp_path):
     for src in written:
         data = src.read_bytes()
         # the end its header records: a live file has space reserved past it
-        end = hdf5._superblock(src).eof
+        end = safety._superblock(src).eof
         for n in (0, 1, 100, 1024, 4096, 8192, end // 2, end - 1):
             p = tmp_path / f"{src.stem}-{n}.h5"
             p.write_bytes(data[:n])
@@ -190,20 +189,20 @@ def test_a_file_being_written_is_waited_for_not_called_truncated(tmp_path, monke
     path = tmp_path / "run.h5"
     outer().run(until=1000 * u.day, outputs=11, output=path, progress=False)
     calls = []
-    real = hdf5._superblock
+    real = safety._superblock
 
     def lagging(p):
         sb = real(p)
         calls.append(1)
         return sb._replace(eof=sb.size + 4096) if len(calls) < 3 else sb
-    monkeypatch.setattr(hdf5, "_superblock", lagging)
-    monkeypatch.setattr(hdf5, "_writer", lambda p: ({"pid": 1, "host": "h"}, True))
+    monkeypatch.setattr(safety, "_superblock", lagging)
+    monkeypatch.setattr(safety, "_writer", lambda p: ({"pid": 1, "host": "h"}, True))
     with pytest.raises(OrbitsFileError, match="truncated"):
         orbits.load(path)             # not marked as being written: no wait
     calls.clear()
-    monkeypatch.setattr(hdf5, "_superblock",
-                        lambda p: lagging(p)._replace(flags=hdf5._OPEN_FOR_SWMR_WRITE))
-    monkeypatch.setattr(hdf5, "_open_swmr", lambda p: h5py.File(p, "r"))
+    monkeypatch.setattr(safety, "_superblock",
+                        lambda p: lagging(p)._replace(flags=safety._OPEN_FOR_SWMR_WRITE))
+    monkeypatch.setattr(safety, "_open_swmr", lambda p: h5py.File(p, "r"))
     assert len(orbits.load(path)) == 11 and len(calls) == 3
 
 

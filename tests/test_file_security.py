@@ -23,8 +23,7 @@ import orbits
 from orbits import forces
 from orbits.cli import main
 from orbits.errors import ForceTermError, SimulationOptionError
-from orbits.io import hdf5
-from orbits.io.hdf5 import OrbitsFileError
+from orbits.io.h5md import OrbitsFileError, safety
 
 #: what a reader may allocate for a crafted file of a few hundred kB: the
 #: finished run's own arrays take a few kB and load's Quantities and tables a
@@ -364,7 +363,7 @@ def test_the_finished_run_reads_as_before(finished):
     assert len(orbits.load(finished)) == 3
     assert "status          completed" in orbits.io.describe(finished)
     with h5py.File(finished, "r") as f:
-        assert hdf5._inventory(f, finished).groups >= {"restart/ws", "parameters"}
+        assert safety._inventory(f, finished).groups >= {"restart/ws", "parameters"}
 
 
 def test_a_run_in_n_body_units_reads_back(tmp_path):

@@ -14,8 +14,7 @@ import pytest
 import orbits
 from orbits import cli
 from orbits.analysis import frequencies, secular_frequencies
-from orbits.io import hdf5
-from orbits.io.hdf5 import FileRecorder, OrbitsFileError
+from orbits.io.h5md import FileRecorder, OrbitsFileError, safety
 
 # A child that hangs fails the test rather than the suite: it spends 2-5 s
 # importing orbits (astropy, numba) on a loaded two-core machine.
@@ -96,7 +95,7 @@ def test_a_destination_that_is_a_link_is_replaced_only_with_force(tmp_path, caps
     assert not path.is_symlink() and len(orbits.load(path)) == 3
     assert target.read_text() == "not an output"
     # closed, the file holds no more than its end: the space reserved is given back
-    assert path.stat().st_size == hdf5._superblock(path).eof
+    assert path.stat().st_size == safety._superblock(path).eof
 
 
 def test_resume_refuses_a_link(tmp_path, monkeypatch):
@@ -150,7 +149,7 @@ def test_a_full_disk_is_a_file_error_and_the_file_resumes(tmp_path):
     for left in ("run.h5.lock", "run.h5.resume", "run.h5.creating"):
         assert not os.path.lexists(tmp_path / left), left
     # the space reserved past the file's end was given back
-    assert path.stat().st_size == hdf5._superblock(path).eof
+    assert path.stat().st_size == safety._superblock(path).eof
     # what was written resumes, and ends as a run that had room
     assert "interrupted" in orbits.io.describe(path)
     assert cli.main(["resume", str(path), "--no-progress"]) == 0

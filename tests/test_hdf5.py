@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import orbits
-from orbits.io.hdf5 import FileRecorder, OrbitsFileError
+from orbits.io.h5md import FileRecorder, OrbitsFileError
 
 # Implicit Euler damps orbits: at 10-day steps Jupiter spirals into the Sun
 # within 800 steps, where the Newton iteration fails (ConvergenceFailure), so

@@ -141,8 +141,8 @@ def test_streamed_to_a_file_in_pieces(tmp_path, monkeypatch):
     # a file takes the outputs recorded in the loop in pieces of at most
     # max_rows (memory stays flat); made small here so that the run takes
     # many pieces, with checkpoints between them: the file holds what memory does
-    from orbits.io import hdf5
-    monkeypatch.setattr(hdf5.FileRecorder, "max_rows", 7)
+    from orbits.io import h5md
+    monkeypatch.setattr(h5md.FileRecorder, "max_rows", 7)
     scene = orbits.scenes.outer_solar_system()
 
     def make():
@@ -166,8 +166,8 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch,
     # process dies after writing the rows of the fourth piece, before its
     # checkpoint: resumed from the file, the run writes the same file, bit for
     # bit (41 outputs: every 10 steps; 37: 11 or 12 steps apart)
-    from orbits.io import hdf5
-    monkeypatch.setattr(hdf5.FileRecorder, "max_rows", 5)
+    from orbits.io import h5md
+    monkeypatch.setattr(h5md.FileRecorder, "max_rows", 5)
     scene = orbits.scenes.outer_solar_system()
 
     def run(path):
@@ -176,7 +176,7 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch,
                 checkpoint_interval=1e-9)
     whole, cut = tmp_path / "whole.h5", tmp_path / "cut.h5"
     run(whole)
-    real = hdf5.FileRecorder.output_rows
+    real = h5md.FileRecorder.output_rows
     calls = []
 
     def crashing(self, *args):
@@ -184,10 +184,10 @@ def test_a_crash_while_streaming_resumes_to_the_same_file(tmp_path, monkeypatch,
         calls.append(1)
         if len(calls) == 4:
             raise _Crash()
-    monkeypatch.setattr(hdf5.FileRecorder, "output_rows", crashing)
+    monkeypatch.setattr(h5md.FileRecorder, "output_rows", crashing)
     with pytest.raises(_Crash):
         run(cut)
-    monkeypatch.setattr(hdf5.FileRecorder, "output_rows", real)
+    monkeypatch.setattr(h5md.FileRecorder, "output_rows", real)
     orbits.Simulation.from_file(cut).resume(progress=False)
     a, b = orbits.load(whole), orbits.load(cut)
     assert np.array_equal(a.times.value, b.times.value)
@@ -250,8 +250,8 @@ def test_adaptive_outputs_in_the_loop_stop_where_the_run_stops(integrator):
 
 
 def test_ias15_outputs_streamed_to_a_file_in_pieces(tmp_path, monkeypatch):
-    from orbits.io import hdf5
-    monkeypatch.setattr(hdf5.FileRecorder, "max_rows", 7)
+    from orbits.io import h5md
+    monkeypatch.setattr(h5md.FileRecorder, "max_rows", 7)
     scene = orbits.scenes.outer_solar_system()
 
     def make():

@@ -17,7 +17,7 @@ import pytest
 
 import orbits
 from orbits.ensemble import Ensemble
-from orbits.io.hdf5 import TangentShapeError
+from orbits.io.h5md import TangentShapeError
 
 from helpers import jupiter_saturn
 
@@ -73,7 +73,7 @@ def test_file_keeps_the_chaos_series_and_the_derivatives(tmp_path):
         assert obs["megno/value"].attrs["unit"] == "1"
         assert obs["in_loop/fli/value"].shape == memory.monitor["fli"].shape
         assert f["restart/tangent_vectors"].attrs["layout"].tolist() == [1, 0, 18, 0]
-    assert "19 tangent vectors" in orbits.io.hdf5.describe(path)
+    assert "19 tangent vectors" in orbits.io.h5md.describe(path)
 
 
 def test_file_keeps_the_derivatives_with_respect_to_the_masses(tmp_path):

@@ -155,7 +155,7 @@ class _Crash(Exception):
 def test_interrupted_run_resumes_to_the_same_work_series(tmp_path, monkeypatch):
     # a run killed after an output and resumed from the checkpoint writes the
     # same file, its work series and the errors of E + W included
-    from orbits.io.hdf5 import FileRecorder
+    from orbits.io.h5md import FileRecorder
     whole = tmp_path / "whole.h5"
     cut = tmp_path / "cut.h5"
     r_whole = _sim("leapfrog", 1 * u.day, monitor_every=10).run(

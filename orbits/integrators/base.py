@@ -13,7 +13,7 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
    calls (force cache, stage buffers, internal state) as a dict.  Everything
    a bit-exact restart needs lives there, as numpy arrays (a flag or a scalar
    as a one-element array): checkpoints save and restore exactly these
-   arrays (:mod:`orbits.io.hdf5`), and a test parametrized over the registry
+   arrays (:mod:`orbits.io.h5md`), and a test parametrized over the registry
    checks that a resumed run is bit-identical;
 4. implements ``advance(ws, x, v, t, dt, nsteps, force, fargs, mon, step0,
    mon_t, mon_out, velocity_dependent, check_every, stop)``, which advances ``x`` and ``v`` (shape (N, 3), in place)
