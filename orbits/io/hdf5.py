@@ -1,5 +1,5 @@
-"""The public names of :mod:`orbits.io.h5md`, under the name its module had before
-it became a package: the same objects, for code that imports ``orbits.io.hdf5``."""
+"""The public names of :mod:`orbits.io.h5md` under a second name,
+``orbits.io.hdf5``, the one scripts and notebooks import: the same objects."""
 
 from .h5md import (BUFFER_ROWS, CHECKPOINT_SECONDS, FORMAT, FORMAT_VERSION,
                    SWMR_READ_ATTEMPTS, Checkpoint, FileInUse, FileRecorder, OrbitsFileError,
