@@ -32,6 +32,7 @@ from ._kernels.invariants import MONITOR_WIDTH
 from .errors import OrbitsError
 from .integrators.wisdom_holman import MASS_RATIO_LIMIT
 from .monitors import CHAOS_MONITORS, monitor_mask
+from .recorder import Recorder
 
 __all__ = ["run_batched", "batch_key", "FLUSH_OUTPUTS"]
 
@@ -133,8 +134,7 @@ def run_batched(build, params, indices, spec, paths, batch):
 def _recorder(sim, plan, path):
     # the recorder Simulation.run would make for this run
     if path is None:
-        from .simulation import _Recorder
-        return _Recorder(sim, initial=plan.outputs > 1, capacity=plan.outputs)
+        return Recorder(sim, initial=plan.outputs > 1, capacity=plan.outputs)
     from .io import hdf5
     return hdf5.FileRecorder(path, sim, plan, overwrite=True)
 
