@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from . import _stop_conditions as _stops
 from . import collisions as _collisions
 from ._kernels import invariants as _inv
 from ._kernels import stopping as _s
@@ -38,7 +39,7 @@ def resolve(sim, rec, wall0):
         xk, vk, tk = seen
         found = _s.collision_pairs(xk, vk, tk, sim._stop, out)
         found_rows += out[:found].tolist()
-        sim._log_step(xk, vk, tk, rec)
+        _stops.log_step(sim, xk, vk, tk, rec)
         _s.keep_state(xk, vk, tk, sim._stop)
     found = _s.collision_pairs(sim._x, sim._v, t, sim._stop, out)
     found_rows += out[:found].tolist()
@@ -124,7 +125,7 @@ def resolve(sim, rec, wall0):
             if resolve(k, o, t, float(d[o]), float(np.linalg.norm(v[k] - v[o]))):
                 merged.add(root(k))
     if not alive.all():
-        sim._drain_log(rec)
+        _stops.drain_log(sim, rec)
         new_index = _replace_bodies(sim, m, r, x, v, alive)
     else:
         new_index = np.arange(n)
@@ -134,7 +135,7 @@ def resolve(sim, rec, wall0):
     off = sim._ws["collision_offset"]
     off[0] -= E1 - E0
     off[1:4] -= L1 - L0
-    sim._log_step(sim._x, sim._v, t, rec)   # the step's approaches, which the loop left
+    _stops.log_step(sim, sim._x, sim._v, t, rec)   # the step's approaches, which the loop left
     _s.keep_state(sim._x, sim._v, t, sim._stop)
     sim._collisions.extend(rows)
     keep = getattr(rec, "collision_rows", None)

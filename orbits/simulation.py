@@ -16,6 +16,7 @@ import numpy as np
 
 from . import collisions as _collisions
 from . import _collision_resolver as _resolver
+from . import _stop_conditions as _stops
 from . import _integrator_choice as _choice
 from . import epochs as _epochs
 from . import integrators as _integrators
@@ -26,8 +27,8 @@ from ._driver import (CHUNK_SECONDS, FIRST_CHUNK, PROGRESS_DELAY,  # noqa: F401 
 from ._kernels import gravity as _gravity
 from ._kernels.status import Status
 from .bodies import BodySet
-from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
-                     Escape, ForceTermError, IntegratorOptionError, NonFiniteState, OrbitsError,
+from .errors import (BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure, Escape,
+                     ForceTermError, IntegratorOptionError, NonFiniteState, OrbitsError,
                      OrbitsWarning, SimulationOptionError, StepSizeUnderflow)
 from .monitors import DEFAULT_MONITORS, monitor_mask
 from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDescription,
@@ -309,8 +310,9 @@ class Simulation(Driven):
         self.monitor_every = None if monitor_every is None else int(monitor_every)
 
         self._stop_info = np.zeros(2, dtype=np.int64)
-        self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
-                                     escape_unbound, collisions, encounter_log, restitution)
+        self._stop = _stops.set_up(self, encounter_distance, encounter_hill, escape_distance,
+                                   escape_unbound, collisions, encounter_log, restitution,
+                                   LOG_ROWS)
         if self._resolves_collisions and variations is not None:
             raise SimulationOptionError(
                 f"collisions={collisions!r} changes the bodies during the run, which the "
@@ -653,16 +655,7 @@ class Simulation(Driven):
         >>> sim.stop_conditions["escape_distance"], sim.stop_conditions["escape_unbound"]
         (<Quantity 100. AU>, False)
         """
-        c = self._stop_config
-        q = lambda val: None if val is None else self.units.quantity(val, "length")  # noqa: E731
-        return {"encounter_distance": q(c["encounter_distance"]),
-                "encounter_hill": c["encounter_hill"],
-                "escape_distance": q(c["escape_distance"]),
-                "escape_unbound": c["escape_unbound"],
-                "collisions": c["collisions"],
-                "restitution": c.get("restitution"),
-                "encounter_log": (q(c["encounter_log"][0]) if c["encounter_log"][0]
-                                  else c["encounter_log"][1])}
+        return _stops.keywords(self)
 
     @property
     def softening(self):
@@ -681,186 +674,19 @@ class Simulation(Driven):
         """
         return self._softening
 
-    def _positive_length(self, value, field):
-        d = float(self.units.to_internal(value, "length", bare_ok=self._bare_ok, field=field))
-        if not (d > 0 and math.isfinite(d)):
-            raise ValueError(f"{field} must be a positive length, got {value}")
-        return d
-
-    def _stop_args(self, distance, hill, escape, unbound, collisions=None, log=None,
-                   restitution=None):
-        from ._kernels import stopping as _s
-        mask = 0
-        d2 = esc2 = 0.0
-        k = 0.0
-        if distance is not None:
-            mask |= _s.ENCOUNTER_DISTANCE
-            d = self._positive_length(distance, "encounter_distance")
-            d2 = d * d
-        if hill is not None:
-            k = float(hill)
-            if not (k > 0 and math.isfinite(k)):
-                raise ValueError(f"encounter_hill must be a positive number of Hill radii, "
-                                 f"got {hill}")
-            mask |= _s.ENCOUNTER_HILL
-        if escape is not None:
-            mask |= _s.ESCAPE
-            e = self._positive_length(escape, "escape_distance")
-            esc2 = e * e
-        if unbound:
-            if escape is None:
-                raise ValueError("escape_unbound needs escape_distance (the radius beyond "
-                                 "which an unbound body counts as escaped)")
-            mask |= _s.UNBOUND
-        if collisions is not None:
-            self._check_collisions(collisions)
-            mask |= _s.COLLISION
-        if restitution is not None:
-            if collisions is None or collisions in ("halt", "merge"):
-                raise SimulationOptionError(
-                    f"restitution={restitution!r} is for collisions='bounce' (or a "
-                    f"collisions function), not collisions={collisions!r}")
-            ok = (isinstance(restitution, numbers.Real) and not isinstance(restitution, bool)
-                  and 0.0 <= float(restitution) <= 1.0)
-            if not ok:
-                raise SimulationOptionError(f"restitution must be a number from 0 to 1 "
-                                            f"(1: elastic), got {restitution!r}")
-            restitution = float(restitution)
-        log_hill = log_distance = 0.0
-        if log is not None:
-            mask |= _s.ENCOUNTER_LOG
-            if isinstance(log, u.Quantity):
-                log_distance = self._positive_length(log, "encounter_log")
-            else:
-                log_hill = float(log)
-                if not (log_hill > 0 and math.isfinite(log_hill)):
-                    raise SimulationOptionError(
-                        f"encounter_log must be a positive number of mutual Hill radii or "
-                        f"a length, got {log!r}")
-        self._stop_config = {"encounter_distance": d if distance is not None else None,
-                             "encounter_hill": k or None,
-                             "escape_distance": e if escape is not None else None,
-                             "escape_unbound": bool(unbound),
-                             "collisions": collisions,
-                             "restitution": restitution,
-                             "encounter_log": (log_distance or None, log_hill or None)}
-        n = len(self._m)
-        # the encounter log's rows (emptied by the driver, enlarged when a
-        # step has more approaches than they hold), and its count and where a
-        # look that filled it stopped
-        self._log = np.zeros((LOG_ROWS if mask & _s.ENCOUNTER_LOG else 0, 5))
-        self._log_n = np.zeros(3, dtype=np.int64)
-        self._encounters = []
-        # the state of the previous check and its time (for looking inside a
-        # step): the start, so that the first step is looked inside too;
-        # scratch, and where a collision or an encounter was found
-        self._stop_clock = np.array([0.0, 1.0])
-        self._stop_hit = np.zeros(3)
-        if not mask:
-            return None
-        checked = self.integrator.stop_conditions
-        if not checked:
-            what = "collisions" if collisions is not None else "stopping conditions"
-            raise IntegratorOptionError(f"integrator {self.integrator.name!r} does not check "
-                                        f"{what}; use 'ias15' or another method that does")
-        if checked is not True:
-            given = {"encounter_distance": distance, "encounter_hill": hill,
-                     "escape_distance": escape, "escape_unbound": unbound or None,
-                     "collisions": collisions, "encounter_log": log}
-            refused = [k for k, value in given.items() if value is not None and k not in checked]
-            if refused:
-                raise IntegratorOptionError(
-                    f"integrator {self.integrator.name!r} checks only {', '.join(checked)}, "
-                    f"not {', '.join(refused)}; use 'ias15' or another method that does")
-        central = int(np.argmax(self._m))
-        return (mask, d2, k, esc2, self._gm, central, self._stop_info, self._r,
-                np.stack([self._x, self._v]), self._stop_clock, np.zeros((4, 3)),
-                self._stop_hit, log_hill, log_distance, self._log, self._log_n)
-
+    # -- the driver's hooks: the encounter log, resolved collisions ----------------------
     def _drain_log(self, rec=None):
-        """Move the encounter log's rows from the loop's buffer into the run's
-        list, and into ``rec``'s file if it keeps one."""
-        k = int(self._log_n[0])
-        if k:
-            name = lambda i: self._names[self._order[int(i)]]  # noqa: E731
-            rows = [(float(t), name(j), name(i), float(dist), float(speed))
-                    for t, j, i, dist, speed in self._log[:k]]
-            self._encounters.extend(rows)
-            self._log_n[0] = 0
-            keep = getattr(rec, "encounter_rows", None)
-            if keep is not None:
-                keep(self, rows)
-
-    def _grow_log(self):
-        """A log table twice as long (a step had more approaches than it held)."""
-        self._log = np.zeros((max(2 * len(self._log), 1), 5))
-        self._stop = self._stop[:14] + (self._log,) + self._stop[15:]
-
-    def _log_step(self, x, v, t, rec=None):
-        """The encounter log's look at the step that ended at ``t`` with state
-        ``x``, ``v`` (a look the loop did not take), emptying and enlarging the
-        table as it fills."""
-        from ._kernels import stopping as _s
-        if not self._stop[0] & _s.ENCOUNTER_LOG:
-            return
-        while _s.encounter_log(x, v, t, self._stop):
-            self._drain_log(rec)
-            if not self._log_n[1]:
-                break
-            self._grow_log()
+        _stops.drain_log(self, rec)
 
     def _log_full(self, rec, wall0):
-        """The loop handed the encounter log back (``Status.LOG_FULL``): its rows
-        go into the run's list; if it filled inside a step, it is enlarged and
-        the loop's check of that step is finished (the log's look from where it
-        stopped, then the other conditions, which may stop the run)."""
-        from ._kernels import stopping as _s
-        self._drain_log(rec)
-        if not self._log_n[1]:
-            return
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        t = self._now()
-        x, v, t = self.integrator.checked_state(self._ws, t) or (self._x, self._v, t)
-        status = Status.LOG_FULL
-        while status == Status.LOG_FULL and self._log_n[1]:
-            self._grow_log()
-            status = _s.check_stop(x, v, t, self._stop)
-            self._drain_log(rec)
-        if status not in (0, Status.LOG_FULL):
-            self._fail(Status(status), rec, wall0)
+        _stops.log_full(self, rec, wall0)
 
     def _encounter_table(self):
-        """``result.encounters``: an astropy QTable (None without ``encounter_log``)."""
-        if self._stop_config.get("encounter_log", (None, None)) == (None, None):
-            return None
-        from astropy.table import QTable
-        rows = self._encounters
-        q = self.units.quantity
-        col = lambda k: [r[k] for r in rows]  # noqa: E731
-        return QTable({"time": q(np.array(col(0), dtype=float), "time"),
-                       "body_1": np.array(col(1), dtype=str),
-                       "body_2": np.array(col(2), dtype=str),
-                       "distance": q(np.array(col(3), dtype=float), "length"),
-                       "speed": q(np.array(col(4), dtype=float), "length") / self.units.time})
+        return _stops.encounter_table(self)
 
     #: the ways a collision can be resolved (Simulation's ``collisions``; or a
     #: function, see :mod:`orbits.collisions`)
     COLLISION_RESOLUTIONS = _collisions.RESOLUTIONS
-
-    @property
-    def _keeps_previous(self):
-        # the stopping conditions keep the state of the step before
-        # (collisions, encounters, the encounter log)
-        from ._kernels import stopping as _s
-        return self._stop is not None and bool(self._stop[0] & _s.LOOKS_INSIDE)
-
-    def _keep_current(self):
-        """The current state as the one the conditions' next look inside a
-        step starts from (the state was set from outside)."""
-        if self._stop is not None:
-            self._stop[8][0] = self._x
-            self._stop[8][1] = self._v
-            self._stop_clock[:] = (self._now(), 1.0)
 
     @property
     def _resolves_collisions(self):
@@ -868,38 +694,6 @@ class Simulation(Driven):
         c = self._stop_config.get("collisions")
         return c is not None and c != "halt"
 
-    def _check_collisions(self, collisions):
-        if not (callable(collisions) or (isinstance(collisions, str)
-                                         and collisions in self.COLLISION_RESOLUTIONS)):
-            raise SimulationOptionError(
-                f"collisions={collisions!r} is not a resolution; expected one of "
-                f"{', '.join(map(repr, self.COLLISION_RESOLUTIONS))} or a function")
-        r = self._r
-        if not np.any(r > 0):
-            raise BodyError("collisions need sizes: give the bodies that can collide a "
-                            "radius (BodySet.add(..., radius=...))", field="radius")
-        x = self._x
-        if getattr(self, "_touching_ok", False):
-            return   # bodies after a collision step, which may still touch
-        for i in range(1, len(r)):
-            d = np.sqrt(((x[:i] - x[i]) ** 2).sum(axis=1))
-            touch = np.flatnonzero(d < r[:i] + r[i])
-            if touch.size and collisions == "merge":
-                # what the user asked for: they merge at the start (__init__'s end)
-                self._merge_at_start = True
-                return
-            if touch.size:
-                j = int(touch[0])
-                raise BodyError(f"{self._names[self._order[j]]!r} and "
-                                f"{self._names[self._order[i]]!r} touch at the start "
-                                f"(separation {d[j]:.6g} < radii {r[j] + r[i]:.6g}"
-                                f"{f' {self.units.length}' if str(self.units.length) else ''}"
-                                f"); with collisions={collisions!r} the "
-                                f"bodies must start apart (collisions='merge' merges them "
-                                f"at the start)", body=self._names[self._order[i]],
-                                field="radius")
-
-    # -- collisions that the run resolves ----------------------------------------------
     def _offset_rows(self, rows):
         """Monitor rows written before this call carry the collisions' offsets
         (see :mod:`orbits.collisions`)."""
@@ -1181,7 +975,7 @@ class Simulation(Driven):
         # the state the collision check and the encounter log keep from the
         # step before (so that a restart looks inside its first step too)
         ws = {k: a.copy() for k, a in self._ws.items() if isinstance(a, np.ndarray)}
-        if self._keeps_previous:
+        if _stops.keeps_previous(self):
             ws["stop_prev"] = self._stop[8].copy()
             ws["stop_clock"] = self._stop_clock.copy()
         if self._n_tangent:
@@ -1217,11 +1011,11 @@ class Simulation(Driven):
         for name, arr in state.workspace.items():
             if name in self._ws:
                 self._ws[name][...] = arr
-        if self._keeps_previous and "stop_prev" in state.workspace:
+        if _stops.keeps_previous(self) and "stop_prev" in state.workspace:
             self._stop[8][...] = state.workspace["stop_prev"]
             self._stop_clock[...] = state.workspace["stop_clock"]
         else:
-            self._keep_current()
+            _stops.keep_current(self)
         if self._n_tangent:
             tangent = state.workspace.get("tangent")
             if tangent is None or tangent.shape != (2,) + self._rows_x[len(self._m):].shape:
