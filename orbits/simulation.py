@@ -17,6 +17,7 @@ import numpy as np
 from . import collisions as _collisions
 from . import _collision_resolver as _resolver
 from . import _stop_conditions as _stops
+from . import _variations
 from . import _integrator_choice as _choice
 from . import epochs as _epochs
 from . import integrators as _integrators
@@ -320,7 +321,7 @@ class Simulation(Driven):
                 f"variations=")
         # the force without variations, and its arguments
         self._base_force, self._base_fargs = self._force, self._fargs
-        self._bind_variations(variations, seed)
+        _variations.bind(self, variations, seed)
         rows = len(self._rows_x)
         self._ws = (self.integrator.workspace(rows, self._dt) if adaptive
                     else self.integrator.workspace(rows))
@@ -359,91 +360,6 @@ class Simulation(Driven):
             # now, at t = 0, as a run merges them (collisions table, offsets)
             self._resolve_collisions(None, None)
 
-    def _bind_variations(self, variations, seed):
-        """Tangent rows after the bodies' and the force of the augmented system
-        (:mod:`orbits._kernels.variational`), for ``variations`` and the chaos
-        monitors."""
-        from ._kernels import variational as _var
-        from .monitors import CHAOS_MONITORS
-        n = len(self._m)
-        chaos = any(name in CHAOS_MONITORS for name in self.monitors)
-        if chaos and not self.integrator.chaos_indicators:
-            raise IntegratorOptionError(
-                f"{self.integrator.name!r} steps outside the package's compiled loops and "
-                f"cannot follow the chaos monitors "
-                f"{', '.join(n for n in self.monitors if n in CHAOS_MONITORS)}; use 'ias15', "
-                "'dop853', 'leapfrog' or 'wh'")
-        if variations is None:
-            n_state, n_mass, n_random = 0, 0, 0
-        elif isinstance(variations, str) and variations in ("state", "all"):
-            n_state, n_mass, n_random = 6 * n, (n if variations == "all" else 0), 0
-        elif (isinstance(variations, numbers.Integral) and not isinstance(variations, bool)
-              and variations >= 1):
-            n_state, n_mass, n_random = 0, 0, int(variations)
-        else:
-            raise IntegratorOptionError(
-                f"variations must be None, 'state', 'all' or a whole number of random "
-                f"tangent vectors >= 1, got {variations!r}")
-        if seed is not None and not isinstance(seed, numbers.Integral):
-            raise IntegratorOptionError(f"seed must be an integer, got {seed!r}")
-        if seed is None and (chaos or n_random):
-            # drawn once and kept in the config, so that a rebuilt simulation
-            # (a file, an ensemble's member) starts from the same vectors
-            seed = int(np.random.SeedSequence().entropy % 2 ** 63)
-        self._variations = variations
-        self._seed = None if seed is None else int(seed)
-        self._n_chaos = int(chaos)
-        k = self._n_chaos + n_random + n_state + n_mass
-        self._n_tangent = k
-        self._tangent_layout = (self._n_chaos, n_random, n_state, n_mass)
-        self._rows_x = np.zeros((n * (1 + k), 3))
-        self._rows_v = np.zeros((n * (1 + k), 3))
-        self._rows_x[:n] = self._x
-        self._rows_v[:n] = self._v
-        self._x = self._rows_x[:n]
-        self._v = self._rows_v[:n]
-        self._chaos_box = None
-        if k == 0:
-            return
-        if n_mass and self._terms:
-            raise IntegratorOptionError(
-                "variations='all' (derivatives with respect to the masses) take gravity's "
-                "dependence on the masses only, and the force terms "
-                f"{', '.join(map(repr, self._terms))} depend on them too; use "
-                "variations='state', or drop the terms")
-        dx, dv, dm = self._initial_tangents(n, seed)
-        self._rows_x[n:] = dx.reshape(-1, 3)
-        self._rows_v[n:] = dv.reshape(-1, 3)
-        self._chaos_box = _var.chaos_box(0.0)
-        self._force = _var.with_variations(self._base_force, masses=bool(n_mass), chaos=chaos)
-        self._fargs = _var.variation_args(self._base_fargs, n, dm, self._chaos_box,
-                                          self.units.G, self._eps2)
-
-    def _initial_tangents(self, n, seed):
-        # (k, n, 3) position and velocity parts and (k, n) mass parts, in the
-        # internal (massive first) order: the chaos vector, the random ones,
-        # then a unit vector per initial coordinate of each body in the body
-        # set's order (x, y, z, vx, vy, vz), then per mass
-        n_chaos, n_random, n_state, n_mass = self._tangent_layout
-        k = self._n_tangent
-        dx = np.zeros((k, n, 3))
-        dv = np.zeros((k, n, 3))
-        dm = np.zeros((k, n))
-        rng = np.random.default_rng(seed)
-        for j in range(n_chaos + n_random):
-            w = rng.standard_normal((2, n, 3))
-            w /= np.sqrt(np.sum(w * w))
-            dx[j], dv[j] = w
-        j = n_chaos + n_random
-        inv = self._inverse
-        for b in range(n if n_state else 0):
-            for c in range(6):
-                (dx if c < 3 else dv)[j + 6 * b + c, inv[b], c % 3] = 1.0
-        j += n_state
-        for b in range(n_mass):
-            dm[j + b, inv[b]] = 1.0
-        return dx, dv, dm
-
     @property
     def _X(self):
         return self._rows_x
@@ -453,20 +369,7 @@ class Simulation(Driven):
         return self._rows_v
 
     def _renormalise(self):
-        from ._kernels import variational as _var
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        _var.renormalise(self._rows_x, self._rows_v, len(self._m), self._ws["chaos"])
-        self.integrator.invalidate(self._ws)
-
-    def _tangent_rows(self):
-        """The tangent vectors now, shape (k, N, 6) in the body set's order, and
-        the mass parts (k, N)."""
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        n = len(self._m)
-        k = self._n_tangent
-        t = np.concatenate([self._rows_x[n:].reshape(k, n, 3),
-                            self._rows_v[n:].reshape(k, n, 3)], axis=2)
-        return t[:, self._inverse]
+        _variations.renormalise(self)
 
     @property
     def tangent_vectors(self):
@@ -478,7 +381,7 @@ class Simulation(Driven):
         ones, then those of ``variations="state"`` or ``"all"``."""
         if not self._n_tangent:
             return None
-        return self._tangent_rows()
+        return _variations.tangent_rows(self)
 
     @property
     def jacobian(self):
@@ -500,12 +403,7 @@ class Simulation(Driven):
         >>> sim.jacobian.shape
         (12, 12)
         """
-        n_chaos, n_random, n_state, n_mass = self._tangent_layout
-        if not n_state:
-            return None
-        t = self._tangent_rows()[n_chaos + n_random:]
-        n = len(self._m)
-        return t.reshape(n_state + n_mass, 6 * n).T.copy()
+        return _variations.jacobian(self)
 
     def _bind_terms(self, bodies):
         """Compile gravity and the added terms into one force (see :mod:`orbits.forces`).
