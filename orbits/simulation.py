@@ -9,32 +9,32 @@ import math
 import numbers
 import time as _time
 import warnings
-from collections.abc import Mapping
 
 import astropy.units as u
 import numpy as np
 
-from . import collisions as _collisions
 from . import _collision_resolver as _resolver
+from . import _integrator_choice as _choice
 from . import _stop_conditions as _stops
 from . import _variations
-from . import _integrator_choice as _choice
-from . import epochs as _epochs
+from . import collisions as _collisions
 from . import integrators as _integrators
-from ._kernels import invariants as _inv
-from ._kernels import stepping as _stepping
 from ._driver import (CHUNK_SECONDS, FIRST_CHUNK, PROGRESS_DELAY,  # noqa: F401 - documented here
                       Driven)
 from ._kernels import gravity as _gravity
+from ._kernels import invariants as _inv
+from ._kernels import stepping as _stepping
 from ._kernels.status import Status
 from .bodies import BodySet
 from .errors import (BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure, Escape,
-                     ForceTermError, IntegratorOptionError, NonFiniteState, OrbitsError,
-                     OrbitsWarning, SimulationOptionError, StepSizeUnderflow)
+                     ForceTermError, IntegratorOptionError, NonFiniteState, OrbitsWarning,
+                     SimulationOptionError, StepSizeUnderflow)
+from .io import hdf5 as _hdf5
+from .io import restart as _restart
 from .monitors import DEFAULT_MONITORS, monitor_mask
-from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDescription,
-                      SimulationState, Snapshot, _function_name)
 from .recorder import Recorder
+from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
+                      Snapshot, _function_name)
 
 __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescription",
            "Snapshot", "RunPlan", "PARALLEL_THRESHOLD", "LOG_ROWS"]
@@ -59,60 +59,6 @@ DEFAULT_OUTPUTS = 500
 #: The most steps one run may take: beyond 2**53 float64 no longer tells the
 #: times of neighbouring steps apart.
 MAX_STEPS = float(2 ** 53)
-
-
-def _with_callers_functions(path, config, collisions, functions):
-    """The configuration ``config`` that the file ``path`` records, with the
-    collisions function the caller gives; a :class:`SimulationOptionError`
-    unless the caller gives every function of the user's that it names, and
-    no other (see :meth:`Simulation.from_file`)."""
-    from . import forces as _forces
-    from .io.hdf5 import OrbitsFileError
-    try:
-        needed = _forces.functions_needed(config["forces"])
-    except _forces.ForceTermError as exc:
-        raise OrbitsFileError(f"{path}: its recorded force terms do not rebuild: "
-                              f"{exc}") from None
-    given = lambda ref: ref in functions or ref.partition(":")[2] in functions  # noqa: E731
-    used = {k for k in functions for ref in needed if k in (ref, ref.partition(":")[2])}
-    missing = {ref: what for ref, what in needed.items() if not given(ref)}
-    asks = [ref.partition(":")[2] for ref in missing]
-    missing = [f"{ref!r} ({what})" for ref, what in missing.items()]
-    named = config["stop_conditions"].get("collisions")
-    if isinstance(named, str) and named.startswith(FUNCTION_PREFIX):
-        recorded = named[len(FUNCTION_PREFIX):]
-        keys = [k for k in functions if _names_function(recorded, k)]
-        used.update(keys)
-        if collisions is None and keys:
-            collisions = functions[keys[0]]
-        if collisions is None:
-            missing.append(f"{recorded!r} (the collisions function; or collisions=...)")
-            asks.append(recorded.rpartition(".")[2])
-        elif not (_function_name(collisions) == named or _names_function(
-                recorded, getattr(collisions, "__qualname__", ""))):
-            raise SimulationOptionError(
-                f"{path}: its run resolved collisions with the function {recorded}; the "
-                f"function given, {collisions!r}, has another name")
-        else:
-            config = dict(config, stop_conditions=dict(config["stop_conditions"],
-                                                       collisions=collisions))
-    if missing:
-        raise SimulationOptionError(
-            f"{path}: its run used function(s) that a file names but never holds: "
-            + "; ".join(missing) + "; pass them again: Simulation.from_file(path, "
-            "functions={" + ", ".join(f"{name!r}: ..." for name in asks) + "})")
-    unused = sorted(set(functions) - used)
-    if unused:
-        raise SimulationOptionError(
-            f"{path}: functions names {', '.join(map(repr, unused))}, which its run did "
-            f"not use; it records: {', '.join(map(repr, needed)) or 'no functions'}")
-    return config
-
-
-def _names_function(recorded, name):
-    """Whether ``name`` (a qualname, or ``module.qualname``) is the function a
-    plain record names as ``recorded`` (``module.qualname``)."""
-    return bool(name) and (recorded == name or recorded.endswith("." + name))
 
 
 class Simulation(Driven):
@@ -665,38 +611,7 @@ class Simulation(Driven):
         >>> again.time, bool((again.bodies.positions == sim.bodies.positions).all())
         (<Quantity 10. d>, True)
         """
-        from .io import hdf5
-        if functions is None:
-            functions = {}
-        if not isinstance(functions, Mapping) or not all(
-                isinstance(k, str) and callable(f) for k, f in functions.items()):
-            raise SimulationOptionError(
-                f"functions must map the names a file records to functions, as "
-                f"{{'drag': drag}}; got {functions!r}")
-        cp = hdf5.read_checkpoint(path)
-        config = _with_callers_functions(path, cp.config, collisions, functions)
-        try:
-            sim = cls.from_config(cp.bodies, config, _restoring=True, functions=functions)
-        except OrbitsError:
-            raise
-        except (TypeError, ValueError, KeyError, AttributeError, IndexError,
-                u.UnitsError) as exc:
-            raise hdf5.OrbitsFileError(f"{path}: its recorded configuration does not make a "
-                                       f"simulation: {exc}") from None
-        if not np.array_equal(sim._order, cp.state.order):
-            raise hdf5.OrbitsFileError(f"{path}: the stored body order does not match the "
-                                       f"masses")
-        made = sim.state.workspace
-        for name, arr in cp.state.workspace.items():
-            want = made.get(name)
-            if want is not None and (np.shape(arr) != np.shape(want) or np.asarray(
-                    arr).dtype.kind != np.asarray(want).dtype.kind):
-                raise hdf5.OrbitsFileError(
-                    f"{path}: /restart/ws/{name} holds {np.asarray(arr).dtype} values of "
-                    f"shape {np.shape(arr)} at the checkpoint; the simulation the file "
-                    f"describes keeps {np.asarray(want).dtype} values of shape "
-                    f"{np.shape(want)} there")
-        sim.set_state(cp.state)
+        sim, cp = _restart.restored(cls, path, collisions, functions)
         sim._epoch = cp.epoch       # the date of time 0, as the file keeps it
         sim.output_path = cp.path
         sim._resume = cp.point
@@ -748,7 +663,6 @@ class Simulation(Driven):
         ...     print(str(exc).split(";")[0].endswith("finished"))
         True
         """
-        from .io import hdf5
         point = self._resume
         if point is None:
             raise ValueError("this simulation was not restored from a file "
@@ -756,10 +670,7 @@ class Simulation(Driven):
         if point.finished:
             raise ValueError(f"the run in {self.output_path} finished; continue with "
                              f"run(until=..., output={self.output_path!r})")
-        hdf5.truncate(self.output_path, point)
-        rec = hdf5.FileRecorder(self.output_path, self, point.plan,
-                                checkpoint_interval=checkpoint_interval,
-                                resume_rows=point.outputs_written)
+        rec = _restart.resumed_recorder(self, self.output_path, point, checkpoint_interval)
         self._resume = None
         first_mark = max(0, point.outputs_written - 1)
         return self.execute(point.plan, rec, progress, first_mark=first_mark)
@@ -1141,9 +1052,8 @@ class Simulation(Driven):
         if output is None:
             rec = Recorder(self, initial=plan.outputs > 1, capacity=plan.outputs)
         else:
-            from .io import hdf5
-            rec = hdf5.FileRecorder(output, self, plan, overwrite=overwrite,
-                                    checkpoint_interval=checkpoint_interval)
+            rec = _hdf5.FileRecorder(output, self, plan, overwrite=overwrite,
+                                     checkpoint_interval=checkpoint_interval)
         return self.execute(plan, rec, progress)
 
     def _plan(self, until_v, outputs, until=None):
