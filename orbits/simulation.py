@@ -7,14 +7,15 @@ to what it returns.
 
 import math
 import numbers
-import time as _time
-import warnings
 
 import astropy.units as u
 import numpy as np
 
 from . import _collision_resolver as _resolver
+from . import _failures
 from . import _integrator_choice as _choice
+from . import _run_plan
+from . import _state
 from . import _stop_conditions as _stops
 from . import _variations
 from . import collisions as _collisions
@@ -24,17 +25,14 @@ from ._driver import (CHUNK_SECONDS, FIRST_CHUNK, PROGRESS_DELAY,  # noqa: F401 
 from ._kernels import gravity as _gravity
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
-from ._kernels.status import Status
 from .bodies import BodySet
-from .errors import (BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure, Escape,
-                     ForceTermError, IntegratorOptionError, NonFiniteState, OrbitsWarning,
-                     SimulationOptionError, StepSizeUnderflow)
+from .errors import BodyUnitsError, IntegratorOptionError, SimulationOptionError
 from .io import hdf5 as _hdf5
 from .io import restart as _restart
 from .monitors import DEFAULT_MONITORS, monitor_mask
 from .recorder import Recorder
 from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
-                      Snapshot, _function_name)
+                      Snapshot)
 
 __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescription",
            "Snapshot", "RunPlan", "PARALLEL_THRESHOLD", "LOG_ROWS"]
@@ -55,11 +53,6 @@ PARALLEL_THRESHOLD = 128
 
 #: Outputs of a run when none are asked for.
 DEFAULT_OUTPUTS = 500
-
-#: The most steps one run may take: beyond 2**53 float64 no longer tells the
-#: times of neighbouring steps apart.
-MAX_STEPS = float(2 ** 53)
-
 
 class Simulation(Driven):
     """A body set evolving under Newtonian gravity and added force terms with a
@@ -727,19 +720,7 @@ class Simulation(Driven):
         >>> sim.bodies["Planet"].position.shape
         (3,)
         """
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        inv = np.argsort(self._order)
-        bs = BodySet(self.units)
-        bs._bare_ok = self._bare_ok
-        bs._names = list(self._names)
-        bs._m = self._m[inv].copy()
-        bs._r = self._r[inv].copy()
-        bs._x = self._x[inv].copy()
-        bs._v = self._v[inv].copy()
-        bs.history = list(self._history)
-        if self._epoch is not None:
-            bs._epoch = self._epoch + self.time
-        return bs
+        return _state.body_set(self)
 
     @property
     def epoch(self):
@@ -774,23 +755,7 @@ class Simulation(Driven):
         >>> s.x.shape, s.steps
         ((2, 3), 0)
         """
-        return SimulationState(
-            self._x.copy(), self._v.copy(), self._order.copy(), self._t_base,
-            self._steps_since_base, self.steps, self.force_evaluations, self.steps_rejected,
-            self._saved_workspace(), self._reference.copy(), (self._E_scale, self._L_scale))
-
-    def _saved_workspace(self):
-        # the workspace's arrays, the tangent rows of a run with variations, and
-        # the state the collision check and the encounter log keep from the
-        # step before (so that a restart looks inside its first step too)
-        ws = {k: a.copy() for k, a in self._ws.items() if isinstance(a, np.ndarray)}
-        if _stops.keeps_previous(self):
-            ws["stop_prev"] = self._stop[8].copy()
-            ws["stop_clock"] = self._stop_clock.copy()
-        if self._n_tangent:
-            n = len(self._m)
-            ws["tangent"] = np.stack([self._rows_x[n:], self._rows_v[n:]])
-        return ws
+        return _state.record(self)
 
     def set_state(self, state):
         """Put back a :class:`SimulationState` taken from a simulation made alike
@@ -807,37 +772,7 @@ class Simulation(Driven):
         >>> sim.time
         <Quantity 0. d>
         """
-        if not np.array_equal(self._order, state.order):
-            raise ValueError("the state's body order does not match this simulation's "
-                             "masses")
-        self._x[...] = state.x
-        self._v[...] = state.v
-        self._t_base = float(state.t_base)
-        self._steps_since_base = int(state.steps_since_base)
-        self.steps = int(state.steps)
-        self.force_evaluations = int(state.force_evaluations)
-        self.steps_rejected = int(state.steps_rejected)
-        for name, arr in state.workspace.items():
-            if name in self._ws:
-                self._ws[name][...] = arr
-        if _stops.keeps_previous(self) and "stop_prev" in state.workspace:
-            self._stop[8][...] = state.workspace["stop_prev"]
-            self._stop_clock[...] = state.workspace["stop_clock"]
-        else:
-            _stops.keep_current(self)
-        if self._n_tangent:
-            tangent = state.workspace.get("tangent")
-            if tangent is None or tangent.shape != (2,) + self._rows_x[len(self._m):].shape:
-                raise ValueError("the state has no tangent vectors of this simulation's "
-                                 "variations")
-            n = len(self._m)
-            self._rows_x[n:] = tangent[0]
-            self._rows_v[n:] = tangent[1]
-        # a reference row written before the work column was kept: its work is 0
-        ref = np.asarray(state.reference, dtype=float)
-        self._reference = np.zeros(max(_inv.MONITOR_WIDTH, len(ref)))
-        self._reference[:len(ref)] = ref
-        self._E_scale, self._L_scale = (float(s) for s in state.scales)
+        _state.put_back(self, state)
 
     def description(self):
         """The :class:`SimulationDescription`: bodies, units and set-up, as an
@@ -852,16 +787,7 @@ class Simulation(Driven):
         >>> d.names, d.dt, d.units.name
         (('Star', 'Planet'), 1.0, 'au-Msun-day')
         """
-        inv = self._inverse
-        stops = dict(self._stop_config)
-        if callable(stops.get("collisions")):
-            # a plain record names the function (a file cannot hold it)
-            stops["collisions"] = _function_name(stops["collisions"])
-        return SimulationDescription(
-            tuple(self._names), self._m[inv].copy(), self._r[inv].copy(), self.units,
-            self.integrator, self._dt, math.sqrt(self._eps2), self.monitors,
-            self.monitor_every, self.parallel, self.rebound_arithmetic,
-            stops, list(self._history), self.config, self.forces, self._epoch)
+        return _state.description(self)
 
     @property
     def time_value(self):
@@ -891,15 +817,7 @@ class Simulation(Driven):
         >>> snap.t, snap.steps, snap.x.shape
         (0.0, 0, (2, 3))
         """
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        row = np.zeros(_inv.MONITOR_WIDTH)
-        if self._mask:
-            self._monitor_row(row)
-        inv = self._inverse
-        if self._resolves_collisions:
-            return Snapshot(self._now(), self.steps, self._x[inv], self._v[inv], row,
-                            tuple(self._names), self._m[inv], self._r[inv])
-        return Snapshot(self._now(), self.steps, self._x[inv], self._v[inv], row)
+        return _state.snapshot(self)
 
     def _now(self):
         return self._t_base + self._steps_since_base * self._dt
@@ -1058,136 +976,10 @@ class Simulation(Driven):
 
     def _plan(self, until_v, outputs, until=None):
         """Where a run to ``until_v`` takes its outputs: a :class:`RunPlan`."""
-        now = self._now()
-        shown = until if until is not None else until_v
-        if not math.isfinite(until_v):
-            raise ValueError(f"until must be a finite time, got {shown}")
-        if until_v == now:
-            raise ValueError(f"until = {shown} is the current time: there is nothing to run")
-        sign = 1 if until_v > now else -1
-        default = outputs is None
-        if default:
-            outputs = DEFAULT_OUTPUTS
-        if (isinstance(outputs, bool) or not isinstance(outputs, numbers.Integral)) and not (
-                isinstance(outputs, numbers.Real) and float(outputs).is_integer()):
-            raise ValueError(f"outputs must be a whole number >= 1, got {outputs!r}")
-        outputs = int(outputs)
-        if outputs < 1:
-            raise ValueError(f"outputs must be a whole number >= 1, got {outputs}")
-        if self.integrator.adaptive:
-            # outputs at exactly evenly spaced times, hit by shortening a step
-            return RunPlan(until_v, outputs, 0.0, 0, False, self.steps, now)
-        ratio = abs(until_v - now) / self._dt
-        if not ratio < MAX_STEPS:
-            raise ValueError(f"until = {shown} is {ratio:.3g} steps of dt = {self.dt:.6g} "
-                             f"away: more than the {MAX_STEPS:.3g} steps whose times float64 "
-                             f"can tell apart; use a larger dt or a nearer until")
-        n_full = int(round(ratio))
-        if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
-            n_full = int(math.floor(ratio))
-        partial = sign * (until_v - self._time_after(n_full, sign))
-        has_partial = partial > 1e-12 * max(abs(until_v - now), self._dt)
-        plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps, now)
-        total = plan.total_steps
-        if default and outputs > total + 1:
-            # one per step; a shortened last step leaves room for one fewer, as
-            # outputs go to the nearest step boundary
-            outputs = total + 1
-            while outputs > 2 and not _marks_ok(plan._replace(outputs=outputs), total):
-                outputs -= 1
-            steps = f"{total} step" + ("" if total == 1 else "s")
-            warnings.warn(f"the run has only {steps}: taking {outputs} outputs "
-                          f"instead of the default {DEFAULT_OUTPUTS}", OrbitsWarning,
-                          stacklevel=4)
-            plan = plan._replace(outputs=outputs)
-        if outputs > total + 1 or not _marks_ok(plan, total):
-            raise ValueError(f"outputs = {outputs} needs more steps than the run has "
-                             f"({total}); ask for at most {total + 1} outputs or use a "
-                             f"smaller dt")
-        return plan
-
-    def _time_after(self, n, sign=1):
-        # the time after n more steps of dt in the direction sign, computed as
-        # every step count is
-        return self._t_base + (self._steps_since_base + sign * n) * self._dt
+        return _run_plan.plan(self, until_v, outputs, until, DEFAULT_OUTPUTS)
 
     def _fail(self, status, rec, wall0):
-        reason = {Status.NON_FINITE: "non-finite state",
-                  Status.STEP_UNDERFLOW: "step-size underflow",
-                  Status.CLOSE_ENCOUNTER: "close encounter",
-                  Status.ESCAPE: "escape",
-                  Status.COLLISION: "collision",
-                  Status.NO_CONVERGENCE: "no convergence"}.get(status, f"status {status!r}")
-        rec.end_status = int(status)
-        self._drain_log(rec)
-        rec.output(self, final=True)
-        rec.close()
-        result = self._with_log(rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
-                                           status=reason))
-        t = self.time
-        if _user_function_failed(self._fargs):
-            raise ForceTermError(
-                f"a user force returned an array of another shape than during the check "
-                f"before the run, in step {self.steps + 1} (from t = {t:.10g}); the "
-                f"simulation was left at the last good state, step {self.steps}",
-                term="UserForce", field="func")
-        if status == Status.NON_FINITE:
-            raise NonFiniteState(
-                f"the state became non-finite in step {self.steps + 1} (from t = {t:.10g}); "
-                f"the result up to the last good state, at step {self.steps}, is kept on "
-                f"this exception (.result) and the simulation was left there",
-                time=t, step=self.steps, result=result)
-        if status == Status.NO_CONVERGENCE:
-            raise ConvergenceFailure(
-                f"the Newton iteration of {self.integrator.name!r} did not converge in step "
-                f"{self.steps + 1} (from t = {t:.10g}); try a smaller dt; the result up to "
-                f"the last good state is kept on .result", time=t, step=self.steps,
-                result=result)
-        name = lambda k: self._names[self._order[k]]  # noqa: E731
-        if status == Status.STEP_UNDERFLOW:
-            # the bodies that drove it, where the method names them (not trace)
-            who = [name(int(k)) for k in self._ws.get("info", ()) if k >= 0]
-            raise StepSizeUnderflow(
-                f"the step size of {self.integrator.name!r} collapsed at t = {t:.10g} "
-                f"(step {self.steps})" + (f", driven by {', '.join(map(repr, who))}"
-                                           if who else "")
-                + "; the result up to the last good state is kept on .result",
-                time=t, step=self.steps, result=result)
-        i, j = (int(k) for k in self._stop_info)
-        if status == Status.CLOSE_ENCOUNTER:
-            bodies = (name(i), name(j))
-            tc, dist = (float(a) for a in self._stop_hit[:2])
-            raise CloseEncounter(f"close encounter of {bodies[0]!r} and {bodies[1]!r} "
-                                 f"(closest at t = {tc:.10g} {self.units.time}, separation "
-                                 f"{dist:.6g} {self.units.length}) in the step ending at "
-                                 f"t = {t:.10g} (step {self.steps}); the result up to here "
-                                 f"is kept on .result", time=t, step=self.steps,
-                                 result=result, bodies=bodies)
-        if status == Status.COLLISION:
-            bodies = (name(i), name(j))
-            q = self.units.quantity
-            tc, dist, speed = (float(a) for a in self._stop_hit)
-            # after the state kept: a step the integrator could not finish (beyond
-            # the rounding of a contact at a step's end)
-            now = self._now()
-            inside = tc <= now + 1e-9 * abs(self._dt) + 1e-15 * abs(now)
-            where = (f"in the step ending at t = {t:.10g} (step {self.steps})" if inside else
-                     f"in a step the integrator could not finish; the run stopped at "
-                     f"t = {t:.10g} (step {self.steps}), the last state it reached whole")
-            raise Collision(f"{bodies[0]!r} and {bodies[1]!r} collided "
-                            f"({'closest' if inside else 'touching'} at t = {tc:.10g}, "
-                            f"separation {dist:.6g} {self.units.length}) "
-                            f"{where}; the result up to here is kept on .result",
-                            time=t, step=self.steps,
-                            result=result, bodies=bodies, contact_time=q(tc, "time"),
-                            distance=q(dist, "length"),
-                            speed=q(speed, "length") / self.units.time)
-        if status == Status.ESCAPE:
-            bodies = (name(i),)
-            raise Escape(f"{bodies[0]!r} escaped at t = {t:.10g} (step {self.steps}); the "
-                         f"result up to here is kept on .result", time=t, step=self.steps,
-                         result=result, bodies=bodies)
-        raise RuntimeError(f"unexpected status {status!r}")  # pragma: no cover
+        _failures.fail(self, status, rec, wall0)
 
     def __repr__(self):
         """One line: bodies, time, integrator and its options, step, forces, stopping
@@ -1257,40 +1049,6 @@ def _split_forces(forces, softening, parallel, rebound_arithmetic):
     return tuple(t for t in forces if not isinstance(t, Gravity)), gravity
 
 
-def _marks_ok(plan, total):
-    # the plan's marks are strictly increasing and below total, without
-    # walking a million of them where arithmetic tells: marks are round(i s)
-    # with s = ratio / (outputs - 1); within a quarter step of a whole k they
-    # are i k exactly, and at s >= 2 consecutive ones are at least one apart
-    o = plan.outputs
-    if o > 2:
-        s = plan.ratio / (o - 1)
-        k = int(round(s))
-        if (k >= 1 and abs(plan.ratio - k * (o - 1)) < 0.25) or s >= 2:
-            return min(int(round((o - 2) * s)), plan.n_full) < total
-    return _increasing(plan.marks(), total)
-
-
-def _increasing(marks, total):
-    last = 0
-    for mark in marks:
-        if mark <= last:
-            return False
-        last = mark
-    return last < total or (last == 0 and total > 0)
-
-
 def _positive_number(value):
     return (isinstance(value, numbers.Real) and not isinstance(value, bool)
             and 0 < float(value) < math.inf)
-
-
-def _user_function_failed(fargs):
-    """Whether a user term of a table in ``fargs`` (nested tuples) returned the
-    wrong shape (see :mod:`orbits._user_functions`)."""
-    from ._kernels.terms import TermTable
-    if isinstance(fargs, TermTable):
-        return fargs.user is not None and bool(fargs.user.flag[0])
-    if isinstance(fargs, tuple):
-        return any(_user_function_failed(f) for f in fargs)
-    return False
