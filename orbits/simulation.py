@@ -3,8 +3,19 @@
 Units are converted once, when the simulation is made; the run works on
 float64 arrays in the body set's unit system and attaches units again only
 to what it returns.
+
+This module is the facade: :class:`Simulation`'s construction and public
+methods.  The ideas it draws on live in modules of their own: the force terms'
+binding (:mod:`orbits._force_binding`), variations and chaos indicators
+(:mod:`orbits._variations`), stopping conditions and the encounter log
+(:mod:`orbits._stop_conditions`), the collision resolver
+(:mod:`orbits._collision_resolver`), state records (:mod:`orbits._state`), the
+run's plan (:mod:`orbits._run_plan`) and failures (:mod:`orbits._failures`),
+the driver (:mod:`orbits._driver`), the recorder of a run in memory
+(:mod:`orbits.recorder`) and restart from a file (:mod:`orbits.io.restart`).
 """
 
+import html
 import math
 import numbers
 
@@ -13,18 +24,21 @@ import numpy as np
 
 from . import _collision_resolver as _resolver
 from . import _failures
+from . import _force_binding as _binding
 from . import _integrator_choice as _choice
 from . import _run_plan
 from . import _state
 from . import _stop_conditions as _stops
 from . import _variations
 from . import collisions as _collisions
+from . import forces as _forces
 from . import integrators as _integrators
 from ._driver import (CHUNK_SECONDS, FIRST_CHUNK, PROGRESS_DELAY,  # noqa: F401 - documented here
                       Driven)
 from ._kernels import gravity as _gravity
 from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
+from ._kernels import variational as _var
 from .bodies import BodySet
 from .errors import BodyUnitsError, IntegratorOptionError, SimulationOptionError
 from .io import hdf5 as _hdf5
@@ -189,7 +203,7 @@ class Simulation(Driven):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
-        terms, gravity = _split_forces(forces, softening, parallel, rebound_arithmetic)
+        terms, gravity = _binding.split(forces, softening, parallel, rebound_arithmetic)
         softening, parallel = gravity.softening, gravity.parallel
         rebound_arithmetic = gravity.rebound_arithmetic
         self.units = bodies.units
@@ -236,7 +250,7 @@ class Simulation(Driven):
         self._eargs = None
         if terms:
             self.integrator.check_terms(terms)
-            self._bind_terms(bodies)
+            _binding.bind_terms(self, bodies)
 
         if isinstance(monitors, str):
             raise ValueError(f"monitors must be a list of monitor names, got the string "
@@ -344,50 +358,6 @@ class Simulation(Driven):
         """
         return _variations.jacobian(self)
 
-    def _bind_terms(self, bodies):
-        """Compile gravity and the added terms into one force (see :mod:`orbits.forces`).
-
-        The non-conservative terms (``conservative = False``) are chained once
-        more on their own: the loops integrate their work from that chain
-        (:func:`orbits._kernels.stepping.with_terms`), so that the energy
-        monitor can report ``E + W``.
-        """
-        from . import forces as _forces
-        from ._kernels import terms as _kterms
-        ctx = _forces.Context([self._names[k] for k in self._order], self._m, self._gm,
-                              self._n_active, self.units, self._bare_ok, self._order,
-                              np.ascontiguousarray(bodies._x), np.ascontiguousarray(bodies._v))
-        bound = [term.bind(ctx) for term in self._terms]
-        dissipative = [b for term, b in zip(self._terms, bound) if not term.conservative]
-        terms = _kterms.TABLE
-        self._force = _stepping.with_terms(self._force, terms,
-                                           any(t.velocity_dependent for t in self._terms),
-                                           work=terms if dissipative else None)
-        table = self._term_table(bound, ctx)
-        self._fargs = (self._fargs, table)
-        if dissipative:
-            self._fargs += (_stepping.work_args(self._term_table(dissipative, ctx), self._m),)
-        self._eargs = table
-
-    def _term_table(self, bound, ctx):
-        """The :class:`~orbits._kernels.terms.TermTable` of bound terms, with
-        the pointers of their user functions, if any."""
-        from . import _user_functions
-        from ._kernels import terms as _kterms
-        users = [b.user for b in bound if b.user is not None]
-        rows = [b.row for b in bound if b.user is None]
-        user = None
-        if users:
-            accel, energy = _user_functions.term_pointers(users)
-            pos = np.argsort(ctx.order).astype(np.int64)
-            n = len(pos)
-            user = _kterms.UserTerms(accel, energy, pos, np.zeros((n, 3)), np.zeros((n, 3)),
-                                     np.ascontiguousarray(ctx.m[pos]),
-                                     np.zeros(1, dtype=np.int64),
-                                     any(u.velocity_dependent for u in users))
-            rows.append(_kterms.TermRow(_kterms.USER))
-        return _kterms.table(rows, self._gm, self._m, user)
-
     @property
     def config(self):
         """The :class:`SimulationConfig` that rebuilds this simulation from its bodies.
@@ -427,7 +397,6 @@ class Simulation(Driven):
         >>> twin.integrator.name, twin.dt
         ('leapfrog', <Quantity 1. d>)
         """
-        from . import forces as _forces
         if isinstance(config, dict):
             config = SimulationConfig.from_dict(config)
         integ = _integrators.get(config.integrator, **config.integrator_options)
@@ -469,8 +438,7 @@ class Simulation(Driven):
         >>> type(sim.gravity).__name__
         'Gravity'
         """
-        from .forces import Gravity
-        return Gravity(softening=self._softening, parallel=self.parallel,
+        return _forces.Gravity(softening=self._softening, parallel=self.parallel,
                        rebound_arithmetic=self.rebound_arithmetic)
 
     def _mon(self, every):
@@ -841,9 +809,8 @@ class Simulation(Driven):
             row[0] += self._base_force.terms.energy(self._x, self._v, self._eargs)
             row[_inv.WORK_COLUMN] = _stepping.work_total(self._ws)
         if self._chaos_box is not None:
-            from ._kernels.variational import chaos_values
             col = _inv.MONITOR_COLUMNS.index("megno")
-            row[col:col + 3] = chaos_values(self._ws["chaos"])
+            row[col:col + 3] = _var.chaos_values(self._ws["chaos"])
         self._offset_rows(row[None])
         return row
 
@@ -991,7 +958,6 @@ class Simulation(Driven):
 
     def _repr_html_(self):
         """The same as a table, for Jupyter."""
-        import html
         rows = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{html.escape(v)}</td>"
                        f"</tr>" for k, v in self._described())
         return f"<div><strong>Simulation</strong><table>{rows}</table></div>"
@@ -1021,32 +987,6 @@ class Simulation(Driven):
         if stops:
             rows.append(("stopping", stops))
         return rows
-
-
-def _split_forces(forces, softening, parallel, rebound_arithmetic):
-    """The added terms and the gravity term (with the keywords' options) of ``forces``."""
-    from .forces import ForceTerm, Gravity
-    if isinstance(forces, ForceTerm):
-        forces = (forces,)
-    try:
-        forces = tuple(forces)
-    except TypeError:
-        raise TypeError(f"forces must be a sequence of force terms (orbits.forces), "
-                        f"got {forces!r}") from None
-    for term in forces:
-        if not isinstance(term, ForceTerm):
-            raise TypeError(f"forces must hold force terms of orbits.forces (GR, "
-                            f"GRPotential, GRFull, ZonalHarmonics, UserForce, Gravity); "
-                            f"got {term!r}")
-    gravities = [t for t in forces if isinstance(t, Gravity)]
-    if len(gravities) > 1:
-        raise ValueError("forces holds more than one Gravity term; give one")
-    keywords = softening is not None or parallel is not None or rebound_arithmetic
-    if gravities and keywords:
-        raise ValueError("gravity's options are given twice: set softening, parallel and "
-                         "rebound_arithmetic either on the Gravity term or as keywords")
-    gravity = gravities[0] if gravities else Gravity(softening, parallel, rebound_arithmetic)
-    return tuple(t for t in forces if not isinstance(t, Gravity)), gravity
 
 
 def _positive_number(value):
