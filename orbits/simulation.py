@@ -3,36 +3,50 @@
 Units are converted once, when the simulation is made; the run works on
 float64 arrays in the body set's unit system and attaches units again only
 to what it returns.
+
+This module is the facade: :class:`Simulation`'s construction and public
+methods.  The ideas it draws on live in modules of their own: the force terms'
+binding (:mod:`orbits._force_binding`), variations and chaos indicators
+(:mod:`orbits._variations`), stopping conditions and the encounter log
+(:mod:`orbits._stop_conditions`), the collision resolver
+(:mod:`orbits._collision_resolver`), state records (:mod:`orbits._state`), the
+run's plan (:mod:`orbits._run_plan`) and failures (:mod:`orbits._failures`),
+the driver (:mod:`orbits._driver`), the recorder of a run in memory
+(:mod:`orbits.recorder`) and restart from a file (:mod:`orbits.io.restart`).
 """
 
-import functools
+import html
 import math
 import numbers
-import time as _time
-import warnings
-from collections.abc import Mapping
 
 import astropy.units as u
 import numpy as np
 
-from . import collisions as _collisions
+from . import _collision_resolver as _resolver
+from . import _failures
+from . import _force_binding as _binding
 from . import _integrator_choice as _choice
-from . import epochs as _epochs
+from . import _run_plan
+from . import _state
+from . import _stop_conditions as _stops
+from . import _variations
+from . import collisions as _collisions
+from . import forces as _forces
 from . import integrators as _integrators
-from ._kernels import invariants as _inv
-from ._kernels import stepping as _stepping
 from ._driver import (CHUNK_SECONDS, FIRST_CHUNK, PROGRESS_DELAY,  # noqa: F401 - documented here
                       Driven)
 from ._kernels import gravity as _gravity
-from ._kernels.status import Status
+from ._kernels import invariants as _inv
+from ._kernels import stepping as _stepping
+from ._kernels import variational as _var
 from .bodies import BodySet
-from .errors import (BodyError, BodyUnitsError, CloseEncounter, Collision, ConvergenceFailure,
-                     Escape, ForceTermError, IntegratorOptionError, NonFiniteState, OrbitsError,
-                     OrbitsWarning, SimulationOptionError, StepSizeUnderflow)
-from .monitors import DEFAULT_MONITORS, monitor_field_names, monitor_fields, monitor_mask
-from .records import (FUNCTION_PREFIX, RunPlan, SimulationConfig, SimulationDescription,
-                      SimulationState, Snapshot, _function_name)
-from .result import Result
+from .errors import BodyUnitsError, IntegratorOptionError, SimulationOptionError
+from .io import hdf5 as _hdf5
+from .io import restart as _restart
+from .monitors import DEFAULT_MONITORS, monitor_mask
+from .recorder import Recorder
+from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
+                      Snapshot)
 
 __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescription",
            "Snapshot", "RunPlan", "PARALLEL_THRESHOLD", "LOG_ROWS"]
@@ -53,65 +67,6 @@ PARALLEL_THRESHOLD = 128
 
 #: Outputs of a run when none are asked for.
 DEFAULT_OUTPUTS = 500
-
-#: The most steps one run may take: beyond 2**53 float64 no longer tells the
-#: times of neighbouring steps apart.
-MAX_STEPS = float(2 ** 53)
-
-
-def _with_callers_functions(path, config, collisions, functions):
-    """The configuration ``config`` that the file ``path`` records, with the
-    collisions function the caller gives; a :class:`SimulationOptionError`
-    unless the caller gives every function of the user's that it names, and
-    no other (see :meth:`Simulation.from_file`)."""
-    from . import forces as _forces
-    from .io.h5md import OrbitsFileError
-    try:
-        needed = _forces.functions_needed(config["forces"])
-    except _forces.ForceTermError as exc:
-        raise OrbitsFileError(f"{path}: its recorded force terms do not rebuild: "
-                              f"{exc}") from None
-    given = lambda ref: ref in functions or ref.partition(":")[2] in functions  # noqa: E731
-    used = {k for k in functions for ref in needed if k in (ref, ref.partition(":")[2])}
-    missing = {ref: what for ref, what in needed.items() if not given(ref)}
-    asks = [ref.partition(":")[2] for ref in missing]
-    missing = [f"{ref!r} ({what})" for ref, what in missing.items()]
-    named = config["stop_conditions"].get("collisions")
-    if isinstance(named, str) and named.startswith(FUNCTION_PREFIX):
-        recorded = named[len(FUNCTION_PREFIX):]
-        keys = [k for k in functions if _names_function(recorded, k)]
-        used.update(keys)
-        if collisions is None and keys:
-            collisions = functions[keys[0]]
-        if collisions is None:
-            missing.append(f"{recorded!r} (the collisions function; or collisions=...)")
-            asks.append(recorded.rpartition(".")[2])
-        elif not (_function_name(collisions) == named or _names_function(
-                recorded, getattr(collisions, "__qualname__", ""))):
-            raise SimulationOptionError(
-                f"{path}: its run resolved collisions with the function {recorded}; the "
-                f"function given, {collisions!r}, has another name")
-        else:
-            config = dict(config, stop_conditions=dict(config["stop_conditions"],
-                                                       collisions=collisions))
-    if missing:
-        raise SimulationOptionError(
-            f"{path}: its run used function(s) that a file names but never holds: "
-            + "; ".join(missing) + "; pass them again: Simulation.from_file(path, "
-            "functions={" + ", ".join(f"{name!r}: ..." for name in asks) + "})")
-    unused = sorted(set(functions) - used)
-    if unused:
-        raise SimulationOptionError(
-            f"{path}: functions names {', '.join(map(repr, unused))}, which its run did "
-            f"not use; it records: {', '.join(map(repr, needed)) or 'no functions'}")
-    return config
-
-
-def _names_function(recorded, name):
-    """Whether ``name`` (a qualname, or ``module.qualname``) is the function a
-    plain record names as ``recorded`` (``module.qualname``)."""
-    return bool(name) and (recorded == name or recorded.endswith("." + name))
-
 
 class Simulation(Driven):
     """A body set evolving under Newtonian gravity and added force terms with a
@@ -248,7 +203,7 @@ class Simulation(Driven):
         if not isinstance(bodies, BodySet):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
-        terms, gravity = _split_forces(forces, softening, parallel, rebound_arithmetic)
+        terms, gravity = _binding.split(forces, softening, parallel, rebound_arithmetic)
         softening, parallel = gravity.softening, gravity.parallel
         rebound_arithmetic = gravity.rebound_arithmetic
         self.units = bodies.units
@@ -295,7 +250,7 @@ class Simulation(Driven):
         self._eargs = None
         if terms:
             self.integrator.check_terms(terms)
-            self._bind_terms(bodies)
+            _binding.bind_terms(self, bodies)
 
         if isinstance(monitors, str):
             raise ValueError(f"monitors must be a list of monitor names, got the string "
@@ -309,8 +264,9 @@ class Simulation(Driven):
         self.monitor_every = None if monitor_every is None else int(monitor_every)
 
         self._stop_info = np.zeros(2, dtype=np.int64)
-        self._stop = self._stop_args(encounter_distance, encounter_hill, escape_distance,
-                                     escape_unbound, collisions, encounter_log, restitution)
+        self._stop = _stops.set_up(self, encounter_distance, encounter_hill, escape_distance,
+                                   escape_unbound, collisions, encounter_log, restitution,
+                                   LOG_ROWS)
         if self._resolves_collisions and variations is not None:
             raise SimulationOptionError(
                 f"collisions={collisions!r} changes the bodies during the run, which the "
@@ -318,7 +274,7 @@ class Simulation(Driven):
                 f"variations=")
         # the force without variations, and its arguments
         self._base_force, self._base_fargs = self._force, self._fargs
-        self._bind_variations(variations, seed)
+        _variations.bind(self, variations, seed)
         rows = len(self._rows_x)
         self._ws = (self.integrator.workspace(rows, self._dt) if adaptive
                     else self.integrator.workspace(rows))
@@ -357,91 +313,6 @@ class Simulation(Driven):
             # now, at t = 0, as a run merges them (collisions table, offsets)
             self._resolve_collisions(None, None)
 
-    def _bind_variations(self, variations, seed):
-        """Tangent rows after the bodies' and the force of the augmented system
-        (:mod:`orbits._kernels.variational`), for ``variations`` and the chaos
-        monitors."""
-        from ._kernels import variational as _var
-        from .monitors import CHAOS_MONITORS
-        n = len(self._m)
-        chaos = any(name in CHAOS_MONITORS for name in self.monitors)
-        if chaos and not self.integrator.chaos_indicators:
-            raise IntegratorOptionError(
-                f"{self.integrator.name!r} steps outside the package's compiled loops and "
-                f"cannot follow the chaos monitors "
-                f"{', '.join(n for n in self.monitors if n in CHAOS_MONITORS)}; use 'ias15', "
-                "'dop853', 'leapfrog' or 'wh'")
-        if variations is None:
-            n_state, n_mass, n_random = 0, 0, 0
-        elif isinstance(variations, str) and variations in ("state", "all"):
-            n_state, n_mass, n_random = 6 * n, (n if variations == "all" else 0), 0
-        elif (isinstance(variations, numbers.Integral) and not isinstance(variations, bool)
-              and variations >= 1):
-            n_state, n_mass, n_random = 0, 0, int(variations)
-        else:
-            raise IntegratorOptionError(
-                f"variations must be None, 'state', 'all' or a whole number of random "
-                f"tangent vectors >= 1, got {variations!r}")
-        if seed is not None and not isinstance(seed, numbers.Integral):
-            raise IntegratorOptionError(f"seed must be an integer, got {seed!r}")
-        if seed is None and (chaos or n_random):
-            # drawn once and kept in the config, so that a rebuilt simulation
-            # (a file, an ensemble's member) starts from the same vectors
-            seed = int(np.random.SeedSequence().entropy % 2 ** 63)
-        self._variations = variations
-        self._seed = None if seed is None else int(seed)
-        self._n_chaos = int(chaos)
-        k = self._n_chaos + n_random + n_state + n_mass
-        self._n_tangent = k
-        self._tangent_layout = (self._n_chaos, n_random, n_state, n_mass)
-        self._rows_x = np.zeros((n * (1 + k), 3))
-        self._rows_v = np.zeros((n * (1 + k), 3))
-        self._rows_x[:n] = self._x
-        self._rows_v[:n] = self._v
-        self._x = self._rows_x[:n]
-        self._v = self._rows_v[:n]
-        self._chaos_box = None
-        if k == 0:
-            return
-        if n_mass and self._terms:
-            raise IntegratorOptionError(
-                "variations='all' (derivatives with respect to the masses) take gravity's "
-                "dependence on the masses only, and the force terms "
-                f"{', '.join(map(repr, self._terms))} depend on them too; use "
-                "variations='state', or drop the terms")
-        dx, dv, dm = self._initial_tangents(n, seed)
-        self._rows_x[n:] = dx.reshape(-1, 3)
-        self._rows_v[n:] = dv.reshape(-1, 3)
-        self._chaos_box = _var.chaos_box(0.0)
-        self._force = _var.with_variations(self._base_force, masses=bool(n_mass), chaos=chaos)
-        self._fargs = _var.variation_args(self._base_fargs, n, dm, self._chaos_box,
-                                          self.units.G, self._eps2)
-
-    def _initial_tangents(self, n, seed):
-        # (k, n, 3) position and velocity parts and (k, n) mass parts, in the
-        # internal (massive first) order: the chaos vector, the random ones,
-        # then a unit vector per initial coordinate of each body in the body
-        # set's order (x, y, z, vx, vy, vz), then per mass
-        n_chaos, n_random, n_state, n_mass = self._tangent_layout
-        k = self._n_tangent
-        dx = np.zeros((k, n, 3))
-        dv = np.zeros((k, n, 3))
-        dm = np.zeros((k, n))
-        rng = np.random.default_rng(seed)
-        for j in range(n_chaos + n_random):
-            w = rng.standard_normal((2, n, 3))
-            w /= np.sqrt(np.sum(w * w))
-            dx[j], dv[j] = w
-        j = n_chaos + n_random
-        inv = self._inverse
-        for b in range(n if n_state else 0):
-            for c in range(6):
-                (dx if c < 3 else dv)[j + 6 * b + c, inv[b], c % 3] = 1.0
-        j += n_state
-        for b in range(n_mass):
-            dm[j + b, inv[b]] = 1.0
-        return dx, dv, dm
-
     @property
     def _X(self):
         return self._rows_x
@@ -451,20 +322,7 @@ class Simulation(Driven):
         return self._rows_v
 
     def _renormalise(self):
-        from ._kernels import variational as _var
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        _var.renormalise(self._rows_x, self._rows_v, len(self._m), self._ws["chaos"])
-        self.integrator.invalidate(self._ws)
-
-    def _tangent_rows(self):
-        """The tangent vectors now, shape (k, N, 6) in the body set's order, and
-        the mass parts (k, N)."""
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        n = len(self._m)
-        k = self._n_tangent
-        t = np.concatenate([self._rows_x[n:].reshape(k, n, 3),
-                            self._rows_v[n:].reshape(k, n, 3)], axis=2)
-        return t[:, self._inverse]
+        _variations.renormalise(self)
 
     @property
     def tangent_vectors(self):
@@ -476,7 +334,7 @@ class Simulation(Driven):
         ones, then those of ``variations="state"`` or ``"all"``."""
         if not self._n_tangent:
             return None
-        return self._tangent_rows()
+        return _variations.tangent_rows(self)
 
     @property
     def jacobian(self):
@@ -498,56 +356,7 @@ class Simulation(Driven):
         >>> sim.jacobian.shape
         (12, 12)
         """
-        n_chaos, n_random, n_state, n_mass = self._tangent_layout
-        if not n_state:
-            return None
-        t = self._tangent_rows()[n_chaos + n_random:]
-        n = len(self._m)
-        return t.reshape(n_state + n_mass, 6 * n).T.copy()
-
-    def _bind_terms(self, bodies):
-        """Compile gravity and the added terms into one force (see :mod:`orbits.forces`).
-
-        The non-conservative terms (``conservative = False``) are chained once
-        more on their own: the loops integrate their work from that chain
-        (:func:`orbits._kernels.stepping.with_terms`), so that the energy
-        monitor can report ``E + W``.
-        """
-        from . import forces as _forces
-        from ._kernels import terms as _kterms
-        ctx = _forces.Context([self._names[k] for k in self._order], self._m, self._gm,
-                              self._n_active, self.units, self._bare_ok, self._order,
-                              np.ascontiguousarray(bodies._x), np.ascontiguousarray(bodies._v))
-        bound = [term.bind(ctx) for term in self._terms]
-        dissipative = [b for term, b in zip(self._terms, bound) if not term.conservative]
-        terms = _kterms.TABLE
-        self._force = _stepping.with_terms(self._force, terms,
-                                           any(t.velocity_dependent for t in self._terms),
-                                           work=terms if dissipative else None)
-        table = self._term_table(bound, ctx)
-        self._fargs = (self._fargs, table)
-        if dissipative:
-            self._fargs += (_stepping.work_args(self._term_table(dissipative, ctx), self._m),)
-        self._eargs = table
-
-    def _term_table(self, bound, ctx):
-        """The :class:`~orbits._kernels.terms.TermTable` of bound terms, with
-        the pointers of their user functions, if any."""
-        from . import _user_functions
-        from ._kernels import terms as _kterms
-        users = [b.user for b in bound if b.user is not None]
-        rows = [b.row for b in bound if b.user is None]
-        user = None
-        if users:
-            accel, energy = _user_functions.term_pointers(users)
-            pos = np.argsort(ctx.order).astype(np.int64)
-            n = len(pos)
-            user = _kterms.UserTerms(accel, energy, pos, np.zeros((n, 3)), np.zeros((n, 3)),
-                                     np.ascontiguousarray(ctx.m[pos]),
-                                     np.zeros(1, dtype=np.int64),
-                                     any(u.velocity_dependent for u in users))
-            rows.append(_kterms.TermRow(_kterms.USER))
-        return _kterms.table(rows, self._gm, self._m, user)
+        return _variations.jacobian(self)
 
     @property
     def config(self):
@@ -588,7 +397,6 @@ class Simulation(Driven):
         >>> twin.integrator.name, twin.dt
         ('leapfrog', <Quantity 1. d>)
         """
-        from . import forces as _forces
         if isinstance(config, dict):
             config = SimulationConfig.from_dict(config)
         integ = _integrators.get(config.integrator, **config.integrator_options)
@@ -630,8 +438,7 @@ class Simulation(Driven):
         >>> type(sim.gravity).__name__
         'Gravity'
         """
-        from .forces import Gravity
-        return Gravity(softening=self._softening, parallel=self.parallel,
+        return _forces.Gravity(softening=self._softening, parallel=self.parallel,
                        rebound_arithmetic=self.rebound_arithmetic)
 
     def _mon(self, every):
@@ -653,16 +460,7 @@ class Simulation(Driven):
         >>> sim.stop_conditions["escape_distance"], sim.stop_conditions["escape_unbound"]
         (<Quantity 100. AU>, False)
         """
-        c = self._stop_config
-        q = lambda val: None if val is None else self.units.quantity(val, "length")  # noqa: E731
-        return {"encounter_distance": q(c["encounter_distance"]),
-                "encounter_hill": c["encounter_hill"],
-                "escape_distance": q(c["escape_distance"]),
-                "escape_unbound": c["escape_unbound"],
-                "collisions": c["collisions"],
-                "restitution": c.get("restitution"),
-                "encounter_log": (q(c["encounter_log"][0]) if c["encounter_log"][0]
-                                  else c["encounter_log"][1])}
+        return _stops.keywords(self)
 
     @property
     def softening(self):
@@ -681,234 +479,25 @@ class Simulation(Driven):
         """
         return self._softening
 
-    def _positive_length(self, value, field):
-        d = float(self.units.to_internal(value, "length", bare_ok=self._bare_ok, field=field))
-        if not (d > 0 and math.isfinite(d)):
-            raise ValueError(f"{field} must be a positive length, got {value}")
-        return d
-
-    def _stop_args(self, distance, hill, escape, unbound, collisions=None, log=None,
-                   restitution=None):
-        from ._kernels import stopping as _s
-        mask = 0
-        d2 = esc2 = 0.0
-        k = 0.0
-        if distance is not None:
-            mask |= _s.ENCOUNTER_DISTANCE
-            d = self._positive_length(distance, "encounter_distance")
-            d2 = d * d
-        if hill is not None:
-            k = float(hill)
-            if not (k > 0 and math.isfinite(k)):
-                raise ValueError(f"encounter_hill must be a positive number of Hill radii, "
-                                 f"got {hill}")
-            mask |= _s.ENCOUNTER_HILL
-        if escape is not None:
-            mask |= _s.ESCAPE
-            e = self._positive_length(escape, "escape_distance")
-            esc2 = e * e
-        if unbound:
-            if escape is None:
-                raise ValueError("escape_unbound needs escape_distance (the radius beyond "
-                                 "which an unbound body counts as escaped)")
-            mask |= _s.UNBOUND
-        if collisions is not None:
-            self._check_collisions(collisions)
-            mask |= _s.COLLISION
-        if restitution is not None:
-            if collisions is None or collisions in ("halt", "merge"):
-                raise SimulationOptionError(
-                    f"restitution={restitution!r} is for collisions='bounce' (or a "
-                    f"collisions function), not collisions={collisions!r}")
-            ok = (isinstance(restitution, numbers.Real) and not isinstance(restitution, bool)
-                  and 0.0 <= float(restitution) <= 1.0)
-            if not ok:
-                raise SimulationOptionError(f"restitution must be a number from 0 to 1 "
-                                            f"(1: elastic), got {restitution!r}")
-            restitution = float(restitution)
-        log_hill = log_distance = 0.0
-        if log is not None:
-            mask |= _s.ENCOUNTER_LOG
-            if isinstance(log, u.Quantity):
-                log_distance = self._positive_length(log, "encounter_log")
-            else:
-                log_hill = float(log)
-                if not (log_hill > 0 and math.isfinite(log_hill)):
-                    raise SimulationOptionError(
-                        f"encounter_log must be a positive number of mutual Hill radii or "
-                        f"a length, got {log!r}")
-        self._stop_config = {"encounter_distance": d if distance is not None else None,
-                             "encounter_hill": k or None,
-                             "escape_distance": e if escape is not None else None,
-                             "escape_unbound": bool(unbound),
-                             "collisions": collisions,
-                             "restitution": restitution,
-                             "encounter_log": (log_distance or None, log_hill or None)}
-        n = len(self._m)
-        # the encounter log's rows (emptied by the driver, enlarged when a
-        # step has more approaches than they hold), and its count and where a
-        # look that filled it stopped
-        self._log = np.zeros((LOG_ROWS if mask & _s.ENCOUNTER_LOG else 0, 5))
-        self._log_n = np.zeros(3, dtype=np.int64)
-        self._encounters = []
-        # the state of the previous check and its time (for looking inside a
-        # step): the start, so that the first step is looked inside too;
-        # scratch, and where a collision or an encounter was found
-        self._stop_clock = np.array([0.0, 1.0])
-        self._stop_hit = np.zeros(3)
-        if not mask:
-            return None
-        checked = self.integrator.stop_conditions
-        if not checked:
-            what = "collisions" if collisions is not None else "stopping conditions"
-            raise IntegratorOptionError(f"integrator {self.integrator.name!r} does not check "
-                                        f"{what}; use 'ias15' or another method that does")
-        if checked is not True:
-            given = {"encounter_distance": distance, "encounter_hill": hill,
-                     "escape_distance": escape, "escape_unbound": unbound or None,
-                     "collisions": collisions, "encounter_log": log}
-            refused = [k for k, value in given.items() if value is not None and k not in checked]
-            if refused:
-                raise IntegratorOptionError(
-                    f"integrator {self.integrator.name!r} checks only {', '.join(checked)}, "
-                    f"not {', '.join(refused)}; use 'ias15' or another method that does")
-        central = int(np.argmax(self._m))
-        return (mask, d2, k, esc2, self._gm, central, self._stop_info, self._r,
-                np.stack([self._x, self._v]), self._stop_clock, np.zeros((4, 3)),
-                self._stop_hit, log_hill, log_distance, self._log, self._log_n)
-
+    # -- the driver's hooks: the encounter log, resolved collisions ----------------------
     def _drain_log(self, rec=None):
-        """Move the encounter log's rows from the loop's buffer into the run's
-        list, and into ``rec``'s file if it keeps one."""
-        k = int(self._log_n[0])
-        if k:
-            name = lambda i: self._names[self._order[int(i)]]  # noqa: E731
-            rows = [(float(t), name(j), name(i), float(dist), float(speed))
-                    for t, j, i, dist, speed in self._log[:k]]
-            self._encounters.extend(rows)
-            self._log_n[0] = 0
-            keep = getattr(rec, "encounter_rows", None)
-            if keep is not None:
-                keep(self, rows)
-
-    def _grow_log(self):
-        """A log table twice as long (a step had more approaches than it held)."""
-        self._log = np.zeros((max(2 * len(self._log), 1), 5))
-        self._stop = self._stop[:14] + (self._log,) + self._stop[15:]
-
-    def _log_step(self, x, v, t, rec=None):
-        """The encounter log's look at the step that ended at ``t`` with state
-        ``x``, ``v`` (a look the loop did not take), emptying and enlarging the
-        table as it fills."""
-        from ._kernels import stopping as _s
-        if not self._stop[0] & _s.ENCOUNTER_LOG:
-            return
-        while _s.encounter_log(x, v, t, self._stop):
-            self._drain_log(rec)
-            if not self._log_n[1]:
-                break
-            self._grow_log()
+        _stops.drain_log(self, rec)
 
     def _log_full(self, rec, wall0):
-        """The loop handed the encounter log back (``Status.LOG_FULL``): its rows
-        go into the run's list; if it filled inside a step, it is enlarged and
-        the loop's check of that step is finished (the log's look from where it
-        stopped, then the other conditions, which may stop the run)."""
-        from ._kernels import stopping as _s
-        self._drain_log(rec)
-        if not self._log_n[1]:
-            return
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        t = self._now()
-        x, v, t = self.integrator.checked_state(self._ws, t) or (self._x, self._v, t)
-        status = Status.LOG_FULL
-        while status == Status.LOG_FULL and self._log_n[1]:
-            self._grow_log()
-            status = _s.check_stop(x, v, t, self._stop)
-            self._drain_log(rec)
-        if status not in (0, Status.LOG_FULL):
-            self._fail(Status(status), rec, wall0)
+        _stops.log_full(self, rec, wall0)
 
     def _encounter_table(self):
-        """``result.encounters``: an astropy QTable (None without ``encounter_log``)."""
-        if self._stop_config.get("encounter_log", (None, None)) == (None, None):
-            return None
-        from astropy.table import QTable
-        rows = self._encounters
-        q = self.units.quantity
-        col = lambda k: [r[k] for r in rows]  # noqa: E731
-        return QTable({"time": q(np.array(col(0), dtype=float), "time"),
-                       "body_1": np.array(col(1), dtype=str),
-                       "body_2": np.array(col(2), dtype=str),
-                       "distance": q(np.array(col(3), dtype=float), "length"),
-                       "speed": q(np.array(col(4), dtype=float), "length") / self.units.time})
+        return _stops.encounter_table(self)
 
     #: the ways a collision can be resolved (Simulation's ``collisions``; or a
     #: function, see :mod:`orbits.collisions`)
     COLLISION_RESOLUTIONS = _collisions.RESOLUTIONS
 
     @property
-    def _keeps_previous(self):
-        # the stopping conditions keep the state of the step before
-        # (collisions, encounters, the encounter log)
-        from ._kernels import stopping as _s
-        return self._stop is not None and bool(self._stop[0] & _s.LOOKS_INSIDE)
-
-    def _keep_current(self):
-        """The current state as the one the conditions' next look inside a
-        step starts from (the state was set from outside)."""
-        if self._stop is not None:
-            self._stop[8][0] = self._x
-            self._stop[8][1] = self._v
-            self._stop_clock[:] = (self._now(), 1.0)
-
-    @property
     def _resolves_collisions(self):
         # collisions that the run resolves and goes on (not "halt")
         c = self._stop_config.get("collisions")
         return c is not None and c != "halt"
-
-    def _check_collisions(self, collisions):
-        if not (callable(collisions) or (isinstance(collisions, str)
-                                         and collisions in self.COLLISION_RESOLUTIONS)):
-            raise SimulationOptionError(
-                f"collisions={collisions!r} is not a resolution; expected one of "
-                f"{', '.join(map(repr, self.COLLISION_RESOLUTIONS))} or a function")
-        r = self._r
-        if not np.any(r > 0):
-            raise BodyError("collisions need sizes: give the bodies that can collide a "
-                            "radius (BodySet.add(..., radius=...))", field="radius")
-        x = self._x
-        if getattr(self, "_touching_ok", False):
-            return   # bodies after a collision step, which may still touch
-        for i in range(1, len(r)):
-            d = np.sqrt(((x[:i] - x[i]) ** 2).sum(axis=1))
-            touch = np.flatnonzero(d < r[:i] + r[i])
-            if touch.size and collisions == "merge":
-                # what the user asked for: they merge at the start (__init__'s end)
-                self._merge_at_start = True
-                return
-            if touch.size:
-                j = int(touch[0])
-                raise BodyError(f"{self._names[self._order[j]]!r} and "
-                                f"{self._names[self._order[i]]!r} touch at the start "
-                                f"(separation {d[j]:.6g} < radii {r[j] + r[i]:.6g}"
-                                f"{f' {self.units.length}' if str(self.units.length) else ''}"
-                                f"); with collisions={collisions!r} the "
-                                f"bodies must start apart (collisions='merge' merges them "
-                                f"at the start)", body=self._names[self._order[i]],
-                                field="radius")
-
-    # -- collisions that the run resolves ----------------------------------------------
-    def _invariants(self):
-        """Energy (gravity and the conservative terms) and angular momentum of
-        the current state, whatever monitors were asked for."""
-        row = np.zeros(_inv.MONITOR_WIDTH)
-        _inv.monitor_row(self._x, self._v, self._m, self.units.G, self._n_active, self._eps2,
-                         _inv.ENERGY | _inv.ANGULAR_MOMENTUM, row)
-        if self._eargs is not None:
-            row[0] += self._base_force.terms.energy(self._x, self._v, self._eargs)
-        return row[0], row[1:4].copy()
 
     def _offset_rows(self, rows):
         """Monitor rows written before this call carry the collisions' offsets
@@ -920,193 +509,11 @@ class Simulation(Driven):
         return rows
 
     def _resolve_collisions(self, rec, wall0):
-        """Resolve every collision of the step just taken, in the order of
-        their contact times (the loop stopped at the first it found); see
-        :mod:`orbits.collisions`.  A ``"halt"`` from a collisions function
-        stops the run there, after the collisions before it were resolved."""
-        from ._kernels import stopping as _s
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        t = self._now()
-        n = len(self._m)
-        out = np.zeros((max(1, min(n * (n - 1) // 2, 65536)), 5))
-        found_rows = []
-        seen = self.integrator.checked_state(self._ws, t)
-        if seen is not None:
-            # the loop looked (and found the first pair) at a state before t:
-            # the pairs up to there, then those of the rest of the step
-            xk, vk, tk = seen
-            found = _s.collision_pairs(xk, vk, tk, self._stop, out)
-            found_rows += out[:found].tolist()
-            self._log_step(xk, vk, tk, rec)
-            _s.keep_state(xk, vk, tk, self._stop)
-        found = _s.collision_pairs(self._x, self._v, t, self._stop, out)
-        found_rows += out[:found].tolist()
-        j, i = (float(k) for k in self._stop_info)
-        if rec is not None and j != i and (j, i) not in {(row[0], row[1]) for row in found_rows}:
-            # the pair the loop stopped for, touching after the state it left
-            # (an integrator that could not carry them through their contact,
-            # Trace.behind): resolved here, before its contact
-            found_rows.append([j, i] + [float(a) for a in self._stop_hit])
-        first = {}
-        for row in sorted(found_rows, key=lambda row: row[2]):
-            first.setdefault((row[0], row[1]), row)    # a pair once, at its first contact
-        pairs = list(first.values())
-        how = self._stop_config["collisions"]
-        e = self._stop_config.get("restitution")
-        e = 1.0 if e is None else e
-        m, r = self._m.copy(), self._r.copy()
-        x, v = self._x.copy(), self._v.copy()
-        alive = np.ones(n, dtype=bool)
-        into = np.arange(n)          # a merged body's survivor
-        internal = self._names_internal()
-        G = self.units.G
-        E0, L0 = self._invariants()
-        rows, halted = [], None
-
-        def root(k):
-            while into[k] != k:
-                k = into[k]
-            return k
-
-        def resolve(a, b, tc, dist, speed):
-            # one collision of bodies a, b (internal indices, both alive)
-            nonlocal halted
-            a, b = min(a, b), max(a, b)
-            answer = how
-            if callable(how):
-                answer = _collisions.check_answer(how(self._event(
-                    (a, b), m, r, x, v, tc, t, dist, speed)), (internal[a], internal[b]))
-            if answer == "halt":
-                halted = (a, b, tc, dist, speed)
-                return False
-            if answer == "bounce":
-                va, vb, closing = _collisions.bounce_pair(m, x, v, a, b, e)
-                dE = _collisions.pair_energy_change(m, x, v, a, b, va, vb)
-                v[a], v[b] = va, vb
-                rows.append((tc, t, internal[a], internal[b], "bounce", "", dist, speed, dE))
-                return False
-            # merge: the more massive survives (the first in the body set on a tie)
-            keep, gone = (a, b) if (m[a] > m[b] or (m[a] == m[b] and self._order[a]
-                                                    < self._order[b])) else (b, a)
-            dE = _merge_energy_change(m, x, v, alive, keep, gone, G, self._eps2)
-            m[keep], r[keep], x[keep], v[keep] = _collisions.merge_pair(m, r, x, v, keep, gone)
-            alive[gone] = False
-            into[gone] = keep
-            rows.append((tc, t, internal[a], internal[b], "merge", internal[keep], dist,
-                         speed, dE))
-            return True
-
-        merged = set()
-        for j, i, tc, dist, speed in pairs:
-            a, b = root(int(j)), root(int(i))
-            if a == b:
-                continue
-            if (a, b) != (int(j), int(i)):
-                # one of them merged earlier in this step: the merger, at the end
-                d = float(np.linalg.norm(x[a] - x[b]))
-                if d >= r[a] + r[b]:
-                    continue
-                tc, dist, speed = t, d, float(np.linalg.norm(v[a] - v[b]))
-            if resolve(a, b, tc, dist, speed):
-                merged.add(root(a))
-            if halted:
-                break
-        # chains: a merged body that now overlaps another collides again
-        while merged and not halted:
-            k = merged.pop()
-            if not alive[k]:
-                continue
-            d = np.linalg.norm(x - x[k], axis=1)
-            hit = np.flatnonzero(alive & (d < r + r[k]) & (np.arange(n) != k))
-            if hit.size:
-                o = int(hit[0])
-                if resolve(k, o, t, float(d[o]), float(np.linalg.norm(v[k] - v[o]))):
-                    merged.add(root(k))
-        if not alive.all():
-            self._drain_log(rec)
-            new_index = self._replace_bodies(m, r, x, v, alive)
-        else:
-            new_index = np.arange(n)
-            self._v[...] = v
-            self.integrator.invalidate(self._ws)
-        E1, L1 = self._invariants()
-        off = self._ws["collision_offset"]
-        off[0] -= E1 - E0
-        off[1:4] -= L1 - L0
-        self._log_step(self._x, self._v, t, rec)   # the step's approaches, which the loop left
-        _s.keep_state(self._x, self._v, t, self._stop)
-        self._collisions.extend(rows)
-        keep = getattr(rec, "collision_rows", None)
-        if keep is not None and rows:
-            keep(self, rows)
-        if halted:
-            a, b, tc, dist, speed = halted
-            self._stop_info[:] = (new_index[a], new_index[b])
-            self._stop_hit[:] = (tc, dist, speed)
-            self._fail(Status.COLLISION, rec, wall0)
+        """Resolve the collisions of the step just taken (:mod:`orbits._collision_resolver`)."""
+        _resolver.resolve(self, rec, wall0)
 
     def _names_internal(self):
         return [self._names[k] for k in self._order]
-
-    def _event(self, pair, m, r, x, v, tc, t, dist, speed):
-        q = self.units.quantity
-        a, b = pair
-        names = self._names_internal()
-        return _collisions.CollisionEvent(
-            q(tc, "time"), q(t, "time"), (names[a], names[b]), q(m[[a, b]], "mass"),
-            q(r[[a, b]], "length"), q(x[[a, b]], "length"), q(v[[a, b]], "velocity"),
-            q(dist, "length"), q(speed, "velocity"))
-
-    def _replace_bodies(self, m, r, x, v, alive):
-        """Go on with the bodies ``alive`` of these arrays (internal order),
-        after mergers: the clock, counters, monitors' reference, encounter and
-        collision lists and the integrator's scalar state carry over; returns
-        each old internal index's new one (-1: gone)."""
-        user = np.flatnonzero(alive[self._inverse])     # survivors' places in the body set
-        old = self._inverse[user]                        # their internal indices
-        bs = BodySet(self.units)
-        bs._bare_ok = self._bare_ok
-        bs._names = [self._names[k] for k in user]
-        bs._m, bs._r = m[old].copy(), r[old].copy()
-        bs._x, bs._v = x[old].copy(), v[old].copy()
-        bs.history = list(self._history)
-        bs._epoch = self._epoch
-        prev, clock = self._stop[8], self._stop[9]   # the state before the step
-        new = Simulation.__new__(Simulation)
-        new._touching_ok = True
-        stops = dict(self.stop_conditions)
-        stops = {k: val for k, val in stops.items() if val is not None and val is not False}
-        new.__init__(bs, self.integrator, dt=None if self._dt == 0 else self.dt,
-                     forces=list(self._terms), monitors=self.monitors,
-                     monitor_every=self.monitor_every,
-                     softening=self._softening, parallel=self.parallel,
-                     rebound_arithmetic=self.rebound_arithmetic, **stops)
-        # the integrator's state that does not depend on the number of bodies
-        # (an adaptive method's next step, the clock's compensation, the work)
-        for key, arr in self._ws.items():
-            mine = new._ws.get(key)
-            if isinstance(arr, np.ndarray) and isinstance(mine, np.ndarray) \
-                    and mine.shape == arr.shape and mine.dtype == arr.dtype:
-                mine[...] = arr
-        new.integrator.invalidate(new._ws)
-        carry = ("_t_base", "_steps_since_base", "steps", "force_evaluations",
-                 "steps_rejected", "_chunk", "output_path", "_resume", "_reference",
-                 "_E_scale", "_L_scale", "_encounters", "_collisions", "_wall0", "_signals",
-                 "_compile_clock", "_wall_limit", "_in_loop", "_history", "_bodies_changed")
-        for key in carry:
-            if key in self.__dict__:
-                new.__dict__[key] = self.__dict__[key]
-        del new.__dict__["_touching_ok"]
-        # the survivors' state before the step, for the encounter log's look
-        # inside it (a merged body's own)
-        new._stop[8][...] = prev[:, old[new._order]]
-        new._stop[9][...] = clock
-        self.__dict__.clear()
-        self.__dict__.update(new.__dict__)
-        self._bodies_changed += 1
-        index = np.full(len(alive), -1)
-        index[old] = self._inverse
-        return index
 
     def _collision_table(self):
         """``result.collisions``: an astropy QTable (None when the run does
@@ -1165,38 +572,7 @@ class Simulation(Driven):
         >>> again.time, bool((again.bodies.positions == sim.bodies.positions).all())
         (<Quantity 10. d>, True)
         """
-        from .io import hdf5
-        if functions is None:
-            functions = {}
-        if not isinstance(functions, Mapping) or not all(
-                isinstance(k, str) and callable(f) for k, f in functions.items()):
-            raise SimulationOptionError(
-                f"functions must map the names a file records to functions, as "
-                f"{{'drag': drag}}; got {functions!r}")
-        cp = hdf5.read_checkpoint(path)
-        config = _with_callers_functions(path, cp.config, collisions, functions)
-        try:
-            sim = cls.from_config(cp.bodies, config, _restoring=True, functions=functions)
-        except OrbitsError:
-            raise
-        except (TypeError, ValueError, KeyError, AttributeError, IndexError,
-                u.UnitsError) as exc:
-            raise hdf5.OrbitsFileError(f"{path}: its recorded configuration does not make a "
-                                       f"simulation: {exc}") from None
-        if not np.array_equal(sim._order, cp.state.order):
-            raise hdf5.OrbitsFileError(f"{path}: the stored body order does not match the "
-                                       f"masses")
-        made = sim.state.workspace
-        for name, arr in cp.state.workspace.items():
-            want = made.get(name)
-            if want is not None and (np.shape(arr) != np.shape(want) or np.asarray(
-                    arr).dtype.kind != np.asarray(want).dtype.kind):
-                raise hdf5.OrbitsFileError(
-                    f"{path}: /restart/ws/{name} holds {np.asarray(arr).dtype} values of "
-                    f"shape {np.shape(arr)} at the checkpoint; the simulation the file "
-                    f"describes keeps {np.asarray(want).dtype} values of shape "
-                    f"{np.shape(want)} there")
-        sim.set_state(cp.state)
+        sim, cp = _restart.restored(cls, path, collisions, functions)
         sim._epoch = cp.epoch       # the date of time 0, as the file keeps it
         sim.output_path = cp.path
         sim._resume = cp.point
@@ -1248,7 +624,6 @@ class Simulation(Driven):
         ...     print(str(exc).split(";")[0].endswith("finished"))
         True
         """
-        from .io import hdf5
         point = self._resume
         if point is None:
             raise ValueError("this simulation was not restored from a file "
@@ -1256,10 +631,7 @@ class Simulation(Driven):
         if point.finished:
             raise ValueError(f"the run in {self.output_path} finished; continue with "
                              f"run(until=..., output={self.output_path!r})")
-        hdf5.truncate(self.output_path, point)
-        rec = hdf5.FileRecorder(self.output_path, self, point.plan,
-                                checkpoint_interval=checkpoint_interval,
-                                resume_rows=point.outputs_written)
+        rec = _restart.resumed_recorder(self, self.output_path, point, checkpoint_interval)
         self._resume = None
         first_mark = max(0, point.outputs_written - 1)
         return self.execute(point.plan, rec, progress, first_mark=first_mark)
@@ -1316,19 +688,7 @@ class Simulation(Driven):
         >>> sim.bodies["Planet"].position.shape
         (3,)
         """
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        inv = np.argsort(self._order)
-        bs = BodySet(self.units)
-        bs._bare_ok = self._bare_ok
-        bs._names = list(self._names)
-        bs._m = self._m[inv].copy()
-        bs._r = self._r[inv].copy()
-        bs._x = self._x[inv].copy()
-        bs._v = self._v[inv].copy()
-        bs.history = list(self._history)
-        if self._epoch is not None:
-            bs._epoch = self._epoch + self.time
-        return bs
+        return _state.body_set(self)
 
     @property
     def epoch(self):
@@ -1363,23 +723,7 @@ class Simulation(Driven):
         >>> s.x.shape, s.steps
         ((2, 3), 0)
         """
-        return SimulationState(
-            self._x.copy(), self._v.copy(), self._order.copy(), self._t_base,
-            self._steps_since_base, self.steps, self.force_evaluations, self.steps_rejected,
-            self._saved_workspace(), self._reference.copy(), (self._E_scale, self._L_scale))
-
-    def _saved_workspace(self):
-        # the workspace's arrays, the tangent rows of a run with variations, and
-        # the state the collision check and the encounter log keep from the
-        # step before (so that a restart looks inside its first step too)
-        ws = {k: a.copy() for k, a in self._ws.items() if isinstance(a, np.ndarray)}
-        if self._keeps_previous:
-            ws["stop_prev"] = self._stop[8].copy()
-            ws["stop_clock"] = self._stop_clock.copy()
-        if self._n_tangent:
-            n = len(self._m)
-            ws["tangent"] = np.stack([self._rows_x[n:], self._rows_v[n:]])
-        return ws
+        return _state.record(self)
 
     def set_state(self, state):
         """Put back a :class:`SimulationState` taken from a simulation made alike
@@ -1396,37 +740,7 @@ class Simulation(Driven):
         >>> sim.time
         <Quantity 0. d>
         """
-        if not np.array_equal(self._order, state.order):
-            raise ValueError("the state's body order does not match this simulation's "
-                             "masses")
-        self._x[...] = state.x
-        self._v[...] = state.v
-        self._t_base = float(state.t_base)
-        self._steps_since_base = int(state.steps_since_base)
-        self.steps = int(state.steps)
-        self.force_evaluations = int(state.force_evaluations)
-        self.steps_rejected = int(state.steps_rejected)
-        for name, arr in state.workspace.items():
-            if name in self._ws:
-                self._ws[name][...] = arr
-        if self._keeps_previous and "stop_prev" in state.workspace:
-            self._stop[8][...] = state.workspace["stop_prev"]
-            self._stop_clock[...] = state.workspace["stop_clock"]
-        else:
-            self._keep_current()
-        if self._n_tangent:
-            tangent = state.workspace.get("tangent")
-            if tangent is None or tangent.shape != (2,) + self._rows_x[len(self._m):].shape:
-                raise ValueError("the state has no tangent vectors of this simulation's "
-                                 "variations")
-            n = len(self._m)
-            self._rows_x[n:] = tangent[0]
-            self._rows_v[n:] = tangent[1]
-        # a reference row written before the work column was kept: its work is 0
-        ref = np.asarray(state.reference, dtype=float)
-        self._reference = np.zeros(max(_inv.MONITOR_WIDTH, len(ref)))
-        self._reference[:len(ref)] = ref
-        self._E_scale, self._L_scale = (float(s) for s in state.scales)
+        _state.put_back(self, state)
 
     def description(self):
         """The :class:`SimulationDescription`: bodies, units and set-up, as an
@@ -1441,16 +755,7 @@ class Simulation(Driven):
         >>> d.names, d.dt, d.units.name
         (('Star', 'Planet'), 1.0, 'au-Msun-day')
         """
-        inv = self._inverse
-        stops = dict(self._stop_config)
-        if callable(stops.get("collisions")):
-            # a plain record names the function (a file cannot hold it)
-            stops["collisions"] = _function_name(stops["collisions"])
-        return SimulationDescription(
-            tuple(self._names), self._m[inv].copy(), self._r[inv].copy(), self.units,
-            self.integrator, self._dt, math.sqrt(self._eps2), self.monitors,
-            self.monitor_every, self.parallel, self.rebound_arithmetic,
-            stops, list(self._history), self.config, self.forces, self._epoch)
+        return _state.description(self)
 
     @property
     def time_value(self):
@@ -1480,15 +785,7 @@ class Simulation(Driven):
         >>> snap.t, snap.steps, snap.x.shape
         (0.0, 0, (2, 3))
         """
-        self.integrator.synchronize(self._ws, self._rows_x, self._rows_v)
-        row = np.zeros(_inv.MONITOR_WIDTH)
-        if self._mask:
-            self._monitor_row(row)
-        inv = self._inverse
-        if self._resolves_collisions:
-            return Snapshot(self._now(), self.steps, self._x[inv], self._v[inv], row,
-                            tuple(self._names), self._m[inv], self._r[inv])
-        return Snapshot(self._now(), self.steps, self._x[inv], self._v[inv], row)
+        return _state.snapshot(self)
 
     def _now(self):
         return self._t_base + self._steps_since_base * self._dt
@@ -1512,9 +809,8 @@ class Simulation(Driven):
             row[0] += self._base_force.terms.energy(self._x, self._v, self._eargs)
             row[_inv.WORK_COLUMN] = _stepping.work_total(self._ws)
         if self._chaos_box is not None:
-            from ._kernels.variational import chaos_values
             col = _inv.MONITOR_COLUMNS.index("megno")
-            row[col:col + 3] = chaos_values(self._ws["chaos"])
+            row[col:col + 3] = _var.chaos_values(self._ws["chaos"])
         self._offset_rows(row[None])
         return row
 
@@ -1639,145 +935,18 @@ class Simulation(Driven):
                              f"got {checkpoint_interval!r}")
         self._wall_limit = None if wall_limit is None else float(wall_limit)
         if output is None:
-            rec = _Recorder(self, initial=plan.outputs > 1, capacity=plan.outputs)
+            rec = Recorder(self, initial=plan.outputs > 1, capacity=plan.outputs)
         else:
-            from .io import hdf5
-            rec = hdf5.FileRecorder(output, self, plan, overwrite=overwrite,
-                                    checkpoint_interval=checkpoint_interval)
+            rec = _hdf5.FileRecorder(output, self, plan, overwrite=overwrite,
+                                     checkpoint_interval=checkpoint_interval)
         return self.execute(plan, rec, progress)
 
     def _plan(self, until_v, outputs, until=None):
         """Where a run to ``until_v`` takes its outputs: a :class:`RunPlan`."""
-        now = self._now()
-        shown = until if until is not None else until_v
-        if not math.isfinite(until_v):
-            raise ValueError(f"until must be a finite time, got {shown}")
-        if until_v == now:
-            raise ValueError(f"until = {shown} is the current time: there is nothing to run")
-        sign = 1 if until_v > now else -1
-        default = outputs is None
-        if default:
-            outputs = DEFAULT_OUTPUTS
-        if (isinstance(outputs, bool) or not isinstance(outputs, numbers.Integral)) and not (
-                isinstance(outputs, numbers.Real) and float(outputs).is_integer()):
-            raise ValueError(f"outputs must be a whole number >= 1, got {outputs!r}")
-        outputs = int(outputs)
-        if outputs < 1:
-            raise ValueError(f"outputs must be a whole number >= 1, got {outputs}")
-        if self.integrator.adaptive:
-            # outputs at exactly evenly spaced times, hit by shortening a step
-            return RunPlan(until_v, outputs, 0.0, 0, False, self.steps, now)
-        ratio = abs(until_v - now) / self._dt
-        if not ratio < MAX_STEPS:
-            raise ValueError(f"until = {shown} is {ratio:.3g} steps of dt = {self.dt:.6g} "
-                             f"away: more than the {MAX_STEPS:.3g} steps whose times float64 "
-                             f"can tell apart; use a larger dt or a nearer until")
-        n_full = int(round(ratio))
-        if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
-            n_full = int(math.floor(ratio))
-        partial = sign * (until_v - self._time_after(n_full, sign))
-        has_partial = partial > 1e-12 * max(abs(until_v - now), self._dt)
-        plan = RunPlan(until_v, outputs, ratio, n_full, bool(has_partial), self.steps, now)
-        total = plan.total_steps
-        if default and outputs > total + 1:
-            # one per step; a shortened last step leaves room for one fewer, as
-            # outputs go to the nearest step boundary
-            outputs = total + 1
-            while outputs > 2 and not _marks_ok(plan._replace(outputs=outputs), total):
-                outputs -= 1
-            steps = f"{total} step" + ("" if total == 1 else "s")
-            warnings.warn(f"the run has only {steps}: taking {outputs} outputs "
-                          f"instead of the default {DEFAULT_OUTPUTS}", OrbitsWarning,
-                          stacklevel=4)
-            plan = plan._replace(outputs=outputs)
-        if outputs > total + 1 or not _marks_ok(plan, total):
-            raise ValueError(f"outputs = {outputs} needs more steps than the run has "
-                             f"({total}); ask for at most {total + 1} outputs or use a "
-                             f"smaller dt")
-        return plan
-
-    def _time_after(self, n, sign=1):
-        # the time after n more steps of dt in the direction sign, computed as
-        # every step count is
-        return self._t_base + (self._steps_since_base + sign * n) * self._dt
+        return _run_plan.plan(self, until_v, outputs, until, DEFAULT_OUTPUTS)
 
     def _fail(self, status, rec, wall0):
-        reason = {Status.NON_FINITE: "non-finite state",
-                  Status.STEP_UNDERFLOW: "step-size underflow",
-                  Status.CLOSE_ENCOUNTER: "close encounter",
-                  Status.ESCAPE: "escape",
-                  Status.COLLISION: "collision",
-                  Status.NO_CONVERGENCE: "no convergence"}.get(status, f"status {status!r}")
-        rec.end_status = int(status)
-        self._drain_log(rec)
-        rec.output(self, final=True)
-        rec.close()
-        result = self._with_log(rec.result(self, _time.perf_counter() - wall0 if wall0 else 0.0,
-                                           status=reason))
-        t = self.time
-        if _user_function_failed(self._fargs):
-            raise ForceTermError(
-                f"a user force returned an array of another shape than during the check "
-                f"before the run, in step {self.steps + 1} (from t = {t:.10g}); the "
-                f"simulation was left at the last good state, step {self.steps}",
-                term="UserForce", field="func")
-        if status == Status.NON_FINITE:
-            raise NonFiniteState(
-                f"the state became non-finite in step {self.steps + 1} (from t = {t:.10g}); "
-                f"the result up to the last good state, at step {self.steps}, is kept on "
-                f"this exception (.result) and the simulation was left there",
-                time=t, step=self.steps, result=result)
-        if status == Status.NO_CONVERGENCE:
-            raise ConvergenceFailure(
-                f"the Newton iteration of {self.integrator.name!r} did not converge in step "
-                f"{self.steps + 1} (from t = {t:.10g}); try a smaller dt; the result up to "
-                f"the last good state is kept on .result", time=t, step=self.steps,
-                result=result)
-        name = lambda k: self._names[self._order[k]]  # noqa: E731
-        if status == Status.STEP_UNDERFLOW:
-            # the bodies that drove it, where the method names them (not trace)
-            who = [name(int(k)) for k in self._ws.get("info", ()) if k >= 0]
-            raise StepSizeUnderflow(
-                f"the step size of {self.integrator.name!r} collapsed at t = {t:.10g} "
-                f"(step {self.steps})" + (f", driven by {', '.join(map(repr, who))}"
-                                           if who else "")
-                + "; the result up to the last good state is kept on .result",
-                time=t, step=self.steps, result=result)
-        i, j = (int(k) for k in self._stop_info)
-        if status == Status.CLOSE_ENCOUNTER:
-            bodies = (name(i), name(j))
-            tc, dist = (float(a) for a in self._stop_hit[:2])
-            raise CloseEncounter(f"close encounter of {bodies[0]!r} and {bodies[1]!r} "
-                                 f"(closest at t = {tc:.10g} {self.units.time}, separation "
-                                 f"{dist:.6g} {self.units.length}) in the step ending at "
-                                 f"t = {t:.10g} (step {self.steps}); the result up to here "
-                                 f"is kept on .result", time=t, step=self.steps,
-                                 result=result, bodies=bodies)
-        if status == Status.COLLISION:
-            bodies = (name(i), name(j))
-            q = self.units.quantity
-            tc, dist, speed = (float(a) for a in self._stop_hit)
-            # after the state kept: a step the integrator could not finish (beyond
-            # the rounding of a contact at a step's end)
-            now = self._now()
-            inside = tc <= now + 1e-9 * abs(self._dt) + 1e-15 * abs(now)
-            where = (f"in the step ending at t = {t:.10g} (step {self.steps})" if inside else
-                     f"in a step the integrator could not finish; the run stopped at "
-                     f"t = {t:.10g} (step {self.steps}), the last state it reached whole")
-            raise Collision(f"{bodies[0]!r} and {bodies[1]!r} collided "
-                            f"({'closest' if inside else 'touching'} at t = {tc:.10g}, "
-                            f"separation {dist:.6g} {self.units.length}) "
-                            f"{where}; the result up to here is kept on .result",
-                            time=t, step=self.steps,
-                            result=result, bodies=bodies, contact_time=q(tc, "time"),
-                            distance=q(dist, "length"),
-                            speed=q(speed, "length") / self.units.time)
-        if status == Status.ESCAPE:
-            bodies = (name(i),)
-            raise Escape(f"{bodies[0]!r} escaped at t = {t:.10g} (step {self.steps}); the "
-                         f"result up to here is kept on .result", time=t, step=self.steps,
-                         result=result, bodies=bodies)
-        raise RuntimeError(f"unexpected status {status!r}")  # pragma: no cover
+        _failures.fail(self, status, rec, wall0)
 
     def __repr__(self):
         """One line: bodies, time, integrator and its options, step, forces, stopping
@@ -1789,7 +958,6 @@ class Simulation(Driven):
 
     def _repr_html_(self):
         """The same as a table, for Jupyter."""
-        import html
         rows = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{html.escape(v)}</td>"
                        f"</tr>" for k, v in self._described())
         return f"<div><strong>Simulation</strong><table>{rows}</table></div>"
@@ -1821,242 +989,6 @@ class Simulation(Driven):
         return rows
 
 
-def _split_forces(forces, softening, parallel, rebound_arithmetic):
-    """The added terms and the gravity term (with the keywords' options) of ``forces``."""
-    from .forces import ForceTerm, Gravity
-    if isinstance(forces, ForceTerm):
-        forces = (forces,)
-    try:
-        forces = tuple(forces)
-    except TypeError:
-        raise TypeError(f"forces must be a sequence of force terms (orbits.forces), "
-                        f"got {forces!r}") from None
-    for term in forces:
-        if not isinstance(term, ForceTerm):
-            raise TypeError(f"forces must hold force terms of orbits.forces (GR, "
-                            f"GRPotential, GRFull, ZonalHarmonics, UserForce, Gravity); "
-                            f"got {term!r}")
-    gravities = [t for t in forces if isinstance(t, Gravity)]
-    if len(gravities) > 1:
-        raise ValueError("forces holds more than one Gravity term; give one")
-    keywords = softening is not None or parallel is not None or rebound_arithmetic
-    if gravities and keywords:
-        raise ValueError("gravity's options are given twice: set softening, parallel and "
-                         "rebound_arithmetic either on the Gravity term or as keywords")
-    gravity = gravities[0] if gravities else Gravity(softening, parallel, rebound_arithmetic)
-    return tuple(t for t in forces if not isinstance(t, Gravity)), gravity
-
-
-def _marks_ok(plan, total):
-    # the plan's marks are strictly increasing and below total, without
-    # walking a million of them where arithmetic tells: marks are round(i s)
-    # with s = ratio / (outputs - 1); within a quarter step of a whole k they
-    # are i k exactly, and at s >= 2 consecutive ones are at least one apart
-    o = plan.outputs
-    if o > 2:
-        s = plan.ratio / (o - 1)
-        k = int(round(s))
-        if (k >= 1 and abs(plan.ratio - k * (o - 1)) < 0.25) or s >= 2:
-            return min(int(round((o - 2) * s)), plan.n_full) < total
-    return _increasing(plan.marks(), total)
-
-
-def _increasing(marks, total):
-    last = 0
-    for mark in marks:
-        if mark <= last:
-            return False
-        last = mark
-    return last < total or (last == 0 and total > 0)
-
-
-class _Recorder:
-    """Collects outputs and monitor rows during one run."""
-
-    def __init__(self, sim, initial=True, capacity=1):
-        n = len(sim._m)
-        self.inv = np.argsort(sim._order)
-        self.order = sim._order
-        # the outputs: their times, and rows of the monitors, then the
-        # positions and velocities in the simulation's internal order (the
-        # layout of the rows recorded inside the loop, which writes into
-        # this array directly; it grows if a run takes more outputs)
-        self.t = np.empty(capacity)
-        self.rows = np.zeros((capacity, _inv.MONITOR_WIDTH + 6 * n))
-        self.count = 0
-        self.mon_t = []
-        self.mon_rows = []
-        self.steps0 = sim.steps
-        self.forces0 = sim.force_evaluations
-        self.rejected0 = sim.steps_rejected
-        self.t0 = sim._now()
-        self.n = n
-        # the bodies at the start, whose columns the outputs keep when
-        # collisions merge some of them away (then NaN) and change masses
-        self.names0 = list(sim._names)
-        self.m0, self.r0 = sim._m[self.inv].copy(), sim._r[self.inv].copy()
-        self.version = sim._bodies_changed
-        self.slot_of = {name: k for k, name in enumerate(sim._names_internal())}
-        self.slots = None
-        self.mass_rows = [] if sim._resolves_collisions else None
-        if initial:
-            self.output(sim)
-
-    end_status = 0
-
-    def close(self):
-        """Nothing to release for a run kept in memory."""
-
-    def checkpoint(self, finished=False):
-        """Nothing to save for a run kept in memory."""
-
-    def stopped(self, sim):
-        """A run stopped early by a signal: its result ends where it stopped."""
-        self.output(sim, final=True)
-
-    def _room(self, k):
-        # space for k more outputs
-        if self.count + k > len(self.t):
-            size = max(2 * len(self.t), self.count + k)
-            self.t = np.resize(self.t, size)
-            rows = np.zeros((size, self.rows.shape[1]))
-            rows[:self.count] = self.rows[:self.count]
-            self.rows = rows
-
-    def output(self, sim, final=False):
-        snap = sim.snapshot()
-        self._room(1)
-        i = self.count
-        w, n = _inv.MONITOR_WIDTH, self.n
-        self.t[i] = snap.t
-        self.rows[i, :w] = snap.monitors
-        if sim._bodies_changed != self.version:
-            self.version = sim._bodies_changed
-            self.slots = np.array([self.slot_of[name] for name in sim._names_internal()])
-        if self.slots is None:
-            self.rows[i, w:w + 3 * n] = snap.x[self.order].ravel()
-            self.rows[i, w + 3 * n:] = snap.v[self.order].ravel()
-        else:
-            x = np.full((n, 3), np.nan)
-            v = np.full((n, 3), np.nan)
-            x[self.slots] = snap.x[sim._order]
-            v[self.slots] = snap.v[sim._order]
-            self.rows[i, w:w + 3 * n] = x.ravel()
-            self.rows[i, w + 3 * n:] = v.ravel()
-        if self.mass_rows is not None:
-            mass = np.full(n, np.nan)
-            if self.slots is None:
-                mass[:] = sim._m
-            else:
-                mass[self.slots] = sim._m
-            self.mass_rows.append(mass[self.inv])
-        self.count += 1
-
-    def row_buffer(self, k):
-        """Where the compiled loop writes the next ``k`` outputs (see
-        :meth:`orbits._driver.Driven.execute`)."""
-        self._room(k)
-        return self.rows[self.count:self.count + k]
-
-    def output_rows(self, sim, steps, t, rows):
-        """The loop wrote ``rows`` (from :meth:`row_buffer`) at times ``t``."""
-        k = len(t)
-        self.t[self.count:self.count + k] = t
-        self.count += k
-
-    def monitor_rows(self, t, rows):
-        self.mon_t.append(t.copy())
-        self.mon_rows.append(rows.copy())
-
-    def result(self, sim, wall, status="completed"):
-        U = sim.units
-        q = U.quantity
-        n_out = self.count
-        fields = dict(
-            names=list(self.names0),
-            steps=sim.steps - self.steps0,
-            force_evaluations=sim.force_evaluations - self.forces0, wall_time=wall,
-            integrator=sim.integrator.info(), units=U, status=status,
-            monitors=sim.monitors, steps_rejected=sim.steps_rejected - self.rejected0,
-            forces=tuple(map(repr, sim.forces)), epoch=sim.epoch)
-        if sim._n_tangent:
-            fields["jacobian"] = sim.jacobian
-            fields["tangent_vectors"] = sim.tangent_vectors
-            fields["seed"] = sim._seed
-        # the arrays with units and the monitor series are made when first
-        # read (Result's deferred fields), from what is here now
-        w, n = _inv.MONITOR_WIDTH, self.n
-        t, rows = self.t[:n_out], self.rows[:n_out]
-        inv, m0, r0, t0, dt = self.inv, self.m0, self.r0, self.t0, sim._dt
-
-        def outputs():
-            x = rows[:, w:w + 3 * n].reshape(-1, n, 3)
-            v = rows[:, w + 3 * n:w + 6 * n].reshape(-1, n, 3)
-            if not np.array_equal(inv, np.arange(n)):
-                x, v = x[:, inv], v[:, inv]
-            return dict(times=q(t, "time"), masses=q(m0, "mass"), radii=q(r0, "length"),
-                        start_time=q(t0, "time"), dt=q(dt, "time"), positions=q(x, "length"),
-                        velocities=q(v, "velocity"))
-
-        deferred = [(("times", "masses", "radii", "start_time", "dt", "positions",
-                      "velocities"), outputs)]
-        if self.mass_rows is not None:
-            masses = np.array(self.mass_rows).reshape(-1, n)
-            deferred.append((("masses_at_outputs",),
-                             lambda: {"masses_at_outputs": q(masses, "mass")}))
-        # the monitor series of rows, against the reference row of now
-        series = functools.partial(monitor_fields, monitors=sim.monitors,
-                                   reference=sim._reference.copy(),
-                                   scales=(sim._E_scale, sim._L_scale), units=U,
-                                   work=sim._has_work)
-        if sim._mask:
-            block = rows[:, :w]
-            deferred.append((monitor_field_names(sim.monitors, w, sim._has_work),
-                             lambda: series(block)))
-        if self.mon_t:
-            mon_rows = np.concatenate(self.mon_rows)
-            mon_t = np.concatenate(self.mon_t)
-
-            def monitor():
-                mon = series(mon_rows)
-                mon["times"] = q(mon_t, "time")
-                return {"monitor": mon}
-
-            deferred.append((("monitor",), monitor))
-        return Result(_deferred=deferred, **fields)
-
-
 def _positive_number(value):
     return (isinstance(value, numbers.Real) and not isinstance(value, bool)
             and 0 < float(value) < math.inf)
-
-
-def _merge_energy_change(m, x, v, alive, a, b, G, eps2):
-    """The energy change (Newtonian gravity, softened as the simulation is)
-    when bodies ``a`` and ``b`` merge: their kinetic energy of relative motion
-    and their mutual binding go, and the others' pull on them now acts on the
-    centre of mass."""
-    M = m[a] + m[b]
-    if not M > 0:
-        return 0.0
-    X = (m[a] * x[a] + m[b] * x[b]) / M
-    u = v[a] - v[b]
-    dE = -0.5 * m[a] * m[b] / M * float(u @ u)
-    dE += G * m[a] * m[b] / math.sqrt(float((x[a] - x[b]) @ (x[a] - x[b])) + eps2)
-    others = alive.copy()
-    others[[a, b]] = False
-    mk, xk = m[others], x[others]
-    pot = lambda p: np.sqrt(((xk - p) ** 2).sum(axis=1) + eps2)  # noqa: E731
-    dE -= G * float(np.sum(mk * (M / pot(X) - m[a] / pot(x[a]) - m[b] / pot(x[b]))))
-    return dE
-
-
-def _user_function_failed(fargs):
-    """Whether a user term of a table in ``fargs`` (nested tuples) returned the
-    wrong shape (see :mod:`orbits._user_functions`)."""
-    from ._kernels.terms import TermTable
-    if isinstance(fargs, TermTable):
-        return fargs.user is not None and bool(fargs.user.flag[0])
-    if isinstance(fargs, tuple):
-        return any(_user_function_failed(f) for f in fargs)
-    return False

@@ -32,7 +32,7 @@ from ..errors import OrbitsError
 from ..integrators.wisdom_holman import MASS_RATIO_LIMIT
 from ..io import hdf5
 from ..monitors import CHAOS_MONITORS, monitor_mask
-from ..simulation import _Recorder
+from ..recorder import Recorder
 from .compiles import _cache_loads, _CompileRecorder, _sync_numba_config, _worker_fields
 from .table import _parameter_row
 from .worker import _advance, _invalid_row, _run_row
@@ -157,7 +157,7 @@ def lane_width(runs, batch):
 def _recorder(sim, plan, path):
     # the recorder Simulation.run would make for this run
     if path is None:
-        return _Recorder(sim, initial=plan.outputs > 1, capacity=plan.outputs)
+        return Recorder(sim, initial=plan.outputs > 1, capacity=plan.outputs)
     return hdf5.FileRecorder(path, sim, plan, overwrite=True)
 
 

@@ -1,0 +1,84 @@
+"""Force terms bound to a simulation: the ``forces`` given split into the gravity
+term and the added terms (:mod:`orbits.forces`), and the added terms compiled
+with gravity into one force and its argument tables
+(:func:`orbits._kernels.stepping.with_terms`), the pointers of the user's
+functions included; the non-conservative terms are chained once more on their
+own, for the work the loops integrate.
+"""
+
+import numpy as np
+
+from . import _user_functions
+from . import forces as _forces
+from ._kernels import stepping as _stepping
+from ._kernels import terms as _kterms
+
+__all__ = ["split", "bind_terms"]
+
+
+def split(forces, softening, parallel, rebound_arithmetic):
+    """The added terms and the gravity term (with the keywords' options) of ``forces``."""
+    if isinstance(forces, _forces.ForceTerm):
+        forces = (forces,)
+    try:
+        forces = tuple(forces)
+    except TypeError:
+        raise TypeError(f"forces must be a sequence of force terms (orbits.forces), "
+                        f"got {forces!r}") from None
+    for term in forces:
+        if not isinstance(term, _forces.ForceTerm):
+            raise TypeError(f"forces must hold force terms of orbits.forces (GR, "
+                            f"GRPotential, GRFull, ZonalHarmonics, UserForce, Gravity); "
+                            f"got {term!r}")
+    gravities = [t for t in forces if isinstance(t, _forces.Gravity)]
+    if len(gravities) > 1:
+        raise ValueError("forces holds more than one Gravity term; give one")
+    keywords = softening is not None or parallel is not None or rebound_arithmetic
+    if gravities and keywords:
+        raise ValueError("gravity's options are given twice: set softening, parallel and "
+                         "rebound_arithmetic either on the Gravity term or as keywords")
+    gravity = (gravities[0] if gravities
+               else _forces.Gravity(softening, parallel, rebound_arithmetic))
+    return tuple(t for t in forces if not isinstance(t, _forces.Gravity)), gravity
+
+
+def bind_terms(sim, bodies):
+    """Compile gravity and the added terms into one force (see :mod:`orbits.forces`).
+
+    The non-conservative terms (``conservative = False``) are chained once
+    more on their own: the loops integrate their work from that chain
+    (:func:`orbits._kernels.stepping.with_terms`), so that the energy
+    monitor can report ``E + W``.
+    """
+    ctx = _forces.Context([sim._names[k] for k in sim._order], sim._m, sim._gm,
+                          sim._n_active, sim.units, sim._bare_ok, sim._order,
+                          np.ascontiguousarray(bodies._x), np.ascontiguousarray(bodies._v))
+    bound = [term.bind(ctx) for term in sim._terms]
+    dissipative = [b for term, b in zip(sim._terms, bound) if not term.conservative]
+    terms = _kterms.TABLE
+    sim._force = _stepping.with_terms(sim._force, terms,
+                                       any(t.velocity_dependent for t in sim._terms),
+                                       work=terms if dissipative else None)
+    table = _term_table(sim, bound, ctx)
+    sim._fargs = (sim._fargs, table)
+    if dissipative:
+        sim._fargs += (_stepping.work_args(_term_table(sim, dissipative, ctx), sim._m),)
+    sim._eargs = table
+
+
+def _term_table(sim, bound, ctx):
+    """The :class:`~orbits._kernels.terms.TermTable` of bound terms, with
+    the pointers of their user functions, if any."""
+    users = [b.user for b in bound if b.user is not None]
+    rows = [b.row for b in bound if b.user is None]
+    user = None
+    if users:
+        accel, energy = _user_functions.term_pointers(users)
+        pos = np.argsort(ctx.order).astype(np.int64)
+        n = len(pos)
+        user = _kterms.UserTerms(accel, energy, pos, np.zeros((n, 3)), np.zeros((n, 3)),
+                                 np.ascontiguousarray(ctx.m[pos]),
+                                 np.zeros(1, dtype=np.int64),
+                                 any(u.velocity_dependent for u in users))
+        rows.append(_kterms.TermRow(_kterms.USER))
+    return _kterms.table(rows, sim._gm, sim._m, user)

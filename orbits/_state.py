@@ -1,0 +1,121 @@
+"""State accessors: a simulation's state read out as records in the body set's
+order (the :class:`~orbits.records.SimulationState` a checkpoint stores, the
+current :class:`~orbits.BodySet`, an output's :class:`~orbits.records.Snapshot`,
+the :class:`~orbits.records.SimulationDescription` a file records) and put back
+from a state record.
+
+The simulation keeps its bodies massive first (``sim._order``); these records
+undo that order, and the integrator is synchronised before its state is read.
+"""
+
+import math
+
+import numpy as np
+
+from . import _stop_conditions as _stops
+from ._kernels import invariants as _inv
+from .bodies import BodySet
+from .records import SimulationDescription, SimulationState, Snapshot, _function_name
+
+__all__ = ["body_set", "record", "saved_workspace", "put_back", "description", "snapshot"]
+
+
+def body_set(sim):
+    """The current state as a new :class:`~orbits.BodySet` (:attr:`Simulation.bodies`)."""
+    sim.integrator.synchronize(sim._ws, sim._rows_x, sim._rows_v)
+    inv = np.argsort(sim._order)
+    bs = BodySet(sim.units)
+    bs._bare_ok = sim._bare_ok
+    bs._names = list(sim._names)
+    bs._m = sim._m[inv].copy()
+    bs._r = sim._r[inv].copy()
+    bs._x = sim._x[inv].copy()
+    bs._v = sim._v[inv].copy()
+    bs.history = list(sim._history)
+    if sim._epoch is not None:
+        bs._epoch = sim._epoch + sim.time
+    return bs
+
+
+def record(sim):
+    """The :class:`~orbits.records.SimulationState` (copies) of ``sim``."""
+    return SimulationState(
+        sim._x.copy(), sim._v.copy(), sim._order.copy(), sim._t_base,
+        sim._steps_since_base, sim.steps, sim.force_evaluations, sim.steps_rejected,
+        saved_workspace(sim), sim._reference.copy(), (sim._E_scale, sim._L_scale))
+
+
+def put_back(sim, state):
+    """Put ``state`` back into ``sim`` (:meth:`Simulation.set_state`)."""
+    if not np.array_equal(sim._order, state.order):
+        raise ValueError("the state's body order does not match this simulation's "
+                         "masses")
+    sim._x[...] = state.x
+    sim._v[...] = state.v
+    sim._t_base = float(state.t_base)
+    sim._steps_since_base = int(state.steps_since_base)
+    sim.steps = int(state.steps)
+    sim.force_evaluations = int(state.force_evaluations)
+    sim.steps_rejected = int(state.steps_rejected)
+    for name, arr in state.workspace.items():
+        if name in sim._ws:
+            sim._ws[name][...] = arr
+    if _stops.keeps_previous(sim) and "stop_prev" in state.workspace:
+        sim._stop[8][...] = state.workspace["stop_prev"]
+        sim._stop_clock[...] = state.workspace["stop_clock"]
+    else:
+        _stops.keep_current(sim)
+    if sim._n_tangent:
+        tangent = state.workspace.get("tangent")
+        if tangent is None or tangent.shape != (2,) + sim._rows_x[len(sim._m):].shape:
+            raise ValueError("the state has no tangent vectors of this simulation's "
+                             "variations")
+        n = len(sim._m)
+        sim._rows_x[n:] = tangent[0]
+        sim._rows_v[n:] = tangent[1]
+    # a reference row written before the work column was kept: its work is 0
+    ref = np.asarray(state.reference, dtype=float)
+    sim._reference = np.zeros(max(_inv.MONITOR_WIDTH, len(ref)))
+    sim._reference[:len(ref)] = ref
+    sim._E_scale, sim._L_scale = (float(s) for s in state.scales)
+
+
+def description(sim):
+    """The :class:`~orbits.records.SimulationDescription` of ``sim``."""
+    inv = sim._inverse
+    stops = dict(sim._stop_config)
+    if callable(stops.get("collisions")):
+        # a plain record names the function (a file cannot hold it)
+        stops["collisions"] = _function_name(stops["collisions"])
+    return SimulationDescription(
+        tuple(sim._names), sim._m[inv].copy(), sim._r[inv].copy(), sim.units,
+        sim.integrator, sim._dt, math.sqrt(sim._eps2), sim.monitors,
+        sim.monitor_every, sim.parallel, sim.rebound_arithmetic,
+        stops, list(sim._history), sim.config, sim.forces, sim._epoch)
+
+
+def snapshot(sim):
+    """The current output of ``sim`` (:class:`~orbits.records.Snapshot`)."""
+    sim.integrator.synchronize(sim._ws, sim._rows_x, sim._rows_v)
+    row = np.zeros(_inv.MONITOR_WIDTH)
+    if sim._mask:
+        sim._monitor_row(row)
+    inv = sim._inverse
+    if sim._resolves_collisions:
+        return Snapshot(sim._now(), sim.steps, sim._x[inv], sim._v[inv], row,
+                        tuple(sim._names), sim._m[inv], sim._r[inv])
+    return Snapshot(sim._now(), sim.steps, sim._x[inv], sim._v[inv], row)
+
+
+def saved_workspace(sim):
+    # the workspace's arrays, the tangent rows of a run with variations, and
+    # the state the collision check and the encounter log keep from the
+    # step before (so that a restart looks inside its first step too)
+    ws = {k: a.copy() for k, a in sim._ws.items() if isinstance(a, np.ndarray)}
+    if _stops.keeps_previous(sim):
+        ws["stop_prev"] = sim._stop[8].copy()
+        ws["stop_clock"] = sim._stop_clock.copy()
+    if sim._n_tangent:
+        n = len(sim._m)
+        ws["tangent"] = np.stack([sim._rows_x[n:], sim._rows_v[n:]])
+    return ws
