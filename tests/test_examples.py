@@ -54,7 +54,7 @@ def test_plotting_a_run_example(capsys):
     assert len(orbit_axes.lines) == 5          # every body but the Sun, at the centre
     assert [t.get_text() for t in orbit_axes.get_legend().get_texts()][:2] == [
         "Sun (centre)", "Jupiter"]
-    assert error_axes.get_xlabel() == "time since start [yr]"
+    assert error_axes.get_xlabel() == "time since start [kyr]"    # 2000 yr: orbits.units.time_unit
     assert len(error_axes.lines) == 2          # energy and angular momentum
 
     element_axes = figures["elements"].axes
