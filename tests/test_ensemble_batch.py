@@ -104,7 +104,7 @@ def test_runs_that_cannot_be_batched_run_alone_and_keep_their_rows():
     alone = Ensemble(mixed, params).run(100 * u.yr, client="serial", outputs=5,
                                         progress=False)
     df = Ensemble(mixed, params).run(100 * u.yr, client="serial", outputs=5,
-                                     progress=False, batch=3)
+                                     progress=False, batch=4)
     assert_same_rows(alone, df)
     # the unknown kind is invalid; 'wh' with an escape distance runs alone, and
     # its planet, at 4.4 au beside Jupiter, passes 100 au in step 720 of its
