@@ -60,7 +60,7 @@ def test_plotting_a_run_example(capsys):
     element_axes = figures["elements"].axes
     assert [ax.get_ylabel() for ax in element_axes] == ["a [AU]", "e", "inc [deg]"]
     assert [len(ax.lines) for ax in element_axes] == [5, 5, 5]
-    assert element_axes[-1].get_xlabel() == "time [yr]"
+    assert element_axes[-1].get_xlabel() == "time [kyr]"
 
     (sketch_axes,) = figures["sketch"].axes
     assert [line.get_label() for line in sketch_axes.lines] == [
