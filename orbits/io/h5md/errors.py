@@ -81,6 +81,10 @@ class TangentShapeError(OrbitsFileError):
         super().__init__(message)
 
 
+# their public home, where tracebacks, pickles and the reference name them
+OrbitsFileError.__module__ = FileInUse.__module__ = TangentShapeError.__module__ = "orbits.io"
+
+
 #: errno values of a full disk: no space left, a file larger than allowed (the
 #: file system's limit, or ``ulimit -f``), the user's quota used up
 _DISK_FULL = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
