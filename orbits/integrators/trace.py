@@ -138,18 +138,25 @@ class Trace(Integrator):
 
     Examples
     --------
-    Two Earth-mass planets about a Sun-mass star that pass 1e-5 au apart at
-    t = 5 days (the stress suite's encounter), at a half-day step:
+    Two Earth-mass planets about a Sun-mass star, on nearly opposite orbits,
+    that pass 1e-5 au apart at t = 5 days (their state at the pass, run back
+    five days with ``ias15``), at a half-day step:
 
     >>> import astropy.units as u
     >>> import orbits
-    >>> from orbits.validation.stress import encounter_bodies
-    >>> sim = orbits.Simulation(encounter_bodies(1e-5), "trace", dt=0.5 * u.day)
+    >>> b = orbits.BodySet()
+    >>> b.add("Star", mass=1 * u.Msun)
+    >>> b.add("Planet 1", mass=1 * u.Mearth, primary="Star", a=1 * u.au)
+    >>> b.add("Planet 2", mass=1 * u.Mearth, primary="Star", a=1.00001 * u.au,
+    ...       inc=170 * u.deg)
+    >>> meet = orbits.Simulation(b, "ias15")
+    >>> _ = meet.run(until=-5 * u.day, progress=False)
+    >>> sim = orbits.Simulation(meet.bodies, "trace", dt=0.5 * u.day)
     >>> result = sim.run(until=10 * u.day, outputs=2, progress=False)
-    >>> bool(abs(result.energy_error[-1]) < 1e-9)      # wh: 1.6e-3
+    >>> bool(abs(result.energy_error[-1]) < 1e-9)      # 2e-12; wh: 3.1e-6
     True
     >>> int(sim._ws["counts"][0])                       # segments with a flagged pair
-    20
+    7
     """
 
     #: outputs that do not fall a whole number of steps apart are recorded in the
