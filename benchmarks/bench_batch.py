@@ -71,8 +71,9 @@ def advance(state, n):
     s = state
     # the loop an ensemble runs: the kick written out for the systems' size
     # (wh_batch.advance_loop)
-    s["loop"](s["xj"], s["vj"], s["gm"], s["eta"], s["n_active"], s["dt"], n, s["owed"],
-              s["live"], s["status"], s["good"], *s["ws"])
+    lanes = wh_batch.Lanes(s["xj"], s["vj"], s["gm"], s["eta"], s["owed"], s["live"],
+                           s["status"], s["good"])
+    s["loop"](lanes, s["n_active"], s["dt"], n, s["ws"])
 
 
 def main(argv=None):

@@ -15,6 +15,9 @@ when the step is accepted.
 """
 
 import math
+from typing import NamedTuple
+
+import numpy as np
 
 from ._jit import slots, specialize
 from .embedded import initial_step, next_step, step_underflow
@@ -69,10 +72,38 @@ def _rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xo, vo, fargs, p0, track):
     return pw if HAS_WORK and track else 0.0
 
 
-def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2,
-                   dtbox, fsal, info, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps,
-                   rtol, atol, marks, mark_steps):
+class Work(NamedTuple):
+    """The step-doubling loop's workspace: the derivative at the state
+    (``k0x``, ``k0v``) and at the half step (``kmx``, ``kmv``), the RK4
+    stages ``kx``, ``kv``, a stage's state ``xs``, ``vs``, the full step's
+    result ``xf``, ``vf``, the half steps' ``xh``, ``vh`` and ``x2``, ``v2``,
+    the next step's size ``dt[0]``, ``fsal[0]`` (1: ``k0v`` belongs to the
+    state) and ``info`` (where a failure happened)."""
+    k0x: np.ndarray
+    k0v: np.ndarray
+    kmx: np.ndarray
+    kmv: np.ndarray
+    kx: np.ndarray
+    kv: np.ndarray
+    xs: np.ndarray
+    vs: np.ndarray
+    xf: np.ndarray
+    vf: np.ndarray
+    xh: np.ndarray
+    vh: np.ndarray
+    x2: np.ndarray
+    v2: np.ndarray
+    dt: np.ndarray
+    fsal: np.ndarray
+    info: np.ndarray
+
+
+def _doubling_loop(x, v, t, tolerances, work, fargs, outputs, landing, sargs, check):
     # marks: outputs recorded in the loop, as in orbits._kernels.embedded
+    k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2, dtbox, fsal, info = work
+    rtol, atol = tolerances
+    mon, step0, mon_t, mon_out = outputs
+    t_end, max_steps, _, marks, mark_steps = landing
     stopping = (sargs, check)
     n = x.shape[0]
     every = mon[0]
@@ -186,7 +217,10 @@ def _doubling_loop(x, v, t, t_end, k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, x
 
 
 def doubling_loop(force):
-    """The RK4 step-doubling loop compiled for a force."""
+    """The RK4 step-doubling loop compiled for a force: it takes ``(x, v, t,
+    tolerances, work, fargs, outputs, landing, sargs, check)``, a
+    :class:`Work`, the records of :mod:`.records` and the stopping
+    conditions (:func:`~.stopping.stop_record`)."""
     key = force.key
     work = work_kernels(force)
     step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel,

@@ -21,6 +21,9 @@ P(stage j)``, and committed only when the step is accepted.
 """
 
 import math
+from typing import NamedTuple
+
+import numpy as np
 
 from ._jit import njit, slots, specialize
 from .status import Status
@@ -78,9 +81,36 @@ def step_underflow(h, t, t_end):
     return h <= 4.0 * _EPS * max(abs(t), abs(t_end))
 
 
-def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dtbox, fsal,
-                   info, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps, rtol, atol,
-                   marks, mark_steps):
+class Method(NamedTuple):
+    """An embedded pair: its Butcher tableau ``A``, ``b``, ``c``, the
+    weights' difference ``e`` of the error estimate (and ``e3``, a second
+    estimate's, or zeros) and the estimator's order ``q``."""
+    A: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    e: np.ndarray
+    e3: np.ndarray
+    q: float
+
+
+class Work(NamedTuple):
+    """The embedded loop's workspace: the stages' velocities and
+    accelerations ``kx``, ``kv`` (one row a stage, the last the FSAL
+    stage), a stage's state ``xs``, ``vs``, the proposed state ``x1``,
+    ``v1``, the next step's size ``dt[0]``, ``fsal[0]`` (1: ``kv[0]``
+    belongs to the state) and ``info`` (where a failure happened)."""
+    kx: np.ndarray
+    kv: np.ndarray
+    xs: np.ndarray
+    vs: np.ndarray
+    x1: np.ndarray
+    v1: np.ndarray
+    dt: np.ndarray
+    fsal: np.ndarray
+    info: np.ndarray
+
+
+def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, sargs, check):
     # marks (outputs recorded in the loop): the loop lands on each of these
     # times in turn, as it lands on t_end, and records there a row of
     # mon_out (monitors and state) with its time in mon_t and its step count
@@ -88,6 +118,11 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
     # loop is landing on it at the end of a call: the same steps, bit for
     # bit.  Empty marks: the loop lands on t_end alone (the same compiled
     # loop for both uses).
+    A, b, c, e, e3, q = method
+    rtol, atol = tolerances
+    kx, kv, xs, vs, x1, v1, dtbox, fsal, info = work
+    mon, step0, mon_t, mon_out = outputs
+    t_end, max_steps, _, marks, mark_steps = landing
     stopping = (sargs, check)
     n = x.shape[0]
     s = b.shape[0]
@@ -228,7 +263,11 @@ def _embedded_loop(x, v, t, t_end, A, b, c, e, e3, q, kx, kv, xs, vs, x1, v1, dt
 
 
 def embedded_loop(force, has_e3):
-    """The adaptive embedded Runge-Kutta loop compiled for a force and an estimator."""
+    """The adaptive embedded Runge-Kutta loop compiled for a force and an
+    estimator: it takes ``(x, v, t, method, tolerances, work, fargs, outputs,
+    landing, sargs, check)``, a :class:`Method`, a :class:`Work`, the records
+    of :mod:`.records` and the stopping conditions
+    (:func:`~.stopping.stop_record`)."""
     key = f"{force.key}{'_e3' if has_e3 else ''}"
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),

@@ -57,6 +57,7 @@ References
 
 import math
 from fractions import Fraction
+from typing import NamedTuple
 
 import numpy as np
 
@@ -303,9 +304,36 @@ def _b6_rounding(x, xs, a0, acc, n):
     return ROUNDING_MARGIN * B6_ROUNDING_GAIN * _UNIT_ROUNDOFF * xmax * worst
 
 
-def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, dtp, ref,
-                tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps,
-                epsilon, min_dt, mode, marks, mark_steps):
+class Work(NamedTuple):
+    """The IAS15 loop's workspace (:meth:`orbits.integrators.ias15.IAS15.workspace`)."""
+    dt: np.ndarray
+    info: np.ndarray
+    a0: np.ndarray
+    b: np.ndarray
+    g: np.ndarray
+    e: np.ndarray
+    br: np.ndarray
+    er: np.ndarray
+    csx: np.ndarray
+    csv: np.ndarray
+    ref: np.ndarray
+    tc: np.ndarray
+    flags: np.ndarray
+    xs: np.ndarray
+    vs: np.ndarray
+    acc: np.ndarray
+    P: np.ndarray
+    counts: np.ndarray
+
+
+class Control(NamedTuple):
+    """The step control: the tolerance ``epsilon`` of the predictor-corrector
+    and of the next step's size, chosen as ``mode`` says (a ``MODE_*``)."""
+    epsilon: float
+    mode: int
+
+
+def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
     # ref = (length of the reference step, time from its start to now).
     # tc = (time, the part of it that t + dt rounded away): the time is carried
@@ -320,6 +348,11 @@ def _ias15_loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P, d
     # last mark.  The rows count in n_mon.  Empty marks: the loop lands on
     # t_end alone (the same compiled loop: a loop compiled for each use cost
     # every new force two compilations).
+    (dtp, info, a0, b, g, e, br, er, csx, csv, ref, tc, flags, xs, vs, acc, P,
+     counts) = work
+    epsilon, mode = control
+    mon, step0, mon_t, mon_out = outputs
+    t_end, max_steps, min_dt, marks, mark_steps = landing
     stopping = (sargs, check)
     n = x.shape[0]
     # the predictor's and the corrector's loops run over every component of
@@ -654,11 +687,11 @@ def ias15_loop(force):
     (gravity does not), and for forces whose non-conservative terms' work it
     integrates.
 
-    The loop is ``loop(x, v, t, t_end, a0, b, g, e, br, er, csx, csv, xs, vs, acc, P,
-    dt, ref, tc, flags, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, check,
-    max_steps, epsilon, min_dt, mode, marks, mark_steps)`` (``sargs, check`` a
-    stopping record, :func:`~orbits._kernels.stopping.stop_record`) with the arrays of
-    :meth:`orbits.integrators.ias15.IAS15.workspace`; it returns ``(status,
+    The loop is ``loop(x, v, t, control, work, fargs, outputs, landing, sargs,
+    check)``: a :class:`Control`, a :class:`Work` over the arrays of
+    :meth:`orbits.integrators.ias15.IAS15.workspace`, the records of
+    :mod:`.records` and the stopping conditions
+    (:func:`~orbits._kernels.stopping.stop_record`); it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
     # the work rate P = sum m a . v needs the velocities at the nodes

@@ -51,6 +51,9 @@ kinetic-energy change ``h sum m a* . (v0 + v1) / 2`` of the step.
 """
 
 import math
+from typing import NamedTuple
+
+import numpy as np
 
 from ._jit import njit, slots, specialize
 from .jacobians import jacobian_for
@@ -139,13 +142,33 @@ def lu_solve(a, piv, b):
 
 # -- the loop ---------------------------------------------------------------------------
 
-def _implicit_loop(x, v, t, dt, nsteps, w, dw, xs, vs, acc, cache, jx, jv, lu, piv, newton,
-                   fargs, velocity_dependent, mon, step0, mon_t, mon_out, check_every, sargs,
+class Work(NamedTuple):
+    """The Newton loop's workspace: the unknown velocity increment ``w``,
+    the residual and then the Newton update ``dw``, the stage point ``xs``,
+    ``vs`` and its accelerations ``acc`` (kept for the next prediction,
+    valid when ``cache[0] == 1``), the Jacobian's blocks ``jx``, ``jv``, its
+    LU factors ``lu`` with pivots ``piv``, and ``newton_iterations[0]``, the
+    iterations counted."""
+    w: np.ndarray
+    dw: np.ndarray
+    xs: np.ndarray
+    vs: np.ndarray
+    acc: np.ndarray
+    cache: np.ndarray
+    jx: np.ndarray
+    jv: np.ndarray
+    lu: np.ndarray
+    piv: np.ndarray
+    newton_iterations: np.ndarray
+
+
+def _implicit_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, outputs, checks,
                    check):
-    # theta bound by specialize: 1.0 implicit Euler, 0.5 implicit midpoint.
-    # w: the unknown velocity increment W; dw: residual, then Newton update;
-    # xs, vs: stage point; acc: accelerations there (kept for the next
-    # prediction, valid when cache[0] == 1); newton[0] counts iterations.
+    # theta bound by specialize: 1.0 implicit Euler, 0.5 implicit midpoint;
+    # work: a Work record
+    w, dw, xs, vs, acc, cache, jx, jv, lu, piv, newton = work
+    mon, step0, mon_t, mon_out = outputs
+    check_every, sargs = checks
     stopping = (sargs, check)
     n = x.shape[0]
     m = 3 * n
@@ -239,8 +262,10 @@ def implicit_loop(force, name, theta, velocity_dependent):
     """The Newton loop of a one-leg theta-method compiled for a :class:`~.stepping.ForceKernel`.
 
     ``theta`` is 1.0 (implicit Euler) or 0.5 (implicit midpoint); ``name``
-    names the method; the Jacobian is :func:`~.jacobians.jacobian_for`'s; the loop's last
-    arguments are a stopping record (:func:`~.stopping.stop_record`).
+    names the method; the Jacobian is :func:`~.jacobians.jacobian_for`'s.  The
+    loop takes ``(x, v, t, dt, nsteps, work, fargs, velocity_dependent,
+    outputs, checks, check)``: a :class:`Work`, the records of :mod:`.records`
+    and the stopping conditions' pointer (:func:`~.stopping.stop_record`).
     """
     jac, jkey = jacobian_for(force, velocity_dependent)
     if jkey == "fd" and velocity_dependent:

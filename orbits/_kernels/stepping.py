@@ -573,8 +573,17 @@ def add_scaled(a, aF, h, b, bF, flat):
             a[i, 2] += h * b[i, 2]
 
 
-def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_dependent, mon,
-                    step0, mon_t, mon_out, check_every, sargs, check):
+class SplittingWork(NamedTuple):
+    """A splitting loop's workspace: the accelerations, the implicit kick's
+    midpoint velocities, and ``cache[0]`` (1: ``acc`` belongs to the
+    current positions)."""
+    acc: np.ndarray
+    vm: np.ndarray
+    cache: np.ndarray
+
+
+def _splitting_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, outputs, checks,
+                    check):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
     # (v += c dt a(x)), the table KINDS/COEFS bound by specialize as constant
     # tuples, so that the compiler unrolls it.  The acceleration depends only
@@ -586,6 +595,9 @@ def _splitting_loop(x, v, t, dt, nsteps, acc, vm, cache, fargs, velocity_depende
     # the kick stays symmetric; vm is its scratch.  A kick v' = v + h a changes
     # the kinetic energy by exactly h sum m a . (v + v') / 2: the
     # non-conservative terms' part of it is their work (HAS_WORK).
+    acc, vm, cache = work
+    mon, step0, mon_t, mon_out = outputs
+    check_every, sargs = checks
     stopping = (sargs, check)
     n = x.shape[0]
     # flat views of the (N, 3) arrays: the drifts and kicks as loops LLVM
@@ -694,7 +706,10 @@ def splitting_loop(force, name, kinds, coefs):
     """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
 
     ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method.
-    The loop's last two arguments are a stopping record (:func:`~.stopping.stop_record`).
+    The loop takes ``(x, v, t, dt, nsteps, work, fargs, velocity_dependent,
+    outputs, checks, check)``: a :class:`SplittingWork`, the records of
+    :mod:`.records` and the stopping conditions' pointer
+    (:func:`~.stopping.stop_record`).
     """
     return specialize(_splitting_loop, f"{name}_{force.key}",
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
@@ -743,12 +758,31 @@ def rk_sums(sx, sv, kxF, kvF, b, count):
             sv[q] += bs * kvF[s, q]
 
 
-def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, step0,
-                      mon_t, mon_out, check_every, sargs, check):
+class Tableau(NamedTuple):
+    """An explicit Runge-Kutta method's Butcher tableau."""
+    A: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+
+
+class RungeKuttaWork(NamedTuple):
+    """A Runge-Kutta loop's workspace: each stage's velocities and
+    accelerations (one row a stage), and a stage's state."""
+    kx: np.ndarray
+    kv: np.ndarray
+    xs: np.ndarray
+    vs: np.ndarray
+
+
+def _runge_kutta_loop(x, v, t, dt, nsteps, tableau, work, fargs, outputs, checks, check):
     # y = (x, v), y' = (v, a(x, v, t)); stage s has state
     # y + dt sum_j A[s, j] k_j and derivative k_s.  kx[s] = stage velocity,
     # kv[s] = stage acceleration.  The work is the same method applied to
     # W' = -P(x, v, t): W += -dt sum_s b_s P(stage s).
+    A, b, c = tableau
+    kx, kv, xs, vs = work
+    mon, step0, mon_t, mon_out = outputs
+    check_every, sargs = checks
     stopping = (sargs, check)
     n = x.shape[0]
     n_stages = b.shape[0]
@@ -788,8 +822,11 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, A, b, c, kx, kv, xs, vs, fargs, mon, 
 
 
 def runge_kutta_loop(force):
-    """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`; its
-    last two arguments are a stopping record (:func:`~.stopping.stop_record`)."""
+    """The explicit Runge-Kutta loop compiled for a :class:`ForceKernel`: it
+    takes ``(x, v, t, dt, nsteps, tableau, work, fargs, outputs, checks,
+    check)``, a :class:`Tableau`, a :class:`RungeKuttaWork`, the records of
+    :mod:`.records` and the stopping conditions' pointer
+    (:func:`~.stopping.stop_record`)."""
     return specialize(_runge_kutta_loop, force.key,
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force), **work_kernels(force))

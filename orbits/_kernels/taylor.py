@@ -252,12 +252,26 @@ def radius_step(X, order):
     return rho * math.exp(-2.0 - SAFETY_EXPONENT / (order - 1))
 
 
-def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp, tc, info,
-                 counts, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps, order, min_dt,
-                 marks, mark_steps):
-    # counts: (accepted steps, 0, series expanded x order) of this call; tc:
-    # (time reached, the part of it t + dt rounded away), as in the IAS15
-    # loop (orbits._kernels.ias15), and marks, mark_steps as there
+class Work(NamedTuple):
+    """The Taylor loop's workspace besides its :class:`Series`: the last
+    step's proposal ``dt[0]``, ``info`` (bodies behind a stop), the
+    compensation of ``x`` and ``v``, ``tc`` (the time reached and the part
+    of it that ``t + dt`` rounded away, as in :mod:`.ias15`) and ``counts``
+    (accepted steps, 0, series expanded times the order) of a call."""
+    dt: np.ndarray
+    info: np.ndarray
+    csx: np.ndarray
+    csv: np.ndarray
+    tc: np.ndarray
+    counts: np.ndarray
+
+
+def _taylor_loop(x, v, t, order, series, work, fargs, outputs, landing, sargs, check):
+    # marks, mark_steps as in the IAS15 loop (orbits._kernels.ias15)
+    X, V, D, R2, S, W, IR, A, PI, PJ = series
+    dtp, info, csx, csv, tc, counts = work
+    mon, step0, mon_t, mon_out = outputs
+    t_end, max_steps, min_dt, marks, mark_steps = landing
     stopping = (sargs, check)
     n = x.shape[0]
     gm = fargs[0]
@@ -336,11 +350,11 @@ def _taylor_loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv, dtp
 def taylor_loop(force):
     """The Taylor loop compiled for gravity's :class:`~orbits._kernels.stepping.ForceKernel`.
 
-    The loop is ``loop(x, v, t, t_end, X, V, D, R2, S, W, IR, A, PI, PJ, csx, csv,
-    dt, tc, info, counts, fargs, mon, step0, mon_t, mon_out, sargs, check, max_steps,
-    order, min_dt, marks, mark_steps)`` (``sargs, check`` a stopping record,
-    :func:`~orbits._kernels.stopping.stop_record`) with the arrays of
-    :meth:`orbits.integrators.taylor.Taylor.workspace`; it returns ``(status,
+    The loop is ``loop(x, v, t, order, series, work, fargs, outputs, landing,
+    sargs, check)``: the series' order, a :class:`Series`, a :class:`Work`
+    over the arrays of :meth:`orbits.integrators.taylor.Taylor.workspace`,
+    the records of :mod:`.records` and the stopping conditions
+    (:func:`~orbits._kernels.stopping.stop_record`); it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the counts in ``counts``.
     """
     return specialize(_taylor_loop, force.key, jit=force.jit, cache=force.cache,

@@ -58,6 +58,7 @@ References
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -537,8 +538,8 @@ def trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v,
     if owed != 0.0:
         # the inner integrator's step memory and counts are the run's: kept
         # as they were, so that looking does not change the trajectory
-        hbox = inner[10]
-        counts = inner[11]
+        hbox = inner.hbox
+        counts = inner.counts
         h_kept = hbox[0]
         steps_kept = counts[2]
         _drift(xs, vs, gm, eta, n_active, enc, state[4] != 0, state[3] != 0, owed, w1, w2,
@@ -556,9 +557,67 @@ _pair_accelerations_call = called(pair_accelerations)
 _jump_call = called(jump)
 
 
-def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active, acc, xs, vs,
-                w1, w2, state, owed_box, checked, enc, enc_new, params, inner, tabs, mon, step0,
-                mon_t, mon_out, check_every, sargs, check, ahead, targs):
+class Work(NamedTuple):
+    """The ``trace`` loop's workspace (:meth:`orbits.integrators.trace.Trace.workspace`):
+    the democratic heliocentric state ``xh``, ``vb`` and the segment's start
+    ``xc``, ``vc``; each body's ``gm``, Kepler ``eta``, Hill radius and
+    squared criterion radius ``r2``; ``n_active[0]``; scratch ``acc``,
+    ``xs``, ``vs``, ``w1``, ``w2``; the flags ``state``, the owed drift
+    ``owed[0]``, ``checked``, and the pairs flagged (``enc``, ``enc_new``)."""
+    xh: np.ndarray
+    vb: np.ndarray
+    xc: np.ndarray
+    vc: np.ndarray
+    gm: np.ndarray
+    eta: np.ndarray
+    hill: np.ndarray
+    r2: np.ndarray
+    n_active: np.ndarray
+    acc: np.ndarray
+    xs: np.ndarray
+    vs: np.ndarray
+    w1: np.ndarray
+    w2: np.ndarray
+    state: np.ndarray
+    owed: np.ndarray
+    checked: np.ndarray
+    enc: np.ndarray
+    enc_new: np.ndarray
+
+
+class Criteria(NamedTuple):
+    """The switching criteria: the Hill radii's factor, the close
+    approach's speed factor, the pericentre factor, and the inner
+    integrator's relative tolerance."""
+    hill: float
+    speed: float
+    pericentre: float
+    rtol: float
+
+
+class Inner(NamedTuple):
+    """The inner integrator's arrays (:func:`inner_arrays`): each body's
+    group ``label``, a group's rows ``idx``, the DOP853 stages ``ky``,
+    ``ku``, the group's state ``y``, ``u`` and step result ``y1``, ``u1``,
+    the rows at the segment's start ``ys``, ``us``, the step memory
+    ``hbox[0]`` and ``counts`` (segments with flags, redos, inner steps)."""
+    label: np.ndarray
+    idx: np.ndarray
+    ky: np.ndarray
+    ku: np.ndarray
+    y: np.ndarray
+    u: np.ndarray
+    y1: np.ndarray
+    u1: np.ndarray
+    ys: np.ndarray
+    us: np.ndarray
+    hbox: np.ndarray
+    counts: np.ndarray
+
+
+def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, checks, check, ahead,
+                targs):
+    # work: a Work record, whose
     # state: [0] internal state current, [1] system checked, [2] the segment
     # started at a criterion point (else at a synchronised state: no opening
     # kick), [3] the segment integrates everything (a close pericentre),
@@ -567,16 +626,22 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
     # checked: [time, 1] when the epilogue last checked the stopping
     # conditions at a criterion point (x, v then hold that state), [., 0]
     # when at the end of the step.
-    # params: (k_hill, k_speed, k_peri, rtol); inner: the inner integrator's
-    # arrays, whose counts (segments with flags, redos, inner steps) add up.
+    # criteria: a Criteria record; inner: the inner integrator's arrays
+    # (Inner), whose counts (segments with flags, redos, inner steps) add up.
     # targs: the added terms' arguments (kicked with gravity's interaction,
-    # HAS_TERMS and term_kick bound by specialize).  sargs, check: the
-    # stopping record (orbits._kernels.stopping.stop_record); ahead: the
-    # pointer of orbits._kernels.stopping.ahead_pointer.
+    # HAS_TERMS and term_kick bound by specialize).  checks, check: the
+    # Checks record (orbits._kernels.records) and the stopping conditions'
+    # pointer (orbits._kernels.stopping.stop_record); ahead: the pointer of
+    # orbits._kernels.stopping.ahead_pointer.
+    (xh, vb, xc, vc, gm, eta, hill, r2, n_active_box, acc, xs, vs, w1, w2, state, owed_box,
+     checked, enc, enc_new) = work
+    n_active = n_active_box[0]
+    mon, step0, mon_t, mon_out = outputs
+    check_every, sargs = checks
     stopping = (sargs, check)
-    k_hill, k_speed, k_peri, rtol = params
-    checks = sargs[0] != 0
-    counts = inner[11]
+    k_hill, k_speed, k_peri, rtol = criteria
+    conditions = sargs[0] != 0
+    counts = inner.counts
     n = xh.shape[0]
     every = mon[0]
     n_mon = 0
@@ -671,7 +736,7 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
             from_democratic_heliocentric(xc, vc, gm, x, v)
             state[0] = 0
             checked[1] = 0.0
-            if checks and ahead(x, v, t_start, seg, sargs):
+            if conditions and ahead(x, v, t_start, seg, sargs):
                 return Status.COLLISION, k, n_mon
             return Status.STEP_UNDERFLOW, k, n_mon
         if flagged or peri:
@@ -730,12 +795,12 @@ def _trace_loop(x, v, xh, vb, xc, vc, t, dt, nsteps, gm, eta, hill, r2, n_active
         # encounter, every step); else the epilogue sees the internal state
         # (the finite check)
         seen_x, seen_v, t_seen = xh, vb, t + (k + 1) * dt
-        if until_record == 1 or (checks and k + 1 == nsteps):
+        if until_record == 1 or (conditions and k + 1 == nsteps):
             trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v, w1,
                               w2, inner, tabs, rtol)
             checked[1] = 0.0
             seen_x, seen_v = x, v
-        elif checks:
+        elif conditions:
             from_democratic_heliocentric(xc, vc, gm, x, v)
             t_seen -= owed
             checked[0] = t_seen
@@ -757,9 +822,12 @@ def _no_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
 def trace_loop(record=_record, terms=None):
     """The ``trace`` loop, ``record`` recording the monitors, and ``terms`` (a
     :class:`~orbits._kernels.terms.TermKernel` of position-only terms, or
-    None) kicked with the interaction, as ``wh`` kicks them.  It takes a
-    stopping record (:func:`~.stopping.stop_record`) with
-    :func:`~.stopping.ahead_pointer`'s pointer added."""
+    None) kicked with the interaction, as ``wh`` kicks them.  It takes
+    ``(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, checks,
+    check, ahead, targs)``: a :class:`Work`, a :class:`Criteria`, an
+    :class:`Inner`, the DOP853 tables, the records of :mod:`.records`, the
+    stopping conditions' pointer (:func:`~.stopping.stop_record`),
+    :func:`~.stopping.ahead_pointer`'s pointer and the terms' arguments."""
     key = "trace"
     if terms is None:
         kick, cache = _no_term_kick, True
@@ -774,10 +842,9 @@ def trace_loop(record=_record, terms=None):
 
 
 def inner_arrays(n, stages):
-    """The inner integrator's arrays for ``n`` bodies and a method of
-    ``stages`` stages: ``(label, idx, ky, ku, y, u, y1, u1, ys, us, hbox,
-    counts)``."""
-    return (np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
-            np.zeros((stages + 1, n, 3)), np.zeros((stages + 1, n, 3)),
-            np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)),
-            np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(1), np.zeros(3, dtype=np.int64))
+    """The inner integrator's arrays (:class:`Inner`) for ``n`` bodies and a
+    method of ``stages`` stages."""
+    return Inner(np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
+                 np.zeros((stages + 1, n, 3)), np.zeros((stages + 1, n, 3)),
+                 np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)),
+                 np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(1), np.zeros(3, dtype=np.int64))

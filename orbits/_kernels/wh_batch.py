@@ -90,6 +90,7 @@ import math
 import os
 import sys
 import tempfile
+from typing import NamedTuple
 
 import numpy as np
 
@@ -109,7 +110,7 @@ from .wisdom_holman import synchronize
 # the names the templates below are written against, bound by specialize
 kick, flat_kick, KICK_SYSTEMS, lane_step = slots("kick", "flat_kick", "KICK_SYSTEMS", "lane_step")
 
-__all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "lanes_workspace", "kepler_drift_lanes",
+__all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "Lanes", "Scratch", "lanes_workspace", "kepler_drift_lanes",
            "interaction_kick_lanes", "advance_lanes", "advance_loop", "unrolled_kick",
            "UNROLLED_KICK_BODIES", "record_lanes", "to_lanes", "from_lanes", "lane_inertial"]
 
@@ -132,21 +133,70 @@ _DT = 10
 SCRATCH_ROWS = _DT + 9
 
 
+class Lanes(NamedTuple):
+    """The systems a batch advances, lane ``b`` system ``b``: their Jacobi
+    positions and velocities ``xj``, ``vj`` (N, 3, B), ``G`` times the
+    masses ``gm`` and the interior masses ``eta`` (N, B,
+    :func:`orbits._kernels.coordinates.interior_gm` of each column), the
+    closing half drift each lane still owes ``owed`` (0 before its first
+    step; :func:`orbits._kernels.wisdom_holman.synchronize` applies it),
+    ``live`` (1.0 for a system that goes on, 0.0 for one frozen), and per
+    lane ``status`` and ``good`` (the steps of a call it completed)."""
+    xj: np.ndarray
+    vj: np.ndarray
+    gm: np.ndarray
+    eta: np.ndarray
+    owed: np.ndarray
+    live: np.ndarray
+    status: np.ndarray
+    good: np.ndarray
+
+
+class Scratch(NamedTuple):
+    """:func:`advance_lanes`'s scratch (:func:`lanes_workspace`): the state
+    in the lanes' layout (``X``, ``V``), the interaction's positions and
+    accelerations (``XI``, ``ACC``), the masses (``GM``, ``MU``), the live
+    flags ``LF``, the drift's rows ``d`` and flags ``fl``, the kick's sums
+    (``s3``, ``a3``, ``t4``), a block's start (``ckx``, ``ckv``), a lane's
+    rows (``px``, ``pv``), the central body's kick (``one_x``, ``one_v``)
+    and one lane's flags ``lf1``."""
+    X: np.ndarray
+    V: np.ndarray
+    XI: np.ndarray
+    ACC: np.ndarray
+    GM: np.ndarray
+    MU: np.ndarray
+    LF: np.ndarray
+    d: np.ndarray
+    fl: np.ndarray
+    s3: np.ndarray
+    a3: np.ndarray
+    t4: np.ndarray
+    ckx: np.ndarray
+    ckv: np.ndarray
+    px: np.ndarray
+    pv: np.ndarray
+    one_x: np.ndarray
+    one_v: np.ndarray
+    lf1: np.ndarray
+
+
 def lanes_workspace(n, b):
     """The scratch arrays of :func:`advance_lanes` for ``b`` systems of ``n``
-    bodies, as a tuple in the order of its arguments (pass them as ``*ws``).
+    bodies (a :class:`Scratch`).
 
     Examples
     --------
     >>> from orbits._kernels.wh_batch import lanes_workspace
-    >>> [a.shape for a in lanes_workspace(3, 4)][:2]
-    [(3, 12), (3, 12)]
+    >>> ws = lanes_workspace(3, 4)
+    >>> ws.X.shape, ws.d.shape[1]
+    ((3, 12), 12)
     """
     m = n * b
     z = aligned_zeros   # each array from a cache line on, as the planets' lanes'
-    return (z((3, m)), z((3, m)), z((3, m)), z((3, m)), z(m), z(m), z(m), z((SCRATCH_ROWS, m)),
-            z((3, m)), z((3, b)), z((3, b)), z((4, b)), z((3, m)), z((3, m)), z((n, 3)),
-            z((n, 3)), z((1, 3)), z((1, 3)), z(m))
+    return Scratch(z((3, m)), z((3, m)), z((3, m)), z((3, m)), z(m), z(m), z(m),
+                   z((SCRATCH_ROWS, m)), z((3, m)), z((3, b)), z((3, b)), z((4, b)), z((3, m)),
+                   z((3, m)), z((n, 3)), z((n, 3)), z((1, 3)), z((1, 3)), z(m))
 
 
 @njit(inline="always")
@@ -578,38 +628,26 @@ def _lane_finite(X, V, nb, b):
     return math.isfinite(s)
 
 
-def _advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, good, X, V, XI,
-                  ACC, GM, MU, LF, d, fl, s3, a3, t4, ckx, ckv, px, pv, one_x, one_v, lf1):
+def _advance_lanes(lanes, n_active, dt, nsteps, scratch):
     """Advance every live system ``nsteps`` steps of the Wisdom-Holman map.
 
     Parameters
     ----------
-    xj, vj : ndarray, shape (N, 3, B)
-        The systems' Jacobi positions and velocities (lane ``b`` is system
-        ``b``), advanced in place.
-    gm, eta : ndarray, shape (N, B)
-        G times the masses, and the interior masses
-        (:func:`orbits._kernels.coordinates.interior_gm` of each column).
+    lanes : Lanes
+        The systems, advanced in place: ``xj``, ``vj``, ``owed`` (the live
+        lanes owe the same), ``live``, ``status`` and ``good``.  A lane
+        that fails here gets ``Status.NON_FINITE`` in ``status``; ``xj``,
+        ``vj`` and ``owed`` keep its state after its good steps, and
+        ``live`` turns 0.
     n_active : int
         Massive bodies, the first rows (the same in every system).
     dt : float
         The step.
     nsteps : int
-    owed : ndarray, shape (B,)
-        The closing half drift each lane still owes (0 before its first
-        step; :func:`orbits._kernels.wisdom_holman.synchronize` applies it),
-        in place.  The live lanes owe the same.
-    live : ndarray, shape (B,)
-        1.0 for a system that goes on, 0.0 for one that is frozen; in place.
-    status, good : ndarray, shape (B,), int64
-        ``good``: the steps of this call each lane completed.  A lane that
-        fails here gets ``Status.NON_FINITE`` in ``status``; ``xj``, ``vj``
-        and ``owed`` keep its state after its good steps, and ``live``
-        turns 0.
-    X .. lf1
-        Scratch: :func:`lanes_workspace`'s arrays.  The loop works on the
-        state laid out as :func:`kepler_drift_lanes` says, copied in at the
-        start of the call and out at its end.
+    scratch : Scratch
+        :func:`lanes_workspace`'s arrays.  The loop works on the state laid
+        out as :func:`kepler_drift_lanes` says, copied in at the start of
+        the call and out at its end.
 
     Returns
     -------
@@ -625,14 +663,17 @@ def _advance_lanes(xj, vj, gm, eta, n_active, dt, nsteps, owed, live, status, go
     >>> x[1, 0], v[1, 1] = 1.0, 1.0                               # circular planets
     >>> x[2, 0], v[2, 1] = 2.0, 0.5 ** 0.5
     >>> xj, vj, eta = wh_batch.to_lanes(x, v, gm)
-    >>> ws = wh_batch.lanes_workspace(3, 2)
-    >>> owed, live = np.zeros(2), np.ones(2)
-    >>> status, good = np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64)
-    >>> wh_batch.advance_lanes(xj, vj, gm, eta, 3, 0.01, 100, owed, live, status, good, *ws)
+    >>> lanes = wh_batch.Lanes(xj, vj, gm, eta, owed=np.zeros(2), live=np.ones(2),
+    ...                        status=np.zeros(2, dtype=np.int64),
+    ...                        good=np.zeros(2, dtype=np.int64))
+    >>> wh_batch.advance_lanes(lanes, 3, 0.01, 100, wh_batch.lanes_workspace(3, 2))
     0
-    >>> owed, good
+    >>> lanes.owed, lanes.good
     (array([0.005, 0.005]), array([100, 100]))
     """
+    xj, vj, gm, eta, owed, live, status, good = lanes
+    (X, V, XI, ACC, GM, MU, LF, d, fl, s3, a3, t4, ckx, ckv, px, pv, one_x, one_v,
+     lf1) = scratch
     n = xj.shape[0]
     nb = xj.shape[2]
     failed = 0

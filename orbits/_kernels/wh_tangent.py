@@ -757,7 +757,7 @@ def _chaos_step(xj, vj, t, sync):
 def _chaos_note(sync, mon_out, row):
     # the chaos indicators into the monitor row just recorded, by the
     # variational force's own note (its fargs[1][4] is the box)
-    note(((), (0, 0, 0, 0, sync[11][1][6])), mon_out, row)
+    note(((), (0, 0, 0, 0, sync.targs[1][6])), mon_out, row)
 
 
 _INERTIAL_TANGENT = {"jacobi": jacobi_inertial_tangent,

@@ -98,6 +98,9 @@ References
 """
 
 import math
+from typing import NamedTuple
+
+import numpy as np
 
 from ._jit import called, njit, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
@@ -470,23 +473,74 @@ def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
 
 def _lanes_note(xj, vj, t, mon, n_mon, mon_t, mon_out):
     # the lanes' loop's recorder: the output is noted, to be made beside the
-    # next step's first drift (or when the loop returns)
-    S = mon[1][11][0]
+    # next step's first drift (or when the loop returns); mon is a Recording
+    S = mon.sync.targs[0]
     S[PENDING, 0] = 1.0
     S[PENDING, 1] = n_mon
     S[PENDING, 2] = t
 
 
-def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state, owed_box,
-             corr, cdt, mon, step0, mon_t, mon_out, check_every, targs, sargs, check):
-    # xj, vj: the internal (Jacobi or democratic heliocentric) state;
-    # eta: G times the mass each row's Kepler drift orbits; stopping: the
-    # stopping record (orbits._kernels.stopping.stop_record), whose escape
-    # conditions the loops without lanes check (see escape_kernels).
-    # state[0]: xj, vj hold the current state (else start from x, v);
-    # owed_box[0]: the drift the internal state still owes, deferred from the
-    # last step's closing drift; cdt[0]: the step the mapping state's
-    # corrector belongs to (corr has no rows without corrector).
+class System(NamedTuple):
+    """What the map needs of the bodies: ``G`` times each mass, ``eta`` (``G``
+    times the mass each row's Kepler drift orbits), the number of massive
+    bodies, and the corrector's coefficients (no rows without corrector)."""
+    gm: np.ndarray
+    eta: np.ndarray
+    n_active: int
+    corrector: np.ndarray
+
+
+class Work(NamedTuple):
+    """The Wisdom-Holman loop's workspace: the internal (Jacobi or democratic
+    heliocentric) state ``xj``, ``vj``; scratch ``acc``, ``xs``, ``vs``;
+    ``state[0]`` (``xj``, ``vj`` hold the current state, else the loop
+    starts from ``x``, ``v``); ``owed[0]``, the drift the internal state
+    still owes, deferred from the last step's closing drift; ``cdt[0]``,
+    the step the mapping state's corrector belongs to."""
+    xj: np.ndarray
+    vj: np.ndarray
+    acc: np.ndarray
+    xs: np.ndarray
+    vs: np.ndarray
+    state: np.ndarray
+    owed: np.ndarray
+    cdt: np.ndarray
+
+
+class Sync(NamedTuple):
+    """What the synchronisation takes besides the internal state: the
+    system, the drift owed, scratch, the inertial state to write, the
+    corrector and its step, and the loop's ``targs``."""
+    gm: np.ndarray
+    eta: np.ndarray
+    owed: float
+    xs: np.ndarray
+    vs: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    acc: np.ndarray
+    n_active: int
+    corr: np.ndarray
+    h: float
+    targs: tuple
+
+
+class Recording(NamedTuple):
+    """What the loop's recorder takes for its monitors: the monitors'
+    settings and the synchronisation's arguments."""
+    monitors: tuple
+    sync: Sync
+
+
+def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, targs):
+    # system: a System record, work: a Work record; checks, check: the Checks
+    # record (orbits._kernels.records) and the stopping conditions' pointer,
+    # whose escape conditions the loops without lanes check (see
+    # escape_kernels)
+    gm, eta, n_active, corr = system
+    xj, vj, acc, xs, vs, state, owed_box, cdt = work
+    mon, step0, mon_t, mon_out = outputs
+    check_every, sargs = checks
     stopping = (sargs, check)
     every = mon[0]
     n_mon = 0
@@ -542,13 +596,13 @@ def _wh_loop(x, v, xj, vj, t, dt, nsteps, gm, eta, n_active, acc, xs, vs, state,
         # synchronises first, so the monitors see the inertial state at the
         # time; the synchronisation's arguments are also its fargs, for the
         # chaos indicators of a run with variations (orbits._kernels.wh_tangent)
-        sync = (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)
+        sync = Sync(gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)
         finite, until_check = lanes_check(xj, vj, k, nsteps, until_check, check_every,
                                           until_record, targs)
         if finite:
             status, done, until_check, until_record, n_mon = step_end(
                 xj, vj, t + (k + 1) * dt, k, nsteps, not RESIDENT, until_check, check_every,
-                until_record, every, (mon, sync), n_mon, mon_t, mon_out,
+                until_record, every, Recording(mon, sync), n_mon, mon_t, mon_out,
                 stop_args(stopping, sync), sync)
         else:
             status, done = Status.NON_FINITE, k
@@ -678,7 +732,7 @@ def escape_kernels(key, synchronize_bodies, cache=True, nrt=False):
 
 def _wh_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
     # the recorder the Wisdom-Holman loop hands the shared step epilogue:
-    # mon is (the monitors' arguments, the synchronisation's)
+    # mon is a Recording
     mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs) = mon
     sync_kernel(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs)
     record(x, v, t, mon_args, n_mon, mon_t, mon_out)
@@ -873,8 +927,11 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
     lanes (:mod:`orbits._kernels.wh_lanes`), bit for bit the same results;
     the loop's ``targs`` are then ``(wh_lanes.lanes_scratch(N),)``.  The
     corrector and the synchronisation stay scalar (they run once a call or
-    an output).  The loop takes a stopping record
-    (:func:`~orbits._kernels.stopping.stop_record`); without ``lanes`` it
+    an output).  The loop takes ``(x, v, t, dt, nsteps, system, work,
+    outputs, checks, check, targs)``: a :class:`System`, a :class:`Work`, the
+    records of :mod:`orbits._kernels.records`, the stopping conditions'
+    pointer (:func:`~orbits._kernels.stopping.stop_record`) and the terms'
+    arguments or the lanes' scratch; without ``lanes`` it
     checks the escape conditions of :mod:`orbits._kernels.stopping` after
     every step on the synchronised state where the record has conditions
     (:func:`escape_kernels`); the lanes' loop checks none."""

@@ -191,6 +191,7 @@ def _run_lanes(lanes, spec, width):
         live[len(lanes):] = 0.0         # the idle lanes, frozen
         status = np.zeros(nb, dtype=np.int64)
         good = np.zeros(nb, dtype=np.int64)
+        lanes_record = _lanes.Lanes(xj, vj, gm, eta, owed, live, status, good)
         recs = [_recorder(lane.sim, plan, lane.path) for lane in lanes]
         which = monitor_mask(desc.monitors)
         scratch = (np.zeros((6, n, 3)), np.zeros((2, n)), np.zeros((0, 2)), np.zeros((n, 3)),
@@ -207,7 +208,7 @@ def _run_lanes(lanes, spec, width):
 
         def advance(k, h):
             if k > 0:
-                loop(xj, vj, gm, eta, n_active, h, k, owed, live, status, good, *ws)
+                loop(lanes_record, n_active, h, k, ws)
 
         def flush():
             k = len(marks)

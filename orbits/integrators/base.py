@@ -47,6 +47,7 @@ import warnings
 
 import numpy as np
 
+from .._kernels.records import NO_MARK_STEPS, NO_MARKS, checks, outputs
 from .._kernels.status import with_status
 from .._kernels import stepping
 from .._kernels.stopping import stop_record
@@ -55,11 +56,6 @@ from ..errors import IntegratorOptionError, OrbitsWarning
 __all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
            "RTOL_FLOOR", "NO_MARKS", "NO_MARK_STEPS"]
 
-#: ``advance_to``'s marks when the outputs are not recorded in the loop:
-#: empty arrays of the marks' types, so that each loop compiles once for both
-#: uses (empty: nothing is ever written to them)
-NO_MARKS = np.empty(0)
-NO_MARK_STEPS = np.empty(0, dtype=np.int64)
 
 #: The smallest relative tolerance an adaptive method is run with: 100 float64
 #: roundings (the floor scipy's ``solve_ivp`` also applies).
@@ -413,10 +409,12 @@ class SplittingMethod(Integrator):
         """
         loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs)
         fargs = stepping.work_bound(force, fargs, ws)
-        return with_status(*loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
-                    velocity_dependent or force.velocity_dependent,
-                    mon, step0, mon_t, mon_out, check_every,
-                    *stop_record(stop)))
+        sargs, check = stop_record(stop)
+        work = stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"])
+        return with_status(*loop(x, v, t, dt, nsteps, work, fargs,
+                                 velocity_dependent or force.velocity_dependent,
+                                 outputs(mon, step0, mon_t, mon_out),
+                                 checks(check_every, sargs), check))
 
     def invalidate(self, ws):
         """Drop the cached force: the next kick evaluates it again.
@@ -470,6 +468,7 @@ class ExplicitRungeKutta(Integrator):
         super().__init_subclass__(**kwargs)
         if cls.B is not None:
             cls.forces_per_step = len(cls.B)
+            cls._tableau = stepping.Tableau(cls.A, cls.B, cls.C)
 
     def workspace(self, n):
         """Stage buffers: ``kx``, ``kv`` of shape (stages, n, 3), and the stage
@@ -511,9 +510,11 @@ class ExplicitRungeKutta(Integrator):
         """
         loop = stepping.runge_kutta_loop(force)
         fargs = stepping.work_bound(force, fargs, ws)
-        return with_status(*loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
-                    ws["xs"], ws["vs"], fargs, mon, step0, mon_t, mon_out, check_every,
-                    *stop_record(stop)))
+        sargs, check = stop_record(stop)
+        work = stepping.RungeKuttaWork(ws["kx"], ws["kv"], ws["xs"], ws["vs"])
+        return with_status(*loop(x, v, t, dt, nsteps, self._tableau, work, fargs,
+                                 outputs(mon, step0, mon_t, mon_out),
+                                 checks(check_every, sargs), check))
 
 
 class AdaptiveIntegrator(Integrator):

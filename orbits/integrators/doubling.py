@@ -4,6 +4,7 @@ import numpy as np
 
 from .._kernels.status import with_status
 from .._kernels import doubling as _doubling
+from .._kernels import records
 from .._kernels import stepping as _stepping
 from .._kernels.stopping import stop_record
 from ._loops import loop_for
@@ -66,10 +67,9 @@ class RK4Doubling(AdaptiveIntegrator):
         its time in ``mon_t`` and its step count in ``mark_steps``."""
         loop = loop_for(_doubling.doubling_loop, force)
         fargs = _stepping.work_bound(force, fargs, ws)
-        w = ws
-        args = (x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
-                w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
-                w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
-                *stop_record(stop), int(max_steps),
-                float(self.config["rtol"]), float(self.config["atol"]))
-        return with_status(*loop(*args, marks, mark_steps))
+        tolerances = records.Tolerances(float(self.config["rtol"]), float(self.config["atol"]))
+        sargs, check = stop_record(stop)
+        return with_status(*loop(x, v, float(t), tolerances, records.work(_doubling.Work, ws),
+                                 fargs, records.outputs(mon, step0, mon_t, mon_out),
+                                 records.landing(t_end, max_steps, 0.0, marks, mark_steps),
+                                 sargs, check))

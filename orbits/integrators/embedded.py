@@ -4,6 +4,7 @@ import numpy as np
 
 from .._kernels.status import with_status
 from .._kernels import embedded as _embedded
+from .._kernels import records
 from .._kernels import stepping as _stepping
 from .._kernels.stopping import stop_record
 from . import dop853_coefficients as _dop853
@@ -56,12 +57,15 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
         loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None)
         fargs = _stepping.work_bound(force, fargs, ws)
-        args = (x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
-                float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],
-                ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
-                mon_t, mon_out, *stop_record(stop),
-                int(max_steps), float(self.config["rtol"]), float(self.config["atol"]))
-        return with_status(*loop(*args, marks, mark_steps))
+        method = _embedded.Method(self.A, self.B, self.C, self.E, e3,
+                                  float(self.error_estimator_order))
+        tolerances = records.Tolerances(float(self.config["rtol"]), float(self.config["atol"]))
+        sargs, check = stop_record(stop)
+        return with_status(*loop(x, v, float(t), method, tolerances,
+                                 records.work(_embedded.Work, ws), fargs,
+                                 records.outputs(mon, step0, mon_t, mon_out),
+                                 records.landing(t_end, max_steps, 0.0, marks, mark_steps),
+                                 sargs, check))
 
 
 class Dopri5(EmbeddedRungeKutta):

@@ -4,6 +4,7 @@ import numpy as np
 
 from .._kernels.status import Status
 from .._kernels import ias15 as _k
+from .._kernels import records
 from .._kernels.stepping import work_bound
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
@@ -141,13 +142,14 @@ class IAS15(AdaptiveIntegrator):
         its time in ``mon_t`` and its step count in ``mark_steps``."""
         loop = loop_for(_k.ias15_loop, force)
         fargs = work_bound(force, fargs, ws)
-        args = (x, v, float(t), float(t_end), ws["a0"], ws["b"], ws["g"], ws["e"], ws["br"],
-                ws["er"], ws["csx"], ws["csv"], ws["xs"], ws["vs"], ws["acc"], ws["P"],
-                ws["dt"], ws["ref"], ws["tc"], ws["flags"], ws["info"], ws["counts"], fargs,
-                mon, int(step0), mon_t, mon_out, *stop_record(stop),
-                int(max_steps), float(self.config["epsilon"]), float(self.config["min_dt"]),
-                ADAPTIVE_MODES[self.config["adaptive_mode"]])
-        status, t_reached, n_mon = loop(*args, marks, mark_steps)
+        control = _k.Control(float(self.config["epsilon"]),
+                             ADAPTIVE_MODES[self.config["adaptive_mode"]])
+        sargs, check = stop_record(stop)
+        status, t_reached, n_mon = loop(
+            x, v, float(t), control, records.work(_k.Work, ws), fargs,
+            records.outputs(mon, step0, mon_t, mon_out),
+            records.landing(t_end, max_steps, self.config["min_dt"], marks, mark_steps),
+            sargs, check)
         c = ws["counts"]
         return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
 

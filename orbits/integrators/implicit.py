@@ -15,7 +15,7 @@ O(N^3) work: they are meant for a few bodies, or for a user's force through
 import numpy as np
 
 from .._kernels.status import Status
-from .._kernels import implicit, stepping
+from .._kernels import implicit, records, stepping
 from .._kernels.stopping import stop_record
 from .base import Integrator
 
@@ -56,11 +56,11 @@ class ImplicitOneLeg(Integrator):
         velocity_dependent = bool(velocity_dependent or force.velocity_dependent)
         loop = implicit.implicit_loop(force, self.name, self.theta, velocity_dependent)
         fargs = stepping.work_bound(force, fargs, ws)
-        status, done, n_mon = loop(
-            x, v, t, dt, nsteps, ws["w"], ws["dw"], ws["xs"], ws["vs"], ws["acc"],
-            ws["cache"], ws["jx"], ws["jv"], ws["lu"], ws["piv"], ws["newton_iterations"],
-            fargs, bool(velocity_dependent), mon, step0, mon_t, mon_out, check_every,
-            *stop_record(stop))
+        sargs, check = stop_record(stop)
+        status, done, n_mon = loop(x, v, t, dt, nsteps, records.work(implicit.Work, ws), fargs,
+                                   bool(velocity_dependent),
+                                   records.outputs(mon, step0, mon_t, mon_out),
+                                   records.checks(check_every, sargs), check)
         return Status(status), done, n_mon
 
     def invalidate(self, ws):

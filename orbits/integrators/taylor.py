@@ -4,6 +4,7 @@ import numbers
 
 import numpy as np
 
+from .._kernels import records
 from .._kernels import taylor as _k
 from .._kernels.stopping import stop_record
 from .._kernels.status import Status
@@ -158,11 +159,12 @@ class Taylor(AdaptiveIntegrator):
             # writes as many pairs as the massive bodies make)
             self.bind(ws, force, fargs)
         loop = loop_for(_k.taylor_loop, force)
+        sargs, check = stop_record(stop)
         status, t_reached, n_mon = loop(
-            x, v, float(t), float(t_end), *ws["series"], ws["csx"], ws["csv"], ws["dt"],
-            ws["tc"], ws["info"], ws["counts"], fargs, mon, int(step0), mon_t, mon_out,
-            *stop_record(stop), int(max_steps), self.order_used,
-            float(self.config["min_dt"]), marks, mark_steps)
+            x, v, float(t), int(self.order_used), ws["series"], records.work(_k.Work, ws), fargs,
+            records.outputs(mon, step0, mon_t, mon_out),
+            records.landing(t_end, max_steps, self.config["min_dt"], marks, mark_steps),
+            sargs, check)
         c = ws["counts"]
         return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
 

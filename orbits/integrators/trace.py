@@ -6,6 +6,7 @@ import numbers
 
 import numpy as np
 
+from .._kernels import records
 from .._kernels import trace as _trace
 from .._kernels.coordinates import from_democratic_heliocentric
 from .._kernels.status import with_status
@@ -210,7 +211,7 @@ class Trace(Integrator):
         ((3, 3), [0, 0, 0])
         """
         stages = len(_dop853.B)
-        label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts = _trace.inner_arrays(n, stages)
+        inner = _trace.inner_arrays(n, stages)
         return {"xh": np.zeros((n, 3)), "vb": np.zeros((n, 3)),
                 "xc": np.zeros((n, 3)), "vc": np.zeros((n, 3)),
                 "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3)), "acc": np.zeros((n, 3)),
@@ -225,12 +226,10 @@ class Trace(Integrator):
                 "n_active": np.zeros(1, dtype=np.int64),
                 "enc": np.zeros((n, n), dtype=np.uint8),
                 "enc_new": np.zeros((n, n), dtype=np.uint8),
-                "label": label, "idx": idx, "ky": ky, "ku": ku, "y": y, "u": u, "y1": y1,
-                "u1": u1, "ys": ys, "us": us, "hbox": hbox, "counts": counts}
+                **inner._asdict()}
 
     def _inner(self, ws):
-        return tuple(ws[k] for k in ("label", "idx", "ky", "ku", "y", "u", "y1", "u1", "ys",
-                                     "us", "hbox", "counts"))
+        return records.work(_trace.Inner, ws)
 
     def check_terms(self, terms):
         """As ``wh``: only terms that depend on positions alone and have a
@@ -295,14 +294,13 @@ class Trace(Integrator):
             terms, targs = ws["terms"]
         c = self.config
         loop = _trace.trace_loop(record=force.recorder, terms=terms)
-        params = (c["hill"], c["speed"], c["pericentre"], c["rtol"])
+        criteria = _trace.Criteria(float(c["hill"]), float(c["speed"]), float(c["pericentre"]),
+                                   float(c["rtol"]))
+        sargs, check = stop_record(stop)
         return with_status(*loop(
-            x, v, ws["xh"], ws["vb"], ws["xc"], ws["vc"], float(t), float(dt), int(nsteps),
-            ws["gm"], ws["eta"], ws["hill"], ws["r2"], int(ws["n_active"][0]), ws["acc"],
-            ws["xs"], ws["vs"], ws["w1"], ws["w2"], ws["state"], ws["owed"], ws["checked"],
-            ws["enc"],
-            ws["enc_new"], params, self._inner(ws), self._tabs, mon, step0, mon_t, mon_out,
-            check_every, *stop_record(stop), ahead_pointer(stop is not None), targs))
+            x, v, float(t), float(dt), int(nsteps), records.work(_trace.Work, ws), criteria,
+            self._inner(ws), self._tabs, records.outputs(mon, step0, mon_t, mon_out),
+            records.checks(check_every, sargs), check, ahead_pointer(stop is not None), targs))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v`` (the owed part of the

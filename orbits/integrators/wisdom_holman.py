@@ -18,6 +18,7 @@ import numpy as np
 
 from .._kernels.status import with_status
 from .._kernels import coordinates as _coordinates
+from .._kernels import records
 from .._kernels import wisdom_holman as _wh
 from .._kernels import wh_lanes as _lanes
 from .._kernels import wh_tangent as _wht
@@ -421,10 +422,11 @@ class WisdomHolman(Integrator):
         gm, n_active = gravity[0], gravity[1]
         loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"],
                            terms, force.recorder, lanes)
-        return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"], n_active,
-                    ws["acc"], ws["xs"], ws["vs"], ws["state"], ws["owed"], self._corr,
-                    ws["cdt"], mon, step0, mon_t, mon_out, check_every, targs,
-                    *stop_record(stop)))
+        sargs, check = stop_record(stop)
+        system = _wh.System(gm, ws["eta"], int(n_active), self._corr)
+        return with_status(*loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
+                                 records.outputs(mon, step0, mon_t, mon_out),
+                                 records.checks(check_every, sargs), check, targs))
 
     @staticmethod
     def _loop_terms(ws, n):
@@ -465,11 +467,11 @@ class WisdomHolman(Integrator):
         gm, n_active = gravity[0], gravity[1]
         loop = _wht.wh_tangent_loop(self.name, self._kinds, self._coefs,
                                     self.config["coordinates"], terms, force)
-        return with_status(*loop(x, v, ws["xj"], ws["vj"], t, dt, nsteps, gm, ws["eta"][:n],
-                                 n_active, ws["acc"], ws["xs"], ws["vs"], ws["state"],
-                                 ws["owed"], self._corr, ws["cdt"], mon, step0, mon_t,
-                                 mon_out, check_every, (targs, tp),
-                                 *stop_record(stop)))
+        sargs, check = stop_record(stop)
+        system = _wh.System(gm, ws["eta"][:n], int(n_active), self._corr)
+        return with_status(*loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
+                                 records.outputs(mon, step0, mon_t, mon_out),
+                                 records.checks(check_every, sargs), check, (targs, tp)))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and

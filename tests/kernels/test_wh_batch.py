@@ -202,8 +202,8 @@ def advance(xj, vj, gm, eta, n_active, dt, steps, owed=None, unrolled=False):
     live = np.ones(nb)
     status, good = np.zeros(nb, dtype=np.int64), np.zeros(nb, dtype=np.int64)
     loop = W.advance_loop(n, n_active, nb) if unrolled else W.advance_lanes
-    failed = loop(xj, vj, gm, eta, n_active, dt, steps, owed, live, status, good,
-                  *W.lanes_workspace(n, nb))
+    failed = loop(W.Lanes(xj, vj, gm, eta, owed, live, status, good), n_active, dt, steps,
+                  W.lanes_workspace(n, nb))
     return failed, owed, live, status, good
 
 
@@ -351,5 +351,5 @@ def test_a_loop_of_advance_loop_refuses_another_number_of_systems():
     n = xj.shape[0]
     loop = W.advance_loop(n, n, 4)
     with pytest.raises(ValueError, match="number of systems"):
-        loop(xj, vj, gm, eta, n, 10.0, 5, np.zeros(3), np.ones(3), np.zeros(3, dtype=np.int64),
-             np.zeros(3, dtype=np.int64), *W.lanes_workspace(n, 3))
+        loop(W.Lanes(xj, vj, gm, eta, np.zeros(3), np.ones(3), np.zeros(3, dtype=np.int64),
+                     np.zeros(3, dtype=np.int64)), n, 10.0, 5, W.lanes_workspace(n, 3))
