@@ -11,6 +11,8 @@ from typing import NamedTuple
 import astropy.units as u
 import numpy as np
 
+from ._quantity_json import from_plain, to_plain
+
 __all__ = ["RunPlan", "SimulationConfig", "SimulationState", "Snapshot",
            "SimulationDescription"]
 
@@ -178,12 +180,11 @@ class SimulationConfig(NamedTuple):
         >>> d["integrator"], d["dt"]
         ('leapfrog', [1.0, 'd'])
         """
-        from .forces import _quantity_dict
         return {"integrator": self.integrator,
                 "integrator_options": dict(self.integrator_options),
-                "dt": _quantity_dict(self.dt), "forces": list(self.forces),
+                "dt": to_plain(self.dt), "forces": list(self.forces),
                 "monitors": list(self.monitors), "monitor_every": self.monitor_every,
-                "stop_conditions": {k: (_quantity_dict(v) if isinstance(v, u.Quantity)
+                "stop_conditions": {k: (to_plain(v) if isinstance(v, u.Quantity)
                                         else _function_name(v) if callable(v) else v)
                                     for k, v in self.stop_conditions.items()},
                 "variations": self.variations, "seed": self.seed}
@@ -210,10 +211,9 @@ class SimulationConfig(NamedTuple):
         >>> SimulationConfig.from_dict(cfg.to_dict()) == cfg
         True
         """
-        from .forces import _quantity_from
-        return cls(d["integrator"], dict(d["integrator_options"]), _quantity_from(d["dt"]),
+        return cls(d["integrator"], dict(d["integrator_options"]), from_plain(d["dt"]),
                    tuple(d["forces"]), tuple(d["monitors"]), d["monitor_every"],
-                   {k: _quantity_from(v) for k, v in d["stop_conditions"].items()},
+                   {k: from_plain(v) for k, v in d["stop_conditions"].items()},
                    d.get("variations"), d.get("seed"))
 
 

@@ -654,6 +654,68 @@ def test_terms_round_trip_through_dicts():
         forces.from_dict({"type": "Drag"})
 
 
+@pytest.mark.parametrize("term, record", [
+    (forces.Gravity(softening=0.01 * u.au),
+     {"type": "Gravity", "softening": [0.01, "AU"], "parallel": None,
+      "rebound_arithmetic": False}),
+    (forces.GR("Sun"), {"type": "GR", "source": "Sun", "c": None}),
+    (forces.GRFull(c=3e5 * u.km / u.s), {"type": "GRFull", "c": [300000.0, "km / s"]}),
+    (forces.ZonalHarmonics("Earth", 6378 * u.km, J2=1.08e-3, pole=(0, 0, 2)),
+     {"type": "ZonalHarmonics", "body": "Earth", "radius": [6378.0, "km"], "J2": 0.00108,
+      "J4": 0.0, "pole": [0.0, 0.0, 2.0]}),
+    (forces.Migration("Planet", tau_a=1e4 * u.yr),
+     {"type": "Migration", "body": "Planet", "tau_a": [10000.0, "yr"], "tau_e": None,
+      "tau_inc": None, "primary": None}),
+    (forces.TidesConstantTimeLag("Planet", k2=0.3, time_lag=600 * u.s, radius=7e4 * u.km,
+                                 spin=[0, 0, 2] * u.rad / u.day),
+     {"type": "TidesConstantTimeLag", "body": "Planet", "k2": 0.3, "time_lag": [600.0, "s"],
+      "radius": [70000.0, "km"], "spin": [[0.0, 0.0, 2.0], "rad / d"]}),
+    (forces.RadiationPressure("Sun", beta={"dust": 0.2}),
+     {"type": "RadiationPressure", "source": "Sun", "beta": {"dust": 0.2}, "c": None}),
+], ids=lambda v: type(v).__name__ if isinstance(v, forces.ForceTerm) else None)
+def test_term_records_hold_what_files_store(term, record):
+    # the dictionaries output files and ensembles store, key for key and in order
+    # (the pole as given, not normalised)
+    assert list(term.to_dict().items()) == list(record.items())
+    assert forces.from_dict(record) == term
+
+
+def test_a_record_without_a_required_value_is_named():
+    with pytest.raises(ForceTermError, match="'radius'") as info:
+        forces.from_dict({"type": "TidesConstantTimeLag", "body": "Planet", "k2": 0.3,
+                          "time_lag": [600.0, "s"]})
+    assert info.value.field == "radius"
+
+
+def test_terms_bind_their_parameters_in_internal_units():
+    # the rows the kernels read, for the star and planet of scenes.kepler (au, Msun,
+    # day): each value is one conversion or product of the given ones, so equal to
+    # the same arithmetic here to round-off (rel 1e-15)
+    b = orbits.scenes.kepler()
+    ctx = forces.Context.of(b)
+    G, (ms, mp) = b.units.G, b.masses.to_value(u.Msun)
+    yr = u.yr.to(u.day)
+    rows = {
+        forces.GRPotential("Star"): (0, 1 / C_AU_DAY ** 2),
+        forces.GRFull(): (2, 1 / C_AU_DAY ** 2),
+        forces.ZonalHarmonics("Star", 0.005 * u.au, J2=1e-6): (
+            0, G * ms * 1e-6 * 0.005 ** 2, 0.0, 0.0, 0.0, 1.0),
+        forces.Migration("Planet", tau_a=1 * u.yr): (
+            1, 0, ms / (ms + mp), mp / (ms + mp), 1 / yr, 0.0, 0.0),
+        forces.TidesConstantTimeLag("Planet", k2=0.3, time_lag=1 * u.day,
+                                    radius=0.001 * u.au): (
+            1, 3 * 0.3 * 0.001 ** 5, 1.0, 0.0, 0.0, 0.0),
+    }
+    for term, want in rows.items():
+        got = term.bind(ctx).args
+        assert got == pytest.approx(want, rel=1e-15, abs=0), term
+    s, gm, ic, beta = forces.RadiationPressure("Star", beta=0.1).bind(ctx).args
+    assert (s, list(beta)) == (0, [0.0, 0.1])     # the source feels none
+    assert (gm, ic) == pytest.approx((G * ms, 1 / C_AU_DAY), rel=1e-15, abs=0)
+    bound = forces.UserForce(_spring_to_origin).bind(ctx)
+    assert bound.user.func is _spring_to_origin and bound.args == ()
+
+
 # -- files, ensembles, command line -----------------------------------------------------------
 
 def _gr_sim(integrator="leapfrog"):

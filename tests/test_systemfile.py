@@ -11,6 +11,7 @@ import pytest
 import orbits
 from orbits import systemfile
 from orbits.errors import BodyError, SystemFileError
+from orbits.systemfile import _csv, _writer
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -387,7 +388,7 @@ def test_long_runs_of_spaces_and_digits_are_read_in_linear_time():
     # patterns with two adjacent runs that match spaces (or digits) take time
     # quadratic (or worse) in the run's length: minutes for 80 000; a test that
     # hangs shows as the suite's timeout
-    from orbits.systemfile import _TomlLines
+    from orbits.systemfile._toml import _TomlLines
     spaces = " " * 80_000
     text = f'[[body{spaces}]]\nname = "Sun"\nmass = "1 Msun"\n[[body]]\nname = "b"\n' \
            f'mass = 0\n'
@@ -412,18 +413,18 @@ def test_a_table_of_states_reads_as_row_by_row_bit_for_bit():
     rows[5] = "b5,0,,,,,,,"                      # at rest at the origin, no radius
     text = ("name,mass [Mearth],radius [Rsun],x [au],y [km],z [pc],vx [km/s],vy [au/d],"
             "vz [m/s]\n" + "\n".join(rows) + "\n")
-    reader = systemfile._CsvReader(text, "<string>")
+    reader = _csv._CsvReader(text, "<string>")
     table = reader.read_table()
     assert table is not None
-    one_by_one = systemfile._CsvReader(text, "<string>").read_rows()
+    one_by_one = _csv._CsvReader(text, "<string>").read_rows()
     assert table.names == one_by_one.names
     for a, b in ((table._m, one_by_one._m), (table._r, one_by_one._r),
                  (table._x, one_by_one._x), (table._v, one_by_one._v)):
         assert a.tobytes() == b.tobytes()
     units = "# units: length = km; mass = kg; time = s\n"
     plain = units + "name,mass,x,y,z,vx,vy,vz\nEarth,5.972e24,0,0,0,0,0,0\nsat,0,7000,0,0,0,7.5,0\n"
-    assert same_set(systemfile._CsvReader(plain, "").read_table(),
-                    systemfile._CsvReader(plain, "").read_rows())
+    assert same_set(_csv._CsvReader(plain, "").read_table(),
+                    _csv._CsvReader(plain, "").read_rows())
 
 
 def test_a_table_of_states_is_read_as_one_piece():
@@ -488,25 +489,25 @@ def test_a_table_of_elements_reads_as_row_by_row_bit_for_bit():
     # mass of the rows above), elliptic and hyperbolic, f and M, angles left
     # to their defaults, a state among them; every attribute as BodySet.add
     # makes it, the history included
-    table = systemfile._CsvReader(ELEMENT_TABLE, "<string>").read_table()
+    table = _csv._CsvReader(ELEMENT_TABLE, "<string>").read_table()
     assert table is not None
-    one_by_one = systemfile._CsvReader(ELEMENT_TABLE, "<string>").read_rows()
+    one_by_one = _csv._CsvReader(ELEMENT_TABLE, "<string>").read_rows()
     assert vars(table).keys() == vars(one_by_one).keys()
     for key, value in vars(one_by_one).items():
         if isinstance(value, np.ndarray):
             assert getattr(table, key).tobytes() == value.tobytes(), key
         else:
             assert getattr(table, key) == value, key
-    assert [systemfile._elements_note(table, i) for i in range(len(table))] == \
-        [systemfile._elements_note(one_by_one, i) for i in range(len(table))]
+    assert [_writer._elements_note(table, i) for i in range(len(table))] == \
+        [_writer._elements_note(one_by_one, i) for i in range(len(table))]
     assert systemfile.dumps(table, "toml") == systemfile.dumps(one_by_one, "toml")
     # plain numbers in the file's units, e without a unit
     plain = ("# units: length = km; mass = kg; time = s\n"
              "name,mass,primary,a,e,inc [rad],f [deg]\n"
              "Earth,5.972e24,,,,,\nsat,0,Earth,7000,0.001,0.9,33\nsat2,0,,-9000,1.5,,-10\n")
-    table = systemfile._CsvReader(plain, "").read_table()
+    table = _csv._CsvReader(plain, "").read_table()
     assert table is not None
-    one_by_one = systemfile._CsvReader(plain, "").read_rows()
+    one_by_one = _csv._CsvReader(plain, "").read_rows()
     assert same_set(table, one_by_one) and table.history == one_by_one.history
 
 
