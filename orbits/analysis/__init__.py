@@ -19,9 +19,6 @@ Examples
 --------
 Jupiter and Saturn in the outer solar system over 200,000 years, with an
 output every 200 years (500 steps of ``wh``):
-
->>> import astropy.units as u
->>> import orbits
 >>> from orbits.analysis import mean_motion_frequencies, secular_frequencies
 >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "wh", dt=146.1 * u.day)
 >>> result = sim.run(until=2e5 * u.yr, outputs=1001, progress=False)

@@ -35,7 +35,6 @@ class Frequencies:
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.analysis import frequencies
     >>> t = np.arange(2000) * 0.5
     >>> fa = frequencies(t, 2 * np.cos(0.3 * t + 1), n=1)
@@ -59,8 +58,6 @@ class Frequencies:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import numpy as np
         >>> from orbits.analysis import frequencies
         >>> t = np.arange(1000) * u.yr
         >>> frequencies(t, np.exp(-2j * np.pi * t.value / 50), n=1).periods.round(9)
@@ -89,7 +86,6 @@ class Frequencies:
 
         Examples
         --------
-        >>> import numpy as np
         >>> from orbits.analysis import frequencies
         >>> t = np.linspace(0, 100, 1001)
         >>> f = np.exp(1.5j * t) + 0.1 * np.exp(-0.4j * t)

@@ -133,8 +133,6 @@ def frequencies(times, signal, n=5, window=1):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import numpy as np
     >>> from orbits.analysis import frequencies
     >>> t = np.linspace(0, 1e5, 10001) * u.yr
     >>> x = t.to_value(u.yr)

@@ -54,8 +54,6 @@ class BodySet:
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> bodies = orbits.BodySet()
     >>> bodies.add("Sun", mass=1 * u.Msun)
     >>> bodies.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.048,
@@ -140,8 +138,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.BodySet()
         >>> bodies.add("Sun", mass=1 * u.Msun)
         >>> bodies.add("Earth", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, e=0.0167,
@@ -213,8 +209,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import numpy as np
-        >>> import orbits
         >>> U = orbits.UnitSystem.nbody()
         >>> bodies = orbits.BodySet.from_arrays([1.0, 1e-3], [[0, 0, 0], [1, 0, 0]],
         ...                                     [[0, 0, 0], [0, 1, 0]], names=["A", "B"],
@@ -261,7 +255,6 @@ class BodySet:
         Examples
         --------
         >>> import rebound
-        >>> import orbits
         >>> sim = rebound.Simulation()
         >>> sim.add(m=1.0)
         >>> sim.add(m=1e-3, a=1.0)
@@ -285,7 +278,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> sim = orbits.scenes.kepler().to_rebound()
         >>> sim.N, round(sim.particles[1].a, 12), sim.particles[1].r
         (2, 1.0, 0.0)
@@ -297,8 +289,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> a = orbits.scenes.kepler()
         >>> b = a.copy()
         >>> b.add("Moon", mass=0 * u.kg, position=[2, 0, 0] * u.au)
@@ -337,7 +327,6 @@ class BodySet:
         Examples
         --------
         >>> import os, tempfile
-        >>> import orbits
         >>> path = os.path.join(tempfile.mkdtemp(), "earth-moon.toml")
         >>> orbits.scenes.earth_moon().write(path)
         >>> orbits.BodySet.read(path).names
@@ -357,8 +346,6 @@ class BodySet:
         Examples
         --------
         >>> import os, tempfile
-        >>> import numpy as np
-        >>> import orbits
         >>> bodies = orbits.scenes.figure_eight()
         >>> path = os.path.join(tempfile.mkdtemp(), "figure-eight.csv")
         >>> bodies.write(path)
@@ -404,7 +391,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> bodies = orbits.scenes.outer_solar_system()
         >>> bodies["Jupiter"].mass
         <Quantity 0.00095479 solMass>
@@ -449,7 +435,6 @@ class BodySet:
         Examples
         --------
         >>> from astropy.time import Time
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> print(bodies.epoch)
         None
@@ -469,7 +454,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().names
         ['Star', 'Planet']
         """
@@ -479,7 +463,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().masses
         <Quantity [1.   , 0.001] solMass>
         """)
@@ -489,8 +472,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> bodies.add("moon", mass=0 * u.kg, position=[2, 0, 0] * u.au, radius=1737 * u.km)
         >>> bodies.radii.to(u.km)
@@ -501,7 +482,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> x = orbits.scenes.kepler().positions
         >>> x.shape, x.unit
         ((2, 3), Unit("AU"))
@@ -511,7 +491,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> v = orbits.scenes.kepler().velocities
         >>> v.unit, v.shape
         (Unit("AU / d"), (2, 3))
@@ -527,7 +506,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().index("Planet")
         1
         """
@@ -542,7 +520,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().total_mass
         <Quantity 1.001 solMass>
         """
@@ -553,7 +530,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> x, v = orbits.scenes.kepler().center_of_mass()   # the scene is barycentric
         >>> bool(abs(x).max().value < 1e-15), x.unit, v.unit
         (True, Unit("AU"), Unit("AU / d"))
@@ -571,7 +547,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> bodies.move_to_com()
         >>> x, v = bodies.center_of_mass()
@@ -606,7 +581,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> el = orbits.scenes.outer_solar_system().elements("Jupiter", primary="Sun")
         >>> round(float(el["a"].value), 2), el["a"].unit, round(float(el["e"]), 3)
         (5.2, Unit("AU"), 0.048)
@@ -656,8 +630,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.BodySet()
         >>> bodies.add("Sun", mass=1 * u.Msun)
         >>> bodies.add("b", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, inc=10 * u.deg)
@@ -694,8 +666,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import numpy as np
-        >>> import orbits
         >>> bodies = orbits.scenes.outer_solar_system(com=True)
         >>> bodies.to_invariable_plane()
         >>> m = bodies.masses.value
@@ -733,7 +703,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> fig = orbits.scenes.outer_solar_system().plot_orbits(primary="Sun")
         >>> [line.get_label() for line in fig.axes[0].lines][:2]
         ['Jupiter', 'Saturn']
@@ -749,8 +718,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> bodies.check()
         >>> bodies.add("twin", mass=1 * u.Mearth, position=bodies.positions[1])

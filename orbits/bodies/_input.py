@@ -169,7 +169,6 @@ def describe(value):
 
     Examples
     --------
-    >>> import astropy.units as u
     >>> from orbits.bodies._input import describe
     >>> describe(5.2 * u.au), describe(0.048)
     ('5.2 AU', '0.048')

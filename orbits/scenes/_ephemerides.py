@@ -107,7 +107,6 @@ def solar_system(epoch="2000-01-01 12:00:00", moon=True, frame="ecliptic"):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits import scenes
     >>> bodies = scenes.solar_system()
     >>> len(bodies)
@@ -274,7 +273,6 @@ def de421_states(epoch):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits import scenes
     >>> x, v = scenes.de421_states(2451545.0)
     >>> bool(np.all(x == scenes.de421().positions))
@@ -377,7 +375,6 @@ def de421(com=False, epoch=None):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits import scenes
     >>> bodies = scenes.de421()
     >>> bodies.names[3:5]

@@ -77,7 +77,6 @@ def kepler(e=0.0, a=1.0 * u.au, f=1.0 * u.rad, m_central=1.0 * u.Msun,
 
     Examples
     --------
-    >>> import astropy.units as u
     >>> from orbits import scenes
     >>> bodies = scenes.kepler(e=0.5)
     >>> round(float(bodies.elements("Planet", primary="Star")["e"]), 12)
