@@ -54,13 +54,14 @@ class BodySet:
 
     Examples
     --------
-    >>> bodies = orbits.BodySet()
-    >>> bodies.add("Sun", mass=1 * u.Msun)
-    >>> bodies.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.048,
-    ...            inc=1.3 * u.deg)
+    In a unit system given explicitly, plain numbers are read in it:
+
+    >>> bodies = orbits.BodySet(orbits.UnitSystem.nbody())
+    >>> bodies.add("A", mass=1.0)
+    >>> bodies.add("B", mass=1e-3, primary="A", a=1.0, e=0.1)
     >>> bodies.move_to_com()
-    >>> len(bodies)
-    2
+    >>> len(bodies), bodies.units.G, bodies.masses
+    (2, 1.0, <Quantity [1.   , 0.001]>)
     """
 
     def __init__(self, units=None):
@@ -610,10 +611,9 @@ class BodySet:
         a, b : str
             The bodies' names.
         primary : str, optional
-            The primary of both orbits, as for :meth:`elements`: a body's name,
-            ``"barycentre"``, or None for each body's default (the centre of
-            mass of the bodies before it, so that in a hierarchical system each
-            orbit is about what it goes around).
+            The primary of both orbits, as for :meth:`elements`; by default each
+            body's own, so that in a hierarchical system each orbit is about
+            what it goes around.
 
         Returns
         -------
