@@ -10,10 +10,9 @@ frequencies of secular theory), and :func:`mean_motion_frequencies` to its
 mean longitude or to a combination of mean longitudes, such as the great
 inequality ``2 lambda_J - 5 lambda_S`` of Jupiter and Saturn.
 
-The algorithm is in ``_naff``, the decomposition it returns in
-``_decomposition``, the analyses of a run in ``_planetary`` and the checks of
-the samples in ``_sampling``: private modules of this package, whose public
-names are these.
+The algorithm is in :mod:`orbits.analysis.naff`, the decomposition it returns
+in :mod:`orbits.analysis.decomposition`, and the analyses of a run in
+:mod:`orbits.analysis.planetary`; this package gives their public names.
 
 Examples
 --------
@@ -36,11 +35,10 @@ output every 200 years (500 steps of ``wh``):
 0.97
 """
 
-from ._decomposition import Frequencies
-from ._naff import frequencies
-from ._planetary import (PLANES, SecularFrequencies, mean_motion_frequencies,
+from .decomposition import Frequencies
+from .naff import SPACING_RTOL, frequencies
+from .planetary import (PLANES, SecularFrequencies, mean_motion_frequencies,
                          secular_frequencies)
-from ._sampling import SPACING_RTOL
 
 __all__ = ["Frequencies", "SecularFrequencies", "frequencies", "secular_frequencies",
            "mean_motion_frequencies", "SPACING_RTOL", "PLANES"]

@@ -7,15 +7,8 @@ import numbers
 import astropy.units as u
 import numpy as np
 
-__all__ = ["SPACING_RTOL", "as_plain", "sampling_interval", "is_whole", "whole_number",
+__all__ = ["as_plain", "sampling_interval", "is_whole", "whole_number",
            "wrap_angle", "to_float"]
-
-#: Largest spread of the sampling intervals, relative to their mean, that
-#: counts as even: the rounding of times ``t0 + k dt`` stays below 2e-9 of
-#: ``dt`` up to 1e7 outputs, while outputs that snap to the steps of a
-#: fixed-step run vary by a whole step, 1 / (steps per output) of ``dt``.
-SPACING_RTOL = 1e-8
-
 
 def as_plain(q, name):
     """Plain values and unit (None when not a Quantity)."""
@@ -27,9 +20,10 @@ def as_plain(q, name):
         raise ValueError(f"{name}: expected an array, got {q!r}") from exc
 
 
-def sampling_interval(t, hint=""):
-    """The sampling interval of evenly spaced ``t``; a ValueError otherwise
-    (``hint``, on how to space them evenly, ends the message of uneven ones)."""
+def sampling_interval(t, rtol, hint=""):
+    """The sampling interval of ``t``, evenly spaced to ``rtol`` of it; a ValueError
+    otherwise (``hint``, on how to space them evenly, ends the message of uneven
+    ones)."""
     d = np.diff(t.astype(float))
     mean = (t[-1] - t[0]) / (len(t) - 1)
     if np.any(d <= 0):
@@ -39,9 +33,9 @@ def sampling_interval(t, hint=""):
     if not mean > 0:
         raise ValueError("times: expected increasing times")
     spread = float(np.max(np.abs(d - mean))) / mean
-    if spread > SPACING_RTOL:
+    if spread > rtol:
         k = int(np.argmax(np.abs(d - mean)))
-        raise ValueError(f"times: expected evenly spaced times (to {SPACING_RTOL:g} of the "
+        raise ValueError(f"times: expected evenly spaced times (to {rtol:g} of the "
                          f"interval); interval {k} is {d[k]:.10g} against a mean of "
                          f"{mean:.10g} (relative difference {spread:.3g}){hint}")
     return float(mean)

@@ -8,11 +8,16 @@ moved to the centre-of-mass frame unless their docstring says otherwise.
 :data:`SCENES` maps the command-line names (lowercase, with hyphens) to the
 functions; :func:`get` builds a scene by name and :func:`describe` lists them.
 
-The scenes come in families, each in a private module of this package:
-Keplerian orbits (``_keplerian``), initial conditions from the literature
-(``_published``), the solar system from an ephemeris (``_ephemerides``) and
-random samples (``_sampled``); ``_provenance`` holds the GM values their
-masses come from.
+The scenes come in families, each in a module of this package: Keplerian
+orbits (:mod:`orbits.scenes.keplerian`), initial conditions from the
+literature (:mod:`orbits.scenes.published`), the solar system from an
+ephemeris (:mod:`orbits.scenes.ephemerides`) and random samples
+(:mod:`orbits.scenes.sampled`).
+
+Masses of solar-system bodies are given through their GM values, which are
+known far better than the masses themselves: a body's mass is stored as
+``GM / G`` in the set's unit system, so that ``G * m`` equals the published
+GM exactly (the DE440 values are in the private ``_provenance``).
 
 Examples
 --------
@@ -24,11 +29,11 @@ Examples
 ['earth-moon', 'sun-earth-moon', 'kepler']
 """
 
-from ._ephemerides import DE421_AU, J2000_OBLIQUITY, de421, de421_states, solar_system
-from ._keplerian import (MOON_ECCENTRICITY, MOON_SEMI_MAJOR_AXIS, earth_moon, kepler,
-                         sun_earth_moon)
-from ._published import FIGURE_EIGHT_PERIOD, HLW_G, figure_eight, outer_solar_system, pythagorean
-from ._sampled import planetesimal_ring, plummer
+from .ephemerides import DE421_AU, J2000_OBLIQUITY, de421, de421_states, solar_system
+from .keplerian import (MOON_ECCENTRICITY, MOON_SEMI_MAJOR_AXIS, earth_moon, kepler,
+                        sun_earth_moon)
+from .published import FIGURE_EIGHT_PERIOD, HLW_G, figure_eight, outer_solar_system, pythagorean
+from .sampled import planetesimal_ring, plummer
 
 __all__ = [
     "earth_moon",

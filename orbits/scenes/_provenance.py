@@ -1,11 +1,6 @@
 """Where a scene's numbers come from: the published GM values its masses are made
-from, and the record of the scene that a body set keeps in its ``history``.
-
-Masses of solar-system bodies are given through their GM values, which are
-known far better than the masses themselves: a body's mass is stored as
-``GM / G`` in the set's unit system, so that ``G * m`` equals the published
-GM exactly.
-"""
+from (a mass is ``GM / G``, so that ``G * m`` is the published GM exactly), and
+the record of the scene that a body set keeps in its ``history``."""
 
 import astropy.units as u
 

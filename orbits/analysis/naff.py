@@ -8,10 +8,16 @@ import astropy.units as u
 import numpy as np
 
 from ..errors import OrbitsWarning
-from ._decomposition import Frequencies
 from ._sampling import as_plain, sampling_interval, whole_number, wrap_angle
+from .decomposition import Frequencies
 
-__all__ = ["frequencies"]
+__all__ = ["frequencies", "SPACING_RTOL"]
+
+#: Largest spread of the sampling intervals, relative to their mean, that
+#: counts as even: the rounding of times ``t0 + k dt`` stays below 2e-9 of
+#: ``dt`` up to 1e7 outputs, while outputs that snap to the steps of a
+#: fixed-step run vary by a whole step, 1 / (steps per output) of ``dt``.
+SPACING_RTOL = 1e-8
 
 # The coarse peak comes from an FFT zero-padded to this many times the
 # signal's length, so that it lies within an eighth of a resolution element
@@ -87,7 +93,7 @@ def frequencies(times, signal, n=5, window=1):
     ------
     ValueError
         ``times`` is not one-dimensional, increasing and evenly spaced (to
-        :data:`~orbits.analysis.SPACING_RTOL`), or not of the length of ``signal``; either is
+        :data:`~orbits.analysis.naff.SPACING_RTOL`), or not of the length of ``signal``; either is
         not finite; ``n`` or ``window`` is not a whole number in range.
 
     Notes
@@ -153,7 +159,7 @@ def frequencies(times, signal, n=5, window=1):
         raise ValueError(f"times: a frequency analysis needs at least 8 samples, got {N}")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(f))):
         raise ValueError("times and signal must be finite")
-    dt = sampling_interval(t)
+    dt = sampling_interval(t, SPACING_RTOL)
     real = not np.iscomplexobj(f)
     limit = N // 4 if real else N // 2
     n = whole_number(n, "n", 1, limit, f" (at most N // {4 if real else 2} = {limit} terms "

@@ -11,9 +11,9 @@ import numpy as np
 
 from .. import geometry as _geometry
 from ..errors import BodyError
-from ._decomposition import Frequencies
-from ._naff import frequencies
 from ._sampling import as_plain, is_whole, sampling_interval, to_float
+from .decomposition import Frequencies
+from .naff import SPACING_RTOL, frequencies
 
 __all__ = ["SecularFrequencies", "secular_frequencies", "mean_motion_frequencies", "PLANES"]
 
@@ -64,7 +64,7 @@ class SecularFrequencies:
 def secular_frequencies(result, body, n=10, primary=None, plane="invariable", window=1):
     """The secular frequencies of a body in a run: ``g`` of its perihelion, ``s`` of its node.
 
-    Frequency analysis (:func:`frequencies`) of the body's eccentricity and
+    Frequency analysis (:func:`~orbits.analysis.frequencies`) of the body's eccentricity and
     inclination variables at the run's outputs:
     ``z = e exp(i varpi) = k + i h`` and
     ``zeta = sin(inc/2) exp(i Omega) = q + i p``, with
@@ -96,12 +96,12 @@ def secular_frequencies(result, body, n=10, primary=None, plane="invariable", wi
         dominated by the constant tilt and each mode appears at both ``+s``
         and ``-s``.
     window : int
-        As for :func:`frequencies`.
+        As for :func:`~orbits.analysis.frequencies`.
 
     Returns
     -------
     SecularFrequencies
-        ``g`` and ``s``, each a :class:`Frequencies` with frequencies in rad
+        ``g`` and ``s``, each a :class:`~orbits.analysis.Frequencies` with frequencies in rad
         per the unit of ``result.times`` (convert with
         ``.to(u.arcsec / u.yr)``).
 
@@ -112,7 +112,7 @@ def secular_frequencies(result, body, n=10, primary=None, plane="invariable", wi
         ``body`` is the most massive body and no ``primary`` is named.
     ValueError
         The outputs are not evenly spaced; ``plane`` is not one of
-        :data:`PLANES`; as :func:`frequencies` raises it.
+        :data:`~orbits.analysis.planetary.PLANES`; as :func:`~orbits.analysis.frequencies` raises it.
 
     Notes
     -----
@@ -160,7 +160,7 @@ def secular_frequencies(result, body, n=10, primary=None, plane="invariable", wi
 def mean_motion_frequencies(result, bodies, n=5, primary=None, plane="invariable", window=1):
     """Frequencies of a body's mean longitude, or of a combination of mean longitudes.
 
-    Frequency analysis (:func:`frequencies`) of ``exp(i theta)`` with
+    Frequency analysis (:func:`~orbits.analysis.frequencies`) of ``exp(i theta)`` with
     ``theta = sum_b k_b lambda_b`` and the mean longitudes
     ``lambda = Omega + omega + M`` of osculating heliocentric elements.  The
     leading frequency is the combination's mean rate ``sum_b k_b n_b``: the
@@ -245,7 +245,7 @@ def _check_outputs(times):
     """The outputs of a run are evenly spaced; a ValueError that says how to get them otherwise."""
     t, _ = as_plain(times, "times")
     if t.ndim == 1 and len(t) >= 2:
-        sampling_interval(np.asarray(t, dtype=float),
+        sampling_interval(np.asarray(t, dtype=float), SPACING_RTOL,
                  "; a fixed-step run takes each output at the step nearest its even spacing: "
                  "choose dt so that the interval between outputs is a whole number of steps")
 

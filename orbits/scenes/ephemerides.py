@@ -338,7 +338,7 @@ def de421(com=False, epoch=None):
         ``"Mars"``, ``"Jupiter"``, ``"Saturn"``, ``"Uranus"``, ``"Neptune"``,
         ``"Pluto"``, in au (IAU 2012), solar masses and days.  G is DE421's
         GM_sun (``GMS = 2.959122082855911e-4`` (DE421 au)^3/day^2, with
-        1 DE421 au = :data:`DE421_AU`) per solar mass, so the Sun's mass is
+        1 DE421 au = :data:`~orbits.scenes.ephemerides.DE421_AU`) per solar mass, so the Sun's mass is
         exactly 1 Msun and each other mass is ``GM / GMS``.  Mars to Pluto are
         the barycentres of the planets' systems, with the systems' masses; the
         Earth and the Moon are separate bodies, their GMs split from DE421's

@@ -109,7 +109,7 @@ def earth_moon():
     -----
     The orbit is a two-body Keplerian ellipse with ``mu = G (m_E + m_M)``; the
     real Moon's orbit is strongly perturbed by the Sun (see
-    :func:`sun_earth_moon` and :func:`solar_system`).
+    :func:`~orbits.scenes.sun_earth_moon` and :func:`~orbits.scenes.solar_system`).
 
     References
     ----------
@@ -161,7 +161,7 @@ def sun_earth_moon():
     Notes
     -----
     A schematic configuration, not an ephemeris: the phases and orientations
-    are not those of any date.  Use :func:`solar_system` for the real sky.
+    are not those of any date.  Use :func:`~orbits.scenes.solar_system` for the real sky.
 
     References
     ----------

@@ -15,7 +15,7 @@ __all__ = ["Frequencies"]
 
 @dataclasses.dataclass(frozen=True, repr=False)
 class Frequencies:
-    """A quasi-periodic decomposition: what :func:`frequencies` returns.
+    """A quasi-periodic decomposition: what :func:`~orbits.analysis.frequencies` returns.
 
     For a complex signal ``f(t) ~ sum_k A_k exp(i (nu_k t + phi_k))``; for a
     real one ``f(t) ~ sum_k A_k cos(nu_k t + phi_k)`` with ``nu_k >= 0``.

@@ -70,7 +70,7 @@ def outer_solar_system(com=False):
     BodySet
         Bodies ``"Sun"``, ``"Jupiter"``, ``"Saturn"``, ``"Uranus"``,
         ``"Neptune"``, ``"Pluto"``, in au, solar masses and days with
-        ``G = 2.95912208286e-4`` au^3/(Msun day^2) (:data:`HLW_G`; the book's
+        ``G = 2.95912208286e-4`` au^3/(Msun day^2) (:data:`~orbits.scenes.published.HLW_G`; the book's
         value, 1.4e-12 relative from Gauss's constant squared).  Masses:
         ``m0 = 1.00000597682`` (Sun plus inner planets),
         ``m1 = 0.000954786104043``, ``m2 = 0.000285583733151``,
@@ -149,7 +149,7 @@ def figure_eight():
     """The figure-eight choreography of three equal masses.
 
     Three bodies of mass 1 chase one another around one figure-eight curve,
-    with ``G = 1`` and period :data:`FIGURE_EIGHT_PERIOD` (6.32591398).  The
+    with ``G = 1`` and period :data:`~orbits.scenes.published.FIGURE_EIGHT_PERIOD` (6.32591398).  The
     initial conditions are Simó's, as given by Chenciner & Montgomery:
     ``x1 = -x2 = (0.97000436, -0.24308753, 0)``, ``x3 = 0``,
     ``v3 = (-0.93240737, -0.86473146, 0)``, ``v1 = v2 = -v3 / 2``.
