@@ -39,7 +39,7 @@ import numpy as np
 from .errors import EpochError
 
 __all__ = ["as_epoch", "parse", "from_text", "to_text", "from_pair", "to_pair", "describe",
-           "at_times", "is_time"]
+           "at_times", "is_time", "to_tdb"]
 
 # "2451545.0", "2451545.0 + 0.25", "2451545 - 0.5": a Julian date in one or two parts
 _NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
@@ -102,11 +102,7 @@ def as_epoch(value, field="epoch"):
         raise EpochError(f"{field} must be a single date, got a Time of shape {value.shape}")
     if value.scale != "tdb":
         try:
-            # UTC needs the leap-second table and UT1 the IERS tables; the
-            # conversion must not go to the network for fresher ones
-            from astropy.utils import iers
-            with iers.conf.set_temp("auto_download", False):
-                value = value.tdb
+            value = to_tdb(value)
         except Exception as exc:
             raise EpochError(f"{field}: cannot carry the date from {value.scale.upper()} to "
                              f"TDB without the network ({exc})") from None
@@ -114,6 +110,27 @@ def as_epoch(value, field="epoch"):
     if not (math.isfinite(jd1) and math.isfinite(jd2)):
         raise EpochError(f"{field} must be a finite date, got {value}")
     return from_pair(jd1, jd2)
+
+
+def to_tdb(time):
+    """``time``, an ``astropy.time.Time`` of any shape and scale, in TDB, converted
+    without the network.
+
+    UTC needs the leap-second table and UT1 the IERS tables: astropy's copies on
+    disk are used, never fresher ones from the network.
+
+    Examples
+    --------
+    >>> from astropy.time import Time
+    >>> from orbits import epochs
+    >>> epochs.to_tdb(Time(["2000-01-01T12:00:00"], scale="tt")).scale
+    'tdb'
+    """
+    if time.scale == "tdb":
+        return time
+    from astropy.utils import iers
+    with iers.conf.set_temp("auto_download", False):
+        return time.tdb
 
 
 def from_pair(jd1, jd2, field="epoch"):

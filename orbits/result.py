@@ -667,13 +667,8 @@ class Result:
 
         Parameters
         ----------
-        a, b : str
-            The bodies' names.
-        primary : str, optional
-            The primary of both orbits, as for :meth:`elements`: a body's name,
-            ``"barycentre"``, or None for each body's default (the centre of
-            mass of the bodies before it, so that in a hierarchical system each
-            orbit is about what it goes around).
+        a, b, primary
+            As for :meth:`orbits.BodySet.mutual_inclination`.
 
         Returns
         -------

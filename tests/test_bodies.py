@@ -296,7 +296,7 @@ def test_no_massive_body_and_coincident_bodies():
 def test_history_describes_quantities_as_str_does():
     # the record of how bodies were made writes each element as str() would
     # (with each unit's string formatted once, not at every add)
-    from orbits.bodies import _describe
+    from orbits.bodies._input import describe as _describe
     for value in (12.0 * u.au, 0.1 * u.one, 180 * u.deg, np.array([1.0, 2.0]) * u.au / u.day,
                   0 * u.kg, 0.1, 5, 1e-300 * u.au, 3.0 * u.au ** 3 / u.yr ** 2):
         assert _describe(value) == str(value)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import orbits
-from orbits import analysis
+from orbits.analysis import naff
 from orbits.analysis import frequencies, mean_motion_frequencies, secular_frequencies
 from orbits.errors import OrbitsWarning
 
@@ -101,7 +101,7 @@ def test_plain_naff_error_falls_as_the_window_says(window, monkeypatch):
     # (Laskar 2003): slopes -2, -4, -6.  Measured -2.2, -4.2, -6.3 over
     # T = 250 ... 8000; the leakage oscillates with Delta nu T / 2 about its
     # envelope, hence the 0.6 allowed.
-    monkeypatch.setattr(analysis, "_CORRECTIONS", 0)
+    monkeypatch.setattr(naff, "_CORRECTIONS", 0)
     spans = [250.0 * 2 ** k for k in range(6)]
     errors = []
     for span in spans:

@@ -355,9 +355,10 @@ def test_de421_constants_are_the_ephemeris_header():
 
     header = Ephemeris(de421_package)
     assert header.DENUM == 421
-    for key, value in scenes._GM_DE421.items():
+    from orbits.scenes import ephemerides
+    for key, value in ephemerides._GM_DE421.items():
         assert value == getattr(header, key), key
-    assert scenes._EMRAT_DE421 == header.EMRAT
+    assert ephemerides._EMRAT_DE421 == header.EMRAT
     assert scenes.DE421_AU.to_value(u.km) == header.AU
 
 

@@ -11,7 +11,9 @@ import astropy.units as u
 import numpy as np
 
 from .._csvcells import read_cell
-from ..bodies import BodySet, _relative_state, _unit_string
+from ..bodies import BodySet
+from ..bodies._elements import relative_state
+from ..bodies._input import unit_string
 from ..errors import BodyError, SystemFileError
 from ..units import UnitSystem
 from ._reader import SystemFile, _Reader
@@ -80,7 +82,7 @@ class _CsvReader(_Reader):
         A column's numbers are converted to the set's unit at once, with the
         factor by which a cell-by-cell reading converts each: the same numbers,
         bit for bit.  A row of elements is then turned into a state with the
-        arithmetic of :meth:`~orbits.BodySet.add` (``bodies._relative_state``
+        arithmetic of :meth:`~orbits.BodySet.add` (:mod:`orbits.bodies._elements`
         and the primary's state, or the centre of mass of the rows above), and
         its history entry is the one ``add`` records: the same set, bit for
         bit.  (Row by row, each body costs a few astropy conversions and an
@@ -179,11 +181,11 @@ class _CsvReader(_Reader):
         index = {}
         history = []
         # the history's text of each cell: str of the Quantity's value and its
-        # unit, as bodies._describe writes a cell of a column with a unit
+        # unit, as orbits.bodies._input.describe writes a cell of a column with a unit
         text = {}
         for c, (_, empty, raw) in elements.items():
             unit = column_units[c]
-            ustr = _unit_string(unit) if unit is not None else ""
+            ustr = unit_string(unit) if unit is not None else ""
             if unit is None:
                 text[c] = [None if e else str(float(r)) for r, e in zip(raw, empty)]
             elif ustr:
@@ -217,7 +219,7 @@ class _CsvReader(_Reader):
                 mp, xp, vp = mass[j], x[j], v[j]
             e = 0.0 if el["e"] is None else el["e"]
             try:
-                pos, vel = _relative_state(name, units, mp, float(mass[i]), el["a"], e,
+                pos, vel = relative_state(name, units, mp, float(mass[i]), el["a"], e,
                                            el["inc"], el["Omega"], el["omega"], el["f"],
                                            el["M"])
             except BodyError:

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import epochs as _epochs
 from .._csvcells import safe_cell
-from ..bodies import _bound_elements
+from ..bodies._elements import bound_elements
 from ._schema import RUN_FIELDS, _unknown
 
 __all__ = []
@@ -77,7 +77,7 @@ def _toml_value(value):
 
 def _elements_note(bodies, i):
     """``a = ..., e = ..., inc = ...`` about the bodies above, for a bound orbit."""
-    el = _bound_elements(bodies, i)
+    el = bound_elements(bodies, i)
     if el is None:
         return ""
     a, e, inc = el

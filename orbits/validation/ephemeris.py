@@ -64,9 +64,10 @@ def horizons(quick):
 
 def _forces(key):
     """Our terms for the run ``key``."""
-    from .. import forces, scenes
+    from .. import forces
+    from ..scenes import ephemerides
     if key == "gr_full_j2":
-        ephemeris = scenes._de421_ephemeris()
+        ephemeris = ephemerides._de421_ephemeris()
         return [forces.GRFull(), forces.ZonalHarmonics("Earth", ephemeris.RE * u.km,
                                                        J2=ephemeris.J2E)]
     return {"newtonian": [], "gr": [forces.GR("Sun")],
@@ -78,8 +79,9 @@ def _bodies_and_reference(moon, years):
     barycentric positions (n, N, 3) in au of its bodies at ``years``."""
     from .. import scenes
     from ..bodies import BodySet
+    from ..scenes import ephemerides
     full = scenes.de421()
-    x, _ = scenes.de421_states(scenes._J2000_JD_TDB + YEAR * np.asarray(years, dtype=float))
+    x, _ = scenes.de421_states(ephemerides._J2000_JD_TDB + YEAR * np.asarray(years, dtype=float))
     keep = [i for i, name in enumerate(full.names) if moon or name != "Moon"]
     bodies = full if moon else BodySet.from_arrays(
         full.masses[keep], full.positions[keep], full.velocities[keep],

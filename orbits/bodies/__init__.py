@@ -9,35 +9,37 @@ A body may also be given a physical radius (``radius=``; default 0, a point
 mass), which the set carries through copies, simulations and output files.
 Every value is checked where it enters; a bad one raises a
 :class:`~orbits.errors.BodyError` naming the body and the field.
+
+This module is the record and its methods; the private modules beside it hold
+the checks of input (``_input``), the orbit arithmetic (``_elements``), the
+table of its repr (``_table``) and the conversion to and from REBOUND
+(``_rebound``).
 """
 
 import copy as _copy
-import functools
-import html
-import math
 
 import astropy.units as u
 import numpy as np
 
-from . import epochs as _epochs
-from . import geometry as _geometry
-from . import orbit_fields as _orbit_fields
-from ._kernels import anomalies as _anomalies
-from ._kernels import elements as _elements
-from ._kernels.status import describe_status
-from .body import Body, _position, unknown_body
-from .errors import (BodyError, CoincidentBodiesError, DuplicateBodyError,
-                     ElementsError, NoMassiveBodyError, UnknownBodyError)
-from .units import UnitSystem
+from .. import epochs as _epochs
+from .. import geometry as _geometry
+from .. import plotting as _plotting
+from .._kernels.status import describe_status
+from ..body import Body, _position, unknown_body
+from ..errors import BodyError, ElementsError
+from ..units import UnitSystem
+from . import _input, _rebound, _table
+from ._elements import ELEMENT_NAMES, element_values, relative_to_primary, state_from_elements
 
 __all__ = ["BodySet"]
 
-_ELEMENT_NAMES = ("a", "e", "inc", "Omega", "omega", "f", "M")
-#: what each field of :meth:`BodySet.add`'s orbit is
-_FIELD_KINDS = {"a": "length", "e": "dimensionless", "inc": "angle", "Omega": "angle",
-                "omega": "angle", "f": "angle", "M": "angle",
-                **_orbit_fields.ALTERNATIVE_FIELDS}
-_REPR_ROWS = 5  # rows a repr shows at each end of a long set
+
+def _stored(attribute, kind, doc):
+    """A read-only property: the array ``attribute`` as a Quantity of ``kind``
+    (a copy, so that the set cannot be changed through it)."""
+    def get(self):
+        return self.units.quantity(getattr(self, attribute).copy(), kind)
+    return property(get, doc=doc)
 
 
 class BodySet:
@@ -52,15 +54,14 @@ class BodySet:
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
-    >>> bodies = orbits.BodySet()
-    >>> bodies.add("Sun", mass=1 * u.Msun)
-    >>> bodies.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.048,
-    ...            inc=1.3 * u.deg)
+    In a unit system given explicitly, plain numbers are read in it:
+
+    >>> bodies = orbits.BodySet(orbits.UnitSystem.nbody())
+    >>> bodies.add("A", mass=1.0)
+    >>> bodies.add("B", mass=1e-3, primary="A", a=1.0, e=0.1)
     >>> bodies.move_to_com()
-    >>> len(bodies)
-    2
+    >>> len(bodies), bodies.units.G, bodies.masses
+    (2, 1.0, <Quantity [1.   , 0.001]>)
     """
 
     def __init__(self, units=None):
@@ -138,8 +139,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.BodySet()
         >>> bodies.add("Sun", mass=1 * u.Msun)
         >>> bodies.add("Earth", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, e=0.0167,
@@ -162,17 +161,11 @@ class BodySet:
         >>> round(float(el["a"].to_value(u.au)), 4), round(float(el["omega"].to(u.deg).value), 2)
         (1.5237, 336.04)
         """
-        self._check_name(name)
+        _input.check_names([name], self._names)
         m = self._scalar(mass, "mass", name, "mass")
-        if not math.isfinite(m):
-            raise BodyError(f"mass must be finite, got {m}", body=name, field="mass")
-        if m < 0:
-            raise BodyError(f"mass must be >= 0, got {m} {self.units.mass}",
-                            body=name, field="mass")
+        _input.check_masses(np.array([m]), [name], self.units.mass)
         r = 0.0 if radius is None else self._scalar(radius, "length", name, "radius")
-        if not (math.isfinite(r) and r >= 0):
-            raise BodyError(f"radius must be finite and >= 0, got {r} {self.units.length}",
-                            body=name, field="radius")
+        _input.check_radii(np.array([r]), [name], self.units.length)
         elements = dict(a=a, e=e, inc=inc, Omega=Omega, omega=omega, f=f, M=M, P=P,
                         pomega=pomega, l=l, T=T, E=E, theta=theta)
         given = [k for k, val in elements.items() if val is not None]
@@ -181,9 +174,10 @@ class BodySet:
                 raise BodyError("give either a Cartesian state (position, velocity) or "
                                 f"orbital elements, not both (got {', '.join(given)})",
                                 body=name, field="position")
-            x, v = self._state_from_elements(name, m, primary, **elements)
+            x, v = state_from_elements(self, name, m, primary, elements)
             how = {"name": name, "from": "elements", "primary": primary,
-                   **{k: _describe(val) for k, val in elements.items() if val is not None}}
+                   **{k: _input.describe(val) for k, val in elements.items()
+                      if val is not None}}
         else:
             x = (np.zeros(3) if position is None
                  else self._vector(position, "length", name, "position"))
@@ -216,8 +210,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import numpy as np
-        >>> import orbits
         >>> U = orbits.UnitSystem.nbody()
         >>> bodies = orbits.BodySet.from_arrays([1.0, 1e-3], [[0, 0, 0], [1, 0, 0]],
         ...                                     [[0, 0, 0], [0, 1, 0]], names=["A", "B"],
@@ -236,35 +228,14 @@ class BodySet:
         x = bs._array(positions, "length", "positions", (n, 3))
         v = bs._array(velocities, "velocity", "velocities", (n, 3))
         r = np.zeros(n) if radii is None else bs._array(radii, "length", "radii", (n,))
-        if names is None:
-            names = [str(i) for i in range(n)]
-        names = list(names)
+        names = [str(i) for i in range(n)] if names is None else list(names)
         if len(names) != n:
             raise BodyError(f"expected {n} names (one per mass), got {len(names)}",
                             field="names")
-        for name in names:
-            _check_name_text(name)
-        if len(set(names)) != n:
-            seen = set()
-            dup = next(nm for nm in names if nm in seen or seen.add(nm))
-            raise DuplicateBodyError("a body of this name is already in the set",
-                                     body=dup, field="name")
-        bad = ~np.isfinite(m) | (m < 0)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise BodyError(f"mass must be finite and >= 0, got {m[i]}", body=names[i],
-                            field="mass")
-        bad = ~(np.isfinite(r) & (r >= 0))
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise BodyError(f"radius must be finite and >= 0, got {r[i]} {bs.units.length}",
-                            body=names[i], field="radius")
-        for field, arr in (("position", x), ("velocity", v)):
-            bad = ~np.all(np.isfinite(arr), axis=1)
-            if bad.any():
-                i = int(np.argmax(bad))
-                raise BodyError(f"{field} must be finite, got {arr[i]}", body=names[i],
-                                field=field)
+        _input.check_names(names)
+        _input.check_masses(m, names, bs.units.mass)
+        _input.check_radii(r, names, bs.units.length)
+        _input.check_states(x, v, names)
         bs._names = names
         bs._m = m.copy()
         bs._r = r + 0.0     # a new array, with -0.0 stored as 0.0
@@ -285,7 +256,6 @@ class BodySet:
         Examples
         --------
         >>> import rebound
-        >>> import orbits
         >>> sim = rebound.Simulation()
         >>> sim.add(m=1.0)
         >>> sim.add(m=1e-3, a=1.0)
@@ -295,18 +265,9 @@ class BodySet:
         >>> round(float(bodies.elements("1", primary="0")["a"].value), 12)
         1.0
         """
-        n = sim.N
-        m = np.array([sim.particles[i].m for i in range(n)])
-        x = np.array([sim.particles[i].xyz for i in range(n)], dtype=float).reshape(n, 3)
-        v = np.array([sim.particles[i].vxyz for i in range(n)], dtype=float).reshape(n, 3)
-        r = np.array([sim.particles[i].r for i in range(n)], dtype=float)
-        if units is None:
-            units = UnitSystem.nbody(G=sim.G)
-        elif not math.isclose(units.G, sim.G, rel_tol=1e-15):
-            raise ValueError(f"units.G = {units.G!r} differs from the REBOUND "
-                             f"simulation's G = {sim.G!r}")
+        m, x, v, r, units = _rebound.arrays_from_simulation(sim, units)
         bs = cls.from_arrays(m, x, v, names=names, units=units, radii=r)
-        bs.history[-1] = {"from": "rebound", "n": n}
+        bs.history[-1] = {"from": "rebound", "n": len(m)}
         return bs
 
     def to_rebound(self):
@@ -318,26 +279,17 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> sim = orbits.scenes.kepler().to_rebound()
         >>> sim.N, round(sim.particles[1].a, 12), sim.particles[1].r
         (2, 1.0, 0.0)
         """
-        import rebound
-        sim = rebound.Simulation()
-        sim.G = self.units.G
-        for i in range(len(self)):
-            sim.add(m=float(self._m[i]), r=float(self._r[i]), x=self._x[i, 0], y=self._x[i, 1],
-                    z=self._x[i, 2], vx=self._v[i, 0], vy=self._v[i, 1], vz=self._v[i, 2])
-        return sim
+        return _rebound.simulation_from(self)
 
     def copy(self):
         """An independent copy.
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> a = orbits.scenes.kepler()
         >>> b = a.copy()
         >>> b.add("Moon", mass=0 * u.kg, position=[2, 0, 0] * u.au)
@@ -349,9 +301,8 @@ class BodySet:
         new._names = list(self._names)
         for key in ("_m", "_r", "_x", "_v"):
             setattr(new, key, getattr(self, key).copy())
-        # the history's entries are small dicts of plain values; a deep copy
-        # of the whole set (its unit system too) took 0.3 ms, a sweep's
-        # building of each member
+        # the history's entries are small dicts of plain values: they alone are
+        # deep-copied, not the unit system
         new.history = _copy.deepcopy(self.history)
         return new
 
@@ -377,13 +328,12 @@ class BodySet:
         Examples
         --------
         >>> import os, tempfile
-        >>> import orbits
         >>> path = os.path.join(tempfile.mkdtemp(), "earth-moon.toml")
         >>> orbits.scenes.earth_moon().write(path)
         >>> orbits.BodySet.read(path).names
         ['Earth', 'Moon']
         """
-        from . import systemfile
+        from .. import systemfile     # a cycle: a system file is read into a BodySet
         return systemfile.read(path).bodies
 
     def write(self, path):
@@ -397,15 +347,13 @@ class BodySet:
         Examples
         --------
         >>> import os, tempfile
-        >>> import numpy as np
-        >>> import orbits
         >>> bodies = orbits.scenes.figure_eight()
         >>> path = os.path.join(tempfile.mkdtemp(), "figure-eight.csv")
         >>> bodies.write(path)
         >>> bool(np.array_equal(orbits.BodySet.read(path).velocities, bodies.velocities))
         True
         """
-        from . import systemfile
+        from .. import systemfile     # a cycle: a system file is read into a BodySet
         systemfile.write(self, path)
 
     # -- access -----------------------------------------------------------------
@@ -444,7 +392,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> bodies = orbits.scenes.outer_solar_system()
         >>> bodies["Jupiter"].mass
         <Quantity 0.00095479 solMass>
@@ -466,61 +413,11 @@ class BodySet:
         """The bodies with their masses, their radii where any is non-zero, and, for
         bound orbits, a, e and inc about the bodies before each (the default
         primary of :meth:`elements`); a long set shows its first and last rows."""
-        head, rows = self._table()
-        widths = [max(len(r[k]) for r in [head, *filter(None, rows)])
-                  for k in range(len(head))]
-        lines = [f"BodySet of {len(self)} bodies ({self.units.name}; a, e, inc about the "
-                 f"centre of mass of the bodies before each)"]
-        if self._epoch is not None:
-            lines.append(f"  epoch {_epochs.describe(self._epoch)}")
-        for row in [head, *rows]:
-            if row is None:
-                lines.append(f"  ... {len(self) - 2 * _REPR_ROWS} more ...")
-            else:
-                lines.append("  " + "  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip())
-        return "\n".join(lines)
+        return _table.text(self)
 
     def _repr_html_(self):
         """The table of :meth:`__repr__`, for Jupyter."""
-        head, rows = self._table()
-
-        def cells(row, tag):
-            return "".join(f"<{tag}>{html.escape(c)}</{tag}>" for c in row)
-        body = "".join(
-            f"<tr><td colspan='{len(head)}'>&hellip; {len(self) - 2 * _REPR_ROWS} more "
-            f"&hellip;</td></tr>" if row is None else f"<tr>{cells(row, 'td')}</tr>"
-            for row in rows)
-        return (f"<div><strong>BodySet</strong> of {len(self)} bodies, units "
-                f"{html.escape(self.units.name)} (G = {self.units.G!r})"
-                f"<table><thead><tr>{cells(head, 'th')}</tr></thead><tbody>{body}</tbody>"
-                f"</table><small>a, e, inc: osculating, about the centre of mass of the "
-                f"bodies before each; blank where the orbit is not bound.</small></div>")
-
-    def _table(self):
-        """Header and rows (strings) of the reprs; None marks the rows left out."""
-        n = len(self)
-        if n > 2 * _REPR_ROWS + 1:
-            shown = [*range(_REPR_ROWS), None, *range(n - _REPR_ROWS, n)]
-        else:
-            shown = list(range(n))
-        # point masses (every radius 0, the usual case) get no radius column
-        sized = bool(np.any(self._r != 0))
-        length = str(self.units.length)
-        columns = (("mass", str(self.units.mass)),
-                   *((("radius", length),) if sized else ()), ("a", length))
-        head = ["name", *(f"{label} [{unit}]" if unit else label for label, unit in columns),
-                "e", "inc [deg]"]
-        rows = []
-        for i in shown:
-            if i is None:
-                rows.append(None)
-                continue
-            el = _bound_elements(self, i)
-            rows.append([self._names[i], f"{self._m[i]:.6g}",
-                         *((f"{self._r[i]:.6g}",) if sized else ()),
-                         *(("", "", "") if el is None else
-                           (f"{el[0]:.6g}", f"{el[1]:.4g}", f"{math.degrees(el[2]):.4g}"))])
-        return head, rows
+        return _table.html_table(self)
 
     @property
     def epoch(self):
@@ -539,7 +436,6 @@ class BodySet:
         Examples
         --------
         >>> from astropy.time import Time
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> print(bodies.epoch)
         None
@@ -559,64 +455,47 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().names
         ['Star', 'Planet']
         """
         return list(self._names)
 
-    @property
-    def masses(self):
-        """Quantity, shape (N,), mass.
+    masses = _stored("_m", "mass", """Quantity, shape (N,), mass.
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().masses
         <Quantity [1.   , 0.001] solMass>
-        """
-        return self.units.quantity(self._m.copy(), "mass")
+        """)
 
-    @property
-    def radii(self):
-        """Physical radii: Quantity, shape (N,), length (0 for a point mass).
+    radii = _stored("_r", "length", """Physical radii: Quantity, shape (N,), length (0 for a
+        point mass).
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> bodies.add("moon", mass=0 * u.kg, position=[2, 0, 0] * u.au, radius=1737 * u.km)
         >>> bodies.radii.to(u.km)
         <Quantity [   0.,    0., 1737.] km>
-        """
-        return self.units.quantity(self._r.copy(), "length")
+        """)
 
-    @property
-    def positions(self):
-        """Quantity, shape (N, 3), length.
+    positions = _stored("_x", "length", """Quantity, shape (N, 3), length.
 
         Examples
         --------
-        >>> import orbits
         >>> x = orbits.scenes.kepler().positions
         >>> x.shape, x.unit
         ((2, 3), Unit("AU"))
-        """
-        return self.units.quantity(self._x.copy(), "length")
+        """)
 
-    @property
-    def velocities(self):
-        """Quantity, shape (N, 3), velocity.
+    velocities = _stored("_v", "velocity", """Quantity, shape (N, 3), velocity.
 
         Examples
         --------
-        >>> import orbits
         >>> v = orbits.scenes.kepler().velocities
         >>> v.unit, v.shape
         (Unit("AU / d"), (2, 3))
-        """
-        return self.units.quantity(self._v.copy(), "velocity")
+        """)
 
     def index(self, name):
         """Position of ``name`` in the set (int, from 0).
@@ -628,7 +507,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().index("Planet")
         1
         """
@@ -643,7 +521,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.scenes.kepler().total_mass
         <Quantity 1.001 solMass>
         """
@@ -654,7 +531,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> x, v = orbits.scenes.kepler().center_of_mass()   # the scene is barycentric
         >>> bool(abs(x).max().value < 1e-15), x.unit, v.unit
         (True, Unit("AU"), Unit("AU / d"))
@@ -672,7 +548,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> bodies.move_to_com()
         >>> x, v = bodies.center_of_mass()
@@ -707,7 +582,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> el = orbits.scenes.outer_solar_system().elements("Jupiter", primary="Sun")
         >>> round(float(el["a"].value), 2), el["a"].unit, round(float(el["e"]), 3)
         (5.2, Unit("AU"), 0.048)
@@ -717,32 +591,17 @@ class BodySet:
             raise ElementsError(describe_status(status), body=name, field="elements")
         q = self.units.quantity
         return {"a": q(out[0], "length"), "e": out[1] << u.dimensionless_unscaled,
-                **{k: out[j] << u.rad for j, k in enumerate(_ELEMENT_NAMES[2:], start=2)}}
+                **{k: out[j] << u.rad for j, k in enumerate(ELEMENT_NAMES[2:], start=2)}}
 
     def _element_values(self, name, primary):
         # (a, e, inc, Omega, omega, f, M) in internal units and rad, and the
         # kernel's status
-        mu, r, v = self._relative(name, primary)
-        out = np.empty(7)
-        status = _elements.state_to_elements(mu, r, v, out)
-        return out, status
+        return element_values(self, name, primary)
 
     def _relative(self, name, primary):
         # mu = G (m_primary + m_body) and the state relative to the primary
-        # (internal units): of a named body, of the bodies before ``name``
-        # (None), or of the barycentre of all bodies, ``name`` included
-        i = self.index(name)
-        if _geometry.is_barycentre(primary):
-            self._require_mass()
-            mp = self._m.sum()
-            xp, vp = self._com()
-        else:
-            if primary == name:
-                raise BodyError("a body has no orbit about itself; name another primary",
-                                body=name, field="primary")
-            mp, xp, vp = self._primary_state(name, primary, before=i)
-        mu = self.units.G * (mp + self._m[i])
-        return mu, self._x[i] - xp, self._v[i] - vp
+        # (internal units), for the Body views
+        return relative_to_primary(self, name, primary)
 
     def mutual_inclination(self, a, b, primary=None):
         """The angle between the orbital planes of two bodies.
@@ -752,10 +611,9 @@ class BodySet:
         a, b : str
             The bodies' names.
         primary : str, optional
-            The primary of both orbits, as for :meth:`elements`: a body's name,
-            ``"barycentre"``, or None for each body's default (the centre of
-            mass of the bodies before it, so that in a hierarchical system each
-            orbit is about what it goes around).
+            The primary of both orbits, as for :meth:`elements`; by default each
+            body's own, so that in a hierarchical system each orbit is about
+            what it goes around.
 
         Returns
         -------
@@ -772,8 +630,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.BodySet()
         >>> bodies.add("Sun", mass=1 * u.Msun)
         >>> bodies.add("b", mass=1 * u.Mearth, primary="Sun", a=1 * u.au, inc=10 * u.deg)
@@ -810,8 +666,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import numpy as np
-        >>> import orbits
         >>> bodies = orbits.scenes.outer_solar_system(com=True)
         >>> bodies.to_invariable_plane()
         >>> m = bodies.masses.value
@@ -849,13 +703,11 @@ class BodySet:
 
         Examples
         --------
-        >>> import orbits
         >>> fig = orbits.scenes.outer_solar_system().plot_orbits(primary="Sun")
         >>> [line.get_label() for line in fig.axes[0].lines][:2]
         ['Jupiter', 'Saturn']
         """
-        from .plotting import plot_orbits
-        return plot_orbits(self, primary=primary, plane=plane, ax=ax, path=path)
+        return _plotting.plot_orbits(self, primary=primary, plane=plane, ax=ax, path=path)
 
     def check(self):
         """Check the set as a whole: at least one massive body, no two at one place.
@@ -866,8 +718,6 @@ class BodySet:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> bodies.check()
         >>> bodies.add("twin", mass=1 * u.Mearth, position=bodies.positions[1])
@@ -878,26 +728,7 @@ class BodySet:
         CoincidentBodiesError Planet position
         """
         self._require_mass()
-        n = len(self)
-        if n > 1:
-            if n <= 64:
-                # every pair compared at once: for a few bodies a tenth of the
-                # time of np.unique over rows, which sorts a structured view
-                same = (self._x[:, None, :] == self._x[None, :, :]).all(axis=2)
-                np.fill_diagonal(same, False)
-                repeated = same.any(axis=1)
-                found, j = bool(repeated.any()), int(np.argmax(repeated))
-            else:
-                _, first, counts = np.unique(self._x, axis=0, return_index=True,
-                                             return_counts=True)
-                found, j = bool(np.any(counts > 1)), first[np.argmax(counts > 1)]
-            if found:
-                same = [self._names[k] for k in range(len(self))
-                        if np.array_equal(self._x[k], self._x[j])]
-                raise CoincidentBodiesError(
-                    f"is at the same position as {', '.join(map(repr, same[1:]))} "
-                    f"({self._x[j]} {self.units.length}); bodies must be at distinct "
-                    f"positions", body=same[0], field="position")
+        _input.check_distinct_positions(self._names, self._x, self.units.length)
 
     # -- internals ----------------------------------------------------------------
     def _append(self, name, m, x, v, r=0.0):
@@ -907,17 +738,8 @@ class BodySet:
         self._x = np.vstack([self._x, np.asarray(x, dtype=float).reshape(1, 3)])
         self._v = np.vstack([self._v, np.asarray(v, dtype=float).reshape(1, 3)])
 
-    def _check_name(self, name):
-        _check_name_text(name)
-        if name in self._names:
-            raise DuplicateBodyError("a body of this name is already in the set",
-                                     body=name, field="name")
-
     def _require_mass(self):
-        if len(self) == 0 or not np.any(self._m > 0):
-            raise NoMassiveBodyError(
-                f"the body set has no body with positive mass ({len(self)} bodies); "
-                "at least one is needed")
+        _input.require_mass(self._m)
 
     def _com(self):
         mt = self._m.sum()
@@ -926,161 +748,16 @@ class BodySet:
         return (self._m @ self._x) / mt, (self._m @ self._v) / mt
 
     def _scalar(self, value, kind, body, field):
-        val = self.units.to_internal(value, kind, bare_ok=self._bare_ok, body=body,
-                                     field=field)
-        if val.shape != ():
-            raise BodyError(f"expected a scalar, got shape {val.shape}", body=body,
-                            field=field)
-        return float(val)
+        return float(_input.internal(self.units, value, kind, (), bare_ok=self._bare_ok,
+                                     body=body, field=field))
 
     def _vector(self, value, kind, body, field):
-        val = self.units.to_internal(value, kind, bare_ok=self._bare_ok, body=body,
-                                     field=field)
-        if val.shape != (3,):
-            raise BodyError(f"expected 3 components (x, y, z), got shape {val.shape}",
-                            body=body, field=field)
+        val = _input.internal(self.units, value, kind, (3,), bare_ok=self._bare_ok,
+                              body=body, field=field)
         if not np.all(np.isfinite(val)):
             raise BodyError(f"must be finite, got {val}", body=body, field=field)
         return val.copy()
 
     def _array(self, value, kind, field, shape):
-        val = self.units.to_internal(value, kind, bare_ok=self._bare_ok, field=field)
-        ok = val.ndim == len(shape) and all(s is None or s == d
-                                            for s, d in zip(shape, val.shape))
-        if not ok:
-            want = "(" + ", ".join("N" if s is None else str(s) for s in shape) + ")"
-            raise BodyError(f"expected shape {want}, got {val.shape}", field=field)
-        return np.ascontiguousarray(val, dtype=np.float64)
-
-    def _primary_state(self, name, primary, before):
-        if primary is None:
-            if before == 0 or not np.any(self._m[:before] > 0):
-                raise BodyError("orbital elements need a primary: name one with "
-                                "primary=, or add a massive body first",
-                                body=name, field="primary")
-            m = self._m[:before]
-            mt = m.sum()
-            return mt, (m @ self._x[:before]) / mt, (m @ self._v[:before]) / mt
-        if not isinstance(primary, str):
-            raise BodyError(f"primary must be a body's name, got {primary!r}",
-                            body=name, field="primary")
-        if primary not in self._names:
-            raise unknown_body(primary, self._names, field="primary", body=name,
-                               what=f"unknown primary {primary!r}", label="known bodies")
-        j = self._names.index(primary)
-        return self._m[j], self._x[j], self._v[j]
-
-    def _state_from_elements(self, name, m, primary, **fields):
-        mp, xp, vp = self._primary_state(name, primary, before=len(self))
-        values = {key: None if val is None else self._scalar(val, _FIELD_KINDS[key], name, key)
-                  for key, val in fields.items()}
-        el = _orbit_fields.classical(name, self.units.G * (mp + m), values)
-        e_ = 0.0 if el["e"] is None else el["e"]
-        pos, vel = _relative_state(name, self.units, mp, m, el["a"], e_, el["inc"],
-                                   el["Omega"], el["omega"], el["f"], el["M"])
-        return xp + pos, vp + vel
-
-
-def _relative_state(name, units, mp, m, a, e, inc, Omega, omega, f, M):
-    """Position and velocity, shape (3,) each, of body ``name`` (mass ``m``)
-    relative to its primary (mass ``mp``), from its elements as plain floats in
-    ``units`` (angles in rad; ``None`` for an angle not given).
-
-    What :meth:`BodySet.add` computes for a body given by elements, and
-    :mod:`orbits.systemfile` for a table of them: the same arithmetic, so the
-    same state bit for bit.
-
-    Raises
-    ------
-    ElementsError
-        The elements are not finite, not an orbit, or both masses are zero.
-
-    Examples
-    --------
-    >>> from orbits import UnitSystem
-    >>> from orbits.bodies import _relative_state
-    >>> pos, vel = _relative_state("Earth", UnitSystem(), 1.0, 0.0, 1.0, 0.0, None,
-    ...                            None, None, None, None)
-    >>> pos.tolist()
-    [1.0, 0.0, 0.0]
-    """
-    a_, e_ = a, e
-    ang = dict(inc=inc, Omega=Omega, omega=omega, f=f, M=M)
-    for key, val in (("a", a_), ("e", e_), *ang.items()):
-        if val is not None and not math.isfinite(val):
-            raise ElementsError(f"must be finite, got {val}", body=name, field=key)
-    if e_ < 0:
-        raise ElementsError(f"eccentricity must be >= 0, got {e_}", body=name, field="e")
-    if a_ == 0:
-        raise ElementsError("semi-major axis must be non-zero", body=name, field="a")
-    if a_ > 0 and e_ >= 1:
-        raise ElementsError(f"e = {e_} >= 1 needs a < 0 (a hyperbolic orbit); "
-                            f"got a = {a_} {units.length}. Parabolic orbits "
-                            f"(e = 1) must be given as a state", body=name, field="e")
-    if a_ < 0 and e_ <= 1:
-        raise ElementsError(f"a < 0 means a hyperbolic orbit and needs e > 1; "
-                            f"got e = {e_}", body=name, field="e")
-    if ang["f"] is not None and ang["M"] is not None:
-        raise ElementsError("give the true anomaly f or the mean anomaly M, not both",
-                            body=name, field="f")
-    anomaly = ang["f"] if ang["f"] is not None else (
-        _anomalies.true_from_mean(ang["M"], e_) if ang["M"] is not None else 0.0)
-    mu = units.G * (mp + m)
-    if mu <= 0:
-        raise ElementsError("the primary and the body are both massless; an orbit "
-                            "needs mass", body=name, field="primary")
-    pos, vel = np.empty(3), np.empty(3)
-    status = _elements.elements_to_state(mu, a_, e_, ang["inc"] or 0.0,
-                                       ang["Omega"] or 0.0, ang["omega"] or 0.0,
-                                       anomaly, pos, vel)
-    if status != 0:
-        raise ElementsError(describe_status(status), body=name,
-                            field="f" if ang["f"] is not None else "elements")
-    return pos, vel
-
-
-def _check_name_text(name):
-    """Refuse a name that is not a non-empty string, or that an HDF5 file cannot
-    hold: a NUL character, or a lone surrogate (text that UTF-8 cannot encode)."""
-    if not isinstance(name, str) or not name:
-        raise BodyError(f"name must be a non-empty string, got {name!r}",
-                        body=name, field="name")
-    if "\0" in name:
-        raise BodyError("name must not contain a NUL character ('\\x00'), which an output "
-                        "file cannot hold", body=name, field="name")
-    try:
-        name.encode("utf-8")
-    except UnicodeEncodeError as exc:
-        raise BodyError(f"name must be text that UTF-8 can encode; character "
-                        f"{exc.object[exc.start]!r} at {exc.start} is a lone surrogate",
-                        body=name, field="name") from None
-
-
-def _describe(value):
-    # str(value), with a Quantity's unit written once per unit (astropy
-    # formats the unit anew at every str(), a third of BodySet.add's time)
-    if isinstance(value, u.Quantity):
-        unit = _unit_string(value.unit)
-        return f"{value.value} {unit}" if unit else str(value.value)
-    return str(value)
-
-
-@functools.lru_cache(maxsize=64)
-def _unit_string(unit):
-    return unit.to_string()
-
-
-def _bound_elements(bodies, i):
-    """``(a, e, inc)`` of body ``i`` about the centre of mass of the bodies before it
-    (internal units, inc in rad), or None where that orbit is not a bound ellipse."""
-    m = bodies._m[:i]
-    mt = m.sum()
-    if i == 0 or not mt > 0:
-        return None
-    mu = bodies.units.G * (mt + bodies._m[i])
-    out = np.empty(7)
-    status = _elements.state_to_elements(mu, bodies._x[i] - (m @ bodies._x[:i]) / mt,
-                                       bodies._v[i] - (m @ bodies._v[:i]) / mt, out)
-    if status != 0 or not (0 <= out[1] < 1 and out[0] > 0):
-        return None
-    return float(out[0]), float(out[1]), float(out[2])
+        return _input.internal(self.units, value, kind, shape, bare_ok=self._bare_ok,
+                               field=field)
