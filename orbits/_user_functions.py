@@ -17,6 +17,7 @@ non-finite state and the caller names the cause (:func:`check_flag`).
 
 import hashlib
 import math
+import sys
 import types
 
 import numpy as np
@@ -29,7 +30,7 @@ from ._kernels import terms as _kterms
 adder, head, tail, user, user_accel, user_potential = slots(
     "adder", "head", "tail", "user", "user_accel", "user_potential")
 
-__all__ = ["code_key", "term_pointers", "force_pointer", "force_args", "FORCE_SIZE"]
+__all__ = ["code_key", "cacheable", "term_pointers", "force_pointer", "force_args", "FORCE_SIZE"]
 
 #: ``flag[0]`` after a user function returned the wrong number of values
 FORCE_SIZE = 1
@@ -97,15 +98,34 @@ def code_key(func, _seen=None):
     return hashlib.sha1(b"\0".join(parts)).hexdigest()[:16]
 
 
-def _cfunc(template, signature, suffix, **bindings):
-    # a copy of template with bindings as its globals, compiled as a cached C callable
+def cacheable(func):
+    """Whether code compiled with ``func`` can be cached on disk: a new
+    process finds it again by its module and qualified name (numba's cache
+    refers to the functions a compiled function calls that way).  A function
+    made by ``exec`` in a namespace that is no module, as some documentation
+    and notebook tools do, cannot be found: code that calls it is compiled
+    in each process instead of failing to load."""
+    py = getattr(func, "py_func", func)
+    obj = sys.modules.get(getattr(py, "__module__", None) or "")
+    if obj is None:
+        return False
+    for part in py.__qualname__.split("."):
+        obj = getattr(obj, part, None)
+        if obj is None:
+            return False
+    return getattr(obj, "py_func", obj) is py
+
+
+def _cfunc(template, signature, suffix, cache=True, **bindings):
+    # a copy of template with bindings as its globals, compiled as a C
+    # callable, cached on disk with cache
     glob = bound_globals(template, bindings)
     name = f"{template.__name__}__{suffix}__{KERNEL_STAMP}"
     func = types.FunctionType(template.__code__, glob, name, template.__defaults__,
                               template.__closure__)
     func.__qualname__ = name
     func.__module__ = template.__module__
-    return cfunc(signature, func)
+    return cfunc(signature, func, cache=cache)
 
 
 # -- user terms of a simulation (orbits.forces.UserForce) ------------------------------
@@ -173,23 +193,25 @@ def term_pointers(terms):
                  for t in terms)
     if keys in _POINTERS:
         return _POINTERS[keys]
+    cache = all(cacheable(t.func) and (t.potential is None or cacheable(t.potential))
+                for t in terms)
     add = specialize(_term_none, "none")
     pot = specialize(_potential_none, "none")
     akey = "none"
     pkey = "none"
     for term, (fk, pk) in reversed(list(zip(terms, keys))):
-        one = specialize(_term_add, fk, user=term.func)
+        one = specialize(_term_add, fk, cache=cache, user=term.func)
         akey = f"{fk}_{akey}" if akey != "none" else fk
         add = specialize(_term_chain, hashlib.sha1(akey.encode()).hexdigest()[:16],
-                         head=one, tail=add)
+                         cache=cache, head=one, tail=add)
         if pk is not None:
-            pone = specialize(_potential_one, pk, user_potential=term.potential)
+            pone = specialize(_potential_one, pk, cache=cache, user_potential=term.potential)
             pkey = f"{pk}_{pkey}" if pkey != "none" else pk
             pot = specialize(_potential_chain, hashlib.sha1(pkey.encode()).hexdigest()[:16],
-                             head=pone, tail=pot)
+                             cache=cache, head=pone, tail=pot)
     suffix = hashlib.sha1(f"{akey}|{pkey}".encode()).hexdigest()[:16]
-    out = (_cfunc(_term_pointer, _kterms.USER_ACCEL, suffix, adder=add),
-           _cfunc(_potential_pointer, _kterms.USER_ENERGY, suffix, adder=pot))
+    out = (_cfunc(_term_pointer, _kterms.USER_ACCEL, suffix, cache=cache, adder=add),
+           _cfunc(_potential_pointer, _kterms.USER_ENERGY, suffix, cache=cache, adder=pot))
     _POINTERS[keys] = out
     return out
 
@@ -228,7 +250,7 @@ def force_pointer(accel, ndim):
     key = (code_key(accel), ndim)
     if key not in _POINTERS:
         _POINTERS[key] = _cfunc(_force_pointer, force_signature(ndim), f"{key[0]}_{ndim}",
-                                user_accel=accel)
+                                cache=cacheable(accel), user_accel=accel)
     return _POINTERS[key]
 
 

@@ -112,3 +112,39 @@ def test_user_functions_from_a_module_compile_once_and_load_in_a_new_process(tmp
                              capture_output=True, text=True, check=True)
         runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
     assert runs[1] == []
+
+
+@numba.njit
+def _module_level_drag(x, v, t, m):
+    return -1e-9 * v
+
+
+def test_a_function_made_outside_any_module_is_not_cached_on_disk():
+    # a function that exec made in a namespace that is no module cannot be
+    # found again by name in another process: code calling it compiles anew
+    ns = {"__name__": "<no module>"}
+    exec("import numba\n@numba.njit\ndef drag(x, v, t, m):\n    return -1e-9 * v\n", ns)
+    assert not _user_functions.cacheable(ns["drag"])
+    assert _user_functions.cacheable(_module_level_drag)
+
+
+_EXEC_CHILD = textwrap.dedent("""
+    import astropy.units as u
+    import orbits
+    ns = {"__name__": "<no module>"}
+    exec("import numba\\n@numba.njit\\ndef drag(x, v, t, m):\\n    return -1e-9 * v\\n", ns)
+    force = orbits.forces.UserForce(ns["drag"], velocity_dependent=True)
+    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day, forces=[force])
+    sim.run(until=5 * u.day, progress=False)
+    print(repr(float(sim.state.x[1, 0])))
+""")
+
+
+def test_a_user_force_made_by_exec_runs_again_in_a_new_process():
+    # the second process once failed to load what the first had cached
+    # (numba looked for the module "<no module>"); both now give the same
+    # state.  The package's own cache, as a user's session has it
+    outs = [subprocess.run([sys.executable, "-c", _EXEC_CHILD], capture_output=True,
+                           text=True, timeout=600) for _ in range(2)]
+    assert [o.returncode for o in outs] == [0, 0], outs[1].stderr[-2000:]
+    assert outs[0].stdout == outs[1].stdout

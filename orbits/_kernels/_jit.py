@@ -78,14 +78,15 @@ def _compile(func, options):
     return dispatcher
 
 
-def cfunc(signature, func):
+def cfunc(signature, func, cache=True):
     """``func`` compiled as a C callable of the declared ``signature``, with the
     package's options: a pointer that compiled loops take as an argument of
     that type (numba's first-class functions), so that one loop serves every
-    function of the signature.  Cached on disk under ``func``'s qualified name
-    and :data:`KERNEL_STAMP`, as :func:`njit` caches (a pointer compiles the
-    kernels it calls into itself)."""
+    function of the signature.  Cached on disk (unless ``cache`` is False)
+    under ``func``'s qualified name and :data:`KERNEL_STAMP`, as :func:`njit`
+    caches (a pointer compiles the kernels it calls into itself)."""
     options = {k: v for k, v in NUMBA_OPTIONS.items() if k != "nogil"}
+    options["cache"] = cache
     qualname = func.__qualname__
     func.__qualname__ = f"{qualname}__{KERNEL_STAMP}"
     try:
