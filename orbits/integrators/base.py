@@ -6,9 +6,16 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
 1. sets ``name`` (the registry name, lowercase with hyphens), ``order`` (the
    global order of accuracy, measured by the test suite), ``symplectic``,
    ``time_symmetric``, ``adaptive`` and ``needs_central_body``;
-2. lists its options and their defaults in ``options``; unknown options and
-   bad values are rejected in ``__init__`` with
-   :class:`~orbits.errors.IntegratorOptionError`;
+2. declares its options in ``option_specs``, a tuple of :class:`Option`
+   (name, type, default, help, unit, the values it takes), the one place
+   they are listed: ``options`` (name -> default) and the command line's
+   flags are made from it.  Unknown options and values that do not fit
+   their declaration are rejected in ``__init__`` with
+   :class:`~orbits.errors.IntegratorOptionError`, and ``_check_options``
+   checks what a declaration cannot say.  The arguments of an ``Option``
+   are literals or names of module constants, so that the command line
+   reads them without importing the integrator
+   (:mod:`orbits._integrator_options`);
 3. implements ``workspace(n)``, returning the arrays a run keeps between
    calls (force cache, stage buffers, internal state) as a dict.  Everything
    a bit-exact restart needs lives there, as numpy arrays (a flag or a scalar
@@ -42,18 +49,19 @@ of drift and kick coefficients (:class:`SplittingMethod`), an explicit
 Runge-Kutta method a Butcher table (:class:`ExplicitRungeKutta`).
 """
 
-import numbers
 import warnings
 
 import numpy as np
 
+from .._integrator_options import Option
 from .._kernels.status import with_status
 from .._kernels import stepping
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError, OrbitsWarning
 
 __all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
-           "RTOL_FLOOR", "NO_MARKS", "NO_MARK_STEPS"]
+           "ToleranceControlled", "Option", "MIN_DT", "RTOL_FLOOR", "NO_MARKS",
+           "NO_MARK_STEPS"]
 
 #: ``advance_to``'s marks when the outputs are not recorded in the loop:
 #: empty arrays of the marks' types, so that each loop compiles once for both
@@ -64,6 +72,12 @@ NO_MARK_STEPS = np.empty(0, dtype=np.int64)
 #: The smallest relative tolerance an adaptive method is run with: 100 float64
 #: roundings (the floor scipy's ``solve_ivp`` also applies).
 RTOL_FLOOR = 100 * float(np.finfo(float).eps)
+
+#: The smallest step an adaptive method may take, an option of those that
+#: honour one.
+MIN_DT = Option("min_dt", float, 0.0, "smallest allowed step; a run whose step control "
+                "asks for less stops with StepSizeUnderflow (0: none)", unit="time",
+                sign="non-negative")
 
 
 class Integrator:
@@ -98,7 +112,9 @@ class Integrator:
     time_symmetric = False
     adaptive = False
     needs_central_body = False
-    #: option name -> default value
+    #: the options, each declared once (see the contract, point 2)
+    option_specs = ()
+    #: option name -> default value, made from ``option_specs``
     options = {}
     #: one line for listings
     summary = ""
@@ -127,6 +143,11 @@ class Integrator:
         (``Ensemble.run(..., batch=B)``); False unless a method says otherwise."""
         return False
 
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "option_specs" in vars(cls):
+            cls.options = {spec.name: spec.default for spec in cls.option_specs}
+
     def __init__(self, **options):
         unknown = sorted(set(options) - set(self.options))
         if unknown:
@@ -135,10 +156,16 @@ class Integrator:
                 f"integrator {self.name!r} has no option {', '.join(map(repr, unknown))}; "
                 f"valid options: {valid}")
         self.config = {**self.options, **options}
+        for spec in self.option_specs:
+            try:
+                self.config[spec.name] = spec.checked(self.config[spec.name])
+            except ValueError as exc:
+                raise IntegratorOptionError(f"integrator {self.name!r}: {exc}") from None
         self._check_options()
 
     def _check_options(self):
-        """Subclasses check their option values here."""
+        """Subclasses check here what their options' declarations cannot say
+        (a value that one method of a family refuses, a pair of options)."""
 
     # contract, parts 3-5
     def workspace(self, n):
@@ -537,8 +564,9 @@ class AdaptiveIntegrator(Integrator):
       the ``dt`` the user gave (or 0 to let the method choose).
     * Everything a bit-exact restart needs lives in ``ws`` as arrays, as for
       every integrator.
-    * Options are checked in ``_check_options``: tolerances must be positive,
-      and unknown options are rejected by :class:`Integrator`.
+    * Options are declared and checked as every integrator's (point 2);
+      :class:`ToleranceControlled` declares ``rtol`` and ``atol``, and
+      :data:`MIN_DT` is the ``min_dt`` option of those that take one.
     """
 
     adaptive = True
@@ -551,42 +579,34 @@ class AdaptiveIntegrator(Integrator):
     def workspace(self, n, initial_step=0.0):
         raise NotImplementedError
 
-    def _positive(self, *names):
-        for name in names:
-            value = self.config[name]
-            ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
-                  and 0 < float(value) < float("inf"))
-            if not ok:
-                raise IntegratorOptionError(
-                    f"integrator {self.name!r}: option {name!r} must be a positive finite "
-                    f"number, got {value!r}" + (" (a string)" if isinstance(value, str)
-                                                else ""))
-            self.config[name] = float(value)
 
-    def _min_dt(self):
-        """Check the ``min_dt`` option: a finite number >= 0, kept as a float."""
-        min_dt = self.config["min_dt"]
-        try:
-            ok = 0 <= float(min_dt) < float("inf")
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise IntegratorOptionError(
-                f"integrator {self.name!r}: option 'min_dt' must be a finite number >= 0, "
-                f"got {min_dt!r}")
-        self.config["min_dt"] = float(min_dt)
+class ToleranceControlled(AdaptiveIntegrator):
+    """An adaptive method whose step keeps an estimate of the local error
+    within ``atol + rtol |y|``: the options ``rtol`` and ``atol``.
 
-    def _relative_tolerance(self, name):
-        """Raise ``name`` to :data:`RTOL_FLOOR` if asked for less, with a warning.
+    A relative tolerance below :data:`RTOL_FLOOR` is raised to it with a
+    warning: a relative error below a few float64 roundings cannot be
+    delivered (the error estimate of a step then reads zero only where the
+    stages round to the same numbers, and the method creeps on with steps far
+    too short to matter: 23 million steps to t = 5e-5 d at rtol = 1e-30).
 
-        A relative error below a few float64 roundings cannot be delivered:
-        the error estimate of a step then reads zero only where the stages
-        round to the same numbers, and the method creeps on with steps far
-        too short to matter (23 million steps to t = 5e-5 d at rtol = 1e-30).
-        """
-        self._positive(name)
-        if self.config[name] < RTOL_FLOOR:
-            warnings.warn(f"integrator {self.name!r}: {name} = {self.config[name]:g} is below "
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("dopri5", rtol=1e-10).config
+    {'rtol': 1e-10, 'atol': 1e-12}
+    """
+
+    option_specs = (
+        Option("rtol", float, 1e-9, "relative tolerance of a step's error estimate",
+               sign="positive"),
+        Option("atol", float, 1e-12, "absolute tolerance of a step's error estimate, in "
+               "the simulation's units of length and velocity", sign="positive"),
+    )
+
+    def _check_options(self):
+        if self.config["rtol"] < RTOL_FLOOR:
+            warnings.warn(f"integrator {self.name!r}: rtol = {self.config['rtol']:g} is below "
                           f"what float64 arithmetic can deliver; using {RTOL_FLOOR:.3g} "
-                          f"(100 roundings)", OrbitsWarning, stacklevel=5)
-            self.config[name] = RTOL_FLOOR
+                          f"(100 roundings)", OrbitsWarning, stacklevel=4)
+            self.config["rtol"] = RTOL_FLOOR

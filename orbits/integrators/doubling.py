@@ -7,12 +7,12 @@ from .._kernels import doubling as _doubling
 from .._kernels import stepping as _stepping
 from .._kernels.stopping import stop_record
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
+from .base import NO_MARK_STEPS, NO_MARKS, ToleranceControlled
 
 __all__ = ["RK4Doubling"]
 
 
-class RK4Doubling(AdaptiveIntegrator):
+class RK4Doubling(ToleranceControlled):
     """Classic RK4 made adaptive by step doubling.
 
     Notes
@@ -38,12 +38,7 @@ class RK4Doubling(AdaptiveIntegrator):
     name = "rk4-doubling"
     order = 4
     summary = "RK4 with step doubling, adaptive (rtol, atol)"
-    options = {"rtol": 1e-9, "atol": 1e-12}
     forces_per_step = 11
-
-    def _check_options(self):
-        self._relative_tolerance("rtol")
-        self._positive("atol")
 
     def workspace(self, n, initial_step=0.0):
         z = lambda: np.zeros((n, 3))  # noqa: E731

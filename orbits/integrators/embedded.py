@@ -9,12 +9,12 @@ from .._kernels.stopping import stop_record
 from . import dop853_coefficients as _dop853
 from . import tableaux
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
+from .base import NO_MARK_STEPS, NO_MARKS, ToleranceControlled
 
 __all__ = ["EmbeddedRungeKutta", "Dopri5", "DOP853"]
 
 
-class EmbeddedRungeKutta(AdaptiveIntegrator):
+class EmbeddedRungeKutta(ToleranceControlled):
     """An embedded Runge-Kutta pair given by its table; one compiled loop serves all.
 
     Subclasses set ``A``, ``B``, ``C`` (the method), ``E`` (error weights over
@@ -24,11 +24,6 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
 
     A = B = C = E = E3 = None
     error_estimator_order = None
-    options = {"rtol": 1e-9, "atol": 1e-12}
-
-    def _check_options(self):
-        self._relative_tolerance("rtol")
-        self._positive("atol")
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)

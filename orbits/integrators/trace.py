@@ -1,9 +1,6 @@
 """``trace``: a time-reversible hybrid of the Wisdom-Holman map and an adaptive
 integrator for close encounters (after Lu, Hernandez & Rein 2024)."""
 
-import math
-import numbers
-
 import numpy as np
 
 from .._kernels import trace as _trace
@@ -12,7 +9,7 @@ from .._kernels.status import with_status
 from .._kernels.stopping import ahead_pointer, stop_record
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
-from .base import RTOL_FLOOR, Integrator
+from .base import RTOL_FLOOR, Integrator, Option
 from .wisdom_holman import split_gravity
 
 __all__ = ["Trace", "HILL", "SPEED", "PERICENTRE", "RTOL"]
@@ -170,24 +167,22 @@ class Trace(Integrator):
     needs_central_body = True
     stop_conditions = True
     chaos_indicators = False
-    options = {"hill": HILL, "speed": SPEED, "pericentre": PERICENTRE, "rtol": RTOL}
+    option_specs = (
+        Option("hill", float, HILL, "switching radius in mutual Hill radii",
+               sign="positive"),
+        Option("speed", float, SPEED, "switching radius in steps of relative motion "
+               "(0: off)", sign="non-negative"),
+        Option("pericentre", float, PERICENTRE, "a body closer to the central one than "
+               "pericentre (G m_0 dt^2)^(1/3) makes the segment be integrated whole "
+               "(0: off)", sign="non-negative"),
+        Option("rtol", float, RTOL, "relative tolerance of the encounter integrator's step",
+               sign="positive"),
+    )
     summary = ("TRACE: democratic heliocentric Wisdom-Holman map, adaptive DOP853 for close "
                "encounters, time-reversible switching")
     forces_per_step = 1
 
     def _check_options(self):
-        for name, positive in (("hill", True), ("speed", False), ("pericentre", False),
-                               ("rtol", True)):
-            value = self.config[name]
-            ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
-                  and math.isfinite(float(value))
-                  and (float(value) > 0 if positive else float(value) >= 0))
-            if not ok:
-                kind = "a positive" if positive else "a non-negative"
-                raise IntegratorOptionError(
-                    f"integrator {self.name!r}: option {name!r} must be {kind} finite "
-                    f"number, got {value!r}")
-            self.config[name] = float(value)
         if self.config["rtol"] >= 1.0:
             raise IntegratorOptionError(
                 f"integrator {self.name!r}: option 'rtol' must be below 1, got "

@@ -25,7 +25,7 @@ from .._kernels.stepping import DRIFT, KICK, work_bound
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
 from . import tableaux
-from .base import Integrator
+from .base import Integrator, Option
 
 __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
            "split_gravity",
@@ -267,7 +267,13 @@ class WisdomHolman(Integrator):
     symplectic = True
     time_symmetric = True
     needs_central_body = True
-    options = {"coordinates": "jacobi", "corrector": 0}
+    option_specs = (
+        Option("coordinates", str, "jacobi", "the coordinates of the Kepler split",
+               choices=COORDINATES),
+        Option("corrector", int, 0, "order of the symplectic corrector of the map K(h/2) "
+               "I(h) K(h/2) (Wisdom, Holman & Touma 1996; SABA: 0 only); 0: none",
+               choices=tuple(CORRECTORS)),
+    )
     summary = ("Wisdom-Holman map, Kepler drifts and interaction kicks in Jacobi or "
                "democratic heliocentric coordinates")
     #: the step as a table of Kepler drifts ("drift") and interaction kicks ("kick")
@@ -311,16 +317,7 @@ class WisdomHolman(Integrator):
         cls.forces_per_step = sum(1 for k, _ in ops if k == "kick")
 
     def _check_options(self):
-        coords = self.config["coordinates"]
-        if coords not in COORDINATES:
-            raise IntegratorOptionError(
-                f"{self.name}: unknown coordinates {coords!r}; valid: "
-                f"{', '.join(map(repr, COORDINATES))}")
         corr = self.config["corrector"]
-        if isinstance(corr, bool) or corr not in CORRECTORS:
-            raise IntegratorOptionError(
-                f"{self.name}: unknown corrector order {corr!r}; valid: "
-                f"{', '.join(map(str, CORRECTORS))}")
         if corr and self.operators != tableaux.WH_DKD:
             raise IntegratorOptionError(
                 f"{self.name}: the symplectic correctors belong to the Wisdom-Holman "
