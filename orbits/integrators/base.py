@@ -49,19 +49,22 @@ of drift and kick coefficients (:class:`SplittingMethod`), an explicit
 Runge-Kutta method a Butcher table (:class:`ExplicitRungeKutta`).
 """
 
+import math
 import warnings
 
 import numpy as np
 
 from .._integrator_options import Option
-from .._kernels.status import with_status
+from .._kernels import gravity
 from .._kernels import stepping
+from .._kernels.invariants import MONITOR_WIDTH
+from .._kernels.status import with_status
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError, OrbitsWarning
 
 __all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
-           "ToleranceControlled", "Option", "MIN_DT", "RTOL_FLOOR", "NO_MARKS",
-           "NO_MARK_STEPS"]
+           "ToleranceControlled", "CompiledToleranceControlled", "Option", "MIN_DT", "RTOL_FLOOR", "NO_MARKS",
+           "NO_MARK_STEPS", "around_a_circle"]
 
 #: ``advance_to``'s marks when the outputs are not recorded in the loop:
 #: empty arrays of the marks' types, so that each loop compiles once for both
@@ -78,6 +81,46 @@ RTOL_FLOOR = 100 * float(np.finfo(float).eps)
 MIN_DT = Option("min_dt", float, 0.0, "smallest allowed step; a run whose step control "
                 "asks for less stops with StepSizeUnderflow (0: none)", unit="time",
                 sign="non-negative")
+
+
+def around_a_circle(integ, steps=1000):
+    """Advance a test particle once around a circle of radius 1 about a unit mass
+    (G = M = 1, period 2 pi) from (1, 0, 0), in ``steps`` steps of a fixed-step
+    integrator's compiled loop: the first check of an integrator, which ends
+    near where it started.
+
+    Parameters
+    ----------
+    integ : Integrator
+        A fixed-step integrator (the contract's :meth:`Integrator.advance`).
+    steps : int
+        Steps of ``2 pi / steps``.
+
+    Returns
+    -------
+    tuple
+        ``(status, steps_done, x, v, ws)``: the state (shape (2, 3), the
+        unit mass first) and the workspace after the steps, before any
+        :meth:`Integrator.synchronize`.
+
+    Examples
+    --------
+    >>> from orbits import integrators
+    >>> from orbits.integrators.base import around_a_circle
+    >>> status, steps, x, v, ws = around_a_circle(integrators.get("leapfrog"), 100)
+    >>> status.name, steps, bool(abs(x[1, 0] - 1) < 1e-3)
+    ('OK', 100, True)
+    """
+    x = np.array([[0.0, 0, 0], [1, 0, 0]])
+    v = np.array([[0.0, 0, 0], [0, 1, 0]])
+    force = stepping.gravity_force("small")
+    fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_active, eps2
+    mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)                            # no monitor rows
+    ws = integ.workspace(2)
+    integ.bind(ws, force, fargs)
+    status, done, _ = integ.advance(ws, x, v, 0.0, 2 * math.pi / steps, steps, force, fargs,
+                                    mon, 0, np.empty(0), np.zeros((0, MONITOR_WIDTH)))
+    return status, done, x, v, ws
 
 
 class Integrator:
@@ -217,19 +260,14 @@ class Integrator:
 
         Examples
         --------
-        >>> import math
+        One period of a circular orbit in 1000 steps of ``rk4``, as
+        :func:`around_a_circle` takes them (the class's example makes the call
+        itself):
+
         >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("rk4")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> from orbits.integrators.base import around_a_circle
+        >>> status, steps, x, v, ws = around_a_circle(integrators.get("rk4"))
         >>> status.name, steps, np.round(x[1], 6)
         ('OK', 1000, array([1., 0., 0.]))
         """
@@ -241,18 +279,13 @@ class Integrator:
 
         Examples
         --------
-        >>> import math
         >>> import numpy as np
         >>> from orbits import integrators
         >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
         >>> integ = integrators.get("wh")
         >>> ws = integ.workspace(2)
-        >>> integ.bind(ws, force, fargs)     # gravity alone: nothing kept beside the arrays
+        >>> integ.bind(ws, stepping.gravity_force("small"),      # gravity alone: nothing
+        ...            gravity.gravity_args(1.0, np.ones(2), 2, 0.0))  # kept beside the arrays
         >>> "terms" in ws
         False
         """
@@ -278,19 +311,10 @@ class Integrator:
 
         Examples
         --------
-        >>> import math
-        >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("leapfrog")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> status, steps, x, v, ws = around_a_circle(integ)
         >>> before = x.copy()
         >>> integ.synchronize(ws, x, v)                # x and v are at one time already
         >>> bool((x == before).all())
@@ -298,29 +322,8 @@ class Integrator:
         """
 
     def invalidate(self, ws):
-        """Forget anything computed from the old state.
-
-        Examples
-        --------
-        >>> import math
-        >>> import numpy as np
-        >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("verlet")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
-        >>> int(ws["cache"][0])                        # the last force is cached
-        1
-        >>> integ.invalidate(ws)
-        >>> int(ws["cache"][0])
-        0
-        """
+        """Forget anything computed from the old state (nothing here; a method
+        that caches a force drops it, as :meth:`SplittingMethod.invalidate`)."""
 
     def checked_state(self, ws, t):
         """The state the stopping conditions last looked at, if the loop that
@@ -372,7 +375,8 @@ class SplittingMethod(Integrator):
     Subclasses set ``operators``: a sequence of ``("drift", c)`` and
     ``("kick", c)``, applied left to right, where a drift advances positions by
     ``c dt v`` and a kick velocities by ``c dt a(x)``.  Drift and kick
-    coefficients must each sum to one.
+    coefficients must each sum to one.  A table that reads the same backwards
+    makes a time-symmetric method (``time_symmetric`` is set from it).
 
     Examples
     --------
@@ -399,6 +403,7 @@ class SplittingMethod(Integrator):
             cls._kinds = tuple(codes[k] for k, _ in cls.operators)
             cls._coefs = tuple(float(c) for _, c in cls.operators)
             kinds = [k for k, _ in cls.operators]
+            cls.time_symmetric = tuple(cls.operators) == tuple(cls.operators)[::-1]
             # a closing kick shares its force with the next step's opening kick
             cls.forces_per_step = kinds.count("kick") - (kinds[0] == kinds[-1] == "kick")
 
@@ -418,26 +423,7 @@ class SplittingMethod(Integrator):
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         """Apply the operator table ``nsteps`` times in the compiled loop (see
-        :meth:`Integrator.advance`).
-
-        Examples
-        --------
-        >>> import math
-        >>> import numpy as np
-        >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("yoshida4")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
-        >>> status.name, np.round(x[1], 6)
-        ('OK', array([ 1., -0.,  0.]))
-        """
+        :meth:`Integrator.advance`)."""
         loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs)
         fargs = stepping.work_bound(force, fargs, ws)
         return with_status(*loop(x, v, t, dt, nsteps, ws["acc"], ws["vm"], ws["cache"], fargs,
@@ -450,22 +436,15 @@ class SplittingMethod(Integrator):
 
         Examples
         --------
-        >>> import math
-        >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("verlet")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> *_, ws = around_a_circle(integ)
+        >>> int(ws["cache"][0])                        # the last force is cached
+        1
         >>> integ.invalidate(ws)
-        >>> ws["cache"].tolist()
-        [0]
+        >>> int(ws["cache"][0])
+        0
         """
         ws["cache"][0] = 0
 
@@ -516,26 +495,7 @@ class ExplicitRungeKutta(Integrator):
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         """Take ``nsteps`` steps of the Butcher table in the compiled loop (see
-        :meth:`Integrator.advance`).
-
-        Examples
-        --------
-        >>> import math
-        >>> import numpy as np
-        >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("rk2")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
-        >>> status.name, steps
-        ('OK', 1000)
-        """
+        :meth:`Integrator.advance`)."""
         loop = stepping.runge_kutta_loop(force)
         fargs = stepping.work_bound(force, fargs, ws)
         return with_status(*loop(x, v, t, dt, nsteps, self.A, self.B, self.C, ws["kx"], ws["kv"],
@@ -610,3 +570,38 @@ class ToleranceControlled(AdaptiveIntegrator):
                           f"what float64 arithmetic can deliver; using {RTOL_FLOOR:.3g} "
                           f"(100 roundings)", OrbitsWarning, stacklevel=4)
             self.config["rtol"] = RTOL_FLOOR
+
+
+class CompiledToleranceControlled(ToleranceControlled):
+    """A tolerance-controlled method whose compiled loop keeps the force at a
+    step's end for the next step (the flag ``ws["fsal"]``) and records the
+    outputs at their times (``advance_to``'s ``marks``): the embedded pairs
+    and ``rk4-doubling``.  A subclass gives its loop and the arguments that
+    are its own in :meth:`_loop_call`.
+    """
+
+    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
+    records_marks = True
+
+    def _loop_call(self, ws, force):
+        """``(loop, arguments)``: the compiled loop for ``force`` and its
+        arguments between ``t_end`` and ``fargs`` (the method's tables and
+        workspace arrays)."""
+        raise NotImplementedError
+
+    def invalidate(self, ws):
+        """The state was changed from outside: the force kept from the last step
+        is stale."""
+        ws["fsal"][0] = 0
+
+    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
+                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
+        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
+        on each and record there a row of ``mon_out`` (monitors and state),
+        its time in ``mon_t`` and its step count in ``mark_steps``."""
+        loop, own = self._loop_call(ws, force)
+        fargs = stepping.work_bound(force, fargs, ws)
+        return with_status(*loop(x, v, t, t_end, *own, fargs, mon, step0, mon_t, mon_out,
+                                 *stop_record(stop), int(max_steps),
+                                 float(self.config["rtol"]), float(self.config["atol"]),
+                                 marks, mark_steps))

@@ -2,17 +2,19 @@
 
 import numpy as np
 
-from .._kernels.status import with_status
 from .._kernels import doubling as _doubling
-from .._kernels import stepping as _stepping
-from .._kernels.stopping import stop_record
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, ToleranceControlled
+from .base import CompiledToleranceControlled
 
 __all__ = ["RK4Doubling"]
 
 
-class RK4Doubling(ToleranceControlled):
+#: the workspace's arrays, in the order the loop takes them
+_ARRAYS = ("k0x", "k0v", "kmx", "kmv", "kx", "kv", "xs", "vs", "xf", "vf", "xh", "vh", "x2",
+           "v2", "dt", "fsal", "info")
+
+
+class RK4Doubling(CompiledToleranceControlled):
     """Classic RK4 made adaptive by step doubling.
 
     Notes
@@ -48,23 +50,5 @@ class RK4Doubling(ToleranceControlled):
                 "dt": np.array([float(initial_step)]), "fsal": np.zeros(1, dtype=np.int64),
                 "info": np.full(2, -1, dtype=np.int64)}
 
-    def invalidate(self, ws):
-        ws["fsal"][0] = 0
-
-    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
-    records_marks = True
-
-    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
-        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
-        on each and record there a row of ``mon_out`` (monitors and state),
-        its time in ``mon_t`` and its step count in ``mark_steps``."""
-        loop = loop_for(_doubling.doubling_loop, force)
-        fargs = _stepping.work_bound(force, fargs, ws)
-        w = ws
-        args = (x, v, t, t_end, w["k0x"], w["k0v"], w["kmx"], w["kmv"], w["kx"], w["kv"],
-                w["xs"], w["vs"], w["xf"], w["vf"], w["xh"], w["vh"], w["x2"], w["v2"],
-                w["dt"], w["fsal"], w["info"], fargs, mon, step0, mon_t, mon_out,
-                *stop_record(stop), int(max_steps),
-                float(self.config["rtol"]), float(self.config["atol"]))
-        return with_status(*loop(*args, marks, mark_steps))
+    def _loop_call(self, ws, force):
+        return loop_for(_doubling.doubling_loop, force), tuple(ws[k] for k in _ARRAYS)

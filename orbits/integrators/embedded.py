@@ -2,19 +2,16 @@
 
 import numpy as np
 
-from .._kernels.status import with_status
 from .._kernels import embedded as _embedded
-from .._kernels import stepping as _stepping
-from .._kernels.stopping import stop_record
 from . import dop853_coefficients as _dop853
 from . import tableaux
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, ToleranceControlled
+from .base import CompiledToleranceControlled
 
 __all__ = ["EmbeddedRungeKutta", "Dopri5", "DOP853"]
 
 
-class EmbeddedRungeKutta(ToleranceControlled):
+class EmbeddedRungeKutta(CompiledToleranceControlled):
     """An embedded Runge-Kutta pair given by its table; one compiled loop serves all.
 
     Subclasses set ``A``, ``B``, ``C`` (the method), ``E`` (error weights over
@@ -37,26 +34,12 @@ class EmbeddedRungeKutta(ToleranceControlled):
                 "v1": np.zeros((n, 3)), "dt": np.array([float(initial_step)]),
                 "fsal": np.zeros(1, dtype=np.int64), "info": np.full(2, -1, dtype=np.int64)}
 
-    def invalidate(self, ws):
-        ws["fsal"][0] = 0
-
-    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
-    records_marks = True
-
-    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
-        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
-        on each and record there a row of ``mon_out`` (monitors and state),
-        its time in ``mon_t`` and its step count in ``mark_steps``."""
+    def _loop_call(self, ws, force):
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
         loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None)
-        fargs = _stepping.work_bound(force, fargs, ws)
-        args = (x, v, t, t_end, self.A, self.B, self.C, self.E, e3,
-                float(self.error_estimator_order), ws["kx"], ws["kv"], ws["xs"], ws["vs"],
-                ws["x1"], ws["v1"], ws["dt"], ws["fsal"], ws["info"], fargs, mon, step0,
-                mon_t, mon_out, *stop_record(stop),
-                int(max_steps), float(self.config["rtol"]), float(self.config["atol"]))
-        return with_status(*loop(*args, marks, mark_steps))
+        return loop, (self.A, self.B, self.C, self.E, e3, float(self.error_estimator_order),
+                      *(ws[k] for k in ("kx", "kv", "xs", "vs", "x1", "v1", "dt", "fsal",
+                                        "info")))
 
 
 class Dopri5(EmbeddedRungeKutta):

@@ -10,7 +10,7 @@ from .._kernels.stopping import ahead_pointer, stop_record
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
 from .base import RTOL_FLOOR, Integrator, Option
-from .wisdom_holman import split_gravity
+from .wisdom_holman import refuse_unkickable, split_gravity
 
 __all__ = ["Trace", "HILL", "SPEED", "PERICENTRE", "RTOL"]
 
@@ -231,14 +231,7 @@ class Trace(Integrator):
         """As ``wh``: only terms that depend on positions alone and have a
         potential join the interaction kicks (in the democratic heliocentric
         form of ``wh``); others are refused with the named error."""
-        for term in terms:
-            if not term.wisdom_holman:
-                raise IntegratorOptionError(
-                    f"{self.name} cannot take the force term {term!r}: its interaction "
-                    f"step takes only conservative terms that depend on positions alone "
-                    f"({term.why_not_wisdom_holman}). Use 'ias15', 'leapfrog', "
-                    "'yoshida4', an embedded method such as 'dop853', or, for GR, the "
-                    "term GRPotential, which 'trace' takes.")
+        refuse_unkickable(self, terms)
 
     def bind(self, ws, force, fargs):
         """Keep the added terms' kernel and arguments beside the arrays (rebound
@@ -265,19 +258,11 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import math
         >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)
+        >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("trace")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 100, 100, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> status, steps, x, v, ws = around_a_circle(integ, 100)
         >>> integ.synchronize(ws, x, v)
         >>> status.name, np.round(x[1], 12) + 0.0       # a Kepler orbit is exact
         ('OK', array([1., 0., 0.]))
