@@ -201,7 +201,10 @@ def _forces():
     return forces
 
 
-def _parser():
+def _parser(with_integrator_options=True):
+    """The parser; ``with_integrator_options=False`` leaves out ``run``'s integrator
+    options, whose declarations take about 15 ms to read, for a command line
+    whose command is not ``run`` (see :func:`main`)."""
     p = argparse.ArgumentParser(prog="orbits", description="N-body orbital mechanics.",
                                 epilog=_exit_help(),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -232,7 +235,7 @@ def _parser():
                           "wh takes) or 'full' (Einstein-Infeld-Hoffmann among all bodies)")
     opts = run.add_argument_group("integrator options", "passed only when given; an "
                                   "integrator that does not take one is an error")
-    for option, takers in integrator_options().items():
+    for option, takers in (integrator_options() if with_integrator_options else {}).items():
         spec = takers[0][0]
         opts.add_argument(spec.flag, dest=option, type=_option_type(spec), default=None,
                           help=_option_help(takers))
@@ -359,9 +362,9 @@ examples:
 
 def _negative_values(argv):
     """``--dt -10d`` as ``--dt=-10d``: argparse would read ``-10d`` as an option."""
-    numeric = _NUMBER_OPTIONS + tuple(
+    numeric = _NUMBER_OPTIONS + (tuple(
         takers[0][0].flag for takers in integrator_options().values()
-        if takers[0][0].kind in (int, float))
+        if takers[0][0].kind in (int, float)) if _command(argv) == "run" else ())
     out = []
     it = iter(argv)
     for tok in it:
@@ -376,6 +379,11 @@ def _negative_values(argv):
             continue
         out.append(tok)
     return out
+
+
+def _command(argv):
+    """The command of a command line: its first word that is not an option."""
+    return next((word for word in argv if not word.startswith("-")), None)
 
 
 # options whose value may be negative, so that it reaches the checks (and the
@@ -457,7 +465,7 @@ def main(argv=None):
     """Entry point of the ``orbits`` command; returns the exit status
     (:data:`EXIT_STATUSES`; argparse exits with :data:`EXIT_USAGE` itself)."""
     argv = _negative_values(sys.argv[1:] if argv is None else list(argv))
-    parser = _parser()
+    parser = _parser(with_integrator_options=_command(argv) == "run")
     args = parser.parse_args(argv)
     if args.command == "compile" and args.all and args.integrators:
         parser.error("compile: give integrator names or --all, not both")
