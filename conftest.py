@@ -1,9 +1,10 @@
-"""The names the package's docstring examples assume: ``u`` (astropy.units),
-``np`` (numpy) and ``orbits``, as the documentation's pages do
-(``doctest_global_setup`` in ``docs/conf.py``).
+"""The names the examples in the package's docstrings take as given.
 
-``pytest --doctest-modules`` gives each example a namespace with them, so that
-an example starts with what it shows rather than with its imports.
+Every docstring example runs with ``u`` (``astropy.units``), ``np`` (numpy) and
+``orbits`` imported, and one that uses ``sim`` before making it gets a fresh
+simulation of a star and a planet (``orbits.scenes.kepler()``, in days) with
+``leapfrog`` at a step of one day: the set-up the examples of
+:class:`orbits.Simulation`'s members start from, as its docstring says.
 """
 
 import astropy.units as u
@@ -13,6 +14,19 @@ import pytest
 import orbits
 
 
-@pytest.fixture(autouse=True, scope="session")
-def _doctest_names(doctest_namespace):
+def kepler_simulation():
+    """``sim`` of the examples: a fresh one for each."""
+    return orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
+
+
+@pytest.fixture(autouse=True)
+def _doctest_names(request, doctest_namespace):
+    dtest = getattr(request.node, "dtest", None)
+    if dtest is None:
+        yield
+        return
     doctest_namespace.update(u=u, np=np, orbits=orbits)
+    if "sim." in dtest.docstring and ">>> sim = " not in dtest.docstring.split("sim.")[0]:
+        doctest_namespace["sim"] = kepler_simulation()
+    yield
+    doctest_namespace.pop("sim", None)

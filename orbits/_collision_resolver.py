@@ -19,7 +19,32 @@ from ._kernels import stopping as _s
 from ._kernels.status import Status
 from .bodies import BodySet
 
-__all__ = ["resolve", "merge_energy_change"]
+__all__ = ["resolves", "resolve", "offset_rows", "table", "merge_energy_change"]
+
+
+def resolves(sim):
+    """Whether the simulation's run resolves collisions and goes on (not "halt")."""
+    c = sim._stop_config.get("collisions")
+    return c is not None and c != "halt"
+
+
+def offset_rows(sim, rows):
+    """Monitor rows (shape (k, MONITOR_WIDTH)) with what the collisions resolved
+    before them took out of the bodies: the energy into the work column, the
+    angular momentum into its columns (see :mod:`orbits.collisions`)."""
+    off = sim._ws.get("collision_offset")
+    if off is not None and len(rows) and off.any():
+        rows[:, _inv.WORK_COLUMN] += off[0]
+        rows[:, 1:4] += off[1:4]
+    return rows
+
+
+def table(sim):
+    """``result.collisions``: an astropy QTable of the collisions resolved (None
+    when the run does not resolve collisions)."""
+    if not resolves(sim):
+        return None
+    return _collisions.table(sim._collisions, sim.units)
 
 
 def resolve(sim, rec, wall0):

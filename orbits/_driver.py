@@ -222,7 +222,9 @@ class Driven:
     :func:`orbits.integrate`.
 
     A class that mixes it in holds one state and says how to advance it:
-    ``integrator``, ``_ws`` (its workspace), ``_x``, ``_v``, ``_force`` and
+    ``integrator``, ``_ws`` (its workspace), ``_x``, ``_v``, ``_rows_x`` and
+    ``_rows_v`` (the arrays the compiled loops advance: the state, and after
+    it the tangent rows of a simulation with variations), ``_force`` and
     ``_fargs``, ``_stop`` (stopping arguments or None), ``_mon(every)`` and
     ``monitor_every``, the clock (``_t_base``, ``_steps_since_base``, ``_dt``,
     ``_now()``, ``time``), the counters (``steps``, ``steps_rejected``,
@@ -250,16 +252,6 @@ class Driven:
     def _step(self):
         # the signed step the compiled loops take
         return self._sign * self._dt
-
-    @property
-    def _X(self):
-        # the arrays the compiled loops advance: the state, and after it the
-        # tangent rows of a run with variations (orbits.Simulation)
-        return self._x
-
-    @property
-    def _V(self):
-        return self._v
 
     def _renormalise(self):
         # scale back the chaos indicators' tangent vector (a run with them only)
@@ -425,7 +417,7 @@ class Driven:
         return (getattr(self.integrator, "records_marks", False)
                 and getattr(rec, "row_buffer", None) is not None
                 and getattr(rec, "records_in_loop", True) and not self.monitor_every
-                and plan.outputs >= 3 and len(self._X) == len(self._x)
+                and plan.outputs >= 3 and len(self._rows_x) == len(self._x)
                 and not self._resolves_collisions)
 
     def _advance_marks(self, plan, first, last, rec, bar, wall0):
@@ -440,11 +432,11 @@ class Driven:
         mon_t = np.empty(m)
         steps = np.zeros(m, dtype=np.int64)
         t0 = _time.perf_counter()
-        guard = (restored_on_error(self._X, self._V, self._ws) if self._loop_may_raise
-                 else contextlib.nullcontext())
+        guard = (restored_on_error(self._rows_x, self._rows_v, self._ws)
+                 if self._loop_may_raise else contextlib.nullcontext())
         with guard, self._compile_clock.loop():
             status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
-                self._ws, self._X, self._V, self._t_base, marks[-1], self._force,
+                self._ws, self._rows_x, self._rows_v, self._t_base, marks[-1], self._force,
                 self._fargs, self._mon(0), self.steps, mon_t, rows, self._stop, self._chunk,
                 marks, steps)
         elapsed = _time.perf_counter() - t0
@@ -477,11 +469,11 @@ class Driven:
             t0 = _time.perf_counter()
             # a copy to put back is taken only where the loop can raise (a
             # user's function in it): the package's kernels cannot
-            guard = (restored_on_error(self._X, self._V, self._ws) if self._loop_may_raise
-                     else contextlib.nullcontext())
+            guard = (restored_on_error(self._rows_x, self._rows_v, self._ws)
+                     if self._loop_may_raise else contextlib.nullcontext())
             with guard, self._compile_clock.loop():
                 status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
-                    self._ws, self._X, self._V, self._t_base, t_end, self._force,
+                    self._ws, self._rows_x, self._rows_v, self._t_base, t_end, self._force,
                     self._fargs, mon, self.steps, mon_t, mon_out, self._stop, n)
             elapsed = _time.perf_counter() - t0
             if n_mon:
@@ -610,7 +602,7 @@ class Driven:
                        else np.zeros((size, width)))
             with self._compile_clock.loop():
                 status, steps, n_mon, self._ws = advance_checked(
-                    self.integrator, self._ws, self._X, self._V, self._now(), dt, left,
+                    self.integrator, self._ws, self._rows_x, self._rows_v, self._now(), dt, left,
                     self._force, self._fargs, mon, s0, mon_t, mon_out, stop=self._stop)
             if n_mon and self._in_loop:
                 # the outputs' steps, and their times as _now() gives them there

@@ -1,19 +1,24 @@
 """Force terms bound to a simulation: the ``forces`` given split into the gravity
-term and the added terms (:mod:`orbits.forces`), and the added terms compiled
+term and the added terms (:mod:`orbits.forces`), gravity's kernel and
+arguments chosen for the bodies and options, and the added terms compiled
 with gravity into one force and its argument tables
 (:func:`orbits._kernels.stepping.with_terms`), the pointers of the user's
 functions included; the non-conservative terms are chained once more on their
 own, for the work the loops integrate.
 """
 
+import math
+
 import numpy as np
 
 from . import _user_functions
 from . import forces as _forces
+from ._kernels import gravity as _gravity
 from ._kernels import stepping as _stepping
 from ._kernels import terms as _kterms
+from .errors import IntegratorOptionError
 
-__all__ = ["split", "bind_terms"]
+__all__ = ["split", "bind_gravity", "bind_terms"]
 
 
 def split(forces, softening, parallel, rebound_arithmetic):
@@ -40,6 +45,30 @@ def split(forces, softening, parallel, rebound_arithmetic):
     gravity = (gravities[0] if gravities
                else _forces.Gravity(softening, parallel, rebound_arithmetic))
     return tuple(t for t in forces if not isinstance(t, _forces.Gravity)), gravity
+
+
+def bind_gravity(sim, gravity, parallel_threshold):
+    """Newtonian gravity with ``gravity``'s options (an :class:`orbits.forces.Gravity`)
+    for the simulation's bodies: its softening in the internal units, the
+    kernel (threaded from ``parallel_threshold`` bodies on, unless the term
+    says), the compiled force and its arguments."""
+    softening = gravity.softening
+    eps = 0.0 if softening is None else float(
+        sim.units.to_internal(softening, "length", bare_ok=sim._bare_ok, field="softening"))
+    if not (eps >= 0 and math.isfinite(eps)):
+        raise IntegratorOptionError(f"softening must be a finite length >= 0, got {softening}")
+    sim._eps2 = eps * eps
+    sim._softening = None if softening is None else sim.units.quantity(eps, "length")
+    n = len(sim._m)
+    sim.parallel = ((n >= parallel_threshold) if gravity.parallel is None
+                    else bool(gravity.parallel))
+    sim.rebound_arithmetic = bool(gravity.rebound_arithmetic)
+    kind = ("rebound" if sim.rebound_arithmetic else "parallel" if sim.parallel else
+            _gravity.serial_kind(n, sim._n_active))
+    sim._force = _stepping.gravity_force(kind)
+    sim._fargs = _gravity.gravity_args(sim.units.G, sim._m, sim._n_active, sim._eps2,
+                                       sim.parallel)
+    sim._gm = sim._fargs[0]
 
 
 def bind_terms(sim, bodies):

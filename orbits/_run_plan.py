@@ -1,7 +1,8 @@
 """A run's plan: where a run to a given time takes its outputs (a
 :class:`~orbits.records.RunPlan`): evenly spaced times for an adaptive method,
 the nearest step boundaries and a shortened last step for a fixed-step one,
-with the checks that the outputs fit the run's steps.
+with the checks that the outputs fit the run's steps, and of the run's limits
+in wall-clock seconds.
 """
 
 import math
@@ -11,11 +12,29 @@ import warnings
 from .errors import OrbitsWarning
 from .records import RunPlan
 
-__all__ = ["plan", "MAX_STEPS"]
+__all__ = ["plan", "checked_seconds", "MAX_STEPS"]
 
 #: The most steps one run may take: beyond 2**53 float64 no longer tells the
 #: times of neighbouring steps apart.
 MAX_STEPS = float(2 ** 53)
+
+
+def checked_seconds(wall_limit, checkpoint_interval):
+    """``wall_limit`` as a float (None: no limit), after checking it and
+    ``checkpoint_interval``: a positive number of seconds, and one >= 0."""
+    if wall_limit is not None and not _positive_number(wall_limit):
+        raise ValueError(f"wall_limit must be a positive number of seconds, "
+                         f"got {wall_limit!r}")
+    if checkpoint_interval is not None and not (
+            _positive_number(checkpoint_interval) or checkpoint_interval == 0):
+        raise ValueError(f"checkpoint_interval must be a number of seconds >= 0, "
+                         f"got {checkpoint_interval!r}")
+    return None if wall_limit is None else float(wall_limit)
+
+
+def _positive_number(value):
+    return (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and 0 < float(value) < math.inf)
 
 
 def plan(sim, until_v, outputs, until, default_outputs):

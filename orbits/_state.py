@@ -1,7 +1,8 @@
-"""State accessors: a simulation's state read out as records in the body set's
-order (the :class:`~orbits.records.SimulationState` a checkpoint stores, the
-current :class:`~orbits.BodySet`, an output's :class:`~orbits.records.Snapshot`,
-the :class:`~orbits.records.SimulationDescription` a file records) and put back
+"""A simulation's state: taken from a body set (massive bodies first, with the
+integrator's workspace for them), read out as records in the body set's order
+(the :class:`~orbits.records.SimulationState` a checkpoint stores, the current
+:class:`~orbits.BodySet`, an output's :class:`~orbits.records.Snapshot`, the
+:class:`~orbits.records.SimulationDescription` a file records) and put back
 from a state record.
 
 The simulation keeps its bodies massive first (``sim._order``); these records
@@ -17,7 +18,40 @@ from ._kernels import invariants as _inv
 from .bodies import BodySet
 from .records import SimulationDescription, SimulationState, Snapshot, _function_name
 
-__all__ = ["body_set", "record", "saved_workspace", "put_back", "description", "snapshot"]
+__all__ = ["take_bodies", "workspace", "body_set", "record", "saved_workspace", "put_back",
+           "description", "snapshot"]
+
+
+def take_bodies(sim, bodies):
+    """The simulation's arrays of ``bodies``: massive bodies first (stable), as
+    the gravity kernels expect, with the order and its inverse."""
+    m = bodies._m
+    sim._order = np.concatenate([np.flatnonzero(m > 0), np.flatnonzero(m == 0)])
+    sim._m = np.ascontiguousarray(m[sim._order])
+    sim._r = np.ascontiguousarray(bodies._r[sim._order])
+    sim._x = np.ascontiguousarray(bodies._x[sim._order])
+    sim._v = np.ascontiguousarray(bodies._v[sim._order])
+    sim._n_active = int(np.count_nonzero(sim._m > 0))
+    sim._inverse = np.argsort(sim._order)
+
+
+def workspace(sim):
+    """The integrator's workspace for the simulation's rows (bodies and tangent
+    rows), bound to its force, with what else a checkpoint keeps with the
+    state: the work ``W`` of non-conservative terms, the chaos indicators, and
+    what resolved collisions took out of the bodies (energy, and angular
+    momentum into the merged bodies' spins; :mod:`orbits.collisions`)."""
+    rows = len(sim._rows_x)
+    integ = sim.integrator
+    ws = integ.workspace(rows, sim._dt) if integ.adaptive else integ.workspace(rows)
+    integ.bind(ws, sim._force, sim._fargs)
+    if sim._base_force.work is not None:
+        ws["work"] = sim._base_fargs[2][3]
+    if sim._chaos_box is not None:
+        ws["chaos"] = sim._chaos_box
+    if sim._resolves_collisions:
+        ws["collision_offset"] = np.zeros(4)
+    return ws
 
 
 def body_set(sim):

@@ -14,7 +14,7 @@ import numbers
 import numpy as np
 
 from ._kernels import variational as _var
-from .errors import IntegratorOptionError
+from .errors import IntegratorOptionError, SimulationOptionError
 from .monitors import CHAOS_MONITORS
 
 __all__ = ["bind", "tangent_rows", "jacobian", "renormalise"]
@@ -23,7 +23,14 @@ __all__ = ["bind", "tangent_rows", "jacobian", "renormalise"]
 def bind(sim, variations, seed):
     """Tangent rows after the bodies' and the force of the augmented system
     (:mod:`orbits._kernels.variational`), for ``variations`` and the chaos
-    monitors."""
+    monitors; the force without them is kept as ``_base_force``,
+    ``_base_fargs``."""
+    if sim._resolves_collisions and variations is not None:
+        raise SimulationOptionError(
+            f"collisions={sim._stop_config['collisions']!r} changes the bodies during the "
+            f"run, which the variational equations cannot follow; use collisions='halt' "
+            f"with variations=")
+    sim._base_force, sim._base_fargs = sim._force, sim._fargs
     n = len(sim._m)
     chaos = any(name in CHAOS_MONITORS for name in sim.monitors)
     if chaos and not sim.integrator.chaos_indicators:

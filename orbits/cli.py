@@ -22,6 +22,8 @@ import textwrap
 import threading
 import traceback
 
+from orbits import _integrator_options
+
 __all__ = ["main", "parse_quantity", "EXIT_STATUSES", "EXIT_COMPLETED", "EXIT_STOPPED",
            "EXIT_USAGE", "EXIT_INPUT", "EXIT_FILE", "EXIT_RUN_FAILED", "EXIT_INTERNAL"]
 
@@ -86,28 +88,41 @@ def _length(text):
     return parse_quantity(text, "length")
 
 
-#: ``orbits run`` option -> (type, help); the option is passed under its own name
-INTEGRATOR_OPTIONS = {
-    "epsilon": (float, "IAS15's precision parameter, default 1e-9"),
-    "tol": (float, "the Taylor method's tolerance, default 2.2e-16; it sets the order "
-                   "(20 at the default, 13 at 1e-10)"),
-    "rtol": (float, "relative tolerance of the embedded methods, default 1e-9 (trace's "
-                    "encounter integrator: 1e-12)"),
-    "atol": (float, "absolute tolerance, in the scene's units, default 1e-12"),
-    "corrector": (int, "Wisdom-Holman symplectic corrector order: 0, 3, 5, 7, 11 or 17"),
-    "coordinates": (str, "Wisdom-Holman coordinates: jacobi or democratic-heliocentric"),
-}
+def integrator_options():
+    """Option name -> ``[(Option, integrator names), ...]``: the flags of ``orbits
+    run``'s integrator options, one for each option an integrator declares
+    (:mod:`orbits._integrator_options` reads the declarations without importing
+    the integrators).
 
-#: the integrators that take each option (tests/test_cli_run.py checks it against
-#: the registry; the help is built without importing the integrators)
-OPTION_TAKEN_BY = {
-    "epsilon": ("ias15",),
-    "tol": ("taylor",),
-    "rtol": ("dopri5", "dop853", "rk4-doubling", "radau", "lsoda", "trace"),
-    "atol": ("dopri5", "dop853", "rk4-doubling", "radau", "lsoda"),
-    "corrector": ("wh",),
-    "coordinates": ("wh", "saba2", "saba3", "saba4"),
-}
+    Examples
+    --------
+    >>> from orbits.cli import integrator_options
+    >>> [names for spec, names in integrator_options()["corrector"]]
+    [('wh', 'saba2', 'saba3', 'saba4')]
+    """
+    return _integrator_options.taken_by(_integrator_options.declared())
+
+
+def _option_help(takers):
+    """The help of an integrator option's flag: what it is, the values it takes
+    and its default, for each integrator that takes it."""
+    parts = []
+    for spec, names in takers:
+        values = (f"; one of {', '.join(map(str, spec.choices))}" if spec.choices else "")
+        unit = (f"; a {spec.unit} with a unit, or a plain number in the scene's units"
+                if spec.unit else "")
+        default = f"{spec.default:g}" if spec.kind is float else spec.default
+        parts.append(f"{spec.help}{values}{unit} ({', '.join(names)}; default {default})")
+    return "; ".join(parts)
+
+
+def _option_type(spec):
+    """The argparse type of an integrator option: a quantity for one with a unit,
+    else its declared type (a value outside its choices or range reaches the
+    integrator's check, which names the valid ones)."""
+    if spec.unit:
+        return lambda text: parse_quantity(text, spec.unit)
+    return spec.kind
 
 #: Outputs of a run when ``--outputs`` is not given (orbits.simulation.DEFAULT_OUTPUTS,
 #: written out here so that the help is built without importing the library;
@@ -186,7 +201,10 @@ def _forces():
     return forces
 
 
-def _parser():
+def _parser(with_integrator_options=True):
+    """The parser; ``with_integrator_options=False`` leaves out ``run``'s integrator
+    options, whose declarations take about 15 ms to read, for a command line
+    whose command is not ``run`` (see :func:`main`)."""
     p = argparse.ArgumentParser(prog="orbits", description="N-body orbital mechanics.",
                                 epilog=_exit_help(),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -217,9 +235,10 @@ def _parser():
                           "wh takes) or 'full' (Einstein-Infeld-Hoffmann among all bodies)")
     opts = run.add_argument_group("integrator options", "passed only when given; an "
                                   "integrator that does not take one is an error")
-    for option, (kind, text) in INTEGRATOR_OPTIONS.items():
-        opts.add_argument(f"--{option}", type=kind, default=None,
-                          help=f"{text}; taken by {', '.join(OPTION_TAKEN_BY[option])}")
+    for option, takers in (integrator_options() if with_integrator_options else {}).items():
+        spec = takers[0][0]
+        opts.add_argument(spec.flag, dest=option, type=_option_type(spec), default=None,
+                          help=_option_help(takers))
     stops = run.add_argument_group("stopping conditions", "checked after every step; the "
                                    f"run stops with exit status {EXIT_STOPPED} and prints "
                                    f"what it has")
@@ -343,10 +362,13 @@ examples:
 
 def _negative_values(argv):
     """``--dt -10d`` as ``--dt=-10d``: argparse would read ``-10d`` as an option."""
+    numeric = _NUMBER_OPTIONS + (tuple(
+        takers[0][0].flag for takers in integrator_options().values()
+        if takers[0][0].kind in (int, float)) if _command(argv) == "run" else ())
     out = []
     it = iter(argv)
     for tok in it:
-        if tok in _TIME_OPTIONS:
+        if tok in numeric:
             nxt = next(it, None)
             if nxt is not None and _QUANTITY.match(nxt) and nxt.startswith("-"):
                 out.append(f"{tok}={nxt}")
@@ -359,9 +381,15 @@ def _negative_values(argv):
     return out
 
 
-# options whose value may be negative, so that it reaches the checks
-_TIME_OPTIONS = ("--dt", "--until", "--epsilon", "--tol", "--rtol", "--atol", "--corrector",
-                 "--encounter-distance", "--encounter-hill", "--escape-distance")
+def _command(argv):
+    """The command of a command line: its first word that is not an option."""
+    return next((word for word in argv if not word.startswith("-")), None)
+
+
+# options whose value may be negative, so that it reaches the checks (and the
+# integrators' numeric options)
+_NUMBER_OPTIONS = ("--dt", "--until", "--encounter-distance", "--encounter-hill",
+                   "--escape-distance")
 
 
 def default_outputs(steps):
@@ -437,7 +465,7 @@ def main(argv=None):
     """Entry point of the ``orbits`` command; returns the exit status
     (:data:`EXIT_STATUSES`; argparse exits with :data:`EXIT_USAGE` itself)."""
     argv = _negative_values(sys.argv[1:] if argv is None else list(argv))
-    parser = _parser()
+    parser = _parser(with_integrator_options=_command(argv) == "run")
     args = parser.parse_args(argv)
     if args.command == "compile" and args.all and args.integrators:
         parser.error("compile: give integrator names or --all, not both")
@@ -597,8 +625,12 @@ def _run(args, orbits):
 
     name = args.integrator or defaults.get("integrator", orbits.integrators.DEFAULT)
     options = dict(defaults.get("options", {}))
-    options.update((k, getattr(args, k)) for k in INTEGRATOR_OPTIONS
-                   if getattr(args, k) is not None)
+    for option, takers in integrator_options().items():
+        value, unit = getattr(args, option), takers[0][0].unit
+        if value is not None:
+            options[option] = (value if not unit else
+                               _in_scene_units(value, bodies, unit).to_value(
+                                   bodies.units.unit(unit)))
     integrator = orbits.integrators.get(name, **options)
     dt, until = given("dt"), given("until")
     if dt is None and not integrator.adaptive:

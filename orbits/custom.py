@@ -272,6 +272,7 @@ class _UserRun(Driven):
     def __init__(self, integ, force, fargs, x, v, ws, shape, scalar, t0, dt):
         self.integrator, self._force, self._fargs = integ, force, fargs
         self._x, self._v, self._ws = x, v, ws
+        self._rows_x, self._rows_v = x, v
         self.shape, self.scalar, self.size = shape, scalar, int(np.prod(shape))
         self._t_base, self._steps_since_base = float(t0), 0
         self._dt = 0.0 if dt is None else float(dt)

@@ -5,27 +5,30 @@ float64 arrays in the body set's unit system and attaches units again only
 to what it returns.
 
 This module is the facade: :class:`Simulation`'s construction and public
-methods.  The ideas it draws on live in modules of their own: the force terms'
-binding (:mod:`orbits._force_binding`), variations and chaos indicators
+methods.  The ideas it draws on live in modules of their own: the integrator
+and its options (:mod:`orbits._integrator_choice`), gravity's and the force
+terms' binding (:mod:`orbits._force_binding`), the monitors
+(:mod:`orbits._monitoring`), variations and chaos indicators
 (:mod:`orbits._variations`), stopping conditions and the encounter log
 (:mod:`orbits._stop_conditions`), the collision resolver
-(:mod:`orbits._collision_resolver`), state records (:mod:`orbits._state`), the
-run's plan (:mod:`orbits._run_plan`) and failures (:mod:`orbits._failures`),
-the driver (:mod:`orbits._driver`), the recorder of a run in memory
-(:mod:`orbits.recorder`) and restart from a file (:mod:`orbits.io.restart`).
+(:mod:`orbits._collision_resolver`), the state and its records
+(:mod:`orbits._state`), the run's plan (:mod:`orbits._run_plan`) and failures
+(:mod:`orbits._failures`), the driver (:mod:`orbits._driver`), the recorder of
+a run in memory (:mod:`orbits.recorder`), restart from a file
+(:mod:`orbits.io.restart`) and the simulation in words for its ``repr``
+(:mod:`orbits._described`).
 """
 
-import html
 import math
-import numbers
 
-import astropy.units as u
 import numpy as np
 
 from . import _collision_resolver as _resolver
+from . import _described
 from . import _failures
 from . import _force_binding as _binding
 from . import _integrator_choice as _choice
+from . import _monitoring
 from . import _run_plan
 from . import _state
 from . import _stop_conditions as _stops
@@ -35,15 +38,12 @@ from . import forces as _forces
 from . import integrators as _integrators
 from ._driver import (CHUNK_SECONDS, FIRST_CHUNK, PROGRESS_DELAY,  # noqa: F401 - documented here
                       Driven)
-from ._kernels import gravity as _gravity
-from ._kernels import invariants as _inv
 from ._kernels import stepping as _stepping
-from ._kernels import variational as _var
 from .bodies import BodySet
-from .errors import BodyUnitsError, IntegratorOptionError, SimulationOptionError
+from .errors import BodyUnitsError, IntegratorOptionError
 from .io import hdf5 as _hdf5
 from .io import restart as _restart
-from .monitors import DEFAULT_MONITORS, monitor_mask
+from .monitors import DEFAULT_MONITORS
 from .recorder import Recorder
 from .records import (RunPlan, SimulationConfig, SimulationDescription, SimulationState,
                       Snapshot)
@@ -180,6 +180,14 @@ class Simulation(Driven):
     The stopping conditions are checked inside the compiled loop after every
     step; a simulation without them compiles a loop without the check.
 
+    The examples of the members start from ``sim``, a star and a planet on
+    a circular orbit in days (:func:`orbits.scenes.kepler`) with
+    ``leapfrog`` at a step of one day, and take ``astropy.units as u`` and
+    ``orbits`` as imported::
+
+        sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog",
+                                dt=1 * u.day)
+
     Examples
     --------
     >>> import astropy.units as u
@@ -204,8 +212,6 @@ class Simulation(Driven):
             raise TypeError(f"bodies must be a BodySet, got {type(bodies).__name__}")
         bodies.check()
         terms, gravity = _binding.split(forces, softening, parallel, rebound_arithmetic)
-        softening, parallel = gravity.softening, gravity.parallel
-        rebound_arithmetic = gravity.rebound_arithmetic
         self.units = bodies.units
         self._bare_ok = bodies._bare_ok
         self._names = bodies.names
@@ -221,75 +227,22 @@ class Simulation(Driven):
         if not ((self._dt > 0 or (adaptive and self._dt == 0)) and math.isfinite(self._dt)):
             raise IntegratorOptionError(f"dt must be a positive finite time, got {dt}")
 
-        # massive bodies first (stable), as the gravity kernels expect
-        m = bodies._m
-        self._order = np.concatenate([np.flatnonzero(m > 0), np.flatnonzero(m == 0)])
-        self._m = np.ascontiguousarray(m[self._order])
-        self._r = np.ascontiguousarray(bodies._r[self._order])
-        self._x = np.ascontiguousarray(bodies._x[self._order])
-        self._v = np.ascontiguousarray(bodies._v[self._order])
-        self._n_active = int(np.count_nonzero(self._m > 0))
-        self._inverse = np.argsort(self._order)
-        eps = 0.0 if softening is None else float(
-            self.units.to_internal(softening, "length", bare_ok=self._bare_ok,
-                                   field="softening"))
-        if not (eps >= 0 and math.isfinite(eps)):
-            raise IntegratorOptionError(f"softening must be a finite length >= 0, got {softening}")
-        self._eps2 = eps * eps
-        self._softening = None if softening is None else self.units.quantity(eps, "length")
-        n = len(self._m)
-        self.parallel = (n >= PARALLEL_THRESHOLD) if parallel is None else bool(parallel)
-        self.rebound_arithmetic = bool(rebound_arithmetic)
-        kind = ("rebound" if self.rebound_arithmetic else "parallel" if self.parallel else
-                _gravity.serial_kind(n, self._n_active))
-        self._force = _stepping.gravity_force(kind)
-        self._fargs = _gravity.gravity_args(self.units.G, self._m, self._n_active, self._eps2,
-                                            self.parallel)
-        self._gm = self._fargs[0]
+        _state.take_bodies(self, bodies)
+        _binding.bind_gravity(self, gravity, PARALLEL_THRESHOLD)
         self._terms = terms
         self._eargs = None
         if terms:
             self.integrator.check_terms(terms)
             _binding.bind_terms(self, bodies)
 
-        if isinstance(monitors, str):
-            raise ValueError(f"monitors must be a list of monitor names, got the string "
-                             f"{monitors!r}; write monitors=[{monitors!r}]")
-        self.monitors = tuple(monitors)
-        self._mask = monitor_mask(self.monitors)
-        if monitor_every is not None and (int(monitor_every) != monitor_every
-                                          or monitor_every < 1):
-            raise ValueError(f"monitor_every must be a whole number of steps >= 1, "
-                             f"got {monitor_every}")
-        self.monitor_every = None if monitor_every is None else int(monitor_every)
+        _monitoring.set_up(self, monitors, monitor_every)
 
         self._stop_info = np.zeros(2, dtype=np.int64)
         self._stop = _stops.set_up(self, encounter_distance, encounter_hill, escape_distance,
                                    escape_unbound, collisions, encounter_log, restitution,
                                    LOG_ROWS)
-        if self._resolves_collisions and variations is not None:
-            raise SimulationOptionError(
-                f"collisions={collisions!r} changes the bodies during the run, which the "
-                f"variational equations cannot follow; use collisions='halt' with "
-                f"variations=")
-        # the force without variations, and its arguments
-        self._base_force, self._base_fargs = self._force, self._fargs
         _variations.bind(self, variations, seed)
-        rows = len(self._rows_x)
-        self._ws = (self.integrator.workspace(rows, self._dt) if adaptive
-                    else self.integrator.workspace(rows))
-        self.integrator.bind(self._ws, self._force, self._fargs)
-        if self._base_force.work is not None:
-            # W lives in the workspace, so that it is saved, restored and
-            # checkpointed with the state it belongs to
-            self._ws["work"] = self._base_fargs[2][3]
-        if self._chaos_box is not None:
-            self._ws["chaos"] = self._chaos_box
-        if self._resolves_collisions:
-            # what the resolved collisions took out of the bodies: energy, and
-            # angular momentum into the merged bodies' spins (orbits.collisions);
-            # in the workspace, so that it is checkpointed with the state
-            self._ws["collision_offset"] = np.zeros(4)
+        self._ws = _state.workspace(self)
         self._collisions = []
         self._bodies_changed = 0    # how often collisions changed the set of bodies
         self.steps_rejected = 0
@@ -303,26 +256,11 @@ class Simulation(Driven):
         #: appends to it
         self.output_path = None
         self._resume = None
-        # only the monitors asked for: the energy of a large N costs O(N^2)
-        self._reference = self._monitor_row(np.zeros(_inv.MONITOR_WIDTH))
-        self._E_scale = 0.5 * float(np.sum(self._m * np.sum(self._v ** 2, axis=1))) or 1.0
-        self._L_scale = float(np.sum(self._m * np.linalg.norm(self._x, axis=1)
-                                     * np.linalg.norm(self._v, axis=1))) or 1.0
+        _monitoring.take_references(self)
         if self.__dict__.pop("_merge_at_start", False):
             # bodies in contact at the start with collisions="merge": merged
             # now, at t = 0, as a run merges them (collisions table, offsets)
             self._resolve_collisions(None, None)
-
-    @property
-    def _X(self):
-        return self._rows_x
-
-    @property
-    def _V(self):
-        return self._rows_v
-
-    def _renormalise(self):
-        _variations.renormalise(self)
 
     @property
     def tangent_vectors(self):
@@ -348,8 +286,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
         ...                         variations="state")
         >>> _ = sim.run(until=1 * u.yr, outputs=2, progress=False)
@@ -364,9 +300,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> cfg = sim.config
         >>> cfg.integrator, cfg.dt
         ('leapfrog', <Quantity 1. d>)
@@ -390,9 +323,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> twin = orbits.Simulation.from_config(orbits.scenes.kepler(), sim.config.to_dict())
         >>> twin.integrator.name, twin.dt
         ('leapfrog', <Quantity 1. d>)
@@ -418,7 +348,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import orbits
         >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="ias15",
         ...                         forces=[orbits.forces.GR("Star")])
         >>> [type(term).__name__ for term in sim.forces]
@@ -432,20 +361,11 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> type(sim.gravity).__name__
         'Gravity'
         """
         return _forces.Gravity(softening=self._softening, parallel=self.parallel,
                        rebound_arithmetic=self.rebound_arithmetic)
-
-    def _mon(self, every):
-        # the monitors' arguments of the compiled loops; with terms, their
-        # energy arguments too (orbits._kernels.stepping.with_terms)
-        mon = (every, self._mask, self._m, self.units.G, self._n_active, self._eps2)
-        return mon if self._eargs is None else mon + (self._eargs,)
 
     @property
     def stop_conditions(self):
@@ -453,8 +373,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> sim = orbits.Simulation(orbits.scenes.kepler(), dt=1 * u.day,
         ...                         escape_distance=100 * u.au)
         >>> sim.stop_conditions["escape_distance"], sim.stop_conditions["escape_unbound"]
@@ -468,9 +386,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> print(sim.softening)
         None
         >>> orbits.Simulation(orbits.scenes.kepler(), dt=1 * u.day,
@@ -479,48 +394,25 @@ class Simulation(Driven):
         """
         return self._softening
 
-    # -- the driver's hooks: the encounter log, resolved collisions ----------------------
-    def _drain_log(self, rec=None):
-        _stops.drain_log(self, rec)
-
-    def _log_full(self, rec, wall0):
-        _stops.log_full(self, rec, wall0)
-
-    def _encounter_table(self):
-        return _stops.encounter_table(self)
+    # -- the driver's hooks: monitors, the encounter log, resolved collisions, chaos
+    _mon = _monitoring.loop_args
+    _monitor_row = _monitoring.row
+    _has_work = property(_monitoring.has_work)
+    _drain_log = _stops.drain_log
+    _log_full = _stops.log_full
+    _encounter_table = _stops.encounter_table
+    _resolves_collisions = property(_resolver.resolves)
+    _offset_rows = _resolver.offset_rows
+    _resolve_collisions = _resolver.resolve
+    _collision_table = _resolver.table
+    _renormalise = _variations.renormalise
 
     #: the ways a collision can be resolved (Simulation's ``collisions``; or a
     #: function, see :mod:`orbits.collisions`)
     COLLISION_RESOLUTIONS = _collisions.RESOLUTIONS
 
-    @property
-    def _resolves_collisions(self):
-        # collisions that the run resolves and goes on (not "halt")
-        c = self._stop_config.get("collisions")
-        return c is not None and c != "halt"
-
-    def _offset_rows(self, rows):
-        """Monitor rows written before this call carry the collisions' offsets
-        (see :mod:`orbits.collisions`)."""
-        off = self._ws.get("collision_offset")
-        if off is not None and len(rows) and off.any():
-            rows[:, _inv.WORK_COLUMN] += off[0]
-            rows[:, 1:4] += off[1:4]
-        return rows
-
-    def _resolve_collisions(self, rec, wall0):
-        """Resolve the collisions of the step just taken (:mod:`orbits._collision_resolver`)."""
-        _resolver.resolve(self, rec, wall0)
-
     def _names_internal(self):
         return [self._names[k] for k in self._order]
-
-    def _collision_table(self):
-        """``result.collisions``: an astropy QTable (None when the run does
-        not resolve collisions)."""
-        if not self._resolves_collisions:
-            return None
-        return _collisions.table(self._collisions, self.units)
 
     # -- files ------------------------------------------------------------------------
     @classmethod
@@ -562,15 +454,14 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> import os, tempfile
         >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
         >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
         >>> again = orbits.Simulation.from_file(path)
         >>> again.time, bool((again.bodies.positions == sim.bodies.positions).all())
         (<Quantity 10. d>, True)
+        >>> again.resume_point.finished   # the run finished: nothing to resume
+        True
         """
         sim, cp = _restart.restored(cls, path, collisions, functions)
         sim._epoch = cp.epoch       # the date of time 0, as the file keeps it
@@ -587,9 +478,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> print(sim.resume_point)
         None
         """
@@ -607,22 +495,19 @@ class Simulation(Driven):
             As :meth:`run` with ``output`` returns it: the last output, and the
             whole run's invariants' errors.
 
+        Raises
+        ------
+        ValueError
+            The simulation was not restored from a file (:meth:`from_file`), or
+            the run in it finished (:attr:`resume_point`): :meth:`run` with
+            ``output`` continues it.
+
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
-        >>> import os, tempfile
-        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-        >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-        >>> again = orbits.Simulation.from_file(path)
-        >>> again.resume_point.finished   # this run finished: nothing to resume
-        True
-        >>> try:
-        ...     again.resume(progress=False)
-        ... except ValueError as exc:
-        ...     print(str(exc).split(";")[0].endswith("finished"))
-        True
+        >>> sim.resume(progress=False)
+        Traceback (most recent call last):
+            ...
+        ValueError: this simulation was not restored from a file (use Simulation.from_file)
         """
         point = self._resume
         if point is None:
@@ -643,9 +528,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
         >>> sim.time
         <Quantity 10. d>
@@ -658,9 +540,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> sim.dt
         <Quantity 1. d>
         """
@@ -678,9 +557,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
         >>> b = sim.bodies
         >>> b.names, b.positions.unit, b.radii.unit
@@ -698,9 +574,7 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
         >>> from astropy.time import Time
-        >>> import orbits
         >>> bodies = orbits.scenes.kepler()
         >>> bodies.epoch = Time("2030-01-01T00:00:00", scale="tdb")
         >>> sim = orbits.Simulation(bodies, "leapfrog", dt=1 * u.day)
@@ -716,9 +590,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> s = sim.state
         >>> s.x.shape, s.steps
         ((2, 3), 0)
@@ -731,9 +602,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> start = sim.state
         >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
         >>> sim.set_state(start)
@@ -748,9 +616,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> d = sim.description()
         >>> d.names, d.dt, d.units.name
         (('Star', 'Planet'), 1.0, 'au-Msun-day')
@@ -763,9 +628,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> _ = sim.run(until=1 * u.yr, outputs=2, progress=False)
         >>> sim.time_value, sim.time.unit
         (365.25, Unit("d"))
@@ -778,9 +640,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> snap = sim.snapshot()
         >>> snap.t, snap.steps, snap.x.shape
         (0.0, 0, (2, 3))
@@ -802,24 +661,6 @@ class Simulation(Driven):
             raise IntegratorOptionError(f"{field} must be a scalar time, got shape {val.shape}")
         return float(val)
 
-    def _monitor_row(self, row):
-        _inv.monitor_row(self._x, self._v, self._m, self.units.G, self._n_active, self._eps2,
-                         self._mask, row)
-        if self._eargs is not None and self._mask & _inv.ENERGY:
-            row[0] += self._base_force.terms.energy(self._x, self._v, self._eargs)
-            row[_inv.WORK_COLUMN] = _stepping.work_total(self._ws)
-        if self._chaos_box is not None:
-            col = _inv.MONITOR_COLUMNS.index("megno")
-            row[col:col + 3] = _var.chaos_values(self._ws["chaos"])
-        self._offset_rows(row[None])
-        return row
-
-    @property
-    def _has_work(self):
-        # non-conservative terms, whose work the loops integrate, or collisions
-        # that take energy out of the bodies
-        return self._base_force.work is not None or self._resolves_collisions
-
     @property
     def work(self):
         """W, the energy the non-conservative force terms have taken out of the
@@ -836,10 +677,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog",
-        ...                         dt=1 * u.day)
         >>> sim.work                               # no non-conservative terms
         <Quantity 0. AU2 solMass / d2>
         """
@@ -913,9 +750,6 @@ class Simulation(Driven):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), integrator="leapfrog", dt=1 * u.day)
         >>> result = sim.run(until=1 * u.yr, outputs=5, progress=False)
         >>> result.times.round(2)
         <Quantity [  0.  ,  91.  , 183.  , 274.  , 365.25] d>
@@ -926,14 +760,7 @@ class Simulation(Driven):
         (<Quantity [365.25, 182.25,   0.  ] d>, <Quantity 0. d>)
         """
         plan = self._plan(self._time_value(until, "until"), outputs, until)
-        if wall_limit is not None and not _positive_number(wall_limit):
-            raise ValueError(f"wall_limit must be a positive number of seconds, "
-                             f"got {wall_limit!r}")
-        if checkpoint_interval is not None and not (
-                _positive_number(checkpoint_interval) or checkpoint_interval == 0):
-            raise ValueError(f"checkpoint_interval must be a number of seconds >= 0, "
-                             f"got {checkpoint_interval!r}")
-        self._wall_limit = None if wall_limit is None else float(wall_limit)
+        self._wall_limit = _run_plan.checked_seconds(wall_limit, checkpoint_interval)
         if output is None:
             rec = Recorder(self, initial=plan.outputs > 1, capacity=plan.outputs)
         else:
@@ -951,44 +778,8 @@ class Simulation(Driven):
     def __repr__(self):
         """One line: bodies, time, integrator and its options, step, forces, stopping
         conditions."""
-        d = dict(self._described())
-        return (f"<Simulation of {len(self._names)} bodies at t = {d['time']}: "
-                f"{d['integrator']}, dt = {d['dt']}; forces: {d['forces']}"
-                + (f"; stops: {d['stopping']}" if "stopping" in d else "") + ">")
+        return _described.one_line(self)
 
     def _repr_html_(self):
         """The same as a table, for Jupyter."""
-        rows = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{html.escape(v)}</td>"
-                       f"</tr>" for k, v in self._described())
-        return f"<div><strong>Simulation</strong><table>{rows}</table></div>"
-
-    def _described(self):
-        """(label, text) rows of the reprs."""
-        integ = self.integrator
-        opts = ", ".join(f"{k}={v!r}" for k, v in integ.config.items())
-        kind = ", ".join(w for w, on in (("symplectic", integ.symplectic),
-                                         ("adaptive", integ.adaptive)) if on)
-        if integ.adaptive and self._dt == 0:
-            dt = "chosen by the integrator"
-        else:
-            dt = f"{self.dt:.6g}" + (" (first step)" if integ.adaptive else "")
-        names = ", ".join(self._names[:6]) + (", ..." if len(self._names) > 6 else "")
-        rows = [("bodies", f"{len(self._names)}: {names}"),
-                ("integrator", integ.name + (f"({opts})" if opts else "")
-                 + f" [order {integ.order}{', ' + kind if kind else ''}]"),
-                ("dt", dt),
-                ("time", f"{self.time:.6g}"),
-                ("steps", str(self.steps)),
-                ("forces", " + ".join(["Newtonian gravity", *map(repr, self.forces)])),
-                ("units", f"{self.units.name}, G = {self.units.G!r}")]
-        stops = ", ".join(f"{k} = {v:.6g}" if isinstance(v, u.Quantity) else f"{k} = {v}"
-                          for k, v in self.stop_conditions.items()
-                          if v is not None and v is not False)
-        if stops:
-            rows.append(("stopping", stops))
-        return rows
-
-
-def _positive_number(value):
-    return (isinstance(value, numbers.Real) and not isinstance(value, bool)
-            and 0 < float(value) < math.inf)
+        return _described.html_table(self)

@@ -134,6 +134,16 @@ CHILD = textwrap.dedent("""
 """)
 
 
+def test_a_finished_run_is_not_resumed(tmp_path):
+    # resume finishes an interrupted run only; a finished one is continued by run()
+    path = tmp_path / "run.h5"
+    outer().run(until=100 * u.day, outputs=3, output=path, progress=False)
+    again = orbits.Simulation.from_file(path)
+    assert again.resume_point.finished
+    with pytest.raises(ValueError, match=r"finished; continue with run\(until=\.\.\., output="):
+        again.resume(progress=False)
+
+
 def test_sigkill_leaves_a_resumable_file(tmp_path):
     path = tmp_path / "killed.h5"
     proc = subprocess.Popen([sys.executable, "-c", CHILD, str(path)])

@@ -12,6 +12,7 @@ pytest.importorskip("matplotlib")
 
 from orbits import Simulation, integrators, scenes  # noqa: E402
 from orbits.validation import _runner, cases, stress  # noqa: E402
+from orbits.validation.stress import classes, maps, problems  # noqa: E402
 
 EPS = np.finfo(float).eps
 
@@ -60,13 +61,13 @@ def test_verdict_ranges():
     classes = [stress.ACCURATE, stress.ACCURATE, stress.ACCURATE, stress.DEGRADED,
                stress.FAILED]
     outcomes = ["completed"] * 4 + ["NonFiniteState"]
-    assert stress._verdict(labels, classes, outcomes) == (
+    assert maps._verdict(labels, classes, outcomes) == (
         "accurate at e = 0 to e = 0.9; degraded at e = 0.99; "
         "fails at e = 0.9999 (NonFiniteState)")
     # failed columns grouped by how they failed, the named error after its own
     classes = [stress.DEGRADED, stress.FAILED, stress.FAILED, stress.FAILED, stress.FAILED]
     outcomes = ["completed", "completed", "completed", "StepSizeUnderflow", "NonFiniteState"]
-    assert stress._describe(labels, classes, outcomes)[stress.FAILED] == (
+    assert maps._describe(labels, classes, outcomes)[stress.FAILED] == (
         "e = 0.5 to e = 0.9, e = 0.99 (StepSizeUnderflow), e = 0.9999 (NonFiniteState)")
 
 
@@ -137,15 +138,15 @@ def test_encounter_distance_confirmed_by_our_integrator():
 def test_forced_failure_becomes_a_named_cell():
     # explicit Euler on k = 1e6 at dt = 0.01 (sqrt(k) dt = 10) grows by a
     # factor 10 a step: the state overflows within the 1000 steps
-    cell = stress._spring("euler", 1e6, wall_limit=30)
+    cell = problems.spring("euler", 1e6, wall_limit=30)
     assert cell["outcome"] == "NonFiniteState"
     cls = stress.classify(cell["error"], cell["outcome"])
     assert cls == stress.FAILED
-    assert stress._cell_text(cls, cell["outcome"], cell["error"]) == "NFS"
+    assert classes.cell_text(cls, cell["outcome"], cell["error"]) == "NFS"
 
 
 def test_refusal_is_left_out_with_the_reason():
-    cell = stress._spring("wh", 1.0, wall_limit=30)
+    cell = problems.spring("wh", 1.0, wall_limit=30)
     assert cell["outcome"] == "IntegratorOptionError"
     assert stress.classify(cell["error"], cell["outcome"]) == stress.LEFT_OUT
     assert cell["message"]
@@ -154,7 +155,7 @@ def test_refusal_is_left_out_with_the_reason():
 def test_spring_accurate_where_resolved():
     # leapfrog at sqrt(k) dt = 0.01: phase error about (omega dt)^2 / 24 per
     # radian over 10 radians, 4e-5: degraded by our thresholds, not failed
-    cell = stress._spring("leapfrog", 1.0, wall_limit=30)
+    cell = problems.spring("leapfrog", 1.0, wall_limit=30)
     assert cell["outcome"] == "completed"
     assert 1e-6 < cell["error"] < 1e-4
     assert stress.classify(cell["error"]) == stress.DEGRADED
@@ -167,7 +168,7 @@ def test_tiny_sweep_serial(tmp_path, monkeypatch):
         "eccentricity": stress.SWEEPS["eccentricity"]._replace(quick=(0.5, 0.9999)),
         "spring": stress.SWEEPS["spring"]._replace(quick=(1.0, 1e6)),
     }
-    monkeypatch.setattr(stress, "SWEEPS", sweeps)
+    monkeypatch.setattr(stress.sweeps, "SWEEPS", sweeps)
     monkeypatch.setattr(cases, "integrator_names", lambda: ["euler", "leapfrog", "wh"])
     tasks = stress.tasks(quick=True)
     with _runner.Pool(n_workers=1) as pool:

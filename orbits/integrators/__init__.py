@@ -13,7 +13,7 @@ import difflib
 from typing import NamedTuple
 
 from ..errors import UnknownIntegratorError
-from .base import ExplicitRungeKutta, Integrator, SplittingMethod
+from .base import ExplicitRungeKutta, Integrator, Option, SplittingMethod
 from .composition import Yoshida4, Yoshida6, Yoshida8
 from .doubling import RK4Doubling
 from .embedded import DOP853, Dopri5
@@ -28,7 +28,8 @@ from .trace import Trace
 from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
 __all__ = ["get", "available", "aliases", "register", "adaptive_names", "Integrator",
-           "IntegratorInfo", "SplittingMethod", "ExplicitRungeKutta", "ALIASES", "DEFAULT"]
+           "IntegratorInfo", "Option", "SplittingMethod", "ExplicitRungeKutta", "ALIASES",
+           "DEFAULT"]
 
 _REGISTRY = {}
 

@@ -6,9 +6,16 @@ plus the compiled loop it runs.  Concretely, a subclass of :class:`Integrator`
 1. sets ``name`` (the registry name, lowercase with hyphens), ``order`` (the
    global order of accuracy, measured by the test suite), ``symplectic``,
    ``time_symmetric``, ``adaptive`` and ``needs_central_body``;
-2. lists its options and their defaults in ``options``; unknown options and
-   bad values are rejected in ``__init__`` with
-   :class:`~orbits.errors.IntegratorOptionError`;
+2. declares its options in ``option_specs``, a tuple of :class:`Option`
+   (name, type, default, help, unit, the values it takes), the one place
+   they are listed: ``options`` (name -> default) and the command line's
+   flags are made from it.  Unknown options and values that do not fit
+   their declaration are rejected in ``__init__`` with
+   :class:`~orbits.errors.IntegratorOptionError`, and ``_check_options``
+   checks what a declaration cannot say.  The arguments of an ``Option``
+   are literals or names of module constants, so that the command line
+   reads them without importing the integrator
+   (:mod:`orbits._integrator_options`);
 3. implements ``workspace(n)``, returning the arrays a run keeps between
    calls (force cache, stage buffers, internal state) as a dict.  Everything
    a bit-exact restart needs lives there, as numpy arrays (a flag or a scalar
@@ -42,24 +49,75 @@ of drift and kick coefficients (:class:`SplittingMethod`), an explicit
 Runge-Kutta method a Butcher table (:class:`ExplicitRungeKutta`).
 """
 
-import numbers
+import math
 import warnings
 
 import numpy as np
 
+from .._integrator_options import Option
+from .._kernels import gravity
+from .._kernels import records
 from .._kernels.records import NO_MARK_STEPS, NO_MARKS, checks, outputs
-from .._kernels.status import with_status
 from .._kernels import stepping
+from .._kernels.invariants import MONITOR_WIDTH
+from .._kernels.status import with_status
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError, OrbitsWarning
 
 __all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
-           "RTOL_FLOOR", "NO_MARKS", "NO_MARK_STEPS"]
+           "ToleranceControlled", "CompiledToleranceControlled", "Option", "MIN_DT", "RTOL_FLOOR", "NO_MARKS",
+           "NO_MARK_STEPS", "around_a_circle"]
 
 
 #: The smallest relative tolerance an adaptive method is run with: 100 float64
 #: roundings (the floor scipy's ``solve_ivp`` also applies).
 RTOL_FLOOR = 100 * float(np.finfo(float).eps)
+
+#: The smallest step an adaptive method may take, an option of those that
+#: honour one.
+MIN_DT = Option("min_dt", float, 0.0, "smallest allowed step; a run whose step control "
+                "asks for less stops with StepSizeUnderflow (0: none)", unit="time",
+                sign="non-negative")
+
+
+def around_a_circle(integ, steps=1000):
+    """Advance a test particle once around a circle of radius 1 about a unit mass
+    (G = M = 1, period 2 pi) from (1, 0, 0), in ``steps`` steps of a fixed-step
+    integrator's compiled loop: the first check of an integrator, which ends
+    near where it started.
+
+    Parameters
+    ----------
+    integ : Integrator
+        A fixed-step integrator (the contract's :meth:`Integrator.advance`).
+    steps : int
+        Steps of ``2 pi / steps``.
+
+    Returns
+    -------
+    tuple
+        ``(status, steps_done, x, v, ws)``: the state (shape (2, 3), the
+        unit mass first) and the workspace after the steps, before any
+        :meth:`Integrator.synchronize`.
+
+    Examples
+    --------
+    >>> from orbits import integrators
+    >>> from orbits.integrators.base import around_a_circle
+    >>> status, steps, x, v, ws = around_a_circle(integrators.get("leapfrog"), 100)
+    >>> status.name, steps, bool(abs(x[1, 0] - 1) < 1e-3)
+    ('OK', 100, True)
+    """
+    x = np.array([[0.0, 0, 0], [1, 0, 0]])
+    v = np.array([[0.0, 0, 0], [0, 1, 0]])
+    force = stepping.gravity_force("small")
+    fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_active, eps2
+    mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)                            # no monitor rows
+    ws = integ.workspace(2)
+    integ.bind(ws, force, fargs)
+    status, done, _ = integ.advance(ws, x, v, 0.0, 2 * math.pi / steps, steps, force, fargs,
+                                    mon, 0, np.empty(0), np.zeros((0, MONITOR_WIDTH)))
+    return status, done, x, v, ws
 
 
 class Integrator:
@@ -94,7 +152,9 @@ class Integrator:
     time_symmetric = False
     adaptive = False
     needs_central_body = False
-    #: option name -> default value
+    #: the options, each declared once (see the contract, point 2)
+    option_specs = ()
+    #: option name -> default value, made from ``option_specs``
     options = {}
     #: one line for listings
     summary = ""
@@ -123,6 +183,11 @@ class Integrator:
         (``Ensemble.run(..., batch=B)``); False unless a method says otherwise."""
         return False
 
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "option_specs" in vars(cls):
+            cls.options = {spec.name: spec.default for spec in cls.option_specs}
+
     def __init__(self, **options):
         unknown = sorted(set(options) - set(self.options))
         if unknown:
@@ -131,10 +196,16 @@ class Integrator:
                 f"integrator {self.name!r} has no option {', '.join(map(repr, unknown))}; "
                 f"valid options: {valid}")
         self.config = {**self.options, **options}
+        for spec in self.option_specs:
+            try:
+                self.config[spec.name] = spec.checked(self.config[spec.name])
+            except ValueError as exc:
+                raise IntegratorOptionError(f"integrator {self.name!r}: {exc}") from None
         self._check_options()
 
     def _check_options(self):
-        """Subclasses check their option values here."""
+        """Subclasses check here what their options' declarations cannot say
+        (a value that one method of a family refuses, a pair of options)."""
 
     # contract, parts 3-5
     def workspace(self, n):
@@ -186,19 +257,14 @@ class Integrator:
 
         Examples
         --------
-        >>> import math
+        One period of a circular orbit in 1000 steps of ``rk4``, as
+        :func:`around_a_circle` takes them (the class's example makes the call
+        itself):
+
         >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("rk4")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> from orbits.integrators.base import around_a_circle
+        >>> status, steps, x, v, ws = around_a_circle(integrators.get("rk4"))
         >>> status.name, steps, np.round(x[1], 6)
         ('OK', 1000, array([1., 0., 0.]))
         """
@@ -210,18 +276,13 @@ class Integrator:
 
         Examples
         --------
-        >>> import math
         >>> import numpy as np
         >>> from orbits import integrators
         >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
         >>> integ = integrators.get("wh")
         >>> ws = integ.workspace(2)
-        >>> integ.bind(ws, force, fargs)     # gravity alone: nothing kept beside the arrays
+        >>> integ.bind(ws, stepping.gravity_force("small"),      # gravity alone: nothing
+        ...            gravity.gravity_args(1.0, np.ones(2), 2, 0.0))  # kept beside the arrays
         >>> "terms" in ws
         False
         """
@@ -247,19 +308,10 @@ class Integrator:
 
         Examples
         --------
-        >>> import math
-        >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("leapfrog")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> status, steps, x, v, ws = around_a_circle(integ)
         >>> before = x.copy()
         >>> integ.synchronize(ws, x, v)                # x and v are at one time already
         >>> bool((x == before).all())
@@ -267,29 +319,8 @@ class Integrator:
         """
 
     def invalidate(self, ws):
-        """Forget anything computed from the old state.
-
-        Examples
-        --------
-        >>> import math
-        >>> import numpy as np
-        >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("verlet")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
-        >>> int(ws["cache"][0])                        # the last force is cached
-        1
-        >>> integ.invalidate(ws)
-        >>> int(ws["cache"][0])
-        0
-        """
+        """Forget anything computed from the old state (nothing here; a method
+        that caches a force drops it, as :meth:`SplittingMethod.invalidate`)."""
 
     def checked_state(self, ws, t):
         """The state the stopping conditions last looked at, if the loop that
@@ -341,7 +372,8 @@ class SplittingMethod(Integrator):
     Subclasses set ``operators``: a sequence of ``("drift", c)`` and
     ``("kick", c)``, applied left to right, where a drift advances positions by
     ``c dt v`` and a kick velocities by ``c dt a(x)``.  Drift and kick
-    coefficients must each sum to one.
+    coefficients must each sum to one.  A table that reads the same backwards
+    makes a time-symmetric method (``time_symmetric`` is set from it).
 
     Examples
     --------
@@ -368,6 +400,7 @@ class SplittingMethod(Integrator):
             cls._kinds = tuple(codes[k] for k, _ in cls.operators)
             cls._coefs = tuple(float(c) for _, c in cls.operators)
             kinds = [k for k, _ in cls.operators]
+            cls.time_symmetric = tuple(cls.operators) == tuple(cls.operators)[::-1]
             # a closing kick shares its force with the next step's opening kick
             cls.forces_per_step = kinds.count("kick") - (kinds[0] == kinds[-1] == "kick")
 
@@ -387,26 +420,7 @@ class SplittingMethod(Integrator):
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         """Apply the operator table ``nsteps`` times in the compiled loop (see
-        :meth:`Integrator.advance`).
-
-        Examples
-        --------
-        >>> import math
-        >>> import numpy as np
-        >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("yoshida4")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
-        >>> status.name, np.round(x[1], 6)
-        ('OK', array([ 1., -0.,  0.]))
-        """
+        :meth:`Integrator.advance`)."""
         loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs)
         fargs = stepping.work_bound(force, fargs, ws)
         sargs, check = stop_record(stop)
@@ -421,22 +435,15 @@ class SplittingMethod(Integrator):
 
         Examples
         --------
-        >>> import math
-        >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
+        >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("verlet")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> *_, ws = around_a_circle(integ)
+        >>> int(ws["cache"][0])                        # the last force is cached
+        1
         >>> integ.invalidate(ws)
-        >>> ws["cache"].tolist()
-        [0]
+        >>> int(ws["cache"][0])
+        0
         """
         ws["cache"][0] = 0
 
@@ -488,26 +495,7 @@ class ExplicitRungeKutta(Integrator):
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         """Take ``nsteps`` steps of the Butcher table in the compiled loop (see
-        :meth:`Integrator.advance`).
-
-        Examples
-        --------
-        >>> import math
-        >>> import numpy as np
-        >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)  # G, m, N_act, eps2
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)    # no monitor rows
-        >>> integ = integrators.get("rk2")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 1000, 1000, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
-        >>> status.name, steps
-        ('OK', 1000)
-        """
+        :meth:`Integrator.advance`)."""
         loop = stepping.runge_kutta_loop(force)
         fargs = stepping.work_bound(force, fargs, ws)
         sargs, check = stop_record(stop)
@@ -538,8 +526,9 @@ class AdaptiveIntegrator(Integrator):
       the ``dt`` the user gave (or 0 to let the method choose).
     * Everything a bit-exact restart needs lives in ``ws`` as arrays, as for
       every integrator.
-    * Options are checked in ``_check_options``: tolerances must be positive,
-      and unknown options are rejected by :class:`Integrator`.
+    * Options are declared and checked as every integrator's (point 2);
+      :class:`ToleranceControlled` declares ``rtol`` and ``atol``, and
+      :data:`MIN_DT` is the ``min_dt`` option of those that take one.
     """
 
     adaptive = True
@@ -552,42 +541,71 @@ class AdaptiveIntegrator(Integrator):
     def workspace(self, n, initial_step=0.0):
         raise NotImplementedError
 
-    def _positive(self, *names):
-        for name in names:
-            value = self.config[name]
-            ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
-                  and 0 < float(value) < float("inf"))
-            if not ok:
-                raise IntegratorOptionError(
-                    f"integrator {self.name!r}: option {name!r} must be a positive finite "
-                    f"number, got {value!r}" + (" (a string)" if isinstance(value, str)
-                                                else ""))
-            self.config[name] = float(value)
 
-    def _min_dt(self):
-        """Check the ``min_dt`` option: a finite number >= 0, kept as a float."""
-        min_dt = self.config["min_dt"]
-        try:
-            ok = 0 <= float(min_dt) < float("inf")
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise IntegratorOptionError(
-                f"integrator {self.name!r}: option 'min_dt' must be a finite number >= 0, "
-                f"got {min_dt!r}")
-        self.config["min_dt"] = float(min_dt)
+class ToleranceControlled(AdaptiveIntegrator):
+    """An adaptive method whose step keeps an estimate of the local error
+    within ``atol + rtol |y|``: the options ``rtol`` and ``atol``.
 
-    def _relative_tolerance(self, name):
-        """Raise ``name`` to :data:`RTOL_FLOOR` if asked for less, with a warning.
+    A relative tolerance below :data:`RTOL_FLOOR` is raised to it with a
+    warning: a relative error below a few float64 roundings cannot be
+    delivered (the error estimate of a step then reads zero only where the
+    stages round to the same numbers, and the method creeps on with steps far
+    too short to matter: 23 million steps to t = 5e-5 d at rtol = 1e-30).
 
-        A relative error below a few float64 roundings cannot be delivered:
-        the error estimate of a step then reads zero only where the stages
-        round to the same numbers, and the method creeps on with steps far
-        too short to matter (23 million steps to t = 5e-5 d at rtol = 1e-30).
-        """
-        self._positive(name)
-        if self.config[name] < RTOL_FLOOR:
-            warnings.warn(f"integrator {self.name!r}: {name} = {self.config[name]:g} is below "
+    Examples
+    --------
+    >>> import orbits
+    >>> orbits.integrators.get("dopri5", rtol=1e-10).config
+    {'rtol': 1e-10, 'atol': 1e-12}
+    """
+
+    option_specs = (
+        Option("rtol", float, 1e-9, "relative tolerance of a step's error estimate",
+               sign="positive"),
+        Option("atol", float, 1e-12, "absolute tolerance of a step's error estimate, in "
+               "the simulation's units of length and velocity", sign="positive"),
+    )
+
+    def _check_options(self):
+        if self.config["rtol"] < RTOL_FLOOR:
+            warnings.warn(f"integrator {self.name!r}: rtol = {self.config['rtol']:g} is below "
                           f"what float64 arithmetic can deliver; using {RTOL_FLOOR:.3g} "
-                          f"(100 roundings)", OrbitsWarning, stacklevel=5)
-            self.config[name] = RTOL_FLOOR
+                          f"(100 roundings)", OrbitsWarning, stacklevel=4)
+            self.config["rtol"] = RTOL_FLOOR
+
+
+class CompiledToleranceControlled(ToleranceControlled):
+    """A tolerance-controlled method whose compiled loop keeps the force at a
+    step's end for the next step (the flag ``ws["fsal"]``) and records the
+    outputs at their times (``advance_to``'s ``marks``): the embedded pairs
+    and ``rk4-doubling``.  A subclass gives its loop and the arguments that
+    are its own in :meth:`_loop_call`.
+    """
+
+    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
+    records_marks = True
+
+    def _loop_call(self, ws, force):
+        """``(loop, lead, work)``: the compiled loop for ``force``, its
+        arguments between the time and the tolerances (the method's tables),
+        and its workspace record."""
+        raise NotImplementedError
+
+    def invalidate(self, ws):
+        """The state was changed from outside: the force kept from the last step
+        is stale."""
+        ws["fsal"][0] = 0
+
+    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
+                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
+        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
+        on each and record there a row of ``mon_out`` (monitors and state),
+        its time in ``mon_t`` and its step count in ``mark_steps``."""
+        loop, lead, work = self._loop_call(ws, force)
+        fargs = stepping.work_bound(force, fargs, ws)
+        tolerances = records.Tolerances(float(self.config["rtol"]), float(self.config["atol"]))
+        sargs, check = stop_record(stop)
+        return with_status(*loop(x, v, float(t), *lead, tolerances, work, fargs,
+                                 outputs(mon, step0, mon_t, mon_out),
+                                 records.landing(t_end, max_steps, 0.0, marks, mark_steps),
+                                 sargs, check))

@@ -48,7 +48,6 @@ class Yoshida4(SplittingMethod):
 
     name = "yoshida4"
     order = 4
-    time_symmetric = True
     summary = "Yoshida's fourth-order composition of three leapfrogs"
     operators = tableaux.YOSHIDA4
 
@@ -80,7 +79,6 @@ class Yoshida6(SplittingMethod):
 
     name = "yoshida6"
     order = 6
-    time_symmetric = True
     summary = "Yoshida's sixth-order composition of seven leapfrogs"
     operators = tableaux.YOSHIDA6
 
@@ -102,13 +100,14 @@ class Yoshida8(SplittingMethod):
 
     Examples
     --------
+    Fifteen leapfrogs, fifteen forces a step:
+
     >>> import orbits
-    >>> orbits.integrators.get("yoshida8").order
-    8
+    >>> orbits.integrators.get("yoshida8").forces_per_step
+    15
     """
 
     name = "yoshida8"
     order = 8
-    time_symmetric = True
     summary = "Yoshida's eighth-order composition of fifteen leapfrogs"
     operators = tableaux.YOSHIDA8

@@ -2,18 +2,17 @@
 
 import numpy as np
 
-from .._kernels.status import with_status
 from .._kernels import doubling as _doubling
 from .._kernels import records
-from .._kernels import stepping as _stepping
-from .._kernels.stopping import stop_record
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
+from .base import CompiledToleranceControlled
 
 __all__ = ["RK4Doubling"]
 
 
-class RK4Doubling(AdaptiveIntegrator):
+
+
+class RK4Doubling(CompiledToleranceControlled):
     """Classic RK4 made adaptive by step doubling.
 
     Notes
@@ -39,12 +38,7 @@ class RK4Doubling(AdaptiveIntegrator):
     name = "rk4-doubling"
     order = 4
     summary = "RK4 with step doubling, adaptive (rtol, atol)"
-    options = {"rtol": 1e-9, "atol": 1e-12}
     forces_per_step = 11
-
-    def _check_options(self):
-        self._relative_tolerance("rtol")
-        self._positive("atol")
 
     def workspace(self, n, initial_step=0.0):
         z = lambda: np.zeros((n, 3))  # noqa: E731
@@ -54,22 +48,5 @@ class RK4Doubling(AdaptiveIntegrator):
                 "dt": np.array([float(initial_step)]), "fsal": np.zeros(1, dtype=np.int64),
                 "info": np.full(2, -1, dtype=np.int64)}
 
-    def invalidate(self, ws):
-        ws["fsal"][0] = 0
-
-    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
-    records_marks = True
-
-    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
-        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
-        on each and record there a row of ``mon_out`` (monitors and state),
-        its time in ``mon_t`` and its step count in ``mark_steps``."""
-        loop = loop_for(_doubling.doubling_loop, force)
-        fargs = _stepping.work_bound(force, fargs, ws)
-        tolerances = records.Tolerances(float(self.config["rtol"]), float(self.config["atol"]))
-        sargs, check = stop_record(stop)
-        return with_status(*loop(x, v, float(t), tolerances, records.work(_doubling.Work, ws),
-                                 fargs, records.outputs(mon, step0, mon_t, mon_out),
-                                 records.landing(t_end, max_steps, 0.0, marks, mark_steps),
-                                 sargs, check))
+    def _loop_call(self, ws, force):
+        return loop_for(_doubling.doubling_loop, force), (), records.work(_doubling.Work, ws)

@@ -2,20 +2,17 @@
 
 import numpy as np
 
-from .._kernels.status import with_status
 from .._kernels import embedded as _embedded
 from .._kernels import records
-from .._kernels import stepping as _stepping
-from .._kernels.stopping import stop_record
 from . import dop853_coefficients as _dop853
 from . import tableaux
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
+from .base import CompiledToleranceControlled
 
 __all__ = ["EmbeddedRungeKutta", "Dopri5", "DOP853"]
 
 
-class EmbeddedRungeKutta(AdaptiveIntegrator):
+class EmbeddedRungeKutta(CompiledToleranceControlled):
     """An embedded Runge-Kutta pair given by its table; one compiled loop serves all.
 
     Subclasses set ``A``, ``B``, ``C`` (the method), ``E`` (error weights over
@@ -25,11 +22,6 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
 
     A = B = C = E = E3 = None
     error_estimator_order = None
-    options = {"rtol": 1e-9, "atol": 1e-12}
-
-    def _check_options(self):
-        self._relative_tolerance("rtol")
-        self._positive("atol")
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -43,29 +35,12 @@ class EmbeddedRungeKutta(AdaptiveIntegrator):
                 "v1": np.zeros((n, 3)), "dt": np.array([float(initial_step)]),
                 "fsal": np.zeros(1, dtype=np.int64), "info": np.full(2, -1, dtype=np.int64)}
 
-    def invalidate(self, ws):
-        ws["fsal"][0] = 0
-
-    #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
-    records_marks = True
-
-    def advance_to(self, ws, x, v, t, t_end, force, fargs, mon, step0, mon_t, mon_out, stop,
-                   max_steps, marks=NO_MARKS, mark_steps=NO_MARK_STEPS):
-        """Advance to ``t_end``; with ``marks`` (times, the last ``t_end``), land
-        on each and record there a row of ``mon_out`` (monitors and state),
-        its time in ``mon_t`` and its step count in ``mark_steps``."""
+    def _loop_call(self, ws, force):
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
         loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None)
-        fargs = _stepping.work_bound(force, fargs, ws)
         method = _embedded.Method(self.A, self.B, self.C, self.E, e3,
                                   float(self.error_estimator_order))
-        tolerances = records.Tolerances(float(self.config["rtol"]), float(self.config["atol"]))
-        sargs, check = stop_record(stop)
-        return with_status(*loop(x, v, float(t), method, tolerances,
-                                 records.work(_embedded.Work, ws), fargs,
-                                 records.outputs(mon, step0, mon_t, mon_out),
-                                 records.landing(t_end, max_steps, 0.0, marks, mark_steps),
-                                 sargs, check))
+        return loop, (method,), records.work(_embedded.Work, ws)
 
 
 class Dopri5(EmbeddedRungeKutta):

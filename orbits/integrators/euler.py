@@ -25,9 +25,15 @@ class Euler(ExplicitRungeKutta):
 
     Examples
     --------
+    The energy error of a circular orbit at a step of a day, after 5 and 10
+    years: it only grows.
+
+    >>> import astropy.units as u
     >>> import orbits
-    >>> orbits.integrators.get("euler").order
-    1
+    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "euler", dt=1 * u.day)
+    >>> error = sim.run(until=10 * u.yr, outputs=3, progress=False).energy_error
+    >>> bool(0 < error[1] < error[2])
+    True
     """
 
     name = "euler"

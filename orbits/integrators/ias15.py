@@ -7,9 +7,8 @@ from .._kernels import ias15 as _k
 from .._kernels import records
 from .._kernels.stepping import work_bound
 from .._kernels.stopping import stop_record
-from ..errors import IntegratorOptionError
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
+from .base import MIN_DT, NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator, Option
 
 __all__ = ["IAS15"]
 
@@ -98,18 +97,16 @@ class IAS15(AdaptiveIntegrator):
 
     name = "ias15"
     order = 15
-    options = {"epsilon": 1e-9, "min_dt": 0.0, "adaptive_mode": "global"}
+    option_specs = (
+        Option("epsilon", float, 1e-9, "precision: the step keeps the last term of the "
+               "acceleration's series below epsilon times the acceleration", sign="positive"),
+        MIN_DT,
+        Option("adaptive_mode", str, "global", "how the next step is chosen: from the "
+               "largest last term over all bodies, or per body (Pham, Rein & Spiegel "
+               "2024)", choices=tuple(ADAPTIVE_MODES)),
+    )
     summary = "IAS15, adaptive 15th-order Gauss-Radau predictor-corrector (Rein & Spiegel 2015)"
     forces_per_step = 15
-
-    def _check_options(self):
-        self._positive("epsilon")
-        self._min_dt()
-        mode = self.config["adaptive_mode"]
-        if mode not in ADAPTIVE_MODES:
-            raise IntegratorOptionError(
-                f"integrator {self.name!r}: unknown adaptive_mode {mode!r}; valid values: "
-                f"{', '.join(map(repr, ADAPTIVE_MODES))}")
 
     def workspace(self, n, initial_step=0.0):
         """The state of a run of ``n`` bodies; ``initial_step`` is the first step

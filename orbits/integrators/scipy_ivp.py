@@ -22,14 +22,14 @@ import numpy as np
 from .._kernels import stepping as _stepping
 from .._kernels.status import Status
 from ..errors import IntegratorOptionError
-from .base import AdaptiveIntegrator
+from .base import ToleranceControlled
 
 __all__ = ["ScipyIntegrator", "Radau", "LSODA"]
 
 _EPS = float(np.finfo(float).eps)
 
 
-class ScipyIntegrator(AdaptiveIntegrator):
+class ScipyIntegrator(ToleranceControlled):
     """A ``scipy.integrate.solve_ivp`` method behind the integrator contract.
 
     In-loop monitors (``monitor_every``) and stopping conditions are not
@@ -38,14 +38,9 @@ class ScipyIntegrator(AdaptiveIntegrator):
     """
 
     method = None
-    options = {"rtol": 1e-9, "atol": 1e-12}
     stop_conditions = False
     chaos_indicators = False
     compiled = False
-
-    def _check_options(self):
-        self._relative_tolerance("rtol")
-        self._positive("atol")
 
     def workspace(self, n, initial_step=0.0):
         return {"dt": np.array([float(initial_step)]), "info": np.full(2, -1, dtype=np.int64)}

@@ -1,7 +1,5 @@
 """Taylor's method: the series of the orbits to a high order, with Jorba & Zou's step."""
 
-import numbers
-
 import numpy as np
 
 from .._kernels import records
@@ -10,12 +8,12 @@ from .._kernels.stopping import stop_record
 from .._kernels.status import Status
 from ..errors import IntegratorOptionError
 from ._loops import loop_for
-from .base import NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator
+from .base import MIN_DT, NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator, Option
 
 __all__ = ["Taylor"]
 
-#: the default tolerance: float64's epsilon, 2.2e-16 (order 20)
-TOLERANCE = float(np.finfo(float).eps)
+#: the default tolerance: float64's epsilon, ``np.finfo(float).eps`` (order 20)
+TOLERANCE = 2.220446049250313e-16
 
 
 class Taylor(AdaptiveIntegrator):
@@ -85,22 +83,24 @@ class Taylor(AdaptiveIntegrator):
 
     name = "taylor"
     order = 20
-    options = {"tol": TOLERANCE, "order": 0, "min_dt": 0.0}
+    option_specs = (
+        Option("tol", float, TOLERANCE, "tolerance of a step's truncation error, relative "
+               "to the largest coordinate; it sets the order (20 at the default, 13 at "
+               "1e-10)", sign="positive"),
+        Option("order", int, 0, "the order of the series, at least 2 (0: from tol)",
+               sign="non-negative"),
+        MIN_DT,
+    )
     summary = "Taylor series by automatic differentiation, order from tol (Jorba & Zou 2005)"
     chaos_indicators = False
     #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
     records_marks = True
 
     def _check_options(self):
-        self._positive("tol")
-        order = self.config["order"]
-        if (not isinstance(order, numbers.Integral) or isinstance(order, bool) or order < 0
-                or order == 1):
+        if self.config["order"] == 1:
             raise IntegratorOptionError(
                 f"integrator {self.name!r}: option 'order' must be a whole number >= 2 "
-                f"(or 0: from tol), got {order!r}")
-        self.config["order"] = int(order)
-        self._min_dt()
+                f"(or 0: from tol), got 1")
 
     @property
     def order_used(self):

@@ -1,9 +1,6 @@
 """``trace``: a time-reversible hybrid of the Wisdom-Holman map and an adaptive
 integrator for close encounters (after Lu, Hernandez & Rein 2024)."""
 
-import math
-import numbers
-
 import numpy as np
 
 from .._kernels import records
@@ -13,8 +10,8 @@ from .._kernels.status import with_status
 from .._kernels.stopping import ahead_pointer, stop_record
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
-from .base import RTOL_FLOOR, Integrator
-from .wisdom_holman import split_gravity
+from .base import RTOL_FLOOR, Integrator, Option
+from .wisdom_holman import refuse_unkickable, split_gravity
 
 __all__ = ["Trace", "HILL", "SPEED", "PERICENTRE", "RTOL"]
 
@@ -171,24 +168,22 @@ class Trace(Integrator):
     needs_central_body = True
     stop_conditions = True
     chaos_indicators = False
-    options = {"hill": HILL, "speed": SPEED, "pericentre": PERICENTRE, "rtol": RTOL}
+    option_specs = (
+        Option("hill", float, HILL, "switching radius in mutual Hill radii",
+               sign="positive"),
+        Option("speed", float, SPEED, "switching radius in steps of relative motion "
+               "(0: off)", sign="non-negative"),
+        Option("pericentre", float, PERICENTRE, "a body closer to the central one than "
+               "pericentre (G m_0 dt^2)^(1/3) makes the segment be integrated whole "
+               "(0: off)", sign="non-negative"),
+        Option("rtol", float, RTOL, "relative tolerance of the encounter integrator's step",
+               sign="positive"),
+    )
     summary = ("TRACE: democratic heliocentric Wisdom-Holman map, adaptive DOP853 for close "
                "encounters, time-reversible switching")
     forces_per_step = 1
 
     def _check_options(self):
-        for name, positive in (("hill", True), ("speed", False), ("pericentre", False),
-                               ("rtol", True)):
-            value = self.config[name]
-            ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
-                  and math.isfinite(float(value))
-                  and (float(value) > 0 if positive else float(value) >= 0))
-            if not ok:
-                kind = "a positive" if positive else "a non-negative"
-                raise IntegratorOptionError(
-                    f"integrator {self.name!r}: option {name!r} must be {kind} finite "
-                    f"number, got {value!r}")
-            self.config[name] = float(value)
         if self.config["rtol"] >= 1.0:
             raise IntegratorOptionError(
                 f"integrator {self.name!r}: option 'rtol' must be below 1, got "
@@ -235,14 +230,7 @@ class Trace(Integrator):
         """As ``wh``: only terms that depend on positions alone and have a
         potential join the interaction kicks (in the democratic heliocentric
         form of ``wh``); others are refused with the named error."""
-        for term in terms:
-            if not term.wisdom_holman:
-                raise IntegratorOptionError(
-                    f"{self.name} cannot take the force term {term!r}: its interaction "
-                    f"step takes only conservative terms that depend on positions alone "
-                    f"({term.why_not_wisdom_holman}). Use 'ias15', 'leapfrog', "
-                    "'yoshida4', an embedded method such as 'dop853', or, for GR, the "
-                    "term GRPotential, which 'trace' takes.")
+        refuse_unkickable(self, terms)
 
     def bind(self, ws, force, fargs):
         """Keep the added terms' kernel and arguments beside the arrays (rebound
@@ -269,19 +257,11 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import math
         >>> import numpy as np
         >>> from orbits import integrators
-        >>> from orbits._kernels import gravity, stepping
-        >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
-        >>> v = np.array([[0.0, 0, 0], [0, 1, 0]])    # radius 1 (G = M = 1, period 2 pi)
-        >>> force = stepping.gravity_force("small")
-        >>> fargs = gravity.gravity_args(1.0, np.array([1.0, 0.0]), 1, 0.0)
-        >>> mon = (0, 0, np.zeros(2), 1.0, 1, 0.0)
+        >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("trace")
-        >>> ws = integ.workspace(2)
-        >>> status, steps, rows = integ.advance(ws, x, v, 0.0, 2 * math.pi / 100, 100, force,
-        ...                                      fargs, mon, 0, np.empty(0), np.zeros((0, 11)))
+        >>> status, steps, x, v, ws = around_a_circle(integ, 100)
         >>> integ.synchronize(ws, x, v)
         >>> status.name, np.round(x[1], 12) + 0.0       # a Kepler orbit is exact
         ('OK', array([1., 0., 0.]))

@@ -26,10 +26,10 @@ from .._kernels.stepping import DRIFT, KICK, work_bound
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
 from . import tableaux
-from .base import Integrator
+from .base import Integrator, Option
 
 __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
-           "split_gravity",
+           "split_gravity", "refuse_unkickable",
            "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS", "CORRECTOR_SPACING",
            "corrector_stages"]
 
@@ -80,6 +80,20 @@ CORRECTORS = {
          0.0241435216446845821249, -0.0066265154138761311311, 0.00127199966151635317966,
          -0.000152872710455871476726, 0.00000866948309467471603813),
 }
+
+
+def refuse_unkickable(integ, terms):
+    """Refuse, with :class:`~orbits.errors.IntegratorOptionError`, a force term
+    that the interaction kick of ``integ`` (a map of the Wisdom-Holman family)
+    cannot take: one that depends on velocities or has no potential."""
+    for term in terms:
+        if not term.wisdom_holman:
+            raise IntegratorOptionError(
+                f"{integ.name} cannot take the force term {term!r}: its interaction "
+                f"step takes only conservative terms that depend on positions alone "
+                f"({term.why_not_wisdom_holman}). Use 'ias15', 'leapfrog', "
+                "'yoshida4', an embedded method such as 'dop853', or, for GR, the "
+                f"term GRPotential, which {integ.name!r} takes.")
 
 
 def corrector_stages(order):
@@ -268,7 +282,13 @@ class WisdomHolman(Integrator):
     symplectic = True
     time_symmetric = True
     needs_central_body = True
-    options = {"coordinates": "jacobi", "corrector": 0}
+    option_specs = (
+        Option("coordinates", str, "jacobi", "the coordinates of the Kepler split",
+               choices=COORDINATES),
+        Option("corrector", int, 0, "order of the symplectic corrector of the map K(h/2) "
+               "I(h) K(h/2) (Wisdom, Holman & Touma 1996; SABA: 0 only); 0: none",
+               choices=tuple(CORRECTORS)),
+    )
     summary = ("Wisdom-Holman map, Kepler drifts and interaction kicks in Jacobi or "
                "democratic heliocentric coordinates")
     #: the step as a table of Kepler drifts ("drift") and interaction kicks ("kick")
@@ -312,16 +332,7 @@ class WisdomHolman(Integrator):
         cls.forces_per_step = sum(1 for k, _ in ops if k == "kick")
 
     def _check_options(self):
-        coords = self.config["coordinates"]
-        if coords not in COORDINATES:
-            raise IntegratorOptionError(
-                f"{self.name}: unknown coordinates {coords!r}; valid: "
-                f"{', '.join(map(repr, COORDINATES))}")
         corr = self.config["corrector"]
-        if isinstance(corr, bool) or corr not in CORRECTORS:
-            raise IntegratorOptionError(
-                f"{self.name}: unknown corrector order {corr!r}; valid: "
-                f"{', '.join(map(str, CORRECTORS))}")
         if corr and self.operators != tableaux.WH_DKD:
             raise IntegratorOptionError(
                 f"{self.name}: the symplectic correctors belong to the Wisdom-Holman "
@@ -341,14 +352,7 @@ class WisdomHolman(Integrator):
     def check_terms(self, terms):
         """Only terms that depend on positions alone and have a potential join the
         interaction step; the map is then still symplectic."""
-        for term in terms:
-            if not term.wisdom_holman:
-                raise IntegratorOptionError(
-                    f"{self.name} cannot take the force term {term!r}: its interaction "
-                    f"step takes only conservative terms that depend on positions alone "
-                    f"({term.why_not_wisdom_holman}). Use 'ias15', 'leapfrog', "
-                    "'yoshida4', an embedded method such as 'dop853', or, for GR, the "
-                    "term GRPotential, which 'wh' takes.")
+        refuse_unkickable(self, terms)
 
     def bind(self, ws, force, fargs):
         """Keep the added terms' kernel and arguments in the workspace (not an
@@ -514,11 +518,19 @@ class SABA2(WisdomHolman):
     Laskar, J. & Robutel, P. 2001, "High order symplectic integrators for
     perturbed Hamiltonian systems", Celest. Mech. Dyn. Astron. 80, 39, table 1.
 
+    SABA_3 and SABA_4 (:class:`SABA3`, :class:`SABA4`) are the same with three
+    and four kicks a step, of error ``O(epsilon h^6 + epsilon^2 h^2)`` and
+    ``O(epsilon h^8 + epsilon^2 h^2)``; their tables are in
+    :mod:`orbits.integrators.tableaux`.
+
     Examples
     --------
+    A kick a step more with each, and one more drift:
+
     >>> import orbits
-    >>> orbits.integrators.get("saba2").forces_per_step
-    2
+    >>> [(orbits.integrators.get(name).forces_per_step,
+    ...   len(orbits.integrators.get(name).operators)) for name in ("saba2", "saba3", "saba4")]
+    [(2, 5), (3, 7), (4, 9)]
     """
 
     name = "saba2"
@@ -527,22 +539,8 @@ class SABA2(WisdomHolman):
 
 
 class SABA3(WisdomHolman):
-    """SABA_3 of Laskar & Robutel (2001): three interaction kicks a step.
-
-    Notes
-    -----
-    Error ``O(epsilon h^6 + epsilon^2 h^2)``; see :class:`SABA2`.
-
-    References
-    ----------
-    Laskar & Robutel (2001), table 1.
-
-    Examples
-    --------
-    >>> import orbits
-    >>> orbits.integrators.get("saba3").forces_per_step
-    3
-    """
+    """SABA_3 of Laskar & Robutel (2001, table 1): three interaction kicks a
+    step, error ``O(epsilon h^6 + epsilon^2 h^2)``; see :class:`SABA2`."""
 
     name = "saba3"
     summary = "SABA_3 (Laskar & Robutel 2001): Kepler drifts, three kicks a step"
@@ -550,22 +548,8 @@ class SABA3(WisdomHolman):
 
 
 class SABA4(WisdomHolman):
-    """SABA_4 of Laskar & Robutel (2001): four interaction kicks a step.
-
-    Notes
-    -----
-    Error ``O(epsilon h^8 + epsilon^2 h^2)``; see :class:`SABA2`.
-
-    References
-    ----------
-    Laskar & Robutel (2001), table 1.
-
-    Examples
-    --------
-    >>> import orbits
-    >>> orbits.integrators.get("saba4").forces_per_step
-    4
-    """
+    """SABA_4 of Laskar & Robutel (2001, table 1): four interaction kicks a
+    step, error ``O(epsilon h^8 + epsilon^2 h^2)``; see :class:`SABA2`."""
 
     name = "saba4"
     summary = "SABA_4 (Laskar & Robutel 2001): Kepler drifts, four kicks a step"

@@ -20,8 +20,8 @@ def _encounter_bodies(distance, radii=None):
     # pass at `distance` au at t = 5 days (its initial state is made by
     # REBOUND's IAS15, integrating the pass backwards)
     pytest.importorskip("rebound")
-    from orbits.validation import stress
-    units, m, x0, v0 = stress._encounter_arrays(float(distance))
+    from orbits.validation.stress import problems
+    units, m, x0, v0 = problems._encounter_arrays(float(distance))
     return orbits.BodySet.from_arrays(m, x0, v0, names=["Star", "Planet 1", "Planet 2"],
                                       units=units, radii=radii)
 
