@@ -10,8 +10,6 @@ from .base import CompiledToleranceControlled
 __all__ = ["RK4Doubling"]
 
 
-
-
 class RK4Doubling(CompiledToleranceControlled):
     """Classic RK4 made adaptive by step doubling.
 
