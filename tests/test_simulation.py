@@ -200,6 +200,6 @@ def test_wall_limit_stops_with_the_state_kept():
 
 
 def test_wall_limit_must_be_positive():
-    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * orbits.scenes.u.day)
+    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     with pytest.raises(ValueError, match="wall_limit"):
-        sim.run(until=10 * orbits.scenes.u.day, outputs=2, wall_limit=0)
+        sim.run(until=10 * u.day, outputs=2, wall_limit=0)
