@@ -22,6 +22,7 @@ from .body import Track, unknown_body
 from .errors import (BodyError, ElementsError, NoEpochError, NoMassiveBodyError,
                      UnknownBodyError)
 from .geometry import angle_between, barycentre, is_barycentre
+from ._monitor_specs import BY_NAME, RECORDED_FIELDS, RESULT_FIELDS
 from .monitors import massless_energy_errors
 from .units import UnitSystem, format_time, time_unit
 
@@ -37,14 +38,6 @@ FRAMES = ("barycentric", "heliocentric")
 DOMINANT_MASS_FRACTION = 0.5
 
 _ELEMENT_KEYS = ("a", "e", "inc", "Omega", "omega", "f", "M")
-
-#: Monitor series that :meth:`Result.to_pandas` and :meth:`Result.to_xarray`
-#: export: (attribute, is a 3-vector).
-_MONITOR_SERIES = (("energy", False), ("work", False), ("energy_error", False),
-                   ("test_particle_energy_error", False), ("angular_momentum", True), ("angular_momentum_error", False),
-                   ("momentum", True), ("center_of_mass", True), ("megno", False),
-                   ("lyapunov", False), ("fli", False))
-
 
 class Result:
     """Outputs of one :meth:`orbits.Simulation.run`.
@@ -196,10 +189,8 @@ class Result:
 
     def __init__(self, _deferred=(), **fields):
         self.monitor = None
-        self.energy = self.energy_error = self.work = None
-        self.angular_momentum = self.angular_momentum_error = None
-        self.momentum = self.center_of_mass = None
-        self.megno = self.lyapunov = self.fli = None
+        for name in RECORDED_FIELDS:       # the monitors' series: None unless recorded
+            setattr(self, name, None)
         self.jacobian = self.tangent_vectors = self.seed = None
         self.radii = None
         self.encounters = None
@@ -372,8 +363,7 @@ class Result:
         >>> bool(0 < err < 1e-10), bool(err == result.energy_error.max())
         (True, True)
         """
-        return _largest(self.energy_error, self.monitor and self.monitor.get("energy_error"),
-                        self._recorded("energy"))
+        return self._max_error("energy")
 
     def max_angular_momentum_error(self):
         """Largest relative angular-momentum error seen.
@@ -392,13 +382,17 @@ class Result:
         >>> bool(result.max_angular_momentum_error() < 1e-13)
         True
         """
-        return _largest(self.angular_momentum_error,
-                        self.monitor and self.monitor.get("angular_momentum_error"),
-                        self._recorded("angular_momentum"))
+        return self._max_error("angular_momentum")
 
-    def _recorded(self, name):
-        value = (self.largest_errors or {}).get(name)
-        return None if value is None else np.array([value])
+    def _max_error(self, name):
+        """The largest relative error of monitor ``name`` seen: at the outputs,
+        in the in-loop series, and over the whole run where the result holds
+        only part of it (:attr:`largest_errors`); None where it was not
+        monitored."""
+        field = BY_NAME[name].error_field
+        recorded = (self.largest_errors or {}).get(name)
+        return _largest(getattr(self, field), self.monitor and self.monitor.get(field),
+                        None if recorded is None else np.array([recorded]))
 
     @property
     def test_particle_energy_error(self):
@@ -1081,7 +1075,7 @@ class Result:
     def _monitor_series(self):
         """(name, series) of the monitors recorded at every output."""
         n = len(self.times)
-        for key, _ in _MONITOR_SERIES:
+        for key in RESULT_FIELDS:
             values = getattr(self, key, None)
             if values is not None and len(values) == n:
                 yield key, values
