@@ -82,7 +82,7 @@ def relative_error(values, reference, scale=None):
     Returns
     -------
     numpy.ndarray, shape (n,)
-        Dimensionless.
+        The relative error at each value (dimensionless).
 
     Examples
     --------
@@ -120,7 +120,7 @@ def vector_relative_error(values, reference, scale):
     Returns
     -------
     numpy.ndarray, shape (n,)
-        Dimensionless.
+        The relative error of each vector (dimensionless).
 
     Examples
     --------
