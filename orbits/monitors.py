@@ -2,33 +2,29 @@
 
 The quantities themselves are computed by the compiled kernels in
 :mod:`orbits._kernels.invariants`, inside the stepping loop; this module
-names them, turns raw rows into relative errors, and fits drift laws.
+names them (each declared once, by its spec in :data:`MONITOR_SPECS`), turns
+raw rows into relative errors, and fits drift laws.
 """
 
+import astropy.units as u
 import numpy as np
 
 from ._kernels import invariants as _inv
+from ._monitor_specs import BY_NAME, CHOSEN, MONITOR_SPECS, MonitorSpec, added_to, result_fields
 
-__all__ = ["MONITORS", "CHAOS_MONITORS", "DEFAULT_MONITORS", "CIRCULAR_E", "monitor_mask",
-           "relative_error", "vector_relative_error", "growth_exponent",
+__all__ = ["MONITORS", "CHAOS_MONITORS", "DEFAULT_MONITORS", "MONITOR_SPECS", "MonitorSpec",
+           "CIRCULAR_E", "monitor_mask", "relative_error", "vector_relative_error",
+           "error_series", "row_series", "row_errors", "growth_exponent",
            "ensemble_growth_exponent", "monitor_fields", "massless_energies",
            "massless_energy_errors"]
 
 #: monitor name -> bit of the kernel mask
-MONITORS = {
-    "energy": _inv.ENERGY,
-    "angular_momentum": _inv.ANGULAR_MOMENTUM,
-    "momentum": _inv.MOMENTUM,
-    "center_of_mass": _inv.CENTER_OF_MASS,
-    "megno": _inv.MEGNO,
-    "lyapunov": _inv.LYAPUNOV,
-    "fli": _inv.FLI,
-}
+MONITORS = {s.name: s.bit for s in CHOSEN}
 
 #: the monitors that need a tangent vector (orbits._kernels.variational)
-CHAOS_MONITORS = ("megno", "lyapunov", "fli")
+CHAOS_MONITORS = tuple(s.name for s in CHOSEN if s.chaos)
 
-DEFAULT_MONITORS = ("energy", "angular_momentum")
+DEFAULT_MONITORS = tuple(s.name for s in CHOSEN if s.default)
 
 #: eccentricity below which two massive bodies count as a circular binary, so
 #: that their test particles keep the Jacobi integral (the circular restricted
@@ -86,7 +82,7 @@ def relative_error(values, reference, scale=None):
     Returns
     -------
     numpy.ndarray, shape (n,)
-        Dimensionless.
+        The relative error at each value (dimensionless).
 
     Examples
     --------
@@ -124,7 +120,7 @@ def vector_relative_error(values, reference, scale):
     Returns
     -------
     numpy.ndarray, shape (n,)
-        Dimensionless.
+        The relative error of each vector (dimensionless).
 
     Examples
     --------
@@ -247,12 +243,67 @@ def ensemble_growth_exponent(t, errors, t_from, boots=400, seed=1):
     return exponent, float(np.std(draws))
 
 
+def error_series(name, values, reference, scales, added=None):
+    """The relative error of monitor ``name`` at each row of its series, as its
+    spec says (:attr:`MonitorSpec.error`).
+
+    A scalar monitor's error is that of the series plus those added to it
+    (the energy's, of ``E + W``): ``|(values + added) - (E0 + W0)|`` over
+    ``|E0 + W0|`` (over its scale where that is 0), as
+    :func:`relative_error` gives it, in one compiled pass over the rows; a
+    vector's is :func:`vector_relative_error`.
+
+    Parameters
+    ----------
+    name : str
+        A monitor with an error (``"energy"``, ``"angular_momentum"``).
+    values : array-like, shape (n,) or (n, 3)
+        Its series, in the internal units.
+    reference : array-like, shape (w,)
+        The monitor row at the start (the kernels' layout; a row of 10 columns,
+        written before the work was kept, counts it as 0).
+    scales : sequence of float
+        The simulation's error scales, indexed by :attr:`MonitorSpec.scale`.
+    added : array-like, shape (n,), optional
+        The series added to this one (the work), summed; default 0.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        One relative error (dimensionless) a row of ``values``.
+
+    Examples
+    --------
+    >>> from orbits.monitors import error_series
+    >>> start = [-1.0] + [0.0] * 13                     # E0 = -1, no work yet
+    >>> error_series("energy", [-1.0, -1.5], start, (1.0, 1.0), added=[0.0, 0.5]).tolist()
+    [0.0, 0.0]
+    """
+    spec = BY_NAME[name]
+    reference = np.asarray(reference, dtype=float)
+    if spec.error == "vector":
+        return vector_relative_error(values, reference[spec.row_slice], scales[spec.scale])
+    # the compiled pass takes writable float64 arrays of any stride
+    values = np.require(np.asarray(values, dtype=float).reshape(-1), requirements="W")
+    if added is None or np.ndim(added) == 0:
+        added = np.full(values.shape[0], 0.0 if added is None else float(added))
+    else:
+        added = np.require(np.asarray(added, dtype=float).reshape(-1), requirements="W")
+    ref = float(reference[spec.row_slice.start] + _added(reference, name))
+    out = np.empty(values.shape[0])
+    _inv.error_kernels()[0](values, added, ref, float(_denominator(ref, scales[spec.scale])),
+                            out)
+    return out
+
+
 def monitor_fields(rows, monitors, reference, scales, units, work=False):
     """A result's monitor fields from monitor ``rows`` (the compiled kernels'
     layout, :data:`orbits._kernels.invariants.MONITOR_COLUMNS`: energy, L, P,
-    centre of mass, work), as Quantities, with the relative errors against
+    centre of mass, work, chaos indicators), as Quantities (plain arrays for
+    the dimensionless chaos indicators), with the relative errors against
     ``reference`` (``scales``: energy and angular-momentum scales used where
-    the reference is zero).
+    the reference is zero).  Each monitor's fields are those its spec
+    declares (:data:`MONITOR_SPECS`).
 
     The energy error is that of ``E + W``, the energy plus the work ``W`` that
     non-conservative force terms have taken out (zero without them), so that
@@ -260,12 +311,13 @@ def monitor_fields(rows, monitors, reference, scales, units, work=False):
 
     Parameters
     ----------
-    rows : numpy.ndarray, shape (n, 11)
+    rows : numpy.ndarray, shape (n, 14)
         Monitor rows in the internal units (rows of 10 columns, without the
-        work, count it as zero).
+        work, count it as zero; rows of 10 or 11, without the chaos
+        indicators, give none).
     monitors : sequence of str
         The monitors that were recorded.
-    reference : numpy.ndarray, shape (11,)
+    reference : numpy.ndarray, shape (14,)
         The row at the start.
     scales : tuple of float
         Energy and angular-momentum scales (internal units).
@@ -281,7 +333,8 @@ def monitor_fields(rows, monitors, reference, scales, units, work=False):
         (momentum) and ``center_of_mass`` (length) as Quantities, and
         ``energy_error`` and ``angular_momentum_error`` (dimensionless arrays), for
         the monitors recorded; ``work`` (energy) with ``work`` and the energy
-        monitor.
+        monitor; ``megno``, ``lyapunov`` (1 / time) and ``fli`` with those
+        monitors.
 
     Examples
     --------
@@ -303,36 +356,19 @@ def monitor_fields(rows, monitors, reference, scales, units, work=False):
     >>> out["work"].value.tolist(), out["energy_error"].round(9).tolist()
     ([0.0, 1e-06], [0.0, 0.0])
     """
-    q = units.quantity
-    out = {}
     rows = np.asarray(rows, dtype=float)
-    if "energy" in monitors:
-        w = _work_column(rows)
-        out["energy"] = q(rows[:, 0], "energy")
-        ref = reference[0] + float(_work_column(reference))
-        # relative_error of E + W in one pass over the rows
-        err = np.empty(rows.shape[0])
-        _inv.error_kernels()[0](rows[:, 0], w, float(ref),
-                                float(_denominator(ref, scales[0])), err)
-        out["energy_error"] = err
-        if work:
-            out["work"] = q(np.broadcast_to(w, rows[:, 0].shape).copy(), "energy")
-    if "angular_momentum" in monitors:
-        out["angular_momentum"] = q(rows[:, 1:4], "angular_momentum")
-        out["angular_momentum_error"] = vector_relative_error(rows[:, 1:4], reference[1:4],
-                                                              scales[1])
-    if "momentum" in monitors:
-        out["momentum"] = q(rows[:, 4:7], "momentum")
-    if "center_of_mass" in monitors:
-        out["center_of_mass"] = q(rows[:, 7:10], "length")
-    col = _inv.MONITOR_COLUMNS.index("megno")
-    if rows.shape[1] > col:
-        if "megno" in monitors:
-            out["megno"] = rows[:, col].copy()
-        if "lyapunov" in monitors:
-            out["lyapunov"] = rows[:, col + 1] / q(1.0, "time")
-        if "fli" in monitors:
-            out["fli"] = rows[:, col + 2].copy()
+    out = {}
+    for name, spec in _fields(monitors, rows.shape[1], work):
+        if name == spec.error_field:
+            out[name] = row_errors(spec.name, rows, reference, scales)
+        else:
+            values = row_series(name, rows)
+            if spec.kind == "dimensionless":
+                out[name] = values.copy()
+            else:
+                if spec.adds_to is not None:
+                    values = np.broadcast_to(values, rows.shape[:1]).copy()
+                out[name] = u.Quantity(values, spec.unit(units), copy=False)
     return out
 
 
@@ -340,24 +376,73 @@ def monitor_field_names(monitors, columns, work=False):
     """The keys :func:`monitor_fields` returns for ``monitors``, rows of
     ``columns`` columns and ``work``, without computing them (a run's result
     computes its fields when they are first read)."""
-    names = []
-    if "energy" in monitors:
-        names += ["energy", "energy_error"] + (["work"] if work else [])
-    if "angular_momentum" in monitors:
-        names += ["angular_momentum", "angular_momentum_error"]
-    names += [k for k in ("momentum", "center_of_mass") if k in monitors]
-    if columns > _inv.MONITOR_COLUMNS.index("megno"):
-        names += [k for k in ("megno", "lyapunov", "fli") if k in monitors]
-    return tuple(names)
+    return tuple(name for name, _ in _fields(monitors, columns, work))
 
 
-def _work_column(rows):
-    """The work column of monitor rows (or of one row); 0.0 where the rows have
-    none (written before it was kept)."""
+def _fields(monitors, columns, work):
+    """``(field, spec)`` of :func:`monitor_fields`, in the order of
+    :func:`~orbits._monitor_specs.result_fields` (what is derived from the
+    outputs left out): the monitors recorded, their columns in rows of
+    ``columns``, and the series added to them with ``work``."""
+    for spec in CHOSEN:
+        if spec.name not in monitors or columns < spec.row_slice.stop:
+            continue
+        added = {s.name: s for s in added_to(spec.name)} if work else {}
+        for name in result_fields(spec):
+            if name == spec.name or name == spec.error_field:
+                yield name, spec
+            elif name in added:
+                yield name, added[name]
+
+
+def row_series(name, rows):
+    """The series of monitor ``name`` in monitor ``rows`` (n, w) (the kernels'
+    layout), or its value in one row (w,): shape (n,) for a scalar, (n, 3)
+    for a vector, a view of the rows.  A series added to another (the work)
+    is 0 where the rows lack it (written before it was kept).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits.monitors import row_series
+    >>> rows = np.arange(20.0).reshape(2, 10)           # rows without the work
+    >>> row_series("angular_momentum", rows).tolist(), row_series("work", rows).tolist()
+    ([[1.0, 2.0, 3.0], [11.0, 12.0, 13.0]], [0.0, 0.0])
+    """
+    spec = BY_NAME[name]
     rows = np.asarray(rows)
-    if rows.shape[-1] > _inv.WORK_COLUMN:
-        return rows[..., _inv.WORK_COLUMN]
-    return 0.0 if rows.ndim == 1 else np.zeros(rows.shape[0])
+    where = spec.row_slice
+    if rows.shape[-1] < where.stop and spec.adds_to is not None:
+        return 0.0 if rows.ndim == 1 else np.zeros(rows.shape[0])
+    values = rows[..., where]
+    return values[..., 0] if spec.scalar else values
+
+
+def row_errors(name, rows, reference, scales):
+    """The relative error of monitor ``name`` at each of the monitor ``rows``
+    (n, w): :func:`error_series` of its series and of those added to it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from orbits.monitors import row_errors
+    >>> rows = np.zeros((2, 14))
+    >>> rows[:, 0] = [-1.0, -1.5]                       # energy
+    >>> rows[:, 10] = [0.0, 0.5]                        # work
+    >>> row_errors("energy", rows, rows[0], (1.0, 1.0)).tolist()
+    [0.0, 0.0]
+    """
+    return error_series(name, row_series(name, rows), reference, scales,
+                        added=_added(rows, name))
+
+
+def _added(rows, name):
+    """The sum of the series added to monitor ``name``'s in monitor ``rows`` (or
+    one row): the work, for the energy; 0 where there are none."""
+    total = 0.0
+    for spec in added_to(name):
+        total = total + row_series(spec.name, rows)
+    return total
 
 
 def massless_energies(x, v, m, G, masses=None):

@@ -29,7 +29,9 @@ FLI = 64
 #: loops that integrate it, not by :func:`monitor_row`: it is not a function of
 #: the state), so that E + W is the conserved quantity; "megno", "lyapunov"
 #: and "fli" are the chaos indicators of a run with them (written by the
-#: loops too, from the tangent vector: orbits._kernels.variational)
+#: loops too, from the tangent vector: orbits._kernels.variational).  Each
+#: column belongs to one monitor's spec (orbits._monitor_specs, checked
+#: against this layout and these bits when it is imported)
 MONITOR_COLUMNS = ("energy", "Lx", "Ly", "Lz", "px", "py", "pz", "comx", "comy", "comz",
                    "work", "megno", "lyapunov", "fli")
 #: columns of a monitor row

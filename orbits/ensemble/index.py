@@ -21,7 +21,8 @@ import numpy as np
 from .._csvcells import read_cell, safe_cell
 from .errors import EnsembleOptionError
 from .perturbation import _Perturbation
-from .table import _is_result_column, _known_outcomes, _parameter_row
+from .table import (_ERROR_COLUMNS, _PLAIN_VALUE_COLUMNS, _RESULT_PREFIXES, _is_result_column,
+                    _known_outcomes, _parameter_row)
 
 __all__ = ["INDEX_FILE", "SWEEP_FILE"]
 
@@ -255,8 +256,7 @@ def _csv_records(text):
 
 
 _INTEGER_COLUMNS = ("run", "steps", "kernels_compiled", "kernels_loaded")
-_REAL_COLUMNS = ("energy_error_max", "angular_momentum_error_max", "wall_time_s", "megno",
-                 "fli")
+_REAL_COLUMNS = (*_ERROR_COLUMNS, "wall_time_s", *_PLAIN_VALUE_COLUMNS)
 
 
 def _complete_row(row, n_fields, n_header, n_runs):
@@ -268,7 +268,7 @@ def _complete_row(row, n_fields, n_header, n_runs):
         for key, val in row.items():
             if key in _INTEGER_COLUMNS and not float(val).is_integer():
                 return False
-            if (key in _REAL_COLUMNS or key.startswith(("t_stop", "lyapunov_per"))) \
+            if (key in _REAL_COLUMNS or key.startswith(_RESULT_PREFIXES)) \
                     and val != "":
                 float(val)
     except ValueError:

@@ -13,22 +13,35 @@ import functools
 import astropy.units as u
 import numpy as np
 
+from .._monitor_specs import CHOSEN
 from ..errors import RunError
 from .errors import EnsembleOptionError
 
 __all__ = []
 
 
+#: The monitors with a column each, as their specs declare it: the largest
+#: relative error over the run (``energy_error_max``), or the last value
+#: (``megno``; ``lyapunov_per_<time unit>`` for a series with a unit)
+_ERROR_MONITORS = tuple(s for s in CHOSEN if s.ensemble and s.error is not None)
+_LAST_VALUE_MONITORS = tuple(s for s in CHOSEN if s.ensemble and s.error is None)
+#: the columns of the largest errors
+_ERROR_COLUMNS = tuple(s.ensemble for s in _ERROR_MONITORS)
+#: the last values' columns without a unit, and the beginnings of those with one
+_PLAIN_VALUE_COLUMNS = tuple(s.ensemble for s in _LAST_VALUE_MONITORS
+                             if s.kind == "dimensionless")
+_VALUE_PREFIXES = tuple(s.ensemble for s in _LAST_VALUE_MONITORS if s.kind != "dimensionless")
+
 _FIRST = ("outcome", "message", "stop_bodies")
-_MIDDLE = ("steps", "energy_error_max", "angular_momentum_error_max")
+_MIDDLE = ("steps", *_ERROR_COLUMNS)
 _LAST = ("wall_time_s", "worker", "kernels_compiled", "kernels_loaded", "file")
 
 #: Columns of the results whatever the bodies (those of the elements,
 #: ``<body>_a_<unit>``, ``<body>_e``, ``<body>_inc_rad``, depend on them), and
 #: the beginnings of those that end with a unit (``t_stop_day``)
-_RESULT_COLUMNS = frozenset(("run", *_FIRST, *_MIDDLE, "megno", "fli", "collisions",
+_RESULT_COLUMNS = frozenset(("run", *_FIRST, *_MIDDLE, *_PLAIN_VALUE_COLUMNS, "collisions",
                              "bodies_left", *_LAST))
-_RESULT_PREFIXES = ("t_stop", "lyapunov_per")
+_RESULT_PREFIXES = ("t_stop", *_VALUE_PREFIXES)
 
 
 def _column_order(columns, parameters):
@@ -43,8 +56,10 @@ def _column_order(columns, parameters):
             if name not in params:
                 params.append(name)
     t_stop = sorted(c for c in columns if c.startswith("t_stop"))
-    chaos = ["megno", *sorted(c for c in columns if c.startswith("lyapunov_per")), "fli"]
-    fixed = ["run", *params, *_FIRST, *t_stop, *_MIDDLE, *chaos]
+    values = [c for s in _LAST_VALUE_MONITORS
+              for c in ([s.ensemble] if s.kind == "dimensionless"
+                        else sorted(c for c in columns if c.startswith(s.ensemble)))]
+    fixed = ["run", *params, *_FIRST, *t_stop, *_MIDDLE, *values]
     elements = sorted(c for c in columns if c not in fixed and c not in _LAST)
     return [c for c in (*fixed, *elements, *_LAST) if c in columns]
 
@@ -101,9 +116,21 @@ def _known_outcomes():
     return names
 
 
-def _lyapunov_column(time):
-    """``lyapunov_per_<time unit>``: the column of the Lyapunov estimate, in 1 / ``time``."""
-    return _column("lyapunov_per", time)
+def _monitor_columns(units):
+    """``(spec, column, unit)`` of each monitor's last value in a run's row, in
+    the unit system ``units``: ``unit`` None for a dimensionless series, else
+    the unit of the value, which the column's name ends with
+    (``lyapunov_per_day``: the Lyapunov estimate in 1 / day)."""
+    out = []
+    for spec in _LAST_VALUE_MONITORS:
+        if spec.kind == "dimensionless":
+            out.append((spec, spec.ensemble, None))
+        else:
+            unit = spec.unit(units)
+            # "1 / time" is named "<name>_per_<time unit>"
+            named = units.unit("time") if spec.kind == "1 / time" else unit
+            out.append((spec, _column(spec.ensemble, named), unit))
+    return out
 
 
 def _frame_attrs(spec, frame):

@@ -15,10 +15,10 @@ import numpy as np
 
 from ..errors import OrbitsError, RunError
 from ..io.hdf5 import load
-from ..monitors import CHAOS_MONITORS
 from .compiles import _cache_loads, _CompileRecorder, _sync_numba_config, _worker_fields
 from .errors import EnsembleOptionError
-from .table import _column, _lyapunov_column, _outcome, _parameter_row, _value
+from .table import (_ERROR_MONITORS, _column, _monitor_columns, _outcome, _parameter_row,
+                    _value)
 
 __all__ = ["run_one", "ELEMENTS_MAX_BODIES"]
 
@@ -69,7 +69,7 @@ def _invalid_row(row, err, worker):
     """The row of a run whose parameters made no simulation (``err``)."""
     return _add_results(row, dict(
         outcome="invalid", message=str(err), stop_bodies="", steps=0,
-        energy_error_max=math.nan, angular_momentum_error_max=math.nan,
+        **{monitor.ensemble: math.nan for monitor in _ERROR_MONITORS},
         wall_time_s=0.0, **worker, file=""))
 
 
@@ -84,11 +84,10 @@ def _run_row(row, sim, spec, path, outcome, exc, wall, result, worker):
     out["steps"] = sim.steps
     if path is not None:   # the result of a run to a file holds only its last output
         result = load(path)
-    e = result.max_energy_error() if result is not None else None
-    lerr = result.max_angular_momentum_error() if result is not None else None
-    out["energy_error_max"] = math.nan if e is None else e
-    out["angular_momentum_error_max"] = math.nan if lerr is None else lerr
-    out.update(_chaos_indicators(sim, result))
+    for monitor in _ERROR_MONITORS:
+        largest = result._max_error(monitor.name) if result is not None else None
+        out[monitor.ensemble] = math.nan if largest is None else largest
+    out.update(_last_values(sim, result))
     if result is not None and getattr(result, "collisions", None) is not None:
         # collisions the run resolved (merged or bounced) and the bodies left
         out["collisions"] = len(result.collisions)
@@ -115,22 +114,19 @@ def _add_results(row, results):
     return row
 
 
-def _chaos_indicators(sim, result):
-    """The chaos monitors' last values in ``result`` (NaN where it has none), as
-    ``{"megno": ..., "lyapunov_per_<time unit>": ..., "fli": ...}`` for the
-    monitors ``sim`` follows."""
+def _last_values(sim, result):
+    """The last values in ``result`` of the monitors ``sim`` follows that have
+    one in the table (the chaos indicators), NaN where it has none, as
+    ``{"megno": ..., "lyapunov_per_<time unit>": ..., "fli": ...}``."""
     out = {}
-    for name in CHAOS_MONITORS:
-        if name not in sim.monitors:
+    for spec, column, unit in _monitor_columns(sim.units):
+        if spec.name not in sim.monitors:
             continue
-        series = None if result is None else getattr(result, name, None)
-        if name == "lyapunov":
-            time = sim.units.time
-            value = (math.nan if series is None or not len(series)
-                     else float(series[-1].to_value(time ** -1)))
-            out[_lyapunov_column(time)] = value
+        series = None if result is None else getattr(result, spec.name, None)
+        if series is None or not len(series):
+            out[column] = math.nan
         else:
-            out[name] = math.nan if series is None or not len(series) else float(series[-1])
+            out[column] = float(series[-1] if unit is None else series[-1].to_value(unit))
     return out
 
 

@@ -27,12 +27,13 @@ import numpy as np
 
 from ... import epochs as _epochs
 from ..._kernels import invariants as _inv
+from ..._monitor_specs import BY_NAME, CHOSEN, MONITOR_SPECS, added_to
 from ...errors import OrbitsError
 from ...units import UnitSystem
 from .errors import OrbitsFileError
 from .layout import (FORMAT, FORMAT_VERSION, _COLLISION_COLUMNS, _DATASETS,
-                     _ENCOUNTER_COLUMNS, _GROUPS, _MONITOR_KIND, _PARAMETERS,
-                     _SCALAR_SERIES, _SLOTS, _UNITS, _config, _config_layout)
+                     _ENCOUNTER_COLUMNS, _GROUPS, _PARAMETERS, _SLOTS, _UNITS, _config,
+                     _config_layout)
 from .safety import _VLEN_BYTES, _covered, _inventory, _open_hdf5
 
 __all__ = []
@@ -197,7 +198,7 @@ def _json_attr(par, key, path, kind):
 def _monitors_attr(par, path):
     """The monitors a file records: a list of distinct known names."""
     monitors = _json_attr(par, "monitors", path, list)
-    known = [name for name in _MONITOR_KIND if name != "work"]
+    known = [s.name for s in CHOSEN]
     for name in monitors:
         if not isinstance(name, str) or name not in known:
             raise OrbitsFileError(f"{path}: the 'monitors' attribute of /parameters names "
@@ -376,9 +377,10 @@ def _check_values(f, stored, path, monitors):
     series = {f"{b}/position": ((n, 3), "m"), f"{b}/velocity": ((n, 3), "m / s")}
     if f"{b}/masses_at_outputs/value" in stored:
         series[f"{b}/masses_at_outputs"] = ((n,), "kg")
-    kept = list(monitors) + (["work"] if "observables/work/value" in stored else [])
+    kept = list(monitors) + [s.name for name in monitors for s in added_to(name)
+                             if f"observables/{s.name}/value" in stored]
     for name in kept:
-        shape = () if name in _SCALAR_SERIES else (3,)
+        shape = BY_NAME[name].shape
         series[f"observables/{name}"] = (shape, None)
         if f"observables/in_loop/{name}/value" in stored:
             series[f"observables/in_loop/{name}"] = (shape, None)
@@ -389,11 +391,14 @@ def _check_values(f, stored, path, monitors):
         _unit(f, f"{group}/time", path, "s")
         _unit(f, f"{group}/value", path, like)
     # the parameters' arrays
+    # files written before the series added to others (the work) were kept
+    # have the columns before them
     width = len(_inv.MONITOR_COLUMNS)
+    oldest = min(s.row_slice.start for s in MONITOR_SPECS if s.adds_to is not None)
     ref = _checked(stored, "parameters/reference", path, (None,), "float")
-    if not 10 <= ref.shape[0] <= width:
+    if not oldest <= ref.shape[0] <= width:
         raise OrbitsFileError(f"{path}: /parameters/reference has {ref.shape[0]} values; "
-                              f"expected 10 to {width}")
+                              f"expected {oldest} to {width}")
     _checked(stored, "parameters/scales", path, (2,), "float")
     if "parameters/start_clock" in stored:
         _checked(stored, "parameters/start_clock", path, (3,), "int")

@@ -19,7 +19,9 @@ adds two groups of its own::
         position/time        (T,) float, attr unit
         position/value       (T, N, 3) float, attr unit
         velocity/{step,time,value}   likewise
-    /observables             each an H5MD time-dependent element {step, time, value}
+    /observables             each an H5MD time-dependent element {step, time, value},
+                             with the name, shape and unit its monitor's spec
+                             gives (orbits.monitors.MONITOR_SPECS)
         energy               value (T,)
         angular_momentum     value (T, 3)
         momentum             value (T, 3)
@@ -101,7 +103,8 @@ import numpy as np
 from ... import epochs as _epochs
 from ..._kernels import invariants as _inv
 from ...errors import OrbitsError
-from ...monitors import CHAOS_MONITORS
+from ..._monitor_specs import BY_NAME, WITH_ERROR, added_to
+from ...monitors import CHAOS_MONITORS, error_series
 from .disk import _close_written, _new_file
 from .errors import _write_error
 
@@ -110,21 +113,6 @@ __all__ = ["FORMAT", "FORMAT_VERSION"]
 FORMAT = "orbits-h5md"
 FORMAT_VERSION = 1
 _SLOTS = 2
-#: the chaos indicators, one value per row each (orbits.monitors.CHAOS_MONITORS)
-_CHAOS = ("megno", "lyapunov", "fli")
-_MONITOR_COLUMNS = {"energy": slice(0, 1), "angular_momentum": slice(1, 4),
-                    "momentum": slice(4, 7), "center_of_mass": slice(7, 10),
-                    "work": slice(10, 11),
-                    **{name: slice(_inv.MONITOR_COLUMNS.index(name),
-                                   _inv.MONITOR_COLUMNS.index(name) + 1) for name in _CHAOS}}
-#: the unit of each series: a kind of orbits.units.UnitSystem, or "1 / time"
-_MONITOR_KIND = {"energy": "energy", "angular_momentum": "angular_momentum",
-                 "momentum": "momentum", "center_of_mass": "length", "work": "energy",
-                 "megno": "dimensionless", "lyapunov": "1 / time", "fli": "dimensionless"}
-#: the series of one value per row (the others are 3-vectors)
-_SCALAR_SERIES = ("energy", "work") + _CHAOS
-
-
 #: what an orbits file holds, in words for the message that names what is missing
 _GROUPS = {
     "particles": "the trajectories",
@@ -299,14 +287,14 @@ def _package_version():
         return "0+unknown"
 
 
-def _series_unit(U, name):
-    """The unit (a string) of the monitor series ``name`` in the unit system ``U``."""
-    kind = _MONITOR_KIND[name]
-    if kind == "1 / time":
-        return (U.unit("time") ** -1).to_string()
-    if kind == "dimensionless":
-        return "1"
-    return U.unit(kind).to_string()
+def _series_errors(group, name, rows, reference, scales):
+    """The relative error of monitor ``name`` at ``rows`` (a slice, or
+    increasing indices) of the series in ``group`` (``observables`` or
+    ``observables/in_loop``), those added to it (the work) included where
+    the file keeps them."""
+    added = [group[s.name]["value"][rows] for s in added_to(name) if s.name in group]
+    return error_series(name, group[name]["value"][rows], reference, scales,
+                        added=sum(added) if added else None)
 
 
 def _tangent_layout(monitors, variations, n):
@@ -388,10 +376,10 @@ def _write_layout(f, desc, state):
     obs = f.create_group("observables")
     inloop = obs.create_group("in_loop")
     for name in tuple(desc.monitors) + (("work",) if _keeps_work(desc) else ()):
-        shape = () if name in _SCALAR_SERIES else (3,)
-        u_ = (_series_unit(U, name), unit("time"))
-        _element(obs, name, shape, u_)
-        _element(inloop, name, shape, u_)
+        spec = BY_NAME[name]
+        u_ = (spec.file_unit(U), unit("time"))
+        _element(obs, name, spec.shape, u_)
+        _element(inloop, name, spec.shape, u_)
     par = f.create_group("parameters")
     meta = {
         "orbits_version": __version__, "numpy_version": np.__version__,
@@ -419,12 +407,12 @@ def _write_layout(f, desc, state):
     if desc.epoch is not None:
         par.attrs["epoch_tdb"] = np.array(_epochs.to_pair(desc.epoch), dtype=np.float64)
     ref = par.create_dataset("reference", data=state.reference)
-    ref_units = ([unit("energy")] + [unit("angular_momentum")] * 3 + [unit("momentum")] * 3
-                 + [unit("length")] * 3 + [unit("energy")]
-                 + [_series_unit(U, name) for name in _CHAOS])
-    ref.attrs["unit"] = ", ".join(ref_units[:len(state.reference)])
-    par.create_dataset("scales", data=np.array(state.scales)).attrs["unit"] = \
-        f"{unit('energy')}, {unit('angular_momentum')}"
+    # each column's unit, in the kernels' layout
+    ref_units = {c: spec.file_unit(U) for spec in BY_NAME.values() for c in spec.columns}
+    ref.attrs["unit"] = ", ".join([ref_units[c] for c in _inv.MONITOR_COLUMNS]
+                                  [:len(state.reference)])
+    par.create_dataset("scales", data=np.array(state.scales)).attrs["unit"] = ", ".join(
+        s.file_unit(U) for s in sorted(WITH_ERROR, key=lambda s: s.scale))
     par.create_dataset("start_clock", data=np.array(
         [state.steps, state.force_evaluations, state.steps_rejected], dtype=np.int64))
     r = f.create_group("restart")

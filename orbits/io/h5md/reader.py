@@ -18,13 +18,13 @@ from ... import forces
 from ..._kernels.status import Status
 from ...collisions import table
 from ...errors import OrbitsError
-from ...monitors import _work_column, relative_error, vector_relative_error
+from ..._monitor_specs import BY_NAME, WITH_ERROR, added_to
 from ...result import Result
 from ...units import UnitSystem, format_time, time_unit
 from .checks import _damaged, _epoch, _log_rows, _open_read
 from .errors import OrbitsFileError, TangentShapeError
-from .layout import (FORMAT, FORMAT_VERSION, _CHAOS, _COLLISION_COLUMNS, _ENCOUNTER_COLUMNS,
-                     _MONITOR_KIND, _SLOTS, _config, _config_layout, _decode, _radii)
+from .layout import (FORMAT, FORMAT_VERSION, _COLLISION_COLUMNS, _ENCOUNTER_COLUMNS, _SLOTS,
+                     _config, _config_layout, _decode, _radii, _series_errors)
 from .lock import _writer
 from .safety import _covered
 
@@ -34,8 +34,7 @@ def _rows(f, monitors, in_loop=False):
     """Rows that every series of the outputs (or the in-loop monitors) holds: a
     reader of a live file may see one series extended before the next."""
     obs = f["observables/in_loop"] if in_loop else f["observables"]
-    # the work series, where the file keeps it, goes with the energy's
-    names = list(monitors) + (["work"] if "energy" in monitors and "work" in obs else [])
+    names = _kept(obs, monitors)
     if in_loop:
         groups = [obs[name] for name in names]
     else:
@@ -45,6 +44,14 @@ def _rows(f, monitors, in_loop=False):
             groups.append(b["masses_at_outputs"])
     # only the rows the file stores data for (see safety._covered)
     return min((_covered(g[k]) for g in groups for k in ("step", "time", "value")), default=0)
+
+
+def _kept(group, monitors):
+    """The series of ``monitors`` in ``group`` (``observables`` or its
+    ``in_loop``): theirs, and those added to them (the work) where the file
+    keeps them."""
+    return list(monitors) + [s.name for name in monitors for s in added_to(name)
+                             if s.name in group]
 
 
 def _totals(f):
@@ -112,26 +119,15 @@ def whole_run(path):
             fields["start_time"] = float(t[0]) << u.Unit(t.attrs["unit"])
         ref = par["reference"][()]
         scales = par["scales"][()]
-        work = "energy" in monitors and "work" in obs
         m = _rows(f, monitors, in_loop=True)
         largest = {}
-        for name in ("energy", "angular_momentum"):
-            if name not in monitors:
+        for spec in WITH_ERROR:
+            if spec.name not in monitors:
                 continue
-            errors = []
-            for group, rows in ((obs, n), (obs["in_loop"], m)):
-                if not rows:
-                    continue
-                values = group[name]["value"][:rows]
-                if name == "energy":
-                    if work:
-                        values = values + group["work"]["value"][:rows]
-                    errors.append(relative_error(values, ref[0] + float(_work_column(ref)),
-                                                 scale=scales[0]))
-                else:
-                    errors.append(vector_relative_error(values, ref[1:4], scales[1]))
+            errors = [_series_errors(group, spec.name, slice(0, rows), ref, scales)
+                      for group, rows in ((obs, n), (obs["in_loop"], m)) if rows]
             if errors:
-                largest[name] = float(max(np.max(e) for e in errors))
+                largest[spec.name] = float(max(np.max(e) for e in errors))
         fields["largest_errors"] = largest
         if "encounters" in f:
             fields["encounters"] = _encounters(f["encounters"])
@@ -208,40 +204,13 @@ def load(path):
             status=_status(f, path), path=str(path), metadata=dict(par.attrs),
             epoch=_epoch(par, path))
         ref = par["reference"][()]
-        e_scale, l_scale = par["scales"][()]
+        scales = par["scales"][()]
         obs = f["observables"]
-        for name in monitors:
-            fields[name] = _series(obs[name], name, n)
-        # the work of non-conservative terms, where the file keeps it
-        work = "energy" in monitors and "work" in obs
-        w0 = float(_work_column(ref))
-        if work:
-            fields["work"] = q(obs["work"]["value"])
-        if "energy" in monitors:
-            e = obs["energy/value"][:n]
-            if work:
-                e = e + obs["work/value"][:n]
-            fields["energy_error"] = relative_error(e, ref[0] + w0, scale=e_scale)
-        if "angular_momentum" in monitors:
-            fields["angular_momentum_error"] = vector_relative_error(
-                obs["angular_momentum/value"][:n], ref[1:4], l_scale)
-        inloop = obs["in_loop"]
+        fields.update(_monitor_series(obs, monitors, n, ref, scales))
         m = _rows(f, monitors, in_loop=True)
         if monitors and m:
-            mon = {"times": q(inloop[monitors[0]]["time"], m)}
-            if "energy" in monitors:
-                e = inloop["energy/value"][:m]
-                if work:
-                    mon["work"] = q(inloop["work"]["value"], m)
-                    e = e + inloop["work/value"][:m]
-                mon["energy_error"] = relative_error(e, ref[0] + w0, scale=e_scale)
-            if "angular_momentum" in monitors:
-                mon["angular_momentum_error"] = vector_relative_error(
-                    inloop["angular_momentum/value"][:m], ref[1:4], l_scale)
-            for name in _CHAOS:
-                if name in monitors:
-                    mon[name] = _series(inloop[name], name, m)
-            fields["monitor"] = mon
+            fields["monitor"] = {"times": q(obs["in_loop"][monitors[0]]["time"], m),
+                                 **_monitor_series(obs["in_loop"], monitors, m, ref, scales)}
         fields.update(_derivatives(f, path))
         if "encounters" in f:
             fields["encounters"] = _encounters(f["encounters"])
@@ -274,11 +243,26 @@ def _encounters(g):
                    "distance": col("distance"), "speed": col("speed")})
 
 
+def _monitor_series(group, monitors, rows, reference, scales):
+    """The first ``rows`` values of the series of ``monitors`` in ``group``
+    (``observables`` or its ``in_loop``) and of those added to them, and the
+    monitors' relative errors, as a result holds them (the fields of
+    :func:`orbits.monitors.monitor_fields`)."""
+    out = {}
+    for name in _kept(group, monitors):
+        out[name] = _series(group[name], name, rows)
+    for spec in WITH_ERROR:
+        if spec.name in monitors:
+            out[spec.error_field] = _series_errors(group, spec.name, slice(0, rows),
+                                                   reference, scales)
+    return out
+
+
 def _series(group, name, rows):
     """The first ``rows`` values of a monitor series, as a result holds them:
-    Quantities, but MEGNO and the FLI as plain arrays (dimensionless)."""
+    Quantities, but dimensionless series (MEGNO, the FLI) as plain arrays."""
     values = group["value"][:rows]
-    if _MONITOR_KIND[name] == "dimensionless":
+    if BY_NAME[name].kind == "dimensionless":
         return values
     return values << u.Unit(group["value"].attrs["unit"])
 

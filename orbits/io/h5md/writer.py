@@ -29,15 +29,15 @@ import numpy as np
 
 from ..._kernels.invariants import MONITOR_WIDTH
 from ...errors import OrbitsError
-from ...monitors import _work_column, monitor_fields, relative_error, vector_relative_error
+from ..._monitor_specs import WITH_ERROR
+from ...monitors import monitor_fields, row_errors, row_series
 from ...result import Result
 from .disk import (_LOG_ROW_BYTES, _METADATA_BYTES, _NoRoom, _RESERVE_BYTES, _close_written,
                    _descriptor, _reserve, _trim, _writes)
 from .errors import (OrbitsFileError, TangentShapeError, _DISK_FULL, _error_number,
                      _write_error)
-from .layout import (_MONITOR_COLUMNS, _SCALAR_SERIES, _SLOTS, _append, _create, _datasets,
-                     _decode, _keeps_work, _padded, _radii, _tangent_layout, _write_box,
-                     _write_rows)
+from .layout import (_SLOTS, _append, _create, _datasets, _decode, _keeps_work, _padded,
+                     _radii, _series_errors, _tangent_layout, _write_box, _write_rows)
 from .lock import _acquire, _release
 
 __all__ = ["FileRecorder", "CHECKPOINT_SECONDS", "BUFFER_ROWS"]
@@ -324,44 +324,30 @@ class FileRecorder:
         plan, sim = self.plan, self.sim
         first = max(0, self.rows - self.outputs_written)
         obs = self.f["observables"]
-        for name in ("energy", "angular_momentum"):
-            if name not in sim.monitors:
+        for spec in WITH_ERROR:
+            if spec.name not in sim.monitors:
                 continue
-            g = obs[name]["value"]
-            values = g[first:self.rows]
-            if name == "energy" and self.work:
-                values = values + obs["work"]["value"][first:self.rows]
-            self._note(name, values)
-            t = obs["in_loop"][name]["time"][()]
+            self._note(spec.name, _series_errors(obs, spec.name, slice(first, self.rows),
+                                                 self.reference, self.scales))
+            t = obs["in_loop"][spec.name]["time"][()]
             keep = (t > plan.start_time) & (t <= sim.time_value)
             if keep.any():
-                rows = np.flatnonzero(keep)
-                values = obs["in_loop"][name]["value"][rows]
-                if name == "energy" and self.work:
-                    values = values + obs["in_loop"]["work"]["value"][rows]
-                self._note(name, values)
+                self._note(spec.name, _series_errors(obs["in_loop"], spec.name,
+                                                     np.flatnonzero(keep), self.reference,
+                                                     self.scales))
 
-    def _note(self, name, values):
-        ref = self.reference
-        if not len(values):
+    def _note(self, name, err):
+        # the largest of the relative errors ``err`` of monitor ``name`` so far
+        if not len(err):
             return
-        if name == "energy":
-            # values are E + W, against E0 + W0
-            err = relative_error(np.asarray(values, dtype=float).reshape(-1),
-                                 ref[0] + float(_work_column(ref)), scale=self.scales[0])
-        else:
-            err = vector_relative_error(np.asarray(values, dtype=float).reshape(-1, 3),
-                                        ref[1:4], self.scales[1])
         top = float(np.max(err))
         old = self.largest.get(name)
         self.largest[name] = top if old is None else float(np.max([old, top]))
 
     def _note_rows(self, rows):
-        names = self.sim.monitors
-        if "energy" in names:
-            self._note("energy", rows[:, 0] + _work_column(rows))
-        if "angular_momentum" in names:
-            self._note("angular_momentum", rows[:, 1:4])
+        for spec in WITH_ERROR:
+            if spec.name in self.sim.monitors:
+                self._note(spec.name, row_errors(spec.name, rows, self.reference, self.scales))
 
     # Recorder interface ----------------------------------------------------------------
     @_writes
@@ -442,9 +428,7 @@ class FileRecorder:
             if name is None:
                 values = x if col == 2 else v
             else:
-                values = mon[:, _MONITOR_COLUMNS[name]]
-                if name in _SCALAR_SERIES:
-                    values = values[:, 0]
+                values = row_series(name, mon)
             _append(dsets, self.rows, steps, t, values)
         self.rows += k
         self.outputs_written += k
@@ -699,20 +683,14 @@ class FileRecorder:
             for dsets, col, name in series:
                 values = np.array([b[col] for b in self.buffer])
                 if name is not None:
-                    values = values[:, _MONITOR_COLUMNS[name]]
-                    if name in _SCALAR_SERIES:
-                        values = values[:, 0]
+                    values = row_series(name, values)
                 _append(dsets, n0, steps, t, values)
             self.rows = n0 + k
             self.buffer = []
         if self.mon_buffer:
             t, steps, rows = (np.concatenate(part) for part in zip(*self.mon_buffer))
             for name, dsets in inloop.items():
-                vals = rows[:, _MONITOR_COLUMNS[name]]
-                if name == "work" and rows.shape[1] <= _MONITOR_COLUMNS["work"].start:
-                    vals = np.zeros((len(rows), 1))   # rows without the work column
-                _append(dsets, dsets[1].shape[0], steps, t,
-                        vals[:, 0] if name in _SCALAR_SERIES else vals)
+                _append(dsets, dsets[1].shape[0], steps, t, row_series(name, rows))
             self.mon_buffer = []
         if sync:
             self.f.flush()
@@ -795,3 +773,4 @@ class FileRecorder:
         self.checkpoints += 1
         self._checkpoint_step = state.steps
         self.last_checkpoint = _time.perf_counter()
+
