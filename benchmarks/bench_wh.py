@@ -263,8 +263,8 @@ def main(argv=None):
           f"{'default monitors' if args.monitors == 'default' else 'monitors=()'}); "
           f"ratio: wh / the column before it, the median of the paired ratios")
     print(f"which step: '{SHORT}' the benchmark's short step, where the lanes' Kepler drift "
-          f"always applies;\n  '{USERS}' the users' step, a twentieth of the innermost period; "
-          f"'{LONGEST}' the goal's longest step; '{BETWEEN}' steps between")
+          f"always applies;\n  '{USERS}' the users' step, a twentieth of the innermost "
+          f"period;\n  '{LONGEST}' the goal's longest step; '{BETWEEN}' steps between")
     print(f"{'scene':26s} {'step':>8s} {'which':15s} {'N':>2s} {'wh us':>7s} " + " ".join(
         f"{k + ' us':>{len(k) + 3}s} {'ratio':>5s} {'goal':>9s}" for k in rebound_names))
     for r in rows:
@@ -286,7 +286,7 @@ def main(argv=None):
           f"  worst {w:.2f} at {where} {verdict(w <= WHFAST_RATIO_GOAL)}")
     users = [r for r in issue40 if r["which"] == USERS]
     print("  at the users' step P_in/20, wh / whfast: " + "; ".join(
-        f"{r['scene']} {r['step']} {r['ratio_whfast']:.2f}" for r in users))
+        f"{r['scene']} {r['ratio_whfast']:.2f}" for r in users))
     if ok512:
         w, where = worst("ratio_whfast512", users)
         print(f"goal wh <= {WHFAST512_RATIO_GOAL} x whfast512 at the users' step P_in/20 "
