@@ -49,7 +49,7 @@ clock, as ``bench_wh`` can: on a machine that other work shares, a run that
 is descheduled does not count the other work's time (the HDF5 column then
 leaves out any time spent waiting for the disk).
 
-Run ``python benchmarks/bench_outputs.py`` (about a minute) or ``--quick``.
+Run ``python benchmarks/bench_outputs.py`` (about three minutes of CPU time) or ``--quick``.
 """
 
 import argparse
