@@ -4,11 +4,24 @@ and wall time, side by side.
 Three parts, each timed around the public ``Simulation.run`` (warm: every
 loop compiled by a short run first) and, for REBOUND, around ``integrate``:
 
-1. **Far from encounters** (outer solar system, 100-day step): ``trace``
-   against ``wh`` with ``coordinates="democratic-heliocentric"``, whose map
-   it is when nothing is flagged: microseconds per step, the median of the
-   paired ratios over ``--repeats`` runs, and whether the two trajectories
-   are equal.  Goal (issue 12): at most 1.3 times ``wh``'s time per step.
+1. **Far from encounters**: ``trace`` against ``wh`` with
+   ``coordinates="democratic-heliocentric"``, whose map it is when nothing
+   is flagged, both with the default options (the default monitors, at the
+   run's two outputs; ``--monitors none`` for ``monitors=()``), on the outer
+   solar system and the Sun with eight planets at ``bench_wh.py``'s steps:
+   the benchmark's short step (10 d; 0.5 d), the steps between (50 and
+   100 d; 2 d), the step people use, a twentieth of the innermost period
+   (``P_in / 20``: 216.6 d; 4.4 d), and ``P_in / 15`` (288.8 d; 5.9 d); each
+   row says which.  Microseconds per step, the median of the paired ratios
+   over ``--repeats`` runs, whether the two trajectories are equal, and the
+   segments ``trace`` flagged (its pericentre criterion flags a segment
+   where a planet comes closer to the Sun than ``2 (G m_0 dt^2)^(1/3)``:
+   Mercury's perihelion from steps of about 3.5 d, Jupiter's from about
+   226 d; those rows are no longer far from encounters).  Beside them
+   REBOUND's TRACE and WHFast (democratic heliocentric, ``safe_mode = 0``)
+   at the same step, timed in turn with ours: the peer's own ratio on the
+   same work.  Goal (issue 12, and issue 40 at every one of these steps): at
+   most 1.3 times ``wh``'s time per step.
 2. **Close encounters**: the stress suite's encounter (two Earth-mass
    planets about a Sun-mass star passing at 1e-3 to 1e-8 au at t = 5 days,
    the run ending at 10 days; :func:`orbits.validation.stress.encounter_bodies`),
@@ -30,13 +43,18 @@ Run ``python benchmarks/bench_trace.py`` (a few minutes) or ``--quick``.
 """
 
 import argparse
+import pathlib
 import statistics
+import sys
 import time
 
 import astropy.units as u
 import numpy as np
 
 import orbits
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import bench_wh  # noqa: E402 - its scenes and steps
 
 WH_RATIO_GOAL = 1.3
 IAS15_RATIO_GOAL = 0.2
@@ -69,30 +87,67 @@ def _timed_run(make, until, outputs=2, clock=time.perf_counter, loops=None):
     return clock() - t0, sim, res
 
 
-def far_from_encounters(repeats, steps, clock):
-    b = orbits.scenes.outer_solar_system()
-    dt = 100 * u.day
+def far_from_encounters(repeats, steps, clock, monitors="default"):
+    print(f"1. far from encounters: wh (DH) and trace, {steps} steps a run, median of "
+          f"{repeats} ({'default monitors' if monitors == 'default' else 'monitors=()'}); "
+          f"us per step; which step: see bench_wh.py")
+    print(f"   {'scene':20s} {'step':>8s} {'which':15s} {'wh (DH)':>8s} {'trace':>8s} "
+          f"{'ratio':>6s} {'goal':>10s} {'same bits':>9s} {'flagged':>7s} "
+          f"{'REB whfast':>10s} {'REB trace':>9s} {'ratio':>6s}")
+    rows = []
+    for label, b, short in bench_wh.scenes():
+        if label not in bench_wh.ISSUE40_SCENES:
+            continue
+        for dt, which in bench_wh.steps(label, b, short):
+            rows.append(_far_row(label, b, dt, which, repeats, steps, clock, monitors))
+    worst = max(rows, key=lambda r: r["ratio"])
+    users = [r for r in rows if r["which"] == bench_wh.USERS]
+    print(f"   goal trace <= {WH_RATIO_GOAL} x wh (DH) at every step: worst {worst['ratio']:.2f} "
+          f"at {worst['scene']}, {worst['step']}, {worst['which']} "
+          f"{'PASS' if worst['ratio'] <= WH_RATIO_GOAL else 'MISS'}\n"
+          f"   at the users' step P_in/20: " + "; ".join(
+              f"{r['scene']} {r['step']} {r['ratio']:.2f} ({r['flagged']} segments flagged)"
+              for r in users))
+    return rows
+
+
+def _far_row(label, b, dt, which, repeats, steps, clock, monitors):
+    kw = {} if monitors == "default" else {"monitors": ()}
     wh = orbits.integrators.get("wh", coordinates=DH)
-    makers = {"wh": lambda: orbits.Simulation(b, wh, dt=dt, monitors=()),
-              "trace": lambda: orbits.Simulation(b, "trace", dt=dt, monitors=())}
+    makers = {"wh": lambda: orbits.Simulation(b, wh, dt=dt, **kw),
+              "trace": lambda: orbits.Simulation(b, "trace", dt=dt, **kw)}
     for make in makers.values():
         make().run(until=2 * dt, outputs=2, progress=False)
-    times = {k: [] for k in makers}
+    rebs = {}
+    for name in ("whfast", "trace"):
+        rebs["REB " + name] = sim = b.to_rebound()
+        sim.integrator = name
+        if name == "whfast":
+            sim.integrator.safe_mode = 0
+            sim.integrator.coordinates = "democraticheliocentric"
+        sim.dt = dt.to_value(b.units.unit("time"))
+        sim.steps(10)
+    times = {k: [] for k in [*makers, *rebs]}
     last = {}
     for _ in range(repeats):
         for k, make in makers.items():
             wall, sim, res = _timed_run(make, steps * dt, clock=clock)
             times[k].append(wall / steps)
             last[k] = (sim, res)
+        for k, sim in rebs.items():
+            times[k].append(bench_wh.rebound_step_time(sim, steps, clock))
     ratio = statistics.median(a / b for a, b in zip(times["trace"], times["wh"]))
+    peer = statistics.median(a / b for a, b in zip(times["REB trace"], times["REB whfast"]))
     same = bool(np.array_equal(last["wh"][1].positions, last["trace"][1].positions))
     flagged = int(last["trace"][0]._ws["counts"][0])
-    print(f"1. outer solar system, dt = 100 d, {steps} steps, median of {repeats}")
-    print(f"   wh (DH) {1e6 * statistics.median(times['wh']):.3f} us/step, trace "
-          f"{1e6 * statistics.median(times['trace']):.3f} us/step, ratio {ratio:.2f} "
-          f"(goal <= {WH_RATIO_GOAL}: {'PASS' if ratio <= WH_RATIO_GOAL else 'MISS'}); "
-          f"trajectories equal bit for bit: {same}; segments flagged: {flagged}")
-    return {"ratio": ratio, "same": same}
+    row = {"scene": label, "step": bench_wh.step_text(dt), "which": which, "ratio": ratio,
+           "same": same, "flagged": flagged, "peer ratio": peer,
+           **{k: 1e6 * statistics.median(v) for k, v in times.items()}}
+    goal = f"<={WH_RATIO_GOAL:g} {'PASS' if ratio <= WH_RATIO_GOAL else 'MISS'}"
+    print(f"   {label:20s} {row['step']:>8s} {which:15s} {row['wh']:8.3f} {row['trace']:8.3f} "
+          f"{ratio:6.2f} {goal:>10s} {str(same):>9s} {flagged:7d} "
+          f"{row['REB whfast']:10.3f} {row['REB trace']:9.3f} {peer:6.2f}")
+    return row
 
 
 def encounters(repeats, clock):
@@ -203,11 +258,13 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--clock", choices=("wall", "cpu"), default="wall",
                     help="wall clock (default) or this process's CPU time")
+    ap.add_argument("--monitors", choices=("default", "none"), default="default",
+                    help="part 1 with the default monitors (default) or monitors=()")
     args = ap.parse_args(argv)
     clock = time.perf_counter if args.clock == "wall" else time.process_time
     if args.quick:
         args.repeats, args.steps, args.years = 3, 50_000, 200.0
-    far = far_from_encounters(args.repeats, args.steps, clock)
+    far = far_from_encounters(args.repeats, args.steps, clock, args.monitors)
     enc = encounters(args.repeats, clock)
     scat = scattering(args.years, args.member, clock)
     return {"far": far, "encounters": enc, "scattering": scat}
