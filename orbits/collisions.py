@@ -52,6 +52,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from astropy.table import QTable
+
+from .errors import SimulationOptionError
 
 __all__ = ["RESOLUTIONS", "CollisionEvent", "merge_pair", "bounce_pair", "pair_energy_change"]
 
@@ -162,7 +165,6 @@ def table(rows, units):
     ``rows`` are tuples ``(time, step_time, body_1, body_2, resolution,
     survivor, distance, speed, energy_change)`` in the internal units.
     """
-    from astropy.table import QTable
     q = units.quantity
     col = lambda k, kind=float: np.array([r[k] for r in rows], dtype=kind)  # noqa: E731
     return QTable({"time": q(col(0), "time"), "step_time": q(col(1), "time"),
@@ -175,7 +177,6 @@ def table(rows, units):
 
 def check_answer(answer, bodies):
     """A collision function's answer, checked."""
-    from .errors import SimulationOptionError
     if isinstance(answer, str) and answer in RESOLUTIONS:
         return answer
     raise SimulationOptionError(

@@ -24,6 +24,7 @@ import numpy as np
 
 from ._kernels import elements as _elements
 from .errors import ElementsError
+from .io.h5md import OrbitsFileError, load
 from .units import TIME_UNITS, time_unit
 
 __all__ = ["plot_result", "plot_elements", "plot_orbits", "plot_file", "time_unit",
@@ -383,7 +384,6 @@ def plot_file(path, out=None, frame=None):
     >>> plot_file("run.h5", frame="barycentric")          # doctest: +SKIP
     PosixPath('run.png')
     """
-    from .io.h5md import OrbitsFileError, load
     out = pathlib.Path(out) if out else pathlib.Path(path).with_suffix(".png")
     result = load(path)
     if not len(result.times):

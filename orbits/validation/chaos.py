@@ -43,6 +43,13 @@ import time
 import astropy.units as u
 import numpy as np
 
+from .. import scenes
+from ..analysis import mean_motion_frequencies, secular_frequencies
+from ..bodies import BodySet
+from ..ensemble import Ensemble, local_cluster
+from ..errors import RunError
+from ..simulation import Simulation
+from ..units import UnitSystem
 from ._format import fmt_time
 from ._runner import Task
 
@@ -126,7 +133,6 @@ def grid(quick):
 
 def jupiter_period_days():
     """Jupiter's period about the Sun, days (two-body, with the package's G)."""
-    from ..units import UnitSystem
     mu = UnitSystem().G * (1 + 1 / MASS_RATIOS["Jupiter"])
     return 2 * math.pi * math.sqrt(JUPITER["a"] ** 3 / mu)
 
@@ -163,7 +169,6 @@ def bodies(a, e):
 def _giants():
     # the same for every grid point: made once a process (it is a third of a
     # member's set-up time)
-    from ..bodies import BodySet
     b = BodySet()
     b.add("Sun", mass=1 * u.Msun)
     for name, el in (("Jupiter", JUPITER), ("Saturn", SATURN)):
@@ -175,7 +180,6 @@ def _giants():
 
 def build(a, e, seed=SEED):
     """Our simulation of one grid point (module level: the ensemble pickles it)."""
-    from ..simulation import Simulation
     return Simulation(bodies(a, e), "wh", dt=DT_DAYS * u.day, monitors=("megno", "lyapunov"),
                       seed=seed)
 
@@ -236,7 +240,6 @@ def _tangent_norm(var):
 
 
 def _ours(a, e, steps, seed):
-    from ..errors import RunError
     sim = build(a, e, seed)
     out = {"outcome": "completed", "megno": math.nan, "lyapunov": math.nan}
     t0 = time.perf_counter()
@@ -293,8 +296,6 @@ def maps(quick, workers=None):
     processes), REBOUND's from its own random tangent and REBOUND's from ours
     (a ``multiprocessing.Pool`` of ``workers`` processes).  Exclusive: it needs
     the machine to itself."""
-    from ..ensemble import Ensemble, local_cluster
-
     workers = int(workers or 1)
     a, e = grid(quick)
     steps = span_steps(quick)
@@ -371,11 +372,6 @@ def frequency_span(quick):
 def frequencies(quick):
     """The outer solar system's g5, g6, s6 (arcsec/yr) and great inequality
     (yr) from a ``wh`` run of :func:`frequency_span`."""
-    from .. import scenes
-    from ..analysis import mean_motion_frequencies, secular_frequencies
-    from ..errors import RunError
-    from ..simulation import Simulation
-
     span = frequency_span(quick)
     outputs = int(round((span / FREQUENCY_OUTPUT_EVERY).to_value(u.one))) + 1
     out = {"kind": "frequencies", "span_yr": span.to_value(u.yr), "outcome": "completed",
