@@ -68,7 +68,6 @@ def compile_ahead(names=None, progress=None, report=None):
 
     Examples
     --------
-    >>> import orbits
     >>> [label for label, _ in orbits.compile_ahead(["leapfrog"], progress=False)]
     ['leapfrog']
 

@@ -101,7 +101,6 @@ def merge_pair(m, r, x, v, a, b):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.collisions import merge_pair
     >>> m = np.array([3.0, 1.0]); r = np.array([1.0, 1.0])
     >>> x = np.array([[0.0, 0, 0], [4.0, 0, 0]]); v = np.array([[0.0, 1, 0], [0.0, -3, 0]])
@@ -123,7 +122,6 @@ def bounce_pair(m, x, v, a, b, restitution):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.collisions import bounce_pair
     >>> m = np.array([1.0, 1.0])
     >>> x = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
@@ -148,7 +146,6 @@ def pair_energy_change(m, x, v, a, b, va, vb):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.collisions import pair_energy_change
     >>> m = np.array([1.0, 1.0]); v = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
     >>> float(pair_energy_change(m, None, v, 0, 1, np.zeros(3), np.zeros(3)))

@@ -271,7 +271,6 @@ def at_times(epoch, times):
 
     Examples
     --------
-    >>> import astropy.units as u
     >>> from orbits import epochs
     >>> dates = epochs.at_times(epochs.from_pair(2451545.0, 0.0), [0, 1] * u.yr)
     >>> dates.jd.tolist(), dates.scale

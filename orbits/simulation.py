@@ -190,8 +190,6 @@ class Simulation(Driven):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.earth_moon(), integrator="leapfrog",
     ...                         dt=1 * u.hour)
     >>> result = sim.run(until=30 * u.day, outputs=31, progress=False)

@@ -140,8 +140,6 @@ class Trace(Integrator):
     that pass 1e-5 au apart at t = 5 days (their state at the pass, run back
     five days with ``ias15``), at a half-day step:
 
-    >>> import astropy.units as u
-    >>> import orbits
     >>> b = orbits.BodySet()
     >>> b.add("Star", mass=1 * u.Msun)
     >>> b.add("Planet 1", mass=1 * u.Mearth, primary="Star", a=1 * u.au)
@@ -200,7 +198,6 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import orbits
         >>> ws = orbits.integrators.get("trace").workspace(3)
         >>> ws["enc"].shape, ws["counts"].tolist()
         ((3, 3), [0, 0, 0])
@@ -257,7 +254,6 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import numpy as np
         >>> from orbits import integrators
         >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("trace")
@@ -313,7 +309,6 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import orbits
         >>> integ = orbits.integrators.get("trace")
         >>> integ.behind(integ.workspace(2))
         0.0

@@ -264,8 +264,6 @@ class WisdomHolman(Integrator):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator="wh",
     ...                         dt=200 * u.day)
     >>> result = sim.run(until=10_000 * u.yr, outputs=11, progress=False)
@@ -311,7 +309,6 @@ class WisdomHolman(Integrator):
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.integrators.get("wh").batchable
         True
         >>> orbits.integrators.get("wh", corrector=3).batchable
@@ -527,7 +524,6 @@ class SABA2(WisdomHolman):
     --------
     A kick a step more with each, and one more drift:
 
-    >>> import orbits
     >>> [(orbits.integrators.get(name).forces_per_step,
     ...   len(orbits.integrators.get(name).operators)) for name in ("saba2", "saba3", "saba4")]
     [(2, 5), (3, 7), (4, 9)]

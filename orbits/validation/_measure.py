@@ -27,7 +27,8 @@ from ..simulation import Simulation
 from . import cases
 
 __all__ = ["run_orbits", "run_rebound", "row_template", "on_steps", "REBOUND_INTEGRATORS",
-           "WALL_LIMIT", "energy_and_momentum", "position_error", "exact_two_body"]
+           "WALL_LIMIT", "energy_and_momentum", "position_error", "exact_two_body",
+           "rebound_with_extras", "REBOUNDX_MISSING"]
 
 #: Seconds a single measured run may take before it is stopped with
 #: ``WallTimeExceeded`` (recorded as its outcome): a sweep cell whose step
@@ -181,6 +182,28 @@ def _warm_up(make, dt, until):
 def energy_and_momentum(sim):
     """Energy and angular-momentum vector of a REBOUND simulation."""
     return sim.energy(), np.array(sim.angular_momentum())
+
+
+#: a REBOUNDx run's outcome message where REBOUNDx is not installed
+REBOUNDX_MISSING = "reboundx is not installed (pip install reboundx)"
+
+
+def rebound_with_extras(bodies, load=None):
+    """REBOUND's IAS15 on ``bodies`` with direct-summation gravity, and REBOUNDx's
+    ``Extras`` on it that ``load(sim, extras)`` fills, where ``load`` is given.
+
+    Returns ``(sim, extras)`` (``extras`` None without ``load``; the caller keeps
+    it while ``sim`` integrates); ImportError where REBOUNDx is needed and missing.
+    """
+    sim = bodies.to_rebound()
+    sim.gravity = "basic"
+    sim.integrator = "ias15"
+    if load is None:
+        return sim, None
+    import reboundx
+    extras = reboundx.Extras(sim)
+    load(sim, extras)
+    return sim, extras
 
 
 def run_rebound(bodies, integrator, options=None, *, dt=None, until, outputs=2, times=None,

@@ -37,6 +37,7 @@ from ..errors import RunError
 from ..simulation import Simulation
 from ..units import UnitSystem
 from ._format import fmt_err, fmt_time
+from ._measure import REBOUNDX_MISSING, rebound_with_extras
 from ._runner import Task
 
 __all__ = ["TITLE", "tasks", "section", "measure", "rate", "summary_line", "PARITY_CASES",
@@ -176,19 +177,11 @@ def _run_ours(bodies, terms, times):
 
 
 def _run_rebound(bodies, load, times):
-    sim = bodies.to_rebound()
-    sim.gravity = "basic"
-    sim.integrator = "ias15"
     x = np.full((len(times), len(bodies), 3), np.nan)
-    extras = None
-    if load is not None:
-        try:
-            import reboundx
-        except ImportError:
-            return (x, math.nan, 0, "not run",
-                    "reboundx is not installed (pip install reboundx)")
-        extras = reboundx.Extras(sim)          # kept alive while sim integrates
-        load(sim, extras)
+    try:
+        sim, extras = rebound_with_extras(bodies, load)    # extras kept while sim integrates
+    except ImportError:
+        return x, math.nan, 0, "not run", REBOUNDX_MISSING
     outcome, message = "completed", ""
     t0 = time.perf_counter()
     try:

@@ -37,6 +37,7 @@ from ..bodies import BodySet
 from ..errors import RunError
 from ..scenes import ephemerides
 from ..simulation import Simulation
+from ._measure import REBOUNDX_MISSING, rebound_with_extras
 from ._runner import Task
 
 __all__ = ["TITLE", "tasks", "section", "measure", "summary_line", "TERMS", "horizons",
@@ -105,21 +106,18 @@ def _run_ours(bodies, key, days):
 
 def _run_rebound(bodies, key, days):
     effect = _EFFECT.get(key)
-    sim = bodies.to_rebound()
-    sim.gravity = "basic"
-    sim.integrator = "ias15"
-    x = np.full((len(days), len(bodies), 3), np.nan)
-    extras = None
-    if effect is not None:
-        try:
-            import reboundx
-        except ImportError:
-            return x, "not run", "reboundx is not installed (pip install reboundx)"
-        extras = reboundx.Extras(sim)          # kept alive while sim integrates
+
+    def load(sim, extras):
         force = extras.load_force(effect)
         extras.add_force(force)
         force.params["c"] = const.c.to_value(bodies.units.length / bodies.units.time)
         sim.particles[bodies.names.index("Sun")].params["gr_source"] = 1
+
+    x = np.full((len(days), len(bodies), 3), np.nan)
+    try:
+        sim, extras = rebound_with_extras(bodies, None if effect is None else load)
+    except ImportError:
+        return x, "not run", REBOUNDX_MISSING
     outcome, message = "completed", ""
     try:
         for k, t in enumerate(days):
