@@ -134,8 +134,7 @@ def vector_relative_error(values, reference, scale):
     denom = norm if norm > 1e-14 * scale else scale
     # the norm of each row summed component by component, as np.linalg.norm
     # sums a row of three (the same floats), in one compiled pass over the
-    # rows: a norm along an axis of three took 5 ms for 10^5 rows, numpy's
-    # whole columns 1.6 ms (the monitor rows of a run), the pass 0.6 ms
+    # rows: the cheapest way to a run's monitor rows (benchmarks/RESULTS.md)
     values = np.asarray(values, dtype=float)
     rows = values.reshape(-1, 3)
     out = np.empty(rows.shape[0])

@@ -93,11 +93,9 @@ A_RANGE = (10.0, 16.0)     # au
 E_RANGE = (0.0, 0.45)
 
 #: ``<Y>`` above which an orbit counts as chaotic.  A regular orbit's <Y> tends
-#: to 2, but after 2000 Jupiter orbits it still wanders with the tangent vector
-#: (measured: 1.885 to 2.035 over 12 seeds of each code at 12.35 au, e = 0, near
-#: the 3:2; 1.55 to 2.34 over seeds and integrators at 13.65 and 14.96 au,
-#: e = 0.08, near the 5:3 and 2:1; 1.994 to 2.013 at 15.5 and 16 au, away from
-#: them; 2.03 to 3.11 at 11.55 au, e = 0, the edge of Saturn's chaotic zone).
+#: to 2, but after 2000 Jupiter orbits it still wanders with the tangent vector:
+#: from 1.55 to 2.34 over seeds and codes near the resonances, up to 3.11 at
+#: the edge of Saturn's chaotic zone (benchmarks/RESULTS.md lists the points).
 #: A chaotic orbit's grows as lambda t / 2, passing 3 after six Lyapunov times.
 #: 3 stays above nearly all of that wandering (2.5 would not: half the resonant
 #: points above would then be called chaotic by one seed and regular by
