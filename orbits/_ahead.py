@@ -2,9 +2,11 @@
 :func:`compile_ahead`, for clusters, containers and CI (see :mod:`._compiling`)."""
 
 import astropy.units as u
+from tqdm.auto import tqdm
 
 from . import integrators, scenes
 from ._compiling import COMMON, CompileClock, loop_label, stderr_is_terminal
+from .integrators.wisdom_holman import COORDINATES
 from .simulation import Simulation
 
 __all__ = ["compile_ahead"]
@@ -23,7 +25,6 @@ def _variants(name):
     coords = type(integ).options.get("coordinates")
     if coords is None:
         return [integ]
-    from .integrators.wisdom_holman import COORDINATES
     return [integ] + [integrators.get(name, coordinates=c) for c in COORDINATES if c != coords]
 
 
@@ -67,7 +68,6 @@ def compile_ahead(names=None, progress=None, report=None):
 
     Examples
     --------
-    >>> import orbits
     >>> [label for label, _ in orbits.compile_ahead(["leapfrog"], progress=False)]
     ['leapfrog']
 
@@ -81,7 +81,6 @@ def compile_ahead(names=None, progress=None, report=None):
         progress = stderr_is_terminal()
     bar = None
     if progress:
-        from tqdm.auto import tqdm
         bar = tqdm(total=len(loops), unit="loop", desc="compiling", leave=False)
     bodies = scenes.outer_solar_system()
     done = []

@@ -19,7 +19,11 @@ import sys
 import threading
 import time
 
+from numba.core import config as _config
 from numba.core import event as _event
+from numba.core.dispatcher import Dispatcher
+
+from ._kernels import stepping
 
 __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "loop_label",
            "notice", "cache_dir", "stderr_is_terminal"]
@@ -215,12 +219,8 @@ def cache_dir():
     >>> os.path.isabs(cache_dir())
     True
     """
-    from numba.core import config
-    from numba.core.dispatcher import Dispatcher
-
-    if config.CACHE_DIR:
-        return os.path.abspath(config.CACHE_DIR)
-    from ._kernels import stepping
+    if _config.CACHE_DIR:
+        return os.path.abspath(_config.CACHE_DIR)
     for value in vars(stepping).values():
         if isinstance(value, Dispatcher) and value.stats.cache_path:
             return value.stats.cache_path   # numba's choice: beside the source, or user-wide

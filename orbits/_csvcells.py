@@ -33,10 +33,12 @@ def safe_cell(text):
     Parameters
     ----------
     text : str
+        A cell's text, as the package has it.
 
     Returns
     -------
     str
+        The cell as a file holds it.
     """
     return "'" + text if text.startswith(_ESCAPED) else text
 
@@ -49,9 +51,11 @@ def read_cell(text):
     Parameters
     ----------
     text : str
+        A cell as a file holds it (written by :func:`safe_cell`, or by hand).
 
     Returns
     -------
     str
+        Its text.
     """
     return text[1:] if text[:1] == "'" and text[1:].startswith(_ESCAPED) else text

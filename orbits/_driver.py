@@ -8,6 +8,7 @@ import time as _time
 
 import _signal as _csignal
 import numpy as np
+from tqdm.auto import tqdm
 
 from ._compiling import CompileClock, loop_label
 from ._kernels.invariants import MONITOR_WIDTH
@@ -687,7 +688,6 @@ class _ProgressBar:
             self._open()
 
     def _open(self):
-        from tqdm.auto import tqdm
         self.bar = tqdm(total=self.total, initial=self.done, unit=self.unit, unit_scale=True,
                         leave=False, desc="orbits")
 

@@ -37,7 +37,6 @@ def configured(integrator, options, signature_of):
 
     Examples
     --------
-    >>> import orbits
     >>> from orbits._integrator_choice import configured
     >>> configured("wh", {"corrector": 17}, orbits.Simulation.__init__)
     WisdomHolman(coordinates='jacobi', corrector=17)
@@ -78,7 +77,6 @@ def step_required(integ):
 
     Examples
     --------
-    >>> import orbits
     >>> from orbits._integrator_choice import step_required
     >>> str(step_required(orbits.integrators.get("wh"))).split(";")[0]
     "integrator 'wh' takes fixed steps and needs dt (a time)"

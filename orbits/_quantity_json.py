@@ -4,7 +4,6 @@ terms' dictionaries (:mod:`orbits.forces`) and a simulation's configuration
 
 Examples
 --------
->>> import astropy.units as u
 >>> from orbits._quantity_json import to_plain, from_plain
 >>> to_plain(3e5 * u.km / u.s), to_plain([0, 0, 2] * u.rad / u.day), to_plain(None)
 ([300000.0, 'km / s'], [[0.0, 0.0, 2.0], 'rad / d'], None)

@@ -8,7 +8,6 @@ simulation.
 import astropy.units as u
 import numpy as np
 
-from . import plotting
 from ._monitor_specs import RESULT_FIELDS
 
 __all__ = []
@@ -161,6 +160,10 @@ def plot(result, frame=None, path=None, fig=None):
     >>> fig.axes[0].get_title()
     'orbits (x-y plane), about Sun'
     """
+    # orbits.plotting, matplotlib's gateway, stands above the files, which hold
+    # results (its plot_file reads one): a cycle, and the layers' contract
+    # lists this import and the next
+    from . import plotting
     return plotting.plot_result(result, path=path, frame=frame, fig=fig)
 
 
@@ -189,4 +192,5 @@ def plot_elements(result, bodies=None, primary=None, path=None, fig=None):
     >>> [ax.get_ylabel() for ax in fig.axes]
     ['a [AU]', 'e', 'inc [deg]']
     """
+    from . import plotting
     return plotting.plot_elements(result, bodies=bodies, primary=primary, path=path, fig=fig)

@@ -142,7 +142,6 @@ class Orbit:
 
         Examples
         --------
-        >>> import numpy as np
         >>> from orbits import UnitSystem
         >>> from orbits.body import Orbit
         >>> o = Orbit.from_state(1.0, np.array([1.0, 0, 0]), np.array([0, 1.0, 0]),
@@ -206,7 +205,6 @@ class Body:
 
     Examples
     --------
-    >>> import orbits
     >>> bodies = orbits.scenes.outer_solar_system()
     >>> jupiter = bodies["Jupiter"]
     >>> jupiter
@@ -309,7 +307,6 @@ class Body:
 
         Examples
         --------
-        >>> import orbits
         >>> o = orbits.scenes.outer_solar_system()["Saturn"].orbit(primary="Sun")
         >>> round(float(o.a.value), 1), o.P.to("yr").round(1)
         (9.5, <Quantity 29.5 yr>)
@@ -339,8 +336,6 @@ class Track:
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "leapfrog",
     ...                         dt=10 * u.day)
     >>> result = sim.run(until=100 * u.yr, outputs=11, progress=False)

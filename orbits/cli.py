@@ -6,20 +6,24 @@ call it with a list.  It returns the exit status: one of
 :data:`EXIT_STATUSES`, or 128 + the signal number for a run stopped by
 SIGINT or SIGTERM.
 
-Building the parser and ``--help`` import neither numpy nor astropy nor the
-library: each command's work imports them, and a unit in a value (``10d``)
+Building the parser and ``--help`` import neither numpy nor astropy nor tqdm
+nor the library: each command's function imports what its work uses (the
+function-level imports of this module), and a unit in a value (``10d``)
 imports ``astropy.units`` when it is read.  ``tests/test_startup.py`` checks it
 and ``benchmarks/bench_startup.py`` times it.
 """
 
 import argparse
 import copy
+import csv
 import math
+import os
 import re
 import signal
 import sys
 import textwrap
 import threading
+import time
 import traceback
 
 from orbits import _integrator_options
@@ -555,7 +559,6 @@ def _main(args, orbits):
 
 def _compile(args, orbits):
     """``orbits compile``: a line per loop, then the total and where the cache is."""
-    import time
     from tqdm import tqdm
     from orbits import _compiling
 
@@ -590,7 +593,6 @@ def _elements_body(parser, args):
 
 
 def _elements(args, orbits):
-    import csv
     result = orbits.load(args.file)
     if not len(result):
         raise orbits.io.OrbitsFileError(f"{args.file}: holds no outputs ({result.status})")
@@ -609,7 +611,6 @@ def _elements(args, orbits):
         sys.stdout.flush()
     except BrokenPipeError:
         # the reader stopped (``| head``): no traceback; Python's documented remedy
-        import os
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
 
@@ -730,7 +731,6 @@ def _whole_run(result, path, orbits):
 def _bodies(scene, orbits):
     """A built-in scene (no defaults), or a body-set file and its [run] table."""
     if scene.lower().endswith((".toml", ".csv")):
-        import os
         from orbits import systemfile
         if not os.path.isfile(scene):
             raise ValueError(f"no such file: {scene}")

@@ -52,6 +52,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from astropy.table import QTable
+
+from .errors import SimulationOptionError
 
 __all__ = ["RESOLUTIONS", "CollisionEvent", "merge_pair", "bounce_pair", "pair_energy_change"]
 
@@ -98,7 +101,6 @@ def merge_pair(m, r, x, v, a, b):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.collisions import merge_pair
     >>> m = np.array([3.0, 1.0]); r = np.array([1.0, 1.0])
     >>> x = np.array([[0.0, 0, 0], [4.0, 0, 0]]); v = np.array([[0.0, 1, 0], [0.0, -3, 0]])
@@ -120,7 +122,6 @@ def bounce_pair(m, x, v, a, b, restitution):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.collisions import bounce_pair
     >>> m = np.array([1.0, 1.0])
     >>> x = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
@@ -145,7 +146,6 @@ def pair_energy_change(m, x, v, a, b, va, vb):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.collisions import pair_energy_change
     >>> m = np.array([1.0, 1.0]); v = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
     >>> float(pair_energy_change(m, None, v, 0, 1, np.zeros(3), np.zeros(3)))
@@ -162,7 +162,6 @@ def table(rows, units):
     ``rows`` are tuples ``(time, step_time, body_1, body_2, resolution,
     survivor, distance, speed, energy_change)`` in the internal units.
     """
-    from astropy.table import QTable
     q = units.quantity
     col = lambda k, kind=float: np.array([r[k] for r in rows], dtype=kind)  # noqa: E731
     return QTable({"time": q(col(0), "time"), "step_time": q(col(1), "time"),
@@ -175,7 +174,6 @@ def table(rows, units):
 
 def check_answer(answer, bodies):
     """A collision function's answer, checked."""
-    from .errors import SimulationOptionError
     if isinstance(answer, str) and answer in RESOLUTIONS:
         return answer
     raise SimulationOptionError(

@@ -40,8 +40,6 @@ class Trajectory:
 
     Examples
     --------
-    >>> import numpy as np
-    >>> import orbits
     >>> tr = orbits.integrate(lambda x, v, t: -x, 1.0, 0.0, dt=np.pi / 100, steps=200,
     ...                       method="rk4", every=100)
     >>> tr
@@ -128,7 +126,7 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
 
     Examples
     --------
-    >>> import numba, orbits
+    >>> import numba
     >>> @numba.njit
     ... def spring(x, v, t):
     ...     return -100.0 * x

@@ -47,6 +47,8 @@ _JD = re.compile(rf"\s*(?:JD\s*)?({_NUMBER})(?:\s*([-+])\s*({_NUMBER}))?\s*", re
 
 
 def _Time():
+    # astropy.time (and erfa) load when a date is first read: a body set
+    # without an epoch never needs them
     from astropy.time import Time
     return Time
 
@@ -128,6 +130,7 @@ def to_tdb(time):
     """
     if time.scale == "tdb":
         return time
+    # the IERS tables' settings load with the one conversion that reads them
     from astropy.utils import iers
     with iers.conf.set_temp("auto_download", False):
         return time.tdb
@@ -268,7 +271,6 @@ def at_times(epoch, times):
 
     Examples
     --------
-    >>> import astropy.units as u
     >>> from orbits import epochs
     >>> dates = epochs.at_times(epochs.from_pair(2451545.0, 0.0), [0, 1] * u.yr)
     >>> dates.jd.tolist(), dates.scale

@@ -42,7 +42,6 @@ class OrbitsError(Exception):
 
     Examples
     --------
-    >>> import orbits
     >>> try:
     ...     orbits.integrators.get("rk45")
     ... except orbits.OrbitsError as exc:
@@ -56,10 +55,7 @@ class OrbitsWarning(UserWarning):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> import warnings
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     >>> with warnings.catch_warnings(record=True) as caught:
     ...     warnings.simplefilter("always")
     ...     _ = sim.run(until=3 * u.day, progress=False)   # fewer steps than outputs
@@ -89,8 +85,6 @@ class BodyError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> try:
     ...     orbits.scenes.kepler().add("comet", mass=-1 * u.kg)
     ... except orbits.OrbitsError as exc:
@@ -110,8 +104,6 @@ class BodyUnitsError(BodyError, u.UnitsError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> try:
     ...     orbits.scenes.kepler().add("moon", mass=1 * u.au)
     ... except orbits.OrbitsError as exc:
@@ -125,8 +117,6 @@ class ElementsError(BodyError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> try:
     ...     orbits.scenes.kepler().add("comet", mass=0 * u.kg, a=1 * u.au, e=1.5)
     ... except orbits.OrbitsError as exc:
@@ -140,7 +130,6 @@ class UnknownBodyError(BodyError, KeyError):
 
     Examples
     --------
-    >>> import orbits
     >>> try:
     ...     orbits.scenes.kepler().index("Moon")
     ... except orbits.OrbitsError as exc:
@@ -159,8 +148,6 @@ class DuplicateBodyError(BodyError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> try:
     ...     orbits.scenes.kepler().add("Star", mass=1 * u.Msun)
     ... except orbits.OrbitsError as exc:
@@ -174,8 +161,6 @@ class CoincidentBodiesError(BodyError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> bodies = orbits.scenes.kepler()
     >>> bodies.add("twin", mass=1 * u.Mearth, position=bodies.positions[1])
     >>> try:
@@ -191,8 +176,6 @@ class NoMassiveBodyError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> bodies = orbits.BodySet()
     >>> bodies.add("dust", mass=0 * u.kg)
     >>> try:
@@ -208,7 +191,6 @@ class UnknownIntegratorError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import orbits
     >>> try:
     ...     orbits.integrators.get("rk45")
     ... except orbits.OrbitsError as exc:
@@ -222,7 +204,6 @@ class IntegratorOptionError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import orbits
     >>> try:
     ...     orbits.integrators.get("ias15", eps=1e-9)
     ... except orbits.OrbitsError as exc:
@@ -238,7 +219,6 @@ class EpochError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import orbits
     >>> bodies = orbits.scenes.kepler()
     >>> try:
     ...     bodies.epoch = "2000-01-01"
@@ -254,8 +234,6 @@ class NoEpochError(EpochError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> result = orbits.Simulation(orbits.scenes.kepler(), "leapfrog",
     ...                            dt=1 * u.day).run(until=2 * u.day, progress=False)
     >>> try:
@@ -282,8 +260,6 @@ class ForceTermError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> try:
     ...     orbits.forces.ZonalHarmonics("Star", radius=-1 * u.km, J2=1e-3)
     ... except orbits.OrbitsError as exc:
@@ -314,8 +290,6 @@ class RunError(OrbitsError, RuntimeError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
     ...                         escape_distance=0.5 * u.au)
     >>> try:
@@ -342,8 +316,6 @@ class SimulationStopped(RunError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
     ...                         encounter_distance=2 * u.au)
     >>> try:
@@ -363,8 +335,6 @@ class NonFiniteState(RunError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> bodies = orbits.BodySet()
     >>> bodies.add("A", mass=1 * u.Msun)
     >>> bodies.add("B", mass=1 * u.Msun, position=[1e-200, 0, 0] * u.au)   # r**3 underflows
@@ -382,8 +352,6 @@ class StepSizeUnderflow(RunError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> ias15 = orbits.integrators.get("ias15", min_dt=1e4)   # days: above any step it takes
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), ias15)
     >>> try:
@@ -402,8 +370,6 @@ class ConvergenceFailure(RunError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "implicit-midpoint", dt=100 * u.day)
     >>> try:
     ...     sim.run(until=1000 * u.day, outputs=2, progress=False)
@@ -421,9 +387,6 @@ class WallTimeExceeded(RunError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     >>> try:
     ...     sim.run(until=1000 * u.day, progress=False, wall_limit=1e-9)
     ... except orbits.OrbitsError as exc:
@@ -437,8 +400,6 @@ class CloseEncounter(SimulationStopped):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
     ...                         encounter_distance=2 * u.au)
     >>> try:
@@ -468,8 +429,6 @@ class Collision(SimulationStopped):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> b = orbits.BodySet()
     >>> b.add("Star", mass=1 * u.Msun, radius=0.005 * u.au)
     >>> b.add("Comet", mass=0 * u.kg, position=[1, 0, 0] * u.au,
@@ -496,7 +455,6 @@ class SimulationOptionError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import orbits
     >>> try:
     ...     orbits.Simulation(orbits.scenes.kepler(), "ias15", collisions="explode")
     ... except orbits.OrbitsError as exc:
@@ -510,8 +468,6 @@ class Escape(SimulationStopped):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
     ...                         escape_distance=0.5 * u.au)
     >>> try:
@@ -579,7 +535,6 @@ class SystemFileError(BodyError):
 
     Examples
     --------
-    >>> import orbits
     >>> try:
     ...     orbits.systemfile.loads('[[body]]\\nname = "Sun"\\nmass = 1\\n')
     ... except orbits.OrbitsError as exc:

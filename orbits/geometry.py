@@ -55,7 +55,6 @@ def barycentre(m, x, v):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.geometry import barycentre
     >>> M, X, V = barycentre(np.array([3.0, 1.0]), np.array([[0., 0, 0], [4, 0, 0]]),
     ...                      np.zeros((2, 3)))
@@ -90,7 +89,6 @@ def angular_momentum(m, x, v):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.geometry import angular_momentum
     >>> x = np.array([[0., 0, 0], [1, 0, 0]]) + 5.0      # any origin
     >>> v = np.array([[0., 0, 0], [0, 1, 0]]) + 2.0      # any uniform motion
@@ -132,7 +130,6 @@ def invariable_plane_rotation(L):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.geometry import invariable_plane_rotation
     >>> R = invariable_plane_rotation([0.0, -1.0, 1.0])   # tilted 45 deg about x
     >>> (R @ np.array([0.0, -1.0, 1.0])).round(15).tolist()
@@ -174,7 +171,6 @@ def angle_between(a, b):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.geometry import angle_between
     >>> float(np.degrees(angle_between(np.array([0., 0, 1]), np.array([0., 1, 1]))))
     45.0

@@ -24,6 +24,7 @@ import numpy as np
 
 from ._kernels import elements as _elements
 from .errors import ElementsError
+from .io.h5md import OrbitsFileError, load
 from .units import TIME_UNITS, time_unit
 
 __all__ = ["plot_result", "plot_elements", "plot_orbits", "plot_file", "time_unit",
@@ -100,8 +101,6 @@ def plot_result(result, path=None, frame=None, fig=None):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.plotting import plot_result
     >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
     ...                         integrator="leapfrog", dt=10 * u.day)
@@ -177,11 +176,8 @@ def plot_elements(result, bodies=None, primary=None, path=None, fig=None):
     primary : str, optional
         The body the orbits are about; default the centre of mass of the bodies
         before each one (see :meth:`orbits.Result.elements`).
-    path : str or path-like, optional
-        Also write the figure there (PNG, 110 dpi).
-    fig : matplotlib.figure.Figure, optional
-        An empty figure to draw into, e.g. ``matplotlib.pyplot.figure()`` so
-        that pyplot shows it; default a new figure that pyplot does not manage.
+    path, fig
+        As for :func:`plot_result`.
 
     Returns
     -------
@@ -199,13 +195,10 @@ def plot_elements(result, bodies=None, primary=None, path=None, fig=None):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
+    The outer solar system over a century (``planets``, as in :class:`orbits.Result`):
+
     >>> from orbits.plotting import plot_elements
-    >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
-    ...                         integrator="leapfrog", dt=10 * u.day)
-    >>> result = sim.run(until=100 * u.yr, outputs=50, progress=False)
-    >>> fig = plot_elements(result, bodies=["Jupiter", "Saturn"], primary="Sun")
+    >>> fig = plot_elements(planets, bodies=["Jupiter", "Saturn"], primary="Sun")
     >>> [len(ax.lines) for ax in fig.axes], fig.axes[-1].get_xlabel()
     ([2, 2, 2], 'time [yr]')
     """
@@ -290,7 +283,6 @@ def plot_orbits(bodies, primary=None, plane="xy", ax=None, path=None):
 
     Examples
     --------
-    >>> import orbits
     >>> from orbits.plotting import plot_orbits
     >>> fig = plot_orbits(orbits.scenes.outer_solar_system(), primary="Sun")
     >>> ax = fig.axes[0]
@@ -383,7 +375,6 @@ def plot_file(path, out=None, frame=None):
     >>> plot_file("run.h5", frame="barycentric")          # doctest: +SKIP
     PosixPath('run.png')
     """
-    from .io.h5md import OrbitsFileError, load
     out = pathlib.Path(out) if out else pathlib.Path(path).with_suffix(".png")
     result = load(path)
     if not len(result.times):

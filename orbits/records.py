@@ -151,8 +151,6 @@ class SimulationConfig(NamedTuple):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> cfg = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day).config
     >>> cfg.integrator, cfg.dt, cfg.monitors
     ('leapfrog', <Quantity 1. d>, ('energy', 'angular_momentum'))
@@ -173,9 +171,6 @@ class SimulationConfig(NamedTuple):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
         >>> d = sim.config.to_dict()
         >>> d["integrator"], d["dt"]
         ('leapfrog', [1.0, 'd'])
@@ -204,8 +199,6 @@ class SimulationConfig(NamedTuple):
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> from orbits.records import SimulationConfig
         >>> cfg = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day).config
         >>> SimulationConfig.from_dict(cfg.to_dict()) == cfg
@@ -226,9 +219,6 @@ class SimulationState(NamedTuple):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     >>> state = sim.state
     >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
     >>> state.steps, sim.state.steps, sim.state.x.shape
@@ -256,9 +246,6 @@ class Snapshot(NamedTuple):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
     >>> snap = sim.snapshot()
     >>> snap.t, snap.steps, snap.x.shape, snap.v.shape
@@ -288,8 +275,6 @@ class SimulationDescription(NamedTuple):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> d = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day).description()
     >>> d.names, d.masses.tolist(), d.radii.tolist(), d.dt, d.integrator.name
     (('Star', 'Planet'), [1.0, 0.001], [0.0, 0.0], 1.0, 'leapfrog')

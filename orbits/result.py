@@ -174,8 +174,6 @@ class Result:
     Two runs, which the examples of the methods use as ``two_body`` and
     ``planets``:
 
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     >>> two_body = sim.run(until=10 * u.yr, outputs=11, progress=False)
     >>> two_body

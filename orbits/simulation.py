@@ -56,13 +56,10 @@ __all__ = ["Simulation", "SimulationConfig", "SimulationState", "SimulationDescr
 #: approaches than it holds has it doubled (see orbits._kernels.stopping).
 LOG_ROWS = 1024
 
-#: Bodies from which the threaded gravity kernel is used.  Measured with
-#: benchmarks/bench_gravity.py (whole leapfrog steps, two cores): against the
-#: one-thread batched kernel, break-even at N = 64 and 73 in two runs on the
-#: AVX2 machine (the threshold was 72); against the one-thread lanes kernel
-#: (orbits._kernels.gravity.LANES_FROM) on the AVX-512 machine, break-even at
-#: N = 114 (threaded 0.94 times as fast at 96, 1.05 at 128, 1.50 at 192).
-#: Below it thread start-up (~4 us a step) outweighs the split work.
+#: Bodies from which the threaded gravity kernel is used: below it thread
+#: start-up (~4 us a step) outweighs the split work, against the one-thread
+#: lanes kernel (orbits._kernels.gravity.LANES_FROM) on two cores.
+#: benchmarks/bench_gravity.py measures the break-even (benchmarks/RESULTS.md).
 PARALLEL_THRESHOLD = 128
 
 #: Outputs of a run when none are asked for.
@@ -190,8 +187,6 @@ class Simulation(Driven):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.earth_moon(), integrator="leapfrog",
     ...                         dt=1 * u.hour)
     >>> result = sim.run(until=30 * u.day, outputs=31, progress=False)

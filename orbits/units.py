@@ -67,7 +67,6 @@ class UnitSystem:
 
     Examples
     --------
-    >>> import astropy.units as u
     >>> from orbits import UnitSystem
     >>> round(UnitSystem().G, 15)
     0.000295912208192
@@ -222,8 +221,6 @@ class UnitSystem:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> from orbits import UnitSystem
         >>> U = UnitSystem()
         >>> float(U.to_internal(1 * u.yr, "time"))
@@ -262,7 +259,6 @@ class UnitSystem:
 
         Examples
         --------
-        >>> import numpy as np
         >>> from orbits import UnitSystem
         >>> UnitSystem().quantity(np.array([1.0, 2.0]), "velocity")
         <Quantity [1., 2.] AU / d>
@@ -365,7 +361,6 @@ def time_unit(span):
 
     Examples
     --------
-    >>> import astropy.units as u
     >>> from orbits.units import time_unit
     >>> time_unit(1e5 * u.yr), time_unit(30 * u.day), time_unit(4.383e9 * u.day)
     (Unit("kyr"), Unit("d"), Unit("Myr"))
@@ -399,7 +394,6 @@ def format_time(time, unit=None, digits=6):
 
     Examples
     --------
-    >>> import astropy.units as u
     >>> from orbits.units import format_time, time_unit
     >>> format_time(4.383e9 * u.day), format_time(3652.5 * u.day), format_time(0.5 * u.day)
     ('12 Myr', '10 yr', '43200 s')

@@ -1,7 +1,9 @@
 """The import-linter contracts in pyproject.toml: orbits._kernels never imports astropy;
 orbits.io and orbits.records never import orbits.simulation; the kernel modules import
 one another without cycles (function-local imports count); the modules of orbits.ensemble
-import one way."""
+import one way; and the package's layers, from the command line down to the kernels, each
+module importing only from its own layer and those below (every module of orbits/ given a
+layer)."""
 
 import pathlib
 import shutil
@@ -19,3 +21,4 @@ def test_import_linter_contract():
     assert "Files and ensembles go through the simulation's public records KEPT" in proc.stdout
     assert "Kernels import one another without cycles KEPT" in proc.stdout
     assert "Ensemble modules import one way" in proc.stdout and "BROKEN" not in proc.stdout
+    assert "The package's layers, from the command line down to the kernels KEPT" in proc.stdout

@@ -23,7 +23,6 @@ import numpy as np
 
 from .. import epochs as _epochs
 from .. import geometry as _geometry
-from .. import plotting as _plotting
 from .._kernels.status import describe_status
 from ..body import Body, _position, unknown_body
 from ..errors import BodyError, ElementsError
@@ -707,7 +706,11 @@ class BodySet:
         >>> [line.get_label() for line in fig.axes[0].lines][:2]
         ['Jupiter', 'Saturn']
         """
-        return _plotting.plot_orbits(self, primary=primary, plane=plane, ax=ax, path=path)
+        # orbits.plotting, matplotlib's gateway, stands above the files, which
+        # hold body sets (its plot_file reads one): a cycle, and the layers'
+        # contract lists this import
+        from .. import plotting
+        return plotting.plot_orbits(self, primary=primary, plane=plane, ax=ax, path=path)
 
     def check(self):
         """Check the set as a whole: at least one massive body, no two at one place.

@@ -122,8 +122,6 @@ class Ensemble:
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> def build(e):
     ...     return orbits.Simulation(orbits.scenes.kepler(e=e), integrator="leapfrog",
     ...                              dt=1 * u.day)
@@ -153,7 +151,6 @@ class Ensemble:
     def grid(cls, build, **axes):
         """Every combination of the values along each axis (the first varies slowest).
 
-        >>> import numpy as np
         >>> ens = Ensemble.grid(lambda a, e: None, a=[1.0, 2.0], e=np.linspace(0, 0.2, 3))
         >>> len(ens), ens.parameters[1]
         (6, {'a': 1.0, 'e': 0.1})
@@ -196,9 +193,6 @@ class Ensemble:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
         >>> ens = orbits.Ensemble.perturbed(sim, n=3, scale=1e-10)
         >>> ens.parameters
         [{'member': 0}, {'member': 1}, {'member': 2}]
@@ -234,8 +228,6 @@ class Ensemble:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> def build(e):
         ...     return orbits.Simulation(orbits.scenes.kepler(e=e), "leapfrog", dt=1 * u.day)
         >>> ens = orbits.Ensemble.grid(build, e=[0.1, 0.5])
@@ -318,8 +310,6 @@ class Ensemble:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
         >>> ens = orbits.Ensemble.perturbed(sim, n=3, scale=1e-10)
         >>> df = ens.run(until=1 * u.yr, client="serial", outputs=5, progress=False)

@@ -30,12 +30,10 @@ WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
 #: every 10 ms from a thread of its own, the event loop's latency probe ran
 #: every 20 ms (it only measures; Dask's own tests take 500 ms), the memory
 #: monitor every 0.1 s (1 s still stops a worker whose memory runs away) and
-#: the system monitor every 0.5 s.  Measured on two workers: the 512-run MEGNO
-#: map's runs took 17.3-17.8 s summed without the profiler against 18.4-19.0
-#: s with it; idle for 10 s, the workers used 0.07-0.12 s of CPU with these
-#: settings against 0.40-0.54 s with only the profiler off, and the
-#: scheduler's process 0.10-0.14 s against 0.52-0.61 (0.40-0.45 s against
-#: 0.90-1.07 s over the map).  The preload (``orbits._daskworker``) has
+#: the system monitor every 0.5 s.  Without the profiler a sweep's runs take
+#: about 6 % less time, and with these settings idle workers and the scheduler
+#: use about a fifth of the CPU they use with the profiler alone turned off
+#: (benchmarks/RESULTS.md).  The preload (``orbits._daskworker``) has
 #: each worker process ignore SIGINT, which Ctrl-C in a terminal sends to every
 #: process of the foreground group: the process that started the cluster closes
 #: it, instead of each worker stopping with its own tracebacks.

@@ -34,7 +34,6 @@ class MissingMainGuard(OrbitsError, RuntimeError):
 
     Examples
     --------
-    >>> import orbits
     >>> from orbits.ensemble import MissingMainGuard
     >>> exc = MissingMainGuard("starts a cluster at import", script="sweep.py", line=12)
     >>> isinstance(exc, (orbits.OrbitsError, RuntimeError)), exc.script, exc.line
@@ -55,8 +54,6 @@ class EnsembleOptionError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.ensemble import EnsembleOptionError
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "wh", dt=1 * u.day)
     >>> try:

@@ -15,8 +15,7 @@ __all__ = ["run_chunk", "TASK_SECONDS", "CHUNK_MAX", "QUEUED_PER_WORKER", "RUN_O
 #: first ones alone, then as many together as the runs so far say take this
 #: long.  Each task costs the scheduler, the worker and this process a few
 #: milliseconds, which on runs of tens of milliseconds would take a third of
-#: the machine (measured: 7.5 ms a run of a 512-run MEGNO map, against 1.1 ms
-#: for a process pool); runs of seconds or more still go one a task, so
+#: the machine (benchmarks/RESULTS.md); runs of seconds or more still go one a task, so
 #: that an ``out_dir`` index loses nothing to grouping.
 TASK_SECONDS = 0.5
 

@@ -25,7 +25,6 @@ class ForceTerm:
 
     Examples
     --------
-    >>> import orbits
     >>> from orbits.forces import ForceTerm
     >>> [cls.__name__ for cls in (orbits.forces.GR, orbits.forces.ZonalHarmonics)
     ...  if issubclass(cls, ForceTerm)]
@@ -75,7 +74,6 @@ class ForceTerm:
 
         Examples
         --------
-        >>> import orbits
         >>> from orbits.forces import Context
         >>> bound = orbits.forces.GR("Star").bind(Context.of(orbits.scenes.kepler()))
         >>> bound.args[0], round(1 / bound.args[1] ** 0.5, 1)   # source index; c in au/day
@@ -89,8 +87,6 @@ class ForceTerm:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> orbits.forces.GRPotential("Sun", c=3e5 * u.km / u.s).to_dict()
         {'type': 'GRPotential', 'source': 'Sun', 'c': [300000.0, 'km / s']}
         """
@@ -113,8 +109,6 @@ class ForceTerm:
 
         Examples
         --------
-        >>> import astropy.units as u
-        >>> import orbits
         >>> term = orbits.forces.Migration("Planet", tau_e=-300 * u.yr, primary="Star")
         >>> orbits.forces.Migration.from_dict(term.to_dict()) == term
         True
@@ -135,7 +129,6 @@ class ForceTerm:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.forces.GR.functions_needed({"type": "GR", "source": "Sun", "c": None})
         {}
         """
@@ -147,7 +140,6 @@ class ForceTerm:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.forces.GR("Sun").functions()
         {}
         """
@@ -189,7 +181,6 @@ def from_dict(d, functions=None):
 
     Examples
     --------
-    >>> import orbits
     >>> term = orbits.forces.from_dict({"type": "GR", "source": "Sun", "c": None})
     >>> term
     GR(source='Sun')
@@ -237,7 +228,6 @@ def functions_needed(records):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.forces.functions_needed([{"type": "UserForce", "func": "models:drag",
     ...                                  "velocity_dependent": True, "potential": None}])
     {'models:drag': 'UserForce func(x, v, t, m), velocity-dependent'}
@@ -258,7 +248,6 @@ def functions_of(terms):
     A :class:`~orbits.forces.UserForce` holds functions (see its example); a
     term of numbers holds none:
 
-    >>> import orbits
     >>> orbits.forces.functions_of([orbits.forces.GR("Sun"), orbits.forces.GRFull()])
     {}
     """

@@ -20,7 +20,6 @@ class BoundTerm(NamedTuple):
 
     Examples
     --------
-    >>> import orbits
     >>> from orbits.forces import Context
     >>> bound = orbits.forces.GRPotential("Star").bind(Context.of(orbits.scenes.kepler()))
     >>> type(bound).__name__, bound.args[0]    # the source's internal index
@@ -58,7 +57,6 @@ class Context(NamedTuple):
 
         Examples
         --------
-        >>> import orbits
         >>> from orbits.forces import Context
         >>> ctx = Context.of(orbits.scenes.kepler())
         >>> ctx.names, ctx.n_active

@@ -82,7 +82,6 @@ class Migration(_Dissipative):
 
     Examples
     --------
-    >>> import astropy.units as u, orbits
     >>> term = orbits.forces.Migration("Planet", tau_a=1e4 * u.yr, tau_e=1e3 * u.yr)
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "ias15", forces=[term])
     >>> term.velocity_dependent, term.conservative, term.wisdom_holman
@@ -202,7 +201,6 @@ class TidesConstantTimeLag(_Dissipative):
 
     Examples
     --------
-    >>> import astropy.units as u, orbits
     >>> tide = orbits.forces.TidesConstantTimeLag("Planet", k2=0.3, time_lag=600 * u.s,
     ...                                           radius=1 * u.Rjup)
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "ias15", forces=[tide])
@@ -293,7 +291,6 @@ class RadiationPressure(_Dissipative):
 
     Examples
     --------
-    >>> import astropy.units as u, orbits
     >>> b = orbits.scenes.kepler()
     >>> b.add("dust", mass=0 * u.kg, primary="Star", a=2 * u.au)
     >>> rad = orbits.forces.RadiationPressure("Star", beta={"dust": 0.1})

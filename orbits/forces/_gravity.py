@@ -24,8 +24,6 @@ class Gravity(ForceTerm):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
     ...                         forces=[orbits.forces.Gravity(softening=1e-4 * u.au)])
     >>> sim.softening, sim.forces

@@ -75,7 +75,6 @@ class GR(_SourceTerm):
 
     Examples
     --------
-    >>> import astropy.units as u, orbits
     >>> sim = orbits.Simulation(orbits.scenes.solar_system(), "ias15",
     ...                         forces=[orbits.forces.GR("Sun")])
     >>> sim.forces
@@ -106,8 +105,6 @@ class GRPotential(_SourceTerm):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "wh", dt=5 * u.day,
     ...                         forces=[orbits.forces.GRPotential("Star")])
     >>> sim.forces
@@ -134,7 +131,6 @@ class GRFull(ForceTerm):
 
     Examples
     --------
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "ias15",
     ...                         forces=[orbits.forces.GRFull()])
     >>> sim.forces, orbits.forces.GRFull.velocity_dependent

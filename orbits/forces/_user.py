@@ -47,7 +47,7 @@ class UserForce(ForceTerm):
 
     Examples
     --------
-    >>> import numba, orbits
+    >>> import numba
     >>> @numba.njit
     ... def drag(x, v, t, m):
     ...     return -1e-6 * v
@@ -114,7 +114,6 @@ class UserForce(ForceTerm):
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.forces.UserForce.functions_needed(
         ...     {"func": "models:pull", "velocity_dependent": False, "potential": "models:pot"})
         {'models:pull': 'UserForce func(x, v, t, m)', 'models:pot': 'UserForce potential(x, m)'}

@@ -41,7 +41,6 @@ class ZonalHarmonics(ForceTerm):
 
     Examples
     --------
-    >>> import astropy.units as u, orbits
     >>> J2 = orbits.forces.ZonalHarmonics("Earth", 6378.137 * u.km, J2=1.08263e-3)
     >>> J2.wisdom_holman
     True

@@ -1,6 +1,5 @@
 """The registry of integrators: name -> class, and REBOUND's names for the same methods.
 
->>> import orbits
 >>> [i.name for i in orbits.integrators.available()][:3]
 ['euler', 'symplectic-euler', 'verlet']
 >>> orbits.integrators.get("rk4")
@@ -66,7 +65,6 @@ class IntegratorInfo(NamedTuple):
 
     Examples
     --------
-    >>> import orbits
     >>> info = next(i for i in orbits.integrators.available() if i.name == "wh")
     >>> info.name, info.order, info.symplectic, info.adaptive
     ('wh', 2, True, False)
@@ -148,7 +146,6 @@ def get(name, **options):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.get("ias15", epsilon=1e-10)
     IAS15(epsilon=1e-10, min_dt=0.0, adaptive_mode='global')
     >>> orbits.integrators.get("dopri5").config
@@ -198,7 +195,6 @@ def aliases():
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.aliases()
     {'whfast': 'wh'}
     """
@@ -214,7 +210,6 @@ def adaptive_names():
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.adaptive_names()[-2:]
     ['ias15', 'taylor']
     """
@@ -230,7 +225,6 @@ def available():
 
     Examples
     --------
-    >>> import orbits
     >>> [(i.name, i.order) for i in orbits.integrators.available() if i.symplectic][:3]
     [('symplectic-euler', 1), ('verlet', 2), ('leapfrog', 2)]
     """

@@ -126,7 +126,6 @@ class Integrator:
     Examples
     --------
     >>> import math
-    >>> import numpy as np
     >>> from orbits import integrators
     >>> from orbits._kernels import gravity, stepping
     >>> x = np.array([[0.0, 0, 0], [1, 0, 0]])    # a test particle on a circle of
@@ -261,7 +260,6 @@ class Integrator:
         :func:`around_a_circle` takes them (the class's example makes the call
         itself):
 
-        >>> import numpy as np
         >>> from orbits import integrators
         >>> from orbits.integrators.base import around_a_circle
         >>> status, steps, x, v, ws = around_a_circle(integrators.get("rk4"))
@@ -276,7 +274,6 @@ class Integrator:
 
         Examples
         --------
-        >>> import numpy as np
         >>> from orbits import integrators
         >>> from orbits._kernels import gravity, stepping
         >>> integ = integrators.get("wh")
@@ -293,7 +290,6 @@ class Integrator:
 
         Examples
         --------
-        >>> import orbits
         >>> gr = orbits.forces.GR("Sun")
         >>> orbits.integrators.get("ias15").check_terms([gr])      # accepted
         >>> try:
@@ -336,7 +332,6 @@ class Integrator:
 
         Examples
         --------
-        >>> import orbits
         >>> integ = orbits.integrators.get("leapfrog")
         >>> integ.behind(integ.workspace(2))
         0.0
@@ -354,7 +349,6 @@ class Integrator:
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.integrators.get("ias15", epsilon=1e-10).info()["option.epsilon"]
         1e-10
         """
@@ -455,7 +449,6 @@ class ExplicitRungeKutta(Integrator):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits import integrators
     >>> rk4 = integrators.get("rk4")
     >>> round(float(np.sum(rk4.B)), 12), np.allclose(np.sum(rk4.A, axis=1), rk4.C)
@@ -541,6 +534,20 @@ class AdaptiveIntegrator(Integrator):
     def workspace(self, n, initial_step=0.0):
         raise NotImplementedError
 
+    def _counted_call(self, loop, lead, ws, mon, step0, mon_t, mon_out, t_end, max_steps,
+                      marks, mark_steps, stop):
+        """:meth:`advance_to`'s return from a compiled loop that counts its steps in
+        ``ws["counts"]`` (accepted, rejected, force evaluations): the loop is called
+        with its own arguments ``lead``, then the outputs, the landing (with the
+        option ``min_dt``) and the stopping conditions' record."""
+        sargs, check = stop_record(stop)
+        status, t_reached, n_mon = loop(
+            *lead, outputs(mon, step0, mon_t, mon_out),
+            records.landing(t_end, max_steps, self.config["min_dt"], marks, mark_steps),
+            sargs, check)
+        c = ws["counts"]
+        return with_status(status, t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon)
+
 
 class ToleranceControlled(AdaptiveIntegrator):
     """An adaptive method whose step keeps an estimate of the local error
@@ -554,7 +561,6 @@ class ToleranceControlled(AdaptiveIntegrator):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.get("dopri5", rtol=1e-10).config
     {'rtol': 1e-10, 'atol': 1e-12}
     """

@@ -37,8 +37,6 @@ class Yoshida4(SplittingMethod):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.1), integrator="yoshida4",
     ...                         dt=5 * u.day)
     >>> result = sim.run(until=1 * u.yr, outputs=5, progress=False)
@@ -71,7 +69,6 @@ class Yoshida6(SplittingMethod):
 
     Examples
     --------
-    >>> import orbits
     >>> integ = orbits.integrators.get("yoshida6")
     >>> integ.order, sum(1 for kind, _ in integ.operators if kind == "kick")
     (6, 7)
@@ -102,7 +99,6 @@ class Yoshida8(SplittingMethod):
     --------
     Fifteen leapfrogs, fifteen forces a step:
 
-    >>> import orbits
     >>> orbits.integrators.get("yoshida8").forces_per_step
     15
     """

@@ -28,7 +28,6 @@ class RK4Doubling(CompiledToleranceControlled):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.get("rk4-doubling", rtol=1e-8).order
     4
     """

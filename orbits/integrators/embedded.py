@@ -60,8 +60,6 @@ class Dopri5(EmbeddedRungeKutta):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> integ = orbits.integrators.get("dopri5", rtol=1e-10, atol=1e-12)
     >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.5), integrator=integ)
     >>> r = sim.run(until=10 * u.yr, outputs=11, progress=False)
@@ -93,7 +91,6 @@ class DOP853(EmbeddedRungeKutta):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.get("dop853", rtol=1e-12, atol=1e-14).config["rtol"]
     1e-12
     """

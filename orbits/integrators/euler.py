@@ -28,8 +28,6 @@ class Euler(ExplicitRungeKutta):
     The energy error of a circular orbit at a step of a day, after 5 and 10
     years: it only grows.
 
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "euler", dt=1 * u.day)
     >>> error = sim.run(until=10 * u.yr, outputs=3, progress=False).energy_error
     >>> bool(0 < error[1] < error[2])
@@ -60,7 +58,6 @@ class SymplecticEuler(SplittingMethod):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.get("symplectic-euler").symplectic
     True
     """

@@ -2,11 +2,9 @@
 
 import numpy as np
 
-from .._kernels.status import Status
 from .._kernels import ias15 as _k
 from .._kernels import records
 from .._kernels.stepping import work_bound
-from .._kernels.stopping import stop_record
 from ._loops import loop_for
 from .base import MIN_DT, NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator, Option
 
@@ -78,7 +76,6 @@ class IAS15(AdaptiveIntegrator):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from orbits.integrators import get
     >>> from orbits._kernels.gravity import gravity_args
     >>> from orbits._kernels.stepping import gravity_force
@@ -141,14 +138,10 @@ class IAS15(AdaptiveIntegrator):
         fargs = work_bound(force, fargs, ws)
         control = _k.Control(float(self.config["epsilon"]),
                              ADAPTIVE_MODES[self.config["adaptive_mode"]])
-        sargs, check = stop_record(stop)
-        status, t_reached, n_mon = loop(
-            x, v, float(t), control, records.work(_k.Work, ws), fargs,
-            records.outputs(mon, step0, mon_t, mon_out),
-            records.landing(t_end, max_steps, self.config["min_dt"], marks, mark_steps),
-            sargs, check)
-        c = ws["counts"]
-        return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
+        return self._counted_call(loop, (x, v, float(t), control, records.work(_k.Work, ws),
+                                         fargs),
+                                  ws, mon, step0, mon_t, mon_out, t_end, max_steps, marks,
+                                  mark_steps, stop)
 
     def invalidate(self, ws):
         """The state was changed from outside: recompute the force, forget the

@@ -90,7 +90,7 @@ class ImplicitEuler(ImplicitOneLeg):
 
     Examples
     --------
-    >>> import numba, orbits
+    >>> import numba
     >>> @numba.njit
     ... def stiff(x, v, t):
     ...     return -1.0e4 * x

@@ -30,8 +30,6 @@ class Verlet(SplittingMethod):
     Time-symmetric: a hundred steps forward and a hundred back end where they
     started, to rounding.
 
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.1), "verlet", dt=1 * u.day)
     >>> start = sim.bodies.positions
     >>> _ = sim.run(until=100 * u.day, outputs=2, progress=False)
@@ -85,7 +83,6 @@ class Leapfrog(SplittingMethod):
     --------
     Its table of operators, half drifts about a kick:
 
-    >>> import orbits
     >>> orbits.integrators.get("leapfrog").operators
     (('drift', 0.5), ('kick', 1.0), ('drift', 0.5))
     """

@@ -22,9 +22,6 @@ class RK2(ExplicitRungeKutta):
     Second order: halving the step quarters the error (the final position
     after a year, at steps of 4, 2 and 1 days).
 
-    >>> import astropy.units as u
-    >>> import numpy as np
-    >>> import orbits
     >>> def final(dt):
     ...     sim = orbits.Simulation(orbits.scenes.kepler(e=0.1), "rk2", dt=dt)
     ...     return sim.run(until=1 * u.yr, outputs=2, progress=False).positions[-1, 1]
@@ -55,7 +52,6 @@ class RK4(ExplicitRungeKutta):
     --------
     Its weights, Simpson's rule's over the four stages:
 
-    >>> import orbits
     >>> [round(b, 6) for b in orbits.integrators.get("rk4").B.tolist()]
     [0.166667, 0.333333, 0.333333, 0.166667]
     """

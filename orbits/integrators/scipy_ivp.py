@@ -115,7 +115,6 @@ class Radau(ScipyIntegrator):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.get("radau", rtol=1e-10).order
     5
     """
@@ -136,7 +135,6 @@ class LSODA(ScipyIntegrator):
 
     Examples
     --------
-    >>> import orbits
     >>> orbits.integrators.get("lsoda").adaptive
     True
     """

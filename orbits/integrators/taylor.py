@@ -4,8 +4,6 @@ import numpy as np
 
 from .._kernels import records
 from .._kernels import taylor as _k
-from .._kernels.stopping import stop_record
-from .._kernels.status import Status
 from ..errors import IntegratorOptionError
 from ._loops import loop_for
 from .base import MIN_DT, NO_MARK_STEPS, NO_MARKS, AdaptiveIntegrator, Option
@@ -71,8 +69,6 @@ class Taylor(AdaptiveIntegrator):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.kepler(e=0.5), "taylor", monitors=["energy"])
     >>> res = sim.run(until=10 * u.yr, outputs=3, progress=False)
     >>> bool(abs(res.energy_error[-1]) < 1e-13)
@@ -159,14 +155,10 @@ class Taylor(AdaptiveIntegrator):
             # writes as many pairs as the massive bodies make)
             self.bind(ws, force, fargs)
         loop = loop_for(_k.taylor_loop, force)
-        sargs, check = stop_record(stop)
-        status, t_reached, n_mon = loop(
-            x, v, float(t), int(self.order_used), ws["series"], records.work(_k.Work, ws), fargs,
-            records.outputs(mon, step0, mon_t, mon_out),
-            records.landing(t_end, max_steps, self.config["min_dt"], marks, mark_steps),
-            sargs, check)
-        c = ws["counts"]
-        return Status(status), t_reached, int(c[0]), int(c[1]), int(c[2]), n_mon
+        return self._counted_call(loop, (x, v, float(t), int(self.order_used), ws["series"],
+                                         records.work(_k.Work, ws), fargs),
+                                  ws, mon, step0, mon_t, mon_out, t_end, max_steps, marks,
+                                  mark_steps, stop)
 
     def invalidate(self, ws):
         """The state was changed from outside: forget the compensation terms."""

@@ -29,15 +29,14 @@ SPEED = 1.0
 #: kicks' error grows as the Kepler time scale at the body falls towards the
 #: step.  2 flags a body whose circular orbit at its distance would take
 #: fewer than 18 steps: Jupiter's perihelion at P_J/20 (the usual
-#: Wisdom-Holman step) stays outside.  Measured on a comet with q = 0.005 au
-#: beside Jupiter at a 1-day step over 10 yr: energy error 8e-3 without the
-#: criterion, 1.2e-5 with 1, 2.2e-6 with 2, 3e-7 with 4, 3e-8 with 8.
+#: Wisdom-Holman step) stays outside, and a sungrazing comet's energy error
+#: falls by more than three orders of magnitude against no criterion
+#: (benchmarks/RESULTS.md has the sweep of this factor).
 PERICENTRE = 2.0
 #: The inner integrator's relative tolerance per step, per body, in the
-#: group's own frame (DOP853's error estimate).  Measured on the stress
-#: suite's encounters (two Earth masses passing at 1e-3 to 1e-8 au, 0.5-day
-#: step, 10 days): energy error after the pass 2e-15 to 1.3e-10 with 1e-12,
-#: 1.5e-14 to 1.4e-9 with 1e-11, 5e-16 to 5e-12 with 1e-13.
+#: group's own frame (DOP853's error estimate): the stress suite's close
+#: encounters end with energy errors of at most about 1e-10 at it
+#: (benchmarks/RESULTS.md has the sweep of this tolerance).
 RTOL = 1e-12
 
 
@@ -140,8 +139,6 @@ class Trace(Integrator):
     that pass 1e-5 au apart at t = 5 days (their state at the pass, run back
     five days with ``ias15``), at a half-day step:
 
-    >>> import astropy.units as u
-    >>> import orbits
     >>> b = orbits.BodySet()
     >>> b.add("Star", mass=1 * u.Msun)
     >>> b.add("Planet 1", mass=1 * u.Mearth, primary="Star", a=1 * u.au)
@@ -200,7 +197,6 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import orbits
         >>> ws = orbits.integrators.get("trace").workspace(3)
         >>> ws["enc"].shape, ws["counts"].tolist()
         ((3, 3), [0, 0, 0])
@@ -257,7 +253,6 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import numpy as np
         >>> from orbits import integrators
         >>> from orbits.integrators.base import around_a_circle
         >>> integ = integrators.get("trace")
@@ -313,7 +308,6 @@ class Trace(Integrator):
 
         Examples
         --------
-        >>> import orbits
         >>> integ = orbits.integrators.get("trace")
         >>> integ.behind(integ.workspace(2))
         0.0

@@ -44,18 +44,10 @@ COORDINATES = ("jacobi", "democratic-heliocentric")
 
 #: Bodies from which a run without added terms steps with its planets in
 #: vector lanes (:mod:`orbits._kernels.wh_lanes`; the same results bit for
-#: bit).  Measured on the 2-core AVX2 machine (CPU time a step, lanes against
-#: scalar, median of 5 paired runs of 1.5e5 steps, Jacobi / democratic
-#: heliocentric): the Sun with Jupiter and Saturn (N = 3, 10 days) 1.08 /
-#: 1.10, with three giants (N = 4) 0.90 / 0.79, the outer solar system
-#: (N = 6) 0.93 / 0.93, the Sun and eight planets (N = 9, half a day) 0.87 /
-#: 0.74, and at one day (Mercury's step too long for the lanes) 0.95 / 0.93.
-#: Two planets fill too little of a vector register to pay for the copies
-#: in and out.  On the Intel AVX-512 machine, with lanes 4 wide
-#: (orbits._kernels.gravity.LANE_WIDTH), CPU time a step at 30 days, lanes
-#: against scalar: the Sun with two giants 0.24-0.25 against 0.14-0.16 us,
-#: with three 0.20-0.24 against 0.195-0.199, with four 0.27-0.30 against
-#: 0.30-0.32 (with lanes 8 wide, three giants took 0.35).
+#: bit).  Two planets fill too little of a vector register to pay for the
+#: copies in and out; from three planets the lanes take less time a step on
+#: the AVX2 machine and about as long on the AVX-512 machine, less from four
+#: (benchmarks/RESULTS.md).
 LANES_FROM_BODIES = 4
 
 #: Spacing of the corrector stages: stage i is ``Z(a_i h, b_i h)`` with
@@ -264,8 +256,6 @@ class WisdomHolman(Integrator):
 
     Examples
     --------
-    >>> import astropy.units as u
-    >>> import orbits
     >>> sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator="wh",
     ...                         dt=200 * u.day)
     >>> result = sim.run(until=10_000 * u.yr, outputs=11, progress=False)
@@ -311,7 +301,6 @@ class WisdomHolman(Integrator):
 
         Examples
         --------
-        >>> import orbits
         >>> orbits.integrators.get("wh").batchable
         True
         >>> orbits.integrators.get("wh", corrector=3).batchable
@@ -527,7 +516,6 @@ class SABA2(WisdomHolman):
     --------
     A kick a step more with each, and one more drift:
 
-    >>> import orbits
     >>> [(orbits.integrators.get(name).forces_per_step,
     ...   len(orbits.integrators.get(name).operators)) for name in ("saba2", "saba3", "saba4")]
     [(2, 5), (3, 7), (4, 9)]

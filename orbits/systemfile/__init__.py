@@ -165,7 +165,6 @@ def read(path):
     Examples
     --------
     >>> import os, tempfile
-    >>> import orbits
     >>> from orbits import systemfile
     >>> path = os.path.join(tempfile.mkdtemp(), "kepler.toml")
     >>> systemfile.write(orbits.scenes.kepler(), path)
@@ -240,8 +239,6 @@ def write(bodies, path, run=None):
     Examples
     --------
     >>> import os, tempfile
-    >>> import numpy as np
-    >>> import orbits
     >>> from orbits import systemfile
     >>> bodies = orbits.scenes.outer_solar_system()
     >>> path = os.path.join(tempfile.mkdtemp(), "outer.csv")
@@ -273,7 +270,6 @@ def dumps(bodies, kind="toml", run=None):
 
     Examples
     --------
-    >>> import orbits
     >>> from orbits import systemfile
     >>> print(systemfile.dumps(orbits.scenes.kepler()))  # doctest: +ELLIPSIS
     # A body set for orbits...

@@ -30,11 +30,16 @@ left out, is declared in :mod:`~orbits.validation.cases`.
 """
 
 import datetime as _dt
+import importlib
 import os
 import pathlib
 import platform
 import time
 
+import numba
+import numpy
+
+from .. import __version__
 from ._runner import Pool, Task, run_tasks
 
 __all__ = ["validate", "SECTIONS", "Task", "Pool", "run_tasks", "ValidationError"]
@@ -49,7 +54,6 @@ class ValidationError(RuntimeError):
 
 
 def _modules(names):
-    import importlib
     unknown = [n for n in names if n not in SECTIONS]
     if unknown:
         raise ValidationError(f"unknown section(s) {', '.join(unknown)}; valid: "
@@ -152,11 +156,7 @@ def _cpu_name():
 
 
 def _versions():
-    import numba
-    import numpy
-
-    import orbits
-    out = {"orbits": orbits.__version__, "numpy": numpy.__version__,
+    out = {"orbits": __version__, "numpy": numpy.__version__,
            "numba": numba.__version__, "python": platform.python_version()}
     try:
         import rebound

@@ -19,12 +19,16 @@ import warnings
 import numpy as np
 
 from .. import integrators as _integrators
+from .._kernels import anomalies as _anomalies
+from .._kernels import elements as _elements
 from ..errors import OrbitsError, RunError
 from ..monitors import vector_relative_error
 from ..simulation import Simulation
+from . import cases
 
 __all__ = ["run_orbits", "run_rebound", "row_template", "on_steps", "REBOUND_INTEGRATORS",
-           "WALL_LIMIT", "energy_and_momentum"]
+           "WALL_LIMIT", "energy_and_momentum", "position_error", "exact_two_body",
+           "rebound_with_extras", "REBOUNDX_MISSING"]
 
 #: Seconds a single measured run may take before it is stopped with
 #: ``WallTimeExceeded`` (recorded as its outcome): a sweep cell whose step
@@ -180,6 +184,28 @@ def energy_and_momentum(sim):
     return sim.energy(), np.array(sim.angular_momentum())
 
 
+#: a REBOUNDx run's outcome message where REBOUNDx is not installed
+REBOUNDX_MISSING = "reboundx is not installed (pip install reboundx)"
+
+
+def rebound_with_extras(bodies, load=None):
+    """REBOUND's IAS15 on ``bodies`` with direct-summation gravity, and REBOUNDx's
+    ``Extras`` on it that ``load(sim, extras)`` fills, where ``load`` is given.
+
+    Returns ``(sim, extras)`` (``extras`` None without ``load``; the caller keeps
+    it while ``sim`` integrates); ImportError where REBOUNDx is needed and missing.
+    """
+    sim = bodies.to_rebound()
+    sim.gravity = "basic"
+    sim.integrator = "ias15"
+    if load is None:
+        return sim, None
+    import reboundx
+    extras = reboundx.Extras(sim)
+    load(sim, extras)
+    return sim, extras
+
+
 def run_rebound(bodies, integrator, options=None, *, dt=None, until, outputs=2, times=None,
                 wall_limit=WALL_LIMIT, label=None, count_evaluations=False):
     """Run one of REBOUND's integrators on the same floats and G, and measure it.
@@ -286,3 +312,39 @@ def _count_evaluations(bodies, options, until):
     sim.force_is_velocity_dependent = 0
     sim.integrate(float(until), exact_finish_time=1)
     return count[0]
+
+
+def exact_two_body(body_set, t):
+    """Positions (N=2, 3) of a two-body problem at time ``t``, from its Kepler
+    orbit: the mean anomaly advances by ``n t`` (reduced modulo 2 pi in two
+    parts, so its rounding is that of one orbit's, ~1e-15 rad) and the centre
+    of mass moves uniformly."""
+    m = body_set._m
+    x, v = body_set._x, body_set._v
+    mu = body_set.units.G * (m[0] + m[1])
+    el = np.zeros(7)
+    _elements.state_to_elements(mu, x[1] - x[0], v[1] - v[0], el)
+    a, e, inc, node, peri, _, mean0 = el
+    n = math.sqrt(mu / a ** 3)
+    period = 2 * math.pi / n
+    whole = math.floor(t / period)
+    mean = mean0 + n * (t - whole * period)
+    f = _anomalies.true_from_mean(math.fmod(mean, 2 * math.pi), e)
+    pos, vel = np.zeros(3), np.zeros(3)
+    _elements.elements_to_state(mu, a, e, inc, node, peri, f, pos, vel)
+    com = (m[:, None] * x).sum(0) / m.sum() + (m[:, None] * v).sum(0) / m.sum() * t
+    return np.array([com - m[1] / m.sum() * pos, com + m[0] / m.sum() * pos])
+
+
+def position_error(row, ref, problem=None):
+    """Largest final position error of ``row``: against the exact Kepler orbit
+    for the two-body problems, else against the reference row ``ref``."""
+    if row["x"] is None or row["outcome"] != "completed":
+        return math.nan
+    prob = cases.problem(problem) if problem is not None else None
+    if prob is not None and prob.scene == "kepler":
+        exact = exact_two_body(cases.bodies(prob), row["t_end"])
+        return float(np.abs(np.asarray(row["x"]) - exact).max())
+    if ref is None or ref["x"] is None or ref["outcome"] != "completed":
+        return math.nan
+    return float(np.abs(np.asarray(row["x"]) - np.asarray(ref["x"])).max())

@@ -20,6 +20,11 @@ import os
 import time
 from typing import NamedTuple
 
+from tqdm.auto import tqdm
+
+from ..ensemble import local_cluster
+from ..ensemble.compiles import _sync_numba_config
+
 __all__ = ["Task", "run_tasks", "Pool"]
 
 
@@ -35,7 +40,6 @@ class Task(NamedTuple):
 
 
 def _call(task):
-    from ..ensemble.compiles import _sync_numba_config
     _sync_numba_config()
     module, name = task.function.split(":")
     func = getattr(importlib.import_module(module), name)
@@ -63,7 +67,6 @@ class Pool:
 
     def client(self):
         if self._client is None:
-            from ..ensemble import local_cluster
             self._client = local_cluster(self.n_workers)
             self._own = True
         return self._client
@@ -85,8 +88,6 @@ class Pool:
 
 def run_tasks(tasks, pool, progress=True, desc="measuring"):
     """Run ``tasks`` (a list of :class:`Task`) and return their rows in order."""
-    from tqdm.auto import tqdm
-
     tasks = list(tasks)
     order = sorted(range(len(tasks)), key=lambda i: -tasks[i].cost)
     shared = [i for i in order if not tasks[i].exclusive]

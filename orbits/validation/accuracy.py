@@ -13,13 +13,10 @@ REBOUND's IAS15 and WHFast.
 
 import math
 
-import numpy as np
-
-from .._kernels import anomalies as _anomalies
-from .._kernels import elements as _elements
-from . import cases
+from .. import integrators
+from . import cases, work_precision
 from ._format import fmt_count, fmt_err, fmt_time, outcome_cell
-from ._measure import run_orbits, run_rebound
+from ._measure import position_error, run_orbits, run_rebound
 from ._runner import Task
 
 __all__ = ["TITLE", "tasks", "section", "measure", "OUTPUTS"]
@@ -51,7 +48,6 @@ def measure(problem, integrator, quick, rebound=False, options=None, label=None)
                           outputs=OUTPUTS, count_evaluations=integrator == "ias15",
                           label=label)
     else:
-        from .. import integrators
         adaptive = integrators.get(integrator).adaptive
         row = run_orbits(body_set, integrator, options, dt=None if adaptive else prob.dt,
                          until=until, outputs=OUTPUTS, label=label)
@@ -60,27 +56,6 @@ def measure(problem, integrator, quick, rebound=False, options=None, label=None)
         row.pop(key, None)
     return row
 
-
-def exact_two_body(body_set, t):
-    """Positions (N=2, 3) of a two-body problem at time ``t``, from its Kepler
-    orbit: the mean anomaly advances by ``n t`` (reduced modulo 2 pi in two
-    parts, so its rounding is that of one orbit's, ~1e-15 rad) and the centre
-    of mass moves uniformly."""
-    m = body_set._m
-    x, v = body_set._x, body_set._v
-    mu = body_set.units.G * (m[0] + m[1])
-    el = np.zeros(7)
-    _elements.state_to_elements(mu, x[1] - x[0], v[1] - v[0], el)
-    a, e, inc, node, peri, _, mean0 = el
-    n = math.sqrt(mu / a ** 3)
-    period = 2 * math.pi / n
-    whole = math.floor(t / period)
-    mean = mean0 + n * (t - whole * period)
-    f = _anomalies.true_from_mean(math.fmod(mean, 2 * math.pi), e)
-    pos, vel = np.zeros(3), np.zeros(3)
-    _elements.elements_to_state(mu, a, e, inc, node, peri, f, pos, vel)
-    com = (m[:, None] * x).sum(0) / m.sum() + (m[:, None] * v).sum(0) / m.sum() * t
-    return np.array([com - m[1] / m.sum() * pos, com + m[0] / m.sum() * pos])
 
 
 def _cost(prob, name, quick):
@@ -128,25 +103,10 @@ def left_out(quick):
     return rows
 
 
-def position_error(row, ref, problem=None):
-    """Largest final position error of ``row``: against the exact Kepler orbit
-    for the two-body problems, else against the reference row ``ref``."""
-    if row["x"] is None or row["outcome"] != "completed":
-        return math.nan
-    prob = cases.problem(problem) if problem is not None else None
-    if prob is not None and prob.scene == "kepler":
-        exact = exact_two_body(cases.bodies(prob), row["t_end"])
-        return float(np.abs(np.asarray(row["x"]) - exact).max())
-    if ref is None or ref["x"] is None or ref["outcome"] != "completed":
-        return math.nan
-    return float(np.abs(np.asarray(row["x"]) - np.asarray(ref["x"])).max())
-
-
 def _options(row, prob):
     opts = row.get("options") or {}
     if row.get("dt") is not None:
         return f"dt = {row['dt']:.4g} {prob.time_unit}"
-    from .. import integrators
     name = row["integrator"]
     if name.startswith("rebound-"):
         return "epsilon = 1e-09 (default)"
@@ -213,7 +173,6 @@ def section(rows, out_dir, quick):
 
 def _problems_table(quick):
     """Which checks each problem takes, and how many integrators it leaves out."""
-    from . import work_precision
     skipped = {}
     for key, name, _ in left_out(quick):
         skipped.setdefault(key, []).append(name)

@@ -39,8 +39,8 @@ DIVERGENT = ("euler",)
 
 #: Above this many orbits of the shortest period (full report, quick report)
 #: a Python-force method takes longer than the rest of a problem's rows
-#: together: scipy's Radau was measured at 0.2 to 0.4 s an orbit at its
-#: default tolerance (some 400 steps of about 0.5 ms).
+#: together: scipy's Radau takes some 400 steps of about 0.5 ms an orbit at
+#: its default tolerance.
 PYTHON_FORCE_ORBITS = (150, 30)
 
 _YEAR = 365.25

@@ -43,6 +43,13 @@ import time
 import astropy.units as u
 import numpy as np
 
+from .. import scenes
+from ..analysis import mean_motion_frequencies, secular_frequencies
+from ..bodies import BodySet
+from ..ensemble import Ensemble, local_cluster
+from ..errors import RunError
+from ..simulation import Simulation
+from ..units import UnitSystem
 from ._format import fmt_time
 from ._runner import Task
 
@@ -86,11 +93,9 @@ A_RANGE = (10.0, 16.0)     # au
 E_RANGE = (0.0, 0.45)
 
 #: ``<Y>`` above which an orbit counts as chaotic.  A regular orbit's <Y> tends
-#: to 2, but after 2000 Jupiter orbits it still wanders with the tangent vector
-#: (measured: 1.885 to 2.035 over 12 seeds of each code at 12.35 au, e = 0, near
-#: the 3:2; 1.55 to 2.34 over seeds and integrators at 13.65 and 14.96 au,
-#: e = 0.08, near the 5:3 and 2:1; 1.994 to 2.013 at 15.5 and 16 au, away from
-#: them; 2.03 to 3.11 at 11.55 au, e = 0, the edge of Saturn's chaotic zone).
+#: to 2, but after 2000 Jupiter orbits it still wanders with the tangent vector:
+#: from 1.55 to 2.34 over seeds and codes near the resonances, up to 3.11 at
+#: the edge of Saturn's chaotic zone (benchmarks/RESULTS.md lists the points).
 #: A chaotic orbit's grows as lambda t / 2, passing 3 after six Lyapunov times.
 #: 3 stays above nearly all of that wandering (2.5 would not: half the resonant
 #: points above would then be called chaotic by one seed and regular by
@@ -126,7 +131,6 @@ def grid(quick):
 
 def jupiter_period_days():
     """Jupiter's period about the Sun, days (two-body, with the package's G)."""
-    from ..units import UnitSystem
     mu = UnitSystem().G * (1 + 1 / MASS_RATIOS["Jupiter"])
     return 2 * math.pi * math.sqrt(JUPITER["a"] ** 3 / mu)
 
@@ -163,7 +167,6 @@ def bodies(a, e):
 def _giants():
     # the same for every grid point: made once a process (it is a third of a
     # member's set-up time)
-    from ..bodies import BodySet
     b = BodySet()
     b.add("Sun", mass=1 * u.Msun)
     for name, el in (("Jupiter", JUPITER), ("Saturn", SATURN)):
@@ -175,7 +178,6 @@ def _giants():
 
 def build(a, e, seed=SEED):
     """Our simulation of one grid point (module level: the ensemble pickles it)."""
-    from ..simulation import Simulation
     return Simulation(bodies(a, e), "wh", dt=DT_DAYS * u.day, monitors=("megno", "lyapunov"),
                       seed=seed)
 
@@ -236,7 +238,6 @@ def _tangent_norm(var):
 
 
 def _ours(a, e, steps, seed):
-    from ..errors import RunError
     sim = build(a, e, seed)
     out = {"outcome": "completed", "megno": math.nan, "lyapunov": math.nan}
     t0 = time.perf_counter()
@@ -293,8 +294,6 @@ def maps(quick, workers=None):
     processes), REBOUND's from its own random tangent and REBOUND's from ours
     (a ``multiprocessing.Pool`` of ``workers`` processes).  Exclusive: it needs
     the machine to itself."""
-    from ..ensemble import Ensemble, local_cluster
-
     workers = int(workers or 1)
     a, e = grid(quick)
     steps = span_steps(quick)
@@ -371,11 +370,6 @@ def frequency_span(quick):
 def frequencies(quick):
     """The outer solar system's g5, g6, s6 (arcsec/yr) and great inequality
     (yr) from a ``wh`` run of :func:`frequency_span`."""
-    from .. import scenes
-    from ..analysis import mean_motion_frequencies, secular_frequencies
-    from ..errors import RunError
-    from ..simulation import Simulation
-
     span = frequency_span(quick)
     outputs = int(round((span / FREQUENCY_OUTPUT_EVERY).to_value(u.one))) + 1
     out = {"kind": "frequencies", "span_yr": span.to_value(u.yr), "outcome": "completed",

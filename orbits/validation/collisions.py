@@ -23,11 +23,17 @@ Two measurements:
   with the energy error at the end of each run and the wall time.
 """
 
+import ctypes
 import math
 import time
 
+import astropy.units as u
 import numpy as np
 
+from .. import integrators, scenes
+from ..bodies import BodySet
+from ..errors import Collision, Escape, RunError
+from ..simulation import Simulation
 from ._format import fmt_err, fmt_time
 from ._runner import Task
 
@@ -59,7 +65,6 @@ def _sizes(quick):
 
 def ring(n, seed=1):
     """The planetesimal ring of ``n`` bodies (:func:`orbits.scenes.planetesimal_ring`)."""
-    from .. import scenes
     return scenes.planetesimal_ring(n, seed=seed)
 
 
@@ -68,12 +73,10 @@ def three_planets(member):
     :data:`SPACING` mutual Hill radii apart from :data:`INNER` au, circular,
     inclinations Rayleigh(0.001 rad), random nodes and phases, radii
     :data:`RADIUS_FACTOR` times Jupiter's."""
-    import astropy.units as u
-    import orbits
     rng = np.random.default_rng(1000 + member)
     x = (2 * JUPITER_MASS / 3) ** (1 / 3)
     k = SPACING * x / 2
-    b = orbits.BodySet()
+    b = BodySet()
     b.add("Star", mass=1 * u.Msun, radius=SUN_RADIUS * u.au)
     a = INNER
     for name in ("b", "c", "d"):
@@ -89,15 +92,13 @@ def three_planets(member):
 
 def merge_run(code, quick):
     """The ring with mergers, by ``code`` ("orbits" or "rebound")."""
-    import astropy.units as u
     n, years = _sizes(quick)[:2]
     bodies = ring(n)
     names = list(bodies.names)
     if code == "orbits":
-        import orbits
-        sim = orbits.Simulation(bodies, "ias15", collisions="merge")
+        sim = Simulation(bodies, "ias15", collisions="merge")
         sim.run(until=1 * u.day, outputs=2, progress=False)      # compiled, warmed
-        sim = orbits.Simulation(bodies, "ias15", collisions="merge")
+        sim = Simulation(bodies, "ias15", collisions="merge")
         t0 = time.perf_counter()
         res = sim.run(until=years * u.yr, outputs=101, progress=False)
         wall = time.perf_counter() - t0
@@ -107,7 +108,6 @@ def merge_run(code, quick):
         return {"kind": "merge", "code": code, "events": events, "left": len(sim.bodies),
                 "energy_error": float(res.energy_error.max()), "wall_time": wall,
                 "steps": int(res.steps), "n": n, "years": years}
-    import ctypes
     import rebound
     sim = bodies.to_rebound()
     sim.integrator = "ias15"
@@ -147,7 +147,6 @@ TRACE_CODES = (("orbits trace", True, "trace", 20.0),
 
 
 def _codes():
-    from .. import integrators
     have = any(info.name == "trace" for info in integrators.available())
     return SCATTER_CODES + (TRACE_CODES if have else ())
 
@@ -169,14 +168,9 @@ def _classify(pair, star="Star"):
 
 
 def _scatter_ours(label, member, bodies, integrator, dt, years):
-    import astropy.units as u
-    import orbits
-    from ..errors import Collision, Escape, RunError
-
     def make():
-        return orbits.Simulation(bodies, integrator, dt=None if dt is None else dt * u.day,
-                                 collisions="halt",
-                                 escape_distance=EJECTION_DISTANCE * u.au)
+        return Simulation(bodies, integrator, dt=None if dt is None else dt * u.day,
+                          collisions="halt", escape_distance=EJECTION_DISTANCE * u.au)
     make().run(until=1 * u.day, outputs=2, progress=False)     # compiled, warmed
     sim = make()
     t0 = time.perf_counter()

@@ -27,10 +27,17 @@ import math
 import pathlib
 import time
 
+import astropy.constants as const
 import astropy.units as u
 import numpy as np
 
+from .. import forces
+from ..bodies import BodySet
+from ..errors import RunError
+from ..simulation import Simulation
+from ..units import UnitSystem
 from ._format import fmt_err, fmt_time
+from ._measure import REBOUNDX_MISSING, rebound_with_extras
 from ._runner import Task
 
 __all__ = ["TITLE", "tasks", "section", "measure", "rate", "summary_line", "PARITY_CASES",
@@ -82,7 +89,6 @@ def orbits_run(quick):
 # -- the problems ------------------------------------------------------------------------
 
 def _star_planet(a, e, inc, mass=1 * u.Mjup):
-    from ..bodies import BodySet
     b = BodySet()
     b.add("Star", mass=1 * u.Msun)
     b.add("Planet", mass=mass, primary="Star", a=a * u.au, e=e, inc=inc * u.rad,
@@ -94,7 +100,6 @@ def _star_planet(a, e, inc, mass=1 * u.Mjup):
 def _parity_problem(key):
     """``(bodies, our terms, load(sim, rebx), period [day])`` of a parity case;
     ``load`` adds REBOUNDx's force to a REBOUND simulation of the bodies."""
-    from .. import forces
     if key == "migration":
         b = _star_planet(1.0, 0.1, 0.1)
         taus = {"tau_a": 5000 * YEAR, "tau_e": 2000 * YEAR, "tau_inc": 3000 * YEAR}
@@ -127,9 +132,6 @@ def _parity_problem(key):
             p.params["OmegaMag"] = spin          # a spin along z, as ours
         return b, terms, load, 0.05 ** 1.5 * YEAR
     if key == "radiation":
-        import astropy.constants as const
-
-        from ..bodies import BodySet
         b = BodySet()
         b.add("Sun", mass=1 * u.Msun)
         b.add("Jupiter", mass=1 * u.Mjup, primary="Sun", a=5.2 * u.au, e=0.05)
@@ -159,9 +161,6 @@ def _scale(bodies, key):
 # -- the measurements --------------------------------------------------------------------
 
 def _run_ours(bodies, terms, times):
-    from ..errors import RunError
-    from ..simulation import Simulation
-
     x = np.full((len(times), len(bodies), 3), np.nan)
     make = lambda: Simulation(bodies, "ias15", forces=terms, monitors=())  # noqa: E731
     # compile first (a few steps of a fresh copy), so the wall time is the run's
@@ -178,19 +177,11 @@ def _run_ours(bodies, terms, times):
 
 
 def _run_rebound(bodies, load, times):
-    sim = bodies.to_rebound()
-    sim.gravity = "basic"
-    sim.integrator = "ias15"
     x = np.full((len(times), len(bodies), 3), np.nan)
-    extras = None
-    if load is not None:
-        try:
-            import reboundx
-        except ImportError:
-            return (x, math.nan, 0, "not run",
-                    "reboundx is not installed (pip install reboundx)")
-        extras = reboundx.Extras(sim)          # kept alive while sim integrates
-        load(sim, extras)
+    try:
+        sim, extras = rebound_with_extras(bodies, load)    # extras kept while sim integrates
+    except ImportError:
+        return x, math.nan, 0, "not run", REBOUNDX_MISSING
     outcome, message = "completed", ""
     t0 = time.perf_counter()
     try:
@@ -245,7 +236,6 @@ def hut_de_dt(e, n, a, k2, tau, R, m_body, m_other, spin):
 
 
 def _run(bodies, terms, until_days, outputs):
-    from ..simulation import Simulation
     return Simulation(bodies, "ias15", forces=terms, monitors=()).run(
         until=until_days * u.day, outputs=outputs, progress=False)
 
@@ -257,9 +247,6 @@ def _elements(res, body):
 
 
 def _rate_rows(case):
-    from .. import forces
-    from ..units import UnitSystem
-
     G = UnitSystem().G
     rows = []
     if case == "migration-a":
@@ -315,9 +302,6 @@ def _rate_rows(case):
                          "unit": "1/yr", "left_out": left_out})
     elif case == "radiation":
         # a circular orbit: r^2 = r0^2 - 4 beta G M t / c (Wyatt & Whipple 1950)
-        import astropy.constants as const
-
-        from ..bodies import BodySet
         beta, r0 = 0.2, 1.0
         mu = G * 1.0
         b = BodySet()
@@ -342,7 +326,6 @@ def _rate_rows(case):
 def rate(case, quick):
     """The analytic-rate rows of one case (runs on a worker); the runs are the
     same in the quick report, a few seconds each."""
-    from ..errors import RunError
     out = {"kind": "rate", "case": case, "rows": [], "outcome": "completed", "message": ""}
     try:
         out["rows"] = _rate_rows(case)

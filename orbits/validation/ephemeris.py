@@ -28,9 +28,16 @@ the Moon's floor is the Earth's figure.
 import math
 import pathlib
 
+import astropy.constants as const
 import astropy.units as u
 import numpy as np
 
+from .. import forces, scenes
+from ..bodies import BodySet
+from ..errors import RunError
+from ..scenes import ephemerides
+from ..simulation import Simulation
+from ._measure import REBOUNDX_MISSING, rebound_with_extras
 from ._runner import Task
 
 __all__ = ["TITLE", "tasks", "section", "measure", "summary_line", "TERMS", "horizons",
@@ -64,8 +71,6 @@ def horizons(quick):
 
 def _forces(key):
     """Our terms for the run ``key``."""
-    from .. import forces
-    from ..scenes import ephemerides
     if key == "gr_full_j2":
         ephemeris = ephemerides._de421_ephemeris()
         return [forces.GRFull(), forces.ZonalHarmonics("Earth", ephemeris.RE * u.km,
@@ -77,9 +82,6 @@ def _forces(key):
 def _bodies_and_reference(moon, years):
     """The de421 scene (``moon=False``: without the Moon) and DE421's
     barycentric positions (n, N, 3) in au of its bodies at ``years``."""
-    from .. import scenes
-    from ..bodies import BodySet
-    from ..scenes import ephemerides
     full = scenes.de421()
     x, _ = scenes.de421_states(ephemerides._J2000_JD_TDB + YEAR * np.asarray(years, dtype=float))
     keep = [i for i, name in enumerate(full.names) if moon or name != "Moon"]
@@ -90,9 +92,6 @@ def _bodies_and_reference(moon, years):
 
 
 def _run_ours(bodies, key, days):
-    from ..errors import RunError
-    from ..simulation import Simulation
-
     sim = Simulation(bodies, "ias15", forces=_forces(key), monitors=())
     x = np.full((len(days), len(bodies), 3), np.nan)
     outcome, message = "completed", ""
@@ -106,24 +105,19 @@ def _run_ours(bodies, key, days):
 
 
 def _run_rebound(bodies, key, days):
-    import astropy.constants as const
-
     effect = _EFFECT.get(key)
-    sim = bodies.to_rebound()
-    sim.gravity = "basic"
-    sim.integrator = "ias15"
-    x = np.full((len(days), len(bodies), 3), np.nan)
-    extras = None
-    if effect is not None:
-        try:
-            import reboundx
-        except ImportError:
-            return x, "not run", "reboundx is not installed (pip install reboundx)"
-        extras = reboundx.Extras(sim)          # kept alive while sim integrates
+
+    def load(sim, extras):
         force = extras.load_force(effect)
         extras.add_force(force)
         force.params["c"] = const.c.to_value(bodies.units.length / bodies.units.time)
         sim.particles[bodies.names.index("Sun")].params["gr_source"] = 1
+
+    x = np.full((len(days), len(bodies), 3), np.nan)
+    try:
+        sim, extras = rebound_with_extras(bodies, None if effect is None else load)
+    except ImportError:
+        return x, "not run", REBOUNDX_MISSING
     outcome, message = "completed", ""
     try:
         for k, t in enumerate(days):
@@ -272,7 +266,6 @@ def _com_drift_km(years):
     """How far the scene's centre of mass moves from DE421's barycentre in
     ``years``: the scene keeps DE421's barycentric velocities, and the bodies
     left out (the asteroids) carry the rest of the momentum."""
-    from .. import scenes
     _, v = scenes.de421().center_of_mass()
     return float(np.linalg.norm(v.to_value(u.km / u.day))) * YEAR * years
 

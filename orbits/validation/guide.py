@@ -18,8 +18,12 @@ force and sets the measured figures beside the claimed ones and these.
 import math
 import pathlib
 
+import numba
 import numpy as np
 
+from .. import integrators
+from ..custom import integrate
+from ..errors import OrbitsError, RunError
 from ._format import fmt_err
 from ._runner import Task
 
@@ -42,12 +46,6 @@ def euler_theory(n):
 
 def measure():
     """Every fixed-step method that takes a user force, on the spring (one task)."""
-    import numba
-
-    from .. import integrators
-    from ..custom import integrate
-    from ..errors import OrbitsError, RunError
-
     k_over_m = K / M
 
     @numba.njit

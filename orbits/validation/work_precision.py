@@ -21,10 +21,12 @@ import time
 
 import numpy as np
 
+from .. import integrators
+from ..monitors import vector_relative_error
 from . import cases
 from ._format import fmt_time
-from ._measure import (WALL_LIMIT, _set_options, energy_and_momentum, on_steps, row_template,
-                       run_orbits, run_rebound)
+from ._measure import (WALL_LIMIT, _set_options, energy_and_momentum, on_steps,
+                       position_error, row_template, run_orbits, run_rebound)
 from ._runner import Task
 
 __all__ = ["TITLE", "tasks", "section", "measure", "SWEEP", "TOLERANCES", "EPSILONS",
@@ -190,7 +192,6 @@ def _run_unit_g(bodies, integrator, options=None, *, dt, until, outputs=2,
     errors as they are; it integrates to half a step before each output
     with ``exact_finish_time = 0``, so it takes whole steps as the others do.
     """
-    from ..monitors import vector_relative_error
     options = dict(options or {})
     label = label or f"REBOUND {integrator}"
     row = row_template(label, integrator=f"rebound-{integrator}", options=options, dt=dt)
@@ -292,7 +293,6 @@ def _series_name(integrator, rebound):
 
 
 def tasks(quick):
-    from .. import integrators
     out = []
     k = 1 if quick else 0
     for key, lengths in SWEEP.items():
@@ -341,7 +341,6 @@ def tasks(quick):
 
 def _attach_errors(rows):
     """Add ``position_error`` (against the reference) to every row."""
-    from .accuracy import position_error
     refs = {r["problem"]: r for r in rows if r["series"] == "reference"}
     for r in rows:
         r["position_error"] = (math.nan if r is refs.get(r["problem"]) else

@@ -31,8 +31,6 @@ One module an idea, each importing only those above it:
 Examples
 --------
 >>> import os, tempfile
->>> import astropy.units as u
->>> import orbits
 >>> from orbits.io import h5md
 >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
 >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)

@@ -32,14 +32,8 @@ class Checkpoint(NamedTuple):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
-    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-    >>> cp = h5md.read_checkpoint(path)
+    >>> cp = h5md.read_checkpoint(run_file)
     >>> cp.bodies.names, cp.config["integrator"], cp.state.steps
     (['Star', 'Planet'], 'leapfrog', 10)
     """
@@ -67,14 +61,8 @@ def read_checkpoint(path):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
-    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-    >>> cp = h5md.read_checkpoint(path)
+    >>> cp = h5md.read_checkpoint(run_file)
     >>> cp.point.finished, cp.point.time            # time in the file's unit (days)
     (True, 10.0)
     """
@@ -207,14 +195,8 @@ class ResumePoint(NamedTuple):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
-    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-    >>> point = h5md.read_checkpoint(path).point
+    >>> point = h5md.read_checkpoint(run_file).point
     >>> point.outputs_written, point.rows, point.finished, point.plan.until
     (3, 3, True, 10.0)
     """
@@ -253,16 +235,10 @@ def truncate(path, point):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
-    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-    >>> point = h5md.read_checkpoint(path).point
-    >>> h5md.truncate(path, point._replace(rows=1, time=0.0))   # back to the first output
-    >>> orbits.load(path).times
+    >>> point = h5md.read_checkpoint(run_file).point
+    >>> h5md.truncate(run_file, point._replace(rows=1, time=0.0))   # back to the first output
+    >>> orbits.load(run_file).times
     <Quantity [0.] d>
     """
     if os.path.islink(path):

@@ -44,11 +44,9 @@ except ImportError:     # pragma: no cover - not POSIX
 #: for space about once per this much output rather than at every write
 _RESERVE_BYTES = 4 << 20
 #: bytes of HDF5's own bookkeeping a write may add besides the data and the
-#: chunks it starts (chunk indexes, object headers, heaps).  Measured: the
-#: largest growth of a file past the data of one write, in runs of 2 and 6
-#: bodies (fixed steps, ias15 with a checkpoint at every output, in-loop
-#: monitors, variations), was 0.2 to 0.5 MB (the first write, which starts a
-#: chunk of every series), against a headroom of 0.8 to 1 MB with this
+#: chunks it starts (chunk indexes, object headers, heaps): the first write,
+#: which starts a chunk of every series, adds the most, up to about this
+#: much (benchmarks/RESULTS.md)
 _METADATA_BYTES = 1 << 19
 #: bytes reserved for a row of the collision or encounter log (a few floats,
 #: and names kept in HDF5's global heap)

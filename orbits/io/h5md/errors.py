@@ -18,7 +18,6 @@ class OrbitsFileError(OrbitsError, OSError):
     Examples
     --------
     >>> import os, tempfile
-    >>> import orbits
     >>> path = os.path.join(tempfile.mkdtemp(), "notes.h5")
     >>> with open(path, "w") as fh:
     ...     _ = fh.write("not HDF5")

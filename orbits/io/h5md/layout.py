@@ -100,6 +100,7 @@ import h5py
 import numba
 import numpy as np
 
+from ... import __version__ as _VERSION
 from ... import epochs as _epochs
 from ..._kernels import invariants as _inv
 from ...errors import OrbitsError
@@ -279,14 +280,6 @@ def _element(parent, name, shape, unit):
     return g
 
 
-def _package_version():
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("orbits")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree
-        return "0+unknown"
-
-
 def _series_errors(group, name, rows, reference, scales):
     """The relative error of monitor ``name`` at ``rows`` (a slice, or
     increasing indices) of the series in ``group`` (``observables`` or
@@ -349,8 +342,6 @@ def _create(path, desc, state):
 def _write_layout(f, desc, state):
     """The groups, datasets and metadata of a new file ``f`` (the layout of the
     module's notes) for the simulation ``desc`` describes, at ``state``; flushed."""
-    __version__ = _package_version()
-
     U = desc.units
     f.attrs["orbits_format"] = FORMAT
     f.attrs["orbits_format_version"] = FORMAT_VERSION
@@ -359,7 +350,7 @@ def _write_layout(f, desc, state):
     h.create_group("author").attrs["name"] = os.environ.get("USER", "unknown")
     c = h.create_group("creator")
     c.attrs["name"] = "orbits"
-    c.attrs["version"] = __version__
+    c.attrs["version"] = _VERSION
     n = len(desc.names)
     unit = lambda kind: U.unit(kind).to_string()  # noqa: E731
     b = f.create_group("particles/bodies")
@@ -382,7 +373,7 @@ def _write_layout(f, desc, state):
         _element(inloop, name, spec.shape, u_)
     par = f.create_group("parameters")
     meta = {
-        "orbits_version": __version__, "numpy_version": np.__version__,
+        "orbits_version": _VERSION, "numpy_version": np.__version__,
         "numba_version": numba.__version__, "h5py_version": h5py.__version__,
         "astropy_version": astropy.__version__,
         "written": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),

@@ -91,15 +91,9 @@ def whole_run(path):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
-    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-    >>> last = sim.run(until=20 * u.day, outputs=3, output=path, progress=False)
-    >>> whole = h5md.whole_run(path)
+    >>> last = sim.run(until=20 * u.day, outputs=3, output=run_file, progress=False)
+    >>> whole = h5md.whole_run(run_file)
     >>> last.steps, last.start_time, whole["steps"], whole["start_time"]
     (10, <Quantity 10. d>, 20, <Quantity 0. d>)
     """
@@ -165,14 +159,8 @@ def load(path):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
-    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-    >>> result = orbits.load(path)
+    >>> result = orbits.load(run_file)
     >>> result.times, result.positions.unit, result.steps
     (<Quantity [ 0.,  5., 10.] d>, Unit("AU"), 10)
     """
@@ -366,14 +354,8 @@ def describe(path):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
-    >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-    >>> _ = sim.run(until=10 * u.day, outputs=3, output=path, progress=False)
-    >>> text = h5md.describe(path)
+    >>> text = h5md.describe(run_file)
     >>> [line.split()[0] for line in text.splitlines()[1:4]]
     ['bodies', 'integrator', 'units']
     """

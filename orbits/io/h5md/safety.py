@@ -41,7 +41,7 @@ __all__ = ["SWMR_READ_ATTEMPTS"]
 
 #: tries of a metadata read whose checksum fails, in SWMR mode.  HDF5 sleeps
 #: 1, 2, 4, ... ns between tries, so 24 tries give up after 2**24 ns = 17 ms
-#: (measured: 41 ms for 25 tries, 1.1 s for 30); a live writer rewrites a
+#: (the wait doubles with each further try); a live writer rewrites a
 #: metadata block in microseconds.  HDF5's default, 100, never gives up.
 SWMR_READ_ATTEMPTS = 24
 
@@ -194,8 +194,8 @@ def _open_hdf5(path):
     writing = sb.flags & (_OPEN_FOR_WRITE | _OPEN_FOR_SWMR_WRITE)
     if sb.eof > sb.size:
         # a live writer records a new end of file a moment before the file
-        # reaches it (measured: 0.06 % of the time with a checkpoint at every
-        # output): look again while its lock says it runs
+        # reaches it (rarely: benchmarks/RESULTS.md): look again while its lock
+        # says it runs
         writer, alive = _writer(path) if writing else (None, False)
         deadline = _time.monotonic() + 1.0
         while alive is not False and sb.eof > sb.size and _time.monotonic() < deadline:

@@ -68,9 +68,9 @@ class FileRecorder:
 
     Examples
     --------
+    The methods' examples start from a ``sim`` and a ``rec`` made so:
+
     >>> import os, tempfile
-    >>> import astropy.units as u
-    >>> import orbits
     >>> from orbits.io import h5md
     >>> from orbits.records import RunPlan
     >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
@@ -363,16 +363,6 @@ class FileRecorder:
 
         Examples
         --------
-        >>> import os, tempfile
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> from orbits.io import h5md
-        >>> from orbits.records import RunPlan
-        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
-        ...                start_step=0)
-        >>> rec = h5md.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
         >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
         >>> rec.output(sim, final=True)
         >>> rec.outputs_written, rec.checkpoints
@@ -456,17 +446,6 @@ class FileRecorder:
 
         Examples
         --------
-        >>> import os, tempfile
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> from orbits.io import h5md
-        >>> from orbits.records import RunPlan
-        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
-        ...                start_step=0)
-        >>> rec = h5md.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
-        >>> import numpy as np
         >>> rec.monitor_rows(np.array([1.0]), np.zeros((1, 11)))
         >>> len(rec.mon_buffer)
         1
@@ -483,16 +462,6 @@ class FileRecorder:
 
         Examples
         --------
-        >>> import os, tempfile
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> from orbits.io import h5md
-        >>> from orbits.records import RunPlan
-        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
-        ...                start_step=0)
-        >>> rec = h5md.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
         >>> _ = sim.run(until=4 * u.day, outputs=2, progress=False)
         >>> rec.stopped(sim)
         >>> rec.result(sim, wall=0.0).times
@@ -522,26 +491,12 @@ class FileRecorder:
         if not rows or self.closed:
             return
         self._reserve(_LOG_ROW_BYTES * len(rows))
-        U = sim.units
-        g = self.f.require_group("collisions")
-        text = h5py.string_dtype()
-        unit = lambda kind: U.unit(kind).to_string()  # noqa: E731
-        cols = (("time", np.float64, unit("time")), ("step_time", np.float64, unit("time")),
-                ("body_1", text, None), ("body_2", text, None), ("resolution", text, None),
-                ("survivor", text, None), ("distance", np.float64, unit("length")),
-                ("speed", np.float64, unit("velocity")),
-                ("energy_change", np.float64, unit("energy")))
-        for k, (name, dtype, u_) in enumerate(cols):
-            values = [row[k] for row in rows]
-            if name not in g:
-                ds = g.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype,
-                                      chunks=(256,))
-                if u_ is not None:
-                    ds.attrs["unit"] = u_
-            ds = g[name]
-            start = ds.shape[0]
-            ds.resize((start + len(values),))
-            ds[start:] = np.asarray(values, dtype=object if dtype is text else dtype)
+        unit = lambda kind: sim.units.unit(kind).to_string()  # noqa: E731
+        _append_columns(self.f.require_group("collisions"), rows, (
+            ("time", unit("time")), ("step_time", unit("time")), ("body_1", None),
+            ("body_2", None), ("resolution", None), ("survivor", None),
+            ("distance", unit("length")), ("speed", unit("velocity")),
+            ("energy_change", unit("energy"))))
 
     @_writes
     def encounter_rows(self, sim, rows):
@@ -553,41 +508,19 @@ class FileRecorder:
             return
         self._reserve(_LOG_ROW_BYTES * len(rows))
         U = sim.units
-        g = self.f.require_group("encounters")
-        cols = {"time": ([r[0] for r in rows], np.float64, U.unit("time").to_string()),
-                "body_1": ([r[1] for r in rows], h5py.string_dtype(), None),
-                "body_2": ([r[2] for r in rows], h5py.string_dtype(), None),
-                "distance": ([r[3] for r in rows], np.float64, U.unit("length").to_string()),
-                "speed": ([r[4] for r in rows], np.float64,
-                          (U.unit("length") / U.unit("time")).to_string())}
-        for name, (values, dtype, unit) in cols.items():
-            if name not in g:
-                ds = g.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype,
-                                      chunks=(256,))
-                if unit is not None:
-                    ds.attrs["unit"] = unit
-            ds = g[name]
-            k = ds.shape[0]
-            ds.resize((k + len(values),))
-            ds[k:] = np.asarray(values, dtype=object if dtype is not np.float64 else dtype)
+        _append_columns(self.f.require_group("encounters"), rows, (
+            ("time", U.unit("time").to_string()), ("body_1", None), ("body_2", None),
+            ("distance", U.unit("length").to_string()),
+            ("speed", (U.unit("length") / U.unit("time")).to_string())))
 
     def close(self):
         """Flush what is buffered, close the file and release the writers' lock (idempotent).
 
         Examples
         --------
-        >>> import os, tempfile
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> from orbits.io import h5md
-        >>> from orbits.records import RunPlan
-        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
-        ...                start_step=0)
-        >>> rec = h5md.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
         >>> rec.close()
-        >>> rec.closed, os.path.exists(path + ".lock")    # the writers' lock is released
+        >>> import os
+        >>> rec.closed, os.path.exists(f"{rec.path}.lock")  # the writers' lock is released
         (True, False)
         """
         if not self.closed:
@@ -618,20 +551,10 @@ class FileRecorder:
 
         Examples
         --------
-        >>> import os, tempfile
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> from orbits.io import h5md
-        >>> from orbits.records import RunPlan
-        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
-        ...                start_step=0)
-        >>> rec = h5md.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
         >>> _ = sim.run(until=10 * u.day, outputs=2, progress=False)
         >>> rec.output(sim, final=True)
         >>> r = rec.result(sim, wall=0.5)
-        >>> r.times, r.wall_time, r.path == path
+        >>> r.times, r.wall_time, r.path == str(rec.path)
         (<Quantity [10.] d>, 0.5, True)
         >>> rec.close()
         """
@@ -712,23 +635,13 @@ class FileRecorder:
 
         Examples
         --------
-        >>> import os, tempfile
-        >>> import astropy.units as u
-        >>> import orbits
-        >>> from orbits.io import h5md
-        >>> from orbits.records import RunPlan
-        >>> path = os.path.join(tempfile.mkdtemp(), "run.h5")
-        >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
-        >>> plan = RunPlan(until=10.0, outputs=2, ratio=10.0, n_full=10, has_partial=False,
-        ...                start_step=0)
-        >>> rec = h5md.FileRecorder(path, sim, plan)   # writes the first output, a checkpoint
         >>> rec.checkpoints
         1
         >>> rec.checkpoint()
         >>> rec.checkpoints
         2
         >>> rec.close()
-        >>> h5md.read_checkpoint(path).point.finished
+        >>> orbits.io.h5md.read_checkpoint(rec.path).point.finished
         False
         """
         sim = self.sim
@@ -774,3 +687,22 @@ class FileRecorder:
         self._checkpoint_step = state.steps
         self.last_checkpoint = _time.perf_counter()
 
+
+def _append_columns(group, rows, columns):
+    """Append ``rows`` (tuples) to the one-dimensional datasets of ``group``, one
+    a column: ``columns`` are ``(name, unit)``, a number with its ``unit``
+    attribute, or a name (text) where the unit is None; a dataset is made, of a
+    length that grows, on first use."""
+    text = h5py.string_dtype()
+    for k, (name, unit) in enumerate(columns):
+        dtype = text if unit is None else np.float64
+        values = [row[k] for row in rows]
+        if name not in group:
+            ds = group.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype,
+                                      chunks=(256,))
+            if unit is not None:
+                ds.attrs["unit"] = unit
+        ds = group[name]
+        start = ds.shape[0]
+        ds.resize((start + len(values),))
+        ds[start:] = np.asarray(values, dtype=object if unit is None else dtype)
