@@ -52,8 +52,8 @@ __all__ = [
 KEPLER_MAX_ITER = 100
 
 # Switch from the starter E0 = M + e sin M (error O(e^2)) to the cubic
-# starter, which is exact in the limit e -> 1, M -> 0.  Measured: at most
-# 5 Newton steps on either side of 0.5.
+# starter, which is exact in the limit e -> 1, M -> 0: either side of 0.5
+# takes at most 5 Newton steps.
 _CUBIC_STARTER_E = 0.5
 
 # Up to this eccentricity 1 + e cos f is evaluated in half angles (see

@@ -100,15 +100,12 @@ PC_MAX_ITERATIONS = 12
 #: :data:`PC_TOLERANCE`).  The step follows ``epsilon**(1/7)`` and the error of a step
 #: its 16th power, so a run's truncation error falls as about ``epsilon**(15/7)``; a
 #: corrector tolerance that falls as ``epsilon**2`` keeps about the same ratio to it at
-#: every ``epsilon``.  The share 1e-2 is measured: on Kepler orbits of e = 0.5 to 0.99,
-#: the Earth and Moon, the Sun with eight planets and the outer solar system, at
-#: epsilon 1e-1 to 1e-6, the final positions moved by a small part of the run's own
-#: truncation error (0.1 to 7 %) or, where that error is rounding, within its scatter
-#: (the outer solar system over 1e4 yr at epsilon 1e-5: 1.7e-10 au, against 5e-12 to
-#: 2e-10 au for runs converged to rounding at epsilon 1e-5 to 1e-9), while the force
-#: evaluations fell by up to half (10 times this share made some errors 3 times
-#: larger).  At ``epsilon <= 1e-7`` (the default 1e-9 included) the corrector still
-#: runs to :data:`PC_TOLERANCE`, bit for bit as before.
+#: every ``epsilon``.  With the share 1e-2 the final positions of Kepler orbits, the
+#: Earth and Moon and planetary systems at epsilon 1e-1 to 1e-6 move by a small part
+#: of the run's own truncation error, or within its scatter where that error is
+#: rounding, for up to half the force evaluations (the runs are in
+#: benchmarks/RESULTS.md).  At ``epsilon <= 1e-7`` (the default 1e-9 included) the
+#: corrector runs to :data:`PC_TOLERANCE`.
 PC_EPSILON_SQUARED = 1e-2
 
 #: How much b6 = g6, the seventh divided difference of the accelerations at
@@ -122,8 +119,8 @@ _UNIT_ROUNDOFF = 2.0 ** -53
 #: b6 below this many times its rounding estimate counts as rounding: the
 #: estimate takes ``|da/dx|`` along the step, which in a close encounter is
 #: smaller than its norm by about the ratio of a body's speed to the speed of
-#: the encounter (measured 6 for Earth-mass planets meeting at 5 km/s, where
-#: the estimate came out at 0.2 to 1 times the b6 of tiny steps); 10 covers
+#: the encounter (6 for Earth-mass planets meeting at 5 km/s, where the
+#: estimate comes out at 0.2 to 1 times the b6 of tiny steps); 10 covers
 #: that, and lies far below the truncation error of any useful step
 ROUNDING_MARGIN = 10.0
 
@@ -346,8 +343,8 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     # mon_out (monitors and state, orbits._kernels.stepping.record_state) with
     # its time in mon_t and its step count in mark_steps; t_end is then the
     # last mark.  The rows count in n_mon.  Empty marks: the loop lands on
-    # t_end alone (the same compiled loop: a loop compiled for each use cost
-    # every new force two compilations).
+    # t_end alone (the same compiled loop, so that a new force compiles one
+    # loop for both uses).
     (dtp, info, a0, b, g, e, br, er, csx, csv, ref, tc, flags, xs, vs, acc, P,
      counts) = work
     epsilon, mode = control

@@ -601,11 +601,10 @@ def _splitting_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, output
     stopping = (sargs, check)
     n = x.shape[0]
     # flat views of the (N, 3) arrays: the drifts and kicks as loops LLVM
-    # turns into vector instructions, each component's operation as before
-    # (bit for bit).  Measured (CPU time a step, paired runs): leapfrog on the
-    # Sun and eight planets 0.148-0.151 -> 0.133-0.138 us, the outer solar
-    # system unchanged; two bodies 0.031 -> 0.033 us, too few for the vector
-    # loop's set-up, so below FLAT_FROM_BODIES the nested loops stay
+    # turns into vector instructions, each component's operation that of
+    # the nested loops (bit for bit); below FLAT_FROM_BODIES bodies the
+    # vector loop's set-up costs more than it saves, and the nested loops
+    # are faster (benchmarks/RESULTS.md)
     flat = n >= FLAT_FROM_BODIES
     m3 = 3 * n
     xF = x.reshape(m3)
@@ -692,8 +691,8 @@ def _implicit_kick_for(force):
     # Gravity alone never reads velocities: its loops leave the implicit kick
     # out.  For other forces (whose loops serve velocity-dependent ones and
     # others alike) the kick is a call: it iterates the force a few times, so
-    # a call costs nothing beside it, and an inlined copy of the force cost
-    # its compilation again in every loop
+    # a call costs nothing beside it, and an inlined copy of the force would
+    # cost its compilation again in every loop
     if force.jit and force.terms is None and force.inner is None and not force.opaque \
             and not force.velocity_dependent:
         return _no_implicit_kick

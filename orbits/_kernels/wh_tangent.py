@@ -64,15 +64,15 @@ before the deferred half drift and the corrector, to inertial coordinates
 (a linear map, :func:`jacobi_inertial_tangent`) and hands it to
 :func:`~orbits._kernels.variational.chaos_update`.  Synchronising it fully,
 as an output does, would cost a Kepler drift of the bodies and of the
-vector every step and double the cost of a step with the indicators (0.56
-of 1.2 us on a test planet beside Jupiter and Saturn).  The vector at the
+vector every step, about doubling the cost of a step with the indicators
+(benchmarks/RESULTS.md).  The vector at the
 internal point is the fully synchronised one mapped back by the half drift
 (and corrector), a near-identity map the same every step, so ``|delta|``
 differs by a bounded factor: the Lyapunov exponent and MEGNO's limits (2 on
 regular orbits, slope ``lambda / 2`` on chaotic ones) are the same, and the
 finite-time ``<Y>`` differs by a transient that decays as ``ln(t) / t``
-(measured on Jupiter and Saturn with a 50-day step: 1.5e-2 after 2000
-steps, 2.6e-3 after 20000; tests/kernels/test_wh_tangent.py).  When
+(on Jupiter and Saturn with a 50-day step, 1.5e-2 after 2000 steps and
+2.6e-3 after 20000; tests/kernels/test_wh_tangent.py).  When
 ``|delta|`` has grown large the internal rows of vector 0 are scaled by an
 exact power of two inside the loop
 (:func:`~orbits._kernels.variational.renormalise`, its exponent from the
@@ -314,10 +314,10 @@ def drift_tangent(xj, vj, eta, h, tp, w1, w2):
 
     As in ``kepler_drift_all``, the short steps' anomalies of all the bodies
     come first, then each body's state and tangent rows from its anomaly
-    and the same universal functions (1.6 times faster than each body
-    through :func:`~orbits._kernels.kepler_tangent.kepler_drift_tangent` on the
-    Sun, Jupiter, Saturn and a test planet); the other steps go through
-    that function's bracketed solver."""
+    and the same universal functions (quicker than each body through
+    :func:`~orbits._kernels.kepler_tangent.kepler_drift_tangent`, see
+    benchmarks/RESULTS.md); the other steps go through that function's
+    bracketed solver."""
     n = eta.shape[0]
     deta, k = tp[1], tp[2]
     xj[0, 0] += h * vj[0, 0]
@@ -413,10 +413,10 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
     """:func:`~orbits._kernels.wisdom_holman.interaction_kick` of the bodies (bit
     for bit) and its tangent for the first ``tp[2]`` tangent vectors, in one
     pass: each pair's distance and ``1 / r^3``, and each Jacobi Kepler
-    term's, serve both (a step with one tangent vector beside Jupiter and
-    Saturn: 0.63 -> 0.56 us against the kick and then its tangent).  ``x``
-    and ``acc`` (``n (1 + K)`` rows) are scratch: the inertial positions and
-    accelerations and their tangent rows."""
+    term's, serve both, which is quicker than the kick and then its tangent
+    (benchmarks/RESULTS.md).  ``x`` and ``acc`` (``n (1 + K)`` rows) are
+    scratch: the inertial positions and accelerations and their tangent
+    rows."""
     n = gm.shape[0]
     if n <= 2:
         return
@@ -778,7 +778,7 @@ def _kernels(coordinates, terms, key, cache):
     nrt = _runtime(terms, cache)
     # the tangent kernels are calls, not inlined: a step's tangent costs far
     # more than a call, and inlining them all into every loop and corrector
-    # took minutes to compile
+    # would take minutes to compile
     if terms is None:
         perturbation = specialize(pert, key, cache=cache, nrt=nrt, TERMS=False,
                                   term_kick=None, term_tangent=None)
