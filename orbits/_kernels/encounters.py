@@ -655,22 +655,32 @@ def _tidal_tensor(c):
     return c[3] + d, d - c[3], -2.0 * d, c[0], c[1], c[2]
 
 
+@njit(inline="always")
+def _tidal_field(T, x, y, z):
+    """The acceleration ``T (x, y, z)`` of the tidal field ``T`` (:func:`_tidal_tensor`)."""
+    txx, tyy, tzz, txy, txz, tyz = T
+    return txx * x + txy * y + txz * z, txy * x + tyy * y + tyz * z, txz * x + tyz * y + tzz * z
+
+
+@njit(inline="always")
+def _tidal_kick(T, half, x, y, z, vx, vy, vz):
+    """The velocity after a kick of ``half`` by the tidal field ``T`` at ``(x, y, z)``."""
+    ax, ay, az = _tidal_field(T, x, y, z)
+    return vx + half * ax, vy + half * ay, vz + half * az
+
+
 @njit
 def _tidal_orbit(mu, S, c, h, n):
     """The state after ``n`` kick-drift-kick steps of ``h / n`` from ``S``
     under ``mu`` and the tidal field ``c``."""
-    txx, tyy, tzz, txy, txz, tyz = _tidal_tensor(c)
+    T = _tidal_tensor(c)
     dt = h / n
     x, y, z, vx, vy, vz = S
     half = 0.5 * dt
     for k in range(n):
-        vx += half * (txx * x + txy * y + txz * z)
-        vy += half * (txy * x + tyy * y + tyz * z)
-        vz += half * (txz * x + tyz * y + tzz * z)
+        vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
         x, y, z, vx, vy, vz = _drift(mu, x, y, z, vx, vy, vz, dt)
-        vx += half * (txx * x + txy * y + txz * z)
-        vy += half * (txy * x + tyy * y + tyz * z)
-        vz += half * (txz * x + tyz * y + tzz * z)
+        vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
     return x, y, z, vx, vy, vz
 
 
@@ -828,7 +838,7 @@ def _fit_tidal_field(mu, S0, S1, h, n, tm):
 def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
     """Closest approach along the fitted orbits: the two-body arc of each
     drift, from the start up to ``tm`` and from the end back to it."""
-    txx, tyy, tzz, txy, txz, tyz = _tidal_tensor(c)
+    T = _tidal_tensor(c)
     d_best = math.inf
     t_best = _NAN
     tau_best = 0.0
@@ -844,9 +854,7 @@ def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
         x, y, z, vx, vy, vz = S
         half = 0.5 * dt
         for k in range(n):
-            vx += half * (txx * x + txy * y + txz * z)
-            vy += half * (txy * x + tyy * y + tyz * z)
-            vz += half * (txz * x + tyz * y + tzz * z)
+            vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
             tau, d, v = _kepler_closest(mu, x, y, z, vx, vy, vz, lo, hi)
             if d < d_best:
                 d_best = d
@@ -855,9 +863,7 @@ def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
                 dt_best = dt
                 B = (x, y, z, vx, vy, vz)
             x, y, z, vx, vy, vz = _drift(mu, x, y, z, vx, vy, vz, dt)
-            vx += half * (txx * x + txy * y + txz * z)
-            vy += half * (txy * x + tyy * y + tyz * z)
-            vz += half * (txz * x + tyz * y + tzz * z)
+            vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
     if not math.isfinite(d_best):
         return _NAN, _NAN, _NAN
     # A drift carries the velocity after the half-kick of its start, dt / 2
@@ -866,9 +872,7 @@ def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
     #   v = v_drift + (tau - dt / 2) a,  x = x_drift + (tau^2 / 2 - tau dt / 2) a
     # with a = T x, which removes the O(dt |T| |x|) error of the speed.
     x, y, z, vx, vy, vz = _drift(mu, B[0], B[1], B[2], B[3], B[4], B[5], tau_best)
-    ax = txx * x + txy * y + txz * z
-    ay = txy * x + tyy * y + tyz * z
-    az = txz * x + tyz * y + tzz * z
+    ax, ay, az = _tidal_field(T, x, y, z)
     kv = tau_best - 0.5 * dt_best
     kx = 0.5 * tau_best * kv
     speed = _norm3(vx + kv * ax, vy + kv * ay, vz + kv * az)
@@ -893,13 +897,9 @@ def closest_approach(mu, dx0, dv0, dx1, dv1, h):
     ----------
     mu : float
         ``G (m_i + m_j)`` [length^3 / time^2], ``>= 0``.
-    dx0, dv0 : ndarray, shape (3,)
-        Relative position ``x_i - x_j`` [length] and velocity
-        [length / time] at the start of the step.
-    dx1, dv1 : ndarray, shape (3,)
-        The same at the end of the step.
-    h : float
-        The step [time], either sign.
+    dx0, dv0, dx1, dv1, h
+        The relative states at the step's two ends and the step, as
+        :func:`hermite_closest` takes them.
 
     Returns
     -------
