@@ -104,7 +104,7 @@ import numpy as np
 
 from ._jit import called, njit, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
-                          to_democratic_heliocentric, to_jacobi)
+                          to_democratic_heliocentric, to_jacobi, weighted_sum)
 from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
@@ -220,13 +220,7 @@ def jacobi_velocity_kick(xj, vj, acc, gm, eta, h, kepler):
 def jump(xh, vb, gm, n_active, h):
     """Shift every heliocentric position ``xh[1:]`` by ``h`` times
     ``sum_i m_i V_i / m_0`` (the flow of ``H_jump``); ``vb`` barycentric."""
-    px = 0.0
-    py = 0.0
-    pz = 0.0
-    for i in range(1, n_active):
-        px += gm[i] * vb[i, 0]
-        py += gm[i] * vb[i, 1]
-        pz += gm[i] * vb[i, 2]
+    px, py, pz = weighted_sum(vb, gm, 1, n_active)
     s = h / gm[0]
     px *= s
     py *= s
