@@ -98,16 +98,16 @@ from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democrat
 from .kepler import short_step_anomaly
 from .kepler_tangent import advance_tangent_by_anomaly, kepler_drift_tangent
 from .stepping import epilogue, work_kernels
-from .variational import chaos_update, renormalise
+from .variational import chaos_update, renormalise, tangent_product
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels,
                             heliocentric_interaction_kick, interaction_kick, jump)
 
 # the names the templates below are written against, bound by specialize
-(TERMS, record, inertial_tangent, jacobian, note, synchronize, term_jacobian, term_kick,
- term_tangent) = slots(
-    "TERMS", "record", "inertial_tangent", "jacobian", "note", "synchronize", "term_jacobian",
-    "term_kick", "term_tangent")
+(TERMS, conversion, record, inertial_tangent, jacobian, note, synchronize, term_jacobian,
+ term_kick, term_tangent) = slots(
+    "TERMS", "conversion", "record", "inertial_tangent", "jacobian", "note", "synchronize",
+    "term_jacobian", "term_kick", "term_tangent")
 
 __all__ = ["drift_tangent", "interaction_kick_and_tangent",
            "jump_tangent",
@@ -571,20 +571,6 @@ def heliocentric_kick_tangent(xh, vb, acc, gm, n_active, h, tp):
             vb[o + i, 2] += h * acc[o + i, 2]
 
 
-@njit(inline="always")
-def _term_acc_tangent(x, acc, jx, n, j):
-    # acc's tangent block j = the terms' da/dx (jx) times x's tangent block j
-    o = n * (1 + j)
-    for i in range(n):
-        for a in range(3):
-            r = 3 * i + a
-            s = 0.0
-            for c in range(n):
-                s += (jx[r, 3 * c] * x[o + c, 0] + jx[r, 3 * c + 1] * x[o + c, 1]
-                      + jx[r, 3 * c + 2] * x[o + c, 2])
-            acc[o + i, a] = s
-
-
 def _terms_jacobian(x, targs):
     # the terms' da/dx at the bodies' inertial positions x[:n] into tp's jx
     tp = targs[1]
@@ -610,7 +596,8 @@ def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
     for j in range(k):
         o = n * (1 + j)
         _from_jacobi_block(xj, x, gm, eta, tp[0], tp[1], j, False)
-        _term_acc_tangent(x, acc, tp[4], n, j)
+        # acc's tangent block j: the terms' da/dx times x's
+        tangent_product(tp[4], tp[4], x, x, o, n, acc, False)
         tx = acc[o, 0]
         ty = acc[o, 1]
         tz = acc[o, 2]
@@ -651,7 +638,8 @@ def _heliocentric_term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs):
             x[o, d] = x0
             for i in range(1, n):
                 x[o + i, d] = xh[o + i, d] + x0
-        _term_acc_tangent(x, acc, tp[4], n, j)
+        # acc's tangent block j: the terms' da/dx times x's
+        tangent_product(tp[4], tp[4], x, x, o, n, acc, False)
         for d in range(3):
             f = 0.0
             for i in range(n_active):
@@ -697,24 +685,17 @@ def _drift(xj, vj, eta, h, w1, w2, targs):
     drift_tangent(xj, vj, eta, h, targs[1], w1, w2)
 
 
-@njit(inline="always")
-def _to_jacobi(x, v, gm, eta, xj, vj, targs):
-    to_jacobi_tangent(x, v, gm, eta, xj, vj, targs[1])
+def _conversion(a, b, gm, eta, c, d, targs):
+    # a change of coordinates of the bodies and their tangent vectors, in the
+    # Wisdom-Holman templates' form: (a, b) into (c, d), the tangent
+    # arguments targs[1]
+    conversion(a, b, gm, eta, c, d, targs[1])
 
 
-@njit(inline="always")
-def _from_jacobi(xj, vj, gm, eta, x, v, targs):
-    from_jacobi_tangent(xj, vj, gm, eta, x, v, targs[1])
-
-
-@njit(inline="always")
-def _to_heliocentric(x, v, gm, eta, xh, vb, targs):
-    to_heliocentric_tangent(x, v, gm, eta, xh, vb, targs[1])
-
-
-@njit(inline="always")
-def _from_heliocentric(xh, vb, gm, eta, x, v, targs):
-    from_heliocentric_tangent(xh, vb, gm, eta, x, v, targs[1])
+_to_jacobi, _from_jacobi, _to_heliocentric, _from_heliocentric = (
+    specialize(_conversion, kernel.__name__, inline=True, conversion=kernel)
+    for kernel in (to_jacobi_tangent, from_jacobi_tangent, to_heliocentric_tangent,
+                   from_heliocentric_tangent))
 
 
 @njit(inline="always")
