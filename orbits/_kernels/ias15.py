@@ -64,7 +64,8 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       first_record, must_return, step_epilogue, stop_info, work_kernels)
+                       first_record, mark_recorder, must_return, step_epilogue, stop_info,
+                       work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -629,15 +630,11 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
             if not has_marks:
                 return Status.OK, t, n_mon
             # an output: recorded as the driver would record it on return
-            mon_t[n_mon] = t
-            record_row(x, v, t, mon, n_mon, mon_t, mon_out)
-            work_note(fargs, mon_out, n_mon)
-            mark_steps[n_mon] = step0 + counts[0]
-            n_mon += 1
-            k_mark += 1
-            if k_mark == marks.shape[0]:
+            n_mon, k_mark, target, last = record_mark(
+                x, v, t, step0 + counts[0], mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
+                fargs)
+            if last:
                 return Status.OK, t, n_mon
-            target = marks[k_mark]
 
 
 def _first_step(x, a0, span):
@@ -668,8 +665,8 @@ def _first_step(x, a0, span):
 
 # the names _ias15_loop is written against, bound by ias15_loop (specialize);
 # the helpers default to their Python form, for a loop that runs as Python
-force, rows, step_end, record_row, PREDICT_V = slots(
-    "force", "rows", "step_end", "record_row", "PREDICT_V")
+force, rows, step_end, record_mark, PREDICT_V = slots(
+    "force", "rows", "step_end", "record_mark", "PREDICT_V")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 predict, g_from_b, b_from_g, first_step = slots(
     predict=_predict, g_from_b=_g_from_b, b_from_g=_b_from_g, first_step=_first_step)
@@ -697,5 +694,5 @@ def ias15_loop(force):
     return specialize(_ias15_loop, force.key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force), PREDICT_V=predict_v,
-                      record_row=force.recorder,
+                      record_mark=mark_recorder(force),
                       rows=measured_rows(force), **work_kernels(force), **helpers)

@@ -80,7 +80,7 @@ __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force
            "user_force", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
-           "clock_step", "add_compensated", "stop_info"]
+           "clock_step", "add_compensated", "stop_info", "mark_recorder"]
 
 #: operator codes of a splitting table
 DRIFT = 0
@@ -271,6 +271,32 @@ def epilogue(record, key, jit=True, cache=True, runtime=False, stop=None, work_n
                       record=record, stop_check=stop_check,
                       work_note=_no_work_note if work_note is None else work_note,
                       tangent_step=_no_tangent_step if tangent_step is None else tangent_step)
+
+
+def _record_mark(x, v, t, steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark, fargs):
+    # An adaptive loop's output at the mark k_mark it has landed on (t),
+    # recorded as the driver would record it on return: a row of mon_out
+    # (monitors and state) with its time in mon_t and its step count, steps
+    # from the run's start, in mark_steps.  Returns (the rows, the next
+    # mark's index, its time (t after the last), whether it was the last).
+    mon_t[n_mon] = t
+    record(x, v, t, mon, n_mon, mon_t, mon_out)
+    work_note(fargs, mon_out, n_mon)
+    mark_steps[n_mon] = steps
+    k_mark += 1
+    last = k_mark == marks.shape[0]
+    return n_mon + 1, k_mark, t if last else marks[k_mark], last
+
+
+def mark_recorder(force):
+    """The recording of an output at a mark (an output time an adaptive loop
+    lands on) for the loops compiled for a :class:`ForceKernel`: it takes
+    ``(x, v, t, steps, mon, n_mon, mon_t, mon_out, marks, mark_steps,
+    k_mark, fargs)`` and returns ``(n_mon, k_mark, target, last)``, the
+    rows, the next mark and its time, and whether the mark was the last."""
+    return specialize(_record_mark, force.key, jit=force.jit, inline=True, nrt=force.runtime,
+                      cache=force.cache, record=force.recorder,
+                      work_note=work_kernels(force)["work_note"])
 
 
 # -- forces ------------------------------------------------------------------------
