@@ -19,14 +19,10 @@ makes (numba's ``InlineWorker.inline_function``):
   copied once, and the copy's blocks share one scope as the blocks they copy
   do.
 
-Measured on an empty cache (2-core Intel Xeon, numba 0.68,
-``python benchmarks/bench_compile.py``): the first run of the outer solar
-system with ``wh`` (its planets in vector lanes) in 31-33 s against 50-54 s
-with numba's own inliner, in democratic heliocentric coordinates 33 s against
-52 s, the final states the same to the bit; ``leapfrog`` and ``ias15``, which
-inline little, unchanged (ratios 0.91-1.08).  A batch of 16 systems
-(``Ensemble.run(batch=16)``) 44 s against 81 s; the test suite on a fresh
-clone, mostly compiling, 444-469 s against 637 s.
+The loops that inline most (``wh``, the ensembles' batches) compile in
+about two thirds of the time numba's own inliner takes, to the same code;
+``python benchmarks/bench_compile.py`` measures it, and the figures are in
+benchmarks/RESULTS.md.
 
 Both are applied only where numba's inliner has the shape they were written
 against (:func:`_compatible`); elsewhere numba's own path runs unchanged.

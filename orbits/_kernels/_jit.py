@@ -22,11 +22,10 @@ compilation options are the same everywhere and can be changed once.
   without reference counting, for loops that allocate nothing.  Every array
   that a kernel inlined with ``inline="always"`` receives is a new reference
   to numba, counted up on entry and down on exit with atomic instructions,
-  which also drain the processor's store buffer; in the Wisdom-Holman loop
-  that cost 17 ns a step for a kick that had nothing to do (a two-body
-  problem) and 40 ns for the democratic heliocentric one.  Without the
-  runtime the loop cannot create arrays: numba refuses to compile one that
-  tries.
+  which also drain the processor's store buffer: in the Wisdom-Holman loop
+  they cost more than a kick with nothing to do (benchmarks/RESULTS.md).
+  Without the runtime the loop cannot create arrays: numba refuses to
+  compile one that tries.
 * :mod:`._inlining` makes numba's ``inline="always"`` quicker to compile
   (each inlined function's front end once, and one copy of its scope per
   copy of its IR): the same code, in half the time for the largest loops.
@@ -98,10 +97,10 @@ def cfunc(signature, func, cache=True):
 class Pointer:
     """A C callable (:func:`cfunc`) to hand compiled code as an argument,
     typed at once: numba types a ``CFunc`` argument by building its function
-    type anew, some 50 µs a call, and an argument that is a tuple holding one
-    is typed element by element in Python (200 µs for the stopping
-    conditions' record), where a tuple of arrays and numbers alone takes
-    numba's compiled path (1 µs).  So a pointer travels as an argument of
+    type anew at every call, and an argument that is a tuple holding one is
+    typed element by element in Python, where a tuple of arrays and numbers
+    alone takes numba's compiled path, some hundred times quicker (the
+    figures are in benchmarks/RESULTS.md).  So a pointer travels as an argument of
     its own, as this object: its type is ready (numba reads
     ``_numba_type_``), and numba takes its address through the wrapper
     address protocol (``__wrapper_address__``, as for any first-class
@@ -129,8 +128,8 @@ def pointer(kernel, signature):
     callable of ``signature`` (:func:`cfunc`), as a :class:`Pointer`.  A
     compiled kernel's own code is compiled, cached under its name, not a
     function that calls it, so that a call through the pointer hands the
-    arguments over once (a wrapper hands them on again: some 30 ns for the
-    stopping conditions' 16 arguments, nine of them arrays)."""
+    arguments over once (a wrapper would hand them on again, which shows
+    beside the stopping conditions' 16 arguments, nine of them arrays)."""
     py = getattr(kernel, "py_func", None)
     if py is None:
         return Pointer(cfunc(signature, kernel))

@@ -52,8 +52,8 @@ __all__ = [
 KEPLER_MAX_ITER = 100
 
 # Switch from the starter E0 = M + e sin M (error O(e^2)) to the cubic
-# starter, which is exact in the limit e -> 1, M -> 0.  Measured: at most
-# 5 Newton steps on either side of 0.5.
+# starter, which is exact in the limit e -> 1, M -> 0: either side of 0.5
+# takes at most 5 Newton steps.
 _CUBIC_STARTER_E = 0.5
 
 # Up to this eccentricity 1 + e cos f is evaluated in half angles (see
@@ -161,6 +161,45 @@ def _reduce_angle(x):
 # --------------------------------------------------------------------------
 
 @njit
+def _newton_in_bracket(x, lo, hi, M, e, c, hyperbolic):
+    """The root of ``c x + e (x - sin x) - M`` (``c = 1 - e``, an ellipse) or,
+    with ``hyperbolic``, of ``c x + e (sinh x - x) - M`` (``c = e - 1``): a
+    residual increasing and convex on the bracket ``[lo, hi]`` that holds the
+    root, written so that both terms are positive (the direct forms cancel
+    near 0 for ``e`` near 1).  Newton's method from ``x``, each step kept
+    inside the bracket that the residual's sign narrows first: a step past
+    ``hi`` stops there, one below ``lo`` bisects.  It stops when a step or
+    the bracket is within :data:`_STEP_TOL` relative."""
+    for _ in range(KEPLER_MAX_ITER):
+        if hyperbolic:
+            g = c * x + e * _sinh_minus_x(x) - M
+        else:
+            g = c * x + e * _x_minus_sin(x) - M
+        if g == 0.0:
+            break
+        if g > 0.0:
+            hi = x
+        else:
+            lo = x
+        # the slope, 1 - e cos x or e cosh x - 1, without cancellation at x = 0
+        if hyperbolic:
+            s = math.sinh(0.5 * x)
+        else:
+            s = math.sin(0.5 * x)
+        dg = c + 2.0 * e * s * s
+        x_new = x - g / dg
+        if x_new > hi:
+            x_new = hi
+        elif x_new < lo:
+            x_new = 0.5 * (lo + hi)
+        if abs(x_new - x) <= _STEP_TOL * x or hi - lo <= _STEP_TOL * hi:
+            x = x_new
+            break
+        x = x_new
+    return x
+
+
+@njit
 def _solve_elliptic_reduced(M, e):
     """Root of ``E - e sin E = M`` for ``0 <= M <= pi, 0 < e < 1``."""
     # On [0, pi] the residual g(E) is increasing and convex, and the root lies
@@ -178,30 +217,7 @@ def _solve_elliptic_reduced(M, e):
         E = _cubic_root(2.0 * (1.0 - e) / e, 3.0 * M / e)
         lo = max(lo, E)
     E = min(max(E, lo), hi)
-    one_minus_e = 1.0 - e
-    for _ in range(KEPLER_MAX_ITER):
-        # Split E - e sin E = (1 - e) E + e (E - sin E) so that both terms are
-        # positive: the direct form cancels near E = 0, e = 1.
-        g = one_minus_e * E + e * _x_minus_sin(E) - M
-        if g == 0.0:
-            break
-        if g > 0.0:
-            hi = E
-        else:
-            lo = E
-        # 1 - e cos E written without cancellation at E = 0, e = 1.
-        s = math.sin(0.5 * E)
-        dg = one_minus_e + 2.0 * e * s * s
-        E_new = E - g / dg
-        if E_new > hi:
-            E_new = hi
-        elif E_new < lo:
-            E_new = 0.5 * (lo + hi)
-        if abs(E_new - E) <= _STEP_TOL * E or hi - lo <= _STEP_TOL * hi:
-            E = E_new
-            break
-        E = E_new
-    return E
+    return _newton_in_bracket(E, lo, hi, M, e, 1.0 - e, False)
 
 
 @njit
@@ -289,26 +305,7 @@ def _solve_hyperbolic_positive(M, e):
     # large F.
     F = F_cubic if F_cubic < 1.0 else lo
     F = min(max(F, lo), hi)
-    for _ in range(KEPLER_MAX_ITER):
-        g = em1 * F + e * _sinh_minus_x(F) - M
-        if g == 0.0:
-            break
-        if g > 0.0:
-            hi = F
-        else:
-            lo = F
-        s = math.sinh(0.5 * F)
-        dg = em1 + 2.0 * e * s * s          # e cosh F - 1 without cancellation
-        F_new = F - g / dg
-        if F_new > hi:
-            F_new = hi
-        elif F_new < lo:
-            F_new = 0.5 * (lo + hi)
-        if abs(F_new - F) <= _STEP_TOL * F or hi - lo <= _STEP_TOL * hi:
-            F = F_new
-            break
-        F = F_new
-    return F
+    return _newton_in_bracket(F, lo, hi, M, e, em1, True)
 
 
 @njit

@@ -29,7 +29,8 @@ more: ``x_0 = X - sum_i m_i Q_i / M`` and ``v_0 = V - sum_i m_i V_i / m_0``
 from ._jit import njit
 
 __all__ = ["interior_gm", "to_jacobi", "from_jacobi", "to_jacobi_one", "from_jacobi_one",
-           "to_democratic_heliocentric", "from_democratic_heliocentric"]
+           "to_democratic_heliocentric", "from_democratic_heliocentric", "weighted_sum",
+           "centre_of_mass"]
 
 
 @njit
@@ -39,6 +40,32 @@ def interior_gm(gm, out):
     for i in range(gm.shape[0]):
         s += gm[i]
         out[i] = s
+
+
+@njit(inline="always")
+def weighted_sum(a, gm, first, end):
+    """``sum_i gm[i] a[i]`` over the rows ``first <= i < end`` of ``a`` (shape
+    (N, 3)), summed in order: a momentum, or a centre of mass times the mass."""
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for i in range(first, end):
+        sx += gm[i] * a[i, 0]
+        sy += gm[i] * a[i, 1]
+        sz += gm[i] * a[i, 2]
+    return sx, sy, sz
+
+
+@njit(inline="always")
+def centre_of_mass(x, v, gm, n):
+    """The total ``gm`` of the first ``n`` bodies, their centre of mass and its
+    velocity: ``(M, X, Y, Z, VX, VY, VZ)``."""
+    mtot = 0.0
+    for i in range(n):
+        mtot += gm[i]
+    cx, cy, cz = weighted_sum(x, gm, 0, n)
+    cvx, cvy, cvz = weighted_sum(v, gm, 0, n)
+    return mtot, cx / mtot, cy / mtot, cz / mtot, cvx / mtot, cvy / mtot, cvz / mtot
 
 
 @njit(inline="always")
@@ -134,27 +161,7 @@ def to_democratic_heliocentric(x, v, gm, xh, vb):
     Duncan, M. J., Levison, H. F. & Lee, M. H. 1998, AJ 116, 2067, sect. 2.
     """
     n = x.shape[0]
-    mtot = 0.0
-    cx = 0.0
-    cy = 0.0
-    cz = 0.0
-    cvx = 0.0
-    cvy = 0.0
-    cvz = 0.0
-    for i in range(n):
-        mtot += gm[i]
-        cx += gm[i] * x[i, 0]
-        cy += gm[i] * x[i, 1]
-        cz += gm[i] * x[i, 2]
-        cvx += gm[i] * v[i, 0]
-        cvy += gm[i] * v[i, 1]
-        cvz += gm[i] * v[i, 2]
-    cx /= mtot
-    cy /= mtot
-    cz /= mtot
-    cvx /= mtot
-    cvy /= mtot
-    cvz /= mtot
+    _, cx, cy, cz, cvx, cvy, cvz = centre_of_mass(x, v, gm, n)
     for i in range(1, n):
         xh[i, 0] = x[i, 0] - x[0, 0]
         xh[i, 1] = x[i, 1] - x[0, 1]
@@ -176,15 +183,10 @@ def from_democratic_heliocentric(xh, vb, gm, x, v):
     arguments as :func:`to_democratic_heliocentric`."""
     n = xh.shape[0]
     mtot = 0.0
-    sx = 0.0
-    sy = 0.0
-    sz = 0.0
     for i in range(1, n):
         mtot += gm[i]
-        sx += gm[i] * xh[i, 0]
-        sy += gm[i] * xh[i, 1]
-        sz += gm[i] * xh[i, 2]
     mtot += gm[0]
+    sx, sy, sz = weighted_sum(xh, gm, 1, n)
     x0 = xh[0, 0] - sx / mtot
     y0 = xh[0, 1] - sy / mtot
     z0 = xh[0, 2] - sz / mtot
@@ -195,13 +197,8 @@ def from_democratic_heliocentric(xh, vb, gm, x, v):
     x[0, 0] = x0
     x[0, 1] = y0
     x[0, 2] = z0
-    px = 0.0
-    py = 0.0
-    pz = 0.0
+    px, py, pz = weighted_sum(vb, gm, 1, n)
     for i in range(1, n):
-        px += gm[i] * vb[i, 0]
-        py += gm[i] * vb[i, 1]
-        pz += gm[i] * vb[i, 2]
         v[i, 0] = vb[i, 0] + vb[0, 0]
         v[i, 1] = vb[i, 1] + vb[0, 1]
         v[i, 2] = vb[i, 2] + vb[0, 2]

@@ -22,12 +22,13 @@ import numpy as np
 from ._jit import slots, specialize
 from .embedded import initial_step, next_step, step_underflow
 from .status import Status
-from .stepping import GO, WORK_SLOTS, first_record, step_epilogue, work_kernels
+from .stepping import (GO, WORK_SLOTS, first_record, mark_recorder, step_epilogue, stop_info,
+                       work_kernels)
 from .variational import measured_rows
 
 # the names the templates below are written against, bound by specialize
-force, record_row, rk4_step, rows, step_end = slots(
-    "force", "record_row", "rk4_step", "rows", "step_end")
+force, record_mark, rk4_step, rows, step_end = slots(
+    "force", "record_mark", "rk4_step", "rows", "step_end")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["doubling_loop"]
@@ -192,20 +193,16 @@ def _doubling_loop(x, v, t, tolerances, work, fargs, outputs, landing, sargs, ch
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
                 stopping, fargs)
             if stop != GO:
-                info[0] = stopping[0][6][0]     # the bodies the condition names
-                info[1] = stopping[0][6][1]
+                stop_info(stopping, info)
                 status = stop
                 break
             if has_marks and t == target:
-                mon_t[n_mon] = t
-                record_row(x, v, t, mon, n_mon, mon_t, mon_out)
-                work_note(fargs, mon_out, n_mon)
-                mark_steps[n_mon] = step0 + steps
-                n_mon += 1
-                k_mark += 1
-                if k_mark == marks.shape[0]:
+                # an output: recorded as the driver would record it on return
+                n_mon, k_mark, target, last = record_mark(
+                    x, v, t, step0 + steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
+                    fargs)
+                if last:
                     break
-                target = marks[k_mark]
         else:
             rejected += 1
             h_prop = next_step(h, err, 4.0)
@@ -228,4 +225,4 @@ def doubling_loop(force):
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, rk4_step=step,
                       step_end=step_epilogue(force), rows=measured_rows(force),
-                      record_row=force.recorder, **work)
+                      record_mark=mark_recorder(force), **work)

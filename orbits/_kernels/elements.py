@@ -25,10 +25,8 @@ exception the Python layer raises.
 
 References
 ----------
-.. [1] Murray, C. D. & Dermott, S. F. 1999, *Solar System Dynamics*,
-   Cambridge University Press, ch. 2.
-.. [2] Danby, J. M. A. 1988, *Fundamentals of Celestial Mechanics*, 2nd ed.,
-   Willmann-Bell, ch. 6 (the two-body problem).
+Murray & Dermott (1999), ch. 2, and Danby (1988), ch. 6 (the two-body
+problem), cited in full in :mod:`.anomalies`.
 """
 
 import math
@@ -346,25 +344,11 @@ def elements_to_state_many(mu, elems, pos, vel, status):
 
 @njit
 def state_to_elements_many(mu, pos, vel, out, status):
-    """:func:`state_to_elements` over many bodies.
-
-    Parameters
-    ----------
-    mu : ndarray, shape (n,)
-        ``G (m_primary + m_i)`` for each body.
-    pos, vel : ndarray, shape (n, 3)
-        Relative positions and velocities.
-    out : ndarray, shape (n, 7)
-        Written: rows ``a, e, inc, Omega, omega, f, M``.
-    status : ndarray of int64, shape (n,)
-        Written: each body's status.
-
-    Returns
-    -------
-    int
-        ``Status.OK`` if every body succeeded, otherwise the first
-        non-zero status.
-    """
+    """:func:`state_to_elements` over many bodies, the other way from
+    :func:`elements_to_state_many`: ``mu``, ``status`` and the result as
+    there; ``pos``, ``vel`` (shape (n, 3)) the relative positions and
+    velocities, and ``out`` (shape (n, 7)) written, rows ``a, e, inc,
+    Omega, omega, f, M``."""
     n = mu.shape[0]
     if (pos.shape[0] < n or vel.shape[0] < n or out.shape[0] < n
             or status.shape[0] < n):

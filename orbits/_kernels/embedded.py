@@ -27,12 +27,13 @@ import numpy as np
 
 from ._jit import njit, slots, specialize
 from .status import Status
-from .stepping import GO, WORK_SLOTS, first_record, rk_stage, rk_sums, step_epilogue, work_kernels
+from .stepping import (GO, WORK_SLOTS, first_record, mark_recorder, rk_stage, rk_sums,
+                       step_epilogue, stop_info, work_kernels)
 from .variational import measured_rows
 
 # the names the templates below are written against, bound by specialize
-force, has_e3, record_row, rows, step_end = slots(
-    "force", "has_e3", "record_row", "rows", "step_end")
+force, has_e3, record_mark, rows, step_end = slots(
+    "force", "has_e3", "record_mark", "rows", "step_end")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
@@ -237,21 +238,16 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
                 x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
                 stopping, fargs)
             if stop != GO:
-                info[0] = stopping[0][6][0]     # the bodies the condition names
-                info[1] = stopping[0][6][1]
+                stop_info(stopping, info)
                 status = stop
                 break
             if has_marks and t == target:
                 # an output: recorded as the driver would record it on return
-                mon_t[n_mon] = t
-                record_row(x, v, t, mon, n_mon, mon_t, mon_out)
-                work_note(fargs, mon_out, n_mon)
-                mark_steps[n_mon] = step0 + steps
-                n_mon += 1
-                k_mark += 1
-                if k_mark == marks.shape[0]:
+                n_mon, k_mark, target, last = record_mark(
+                    x, v, t, step0 + steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
+                    fargs)
+                if last:
                     break
-                target = marks[k_mark]
         else:
             rejected += 1
             h_prop = next_step(h, err, q)
@@ -272,4 +268,4 @@ def embedded_loop(force, has_e3):
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),
                       step_end=step_epilogue(force), rows=measured_rows(force),
-                      record_row=force.recorder, **work_kernels(force))
+                      record_mark=mark_recorder(force), **work_kernels(force))

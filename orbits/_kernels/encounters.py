@@ -67,9 +67,9 @@ ROOT_MAX_ITER = 100
 # closest_approach treats the step as two-body motion in a tidal field when
 # the two-body orbit from the start misses the end of the step by less than
 # this fraction of what a straight line misses it by, and otherwise (the
-# pair barely interacts) takes the Hermite interpolant.  Measured beside a
-# Jupiter-mass planet at 5 au (Hill radius 0.35 au): 0.01-0.1 for
-# encounters inside 0.6 Hill radii, 0.25-0.3 at 0.9, 0.7-0.9 at 1.4.
+# pair barely interacts) takes the Hermite interpolant.  Beside a
+# Jupiter-mass planet at 5 au (Hill radius 0.35 au) the fraction is 0.01-0.1
+# for encounters inside 0.6 Hill radii, 0.25-0.3 at 0.9, 0.7-0.9 at 1.4.
 _WEAK_INTERACTION = 0.5
 
 # Kick-drift-kick steps on each side of the junction when the orbits in the
@@ -97,8 +97,8 @@ _FD_STEP = 1e-6
 # linear prediction by more than _REFRESH of the mismatch (the pericentre
 # passage makes the mismatch nonlinear), and otherwise updated by Broyden's
 # formula while the correction exceeds _BROYDEN_MIN of the field (below, the
-# secant is rounding noise).  Measured: 2-6 passes on the encounters, 10 at
-# most; _FIT_MAX_ITER means that no field fits.
+# secant is rounding noise).  The encounters of closest_approach's notes
+# take 2-6 passes, 10 at most; _FIT_MAX_ITER means that no field fits.
 _FIT_TOL = 1e-6
 _FIT_ABS = 1e-14
 _FIT_NOISE = 1e-12
@@ -316,8 +316,8 @@ def hermite_closest(dx0, dv0, dx1, dv1, h):
     smallest of ``|p|`` at these roots and at both ends is returned.  A cubic
     (in particular a straight line) is reproduced exactly, so for such
     motion the result is exact up to rounding: ``d_min`` carries an absolute
-    error of a few ``eps max|a_k|`` (measured: 1.7 on random cubics), of
-    the order of the rounding of the data themselves.  Cost: about 1 us.
+    error of a few ``eps max|a_k|`` (1.7 on random cubics), of the order of
+    the rounding of the data themselves.
 
     References
     ----------
@@ -655,22 +655,32 @@ def _tidal_tensor(c):
     return c[3] + d, d - c[3], -2.0 * d, c[0], c[1], c[2]
 
 
+@njit(inline="always")
+def _tidal_field(T, x, y, z):
+    """The acceleration ``T (x, y, z)`` of the tidal field ``T`` (:func:`_tidal_tensor`)."""
+    txx, tyy, tzz, txy, txz, tyz = T
+    return txx * x + txy * y + txz * z, txy * x + tyy * y + tyz * z, txz * x + tyz * y + tzz * z
+
+
+@njit(inline="always")
+def _tidal_kick(T, half, x, y, z, vx, vy, vz):
+    """The velocity after a kick of ``half`` by the tidal field ``T`` at ``(x, y, z)``."""
+    ax, ay, az = _tidal_field(T, x, y, z)
+    return vx + half * ax, vy + half * ay, vz + half * az
+
+
 @njit
 def _tidal_orbit(mu, S, c, h, n):
     """The state after ``n`` kick-drift-kick steps of ``h / n`` from ``S``
     under ``mu`` and the tidal field ``c``."""
-    txx, tyy, tzz, txy, txz, tyz = _tidal_tensor(c)
+    T = _tidal_tensor(c)
     dt = h / n
     x, y, z, vx, vy, vz = S
     half = 0.5 * dt
     for k in range(n):
-        vx += half * (txx * x + txy * y + txz * z)
-        vy += half * (txy * x + tyy * y + tyz * z)
-        vz += half * (txz * x + tyz * y + tzz * z)
+        vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
         x, y, z, vx, vy, vz = _drift(mu, x, y, z, vx, vy, vz, dt)
-        vx += half * (txx * x + txy * y + txz * z)
-        vy += half * (txy * x + tyy * y + tyz * z)
-        vz += half * (txz * x + tyz * y + tzz * z)
+        vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
     return x, y, z, vx, vy, vz
 
 
@@ -828,7 +838,7 @@ def _fit_tidal_field(mu, S0, S1, h, n, tm):
 def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
     """Closest approach along the fitted orbits: the two-body arc of each
     drift, from the start up to ``tm`` and from the end back to it."""
-    txx, tyy, tzz, txy, txz, tyz = _tidal_tensor(c)
+    T = _tidal_tensor(c)
     d_best = math.inf
     t_best = _NAN
     tau_best = 0.0
@@ -844,9 +854,7 @@ def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
         x, y, z, vx, vy, vz = S
         half = 0.5 * dt
         for k in range(n):
-            vx += half * (txx * x + txy * y + txz * z)
-            vy += half * (txy * x + tyy * y + tyz * z)
-            vz += half * (txz * x + tyz * y + tzz * z)
+            vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
             tau, d, v = _kepler_closest(mu, x, y, z, vx, vy, vz, lo, hi)
             if d < d_best:
                 d_best = d
@@ -855,9 +863,7 @@ def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
                 dt_best = dt
                 B = (x, y, z, vx, vy, vz)
             x, y, z, vx, vy, vz = _drift(mu, x, y, z, vx, vy, vz, dt)
-            vx += half * (txx * x + txy * y + txz * z)
-            vy += half * (txy * x + tyy * y + tyz * z)
-            vz += half * (txz * x + tyz * y + tzz * z)
+            vx, vy, vz = _tidal_kick(T, half, x, y, z, vx, vy, vz)
     if not math.isfinite(d_best):
         return _NAN, _NAN, _NAN
     # A drift carries the velocity after the half-kick of its start, dt / 2
@@ -866,9 +872,7 @@ def _closest_on_tidal_orbits(mu, S0, S1, c, h, n, tm):
     #   v = v_drift + (tau - dt / 2) a,  x = x_drift + (tau^2 / 2 - tau dt / 2) a
     # with a = T x, which removes the O(dt |T| |x|) error of the speed.
     x, y, z, vx, vy, vz = _drift(mu, B[0], B[1], B[2], B[3], B[4], B[5], tau_best)
-    ax = txx * x + txy * y + txz * z
-    ay = txy * x + tyy * y + tyz * z
-    az = txz * x + tyz * y + tzz * z
+    ax, ay, az = _tidal_field(T, x, y, z)
     kv = tau_best - 0.5 * dt_best
     kx = 0.5 * tau_best * kv
     speed = _norm3(vx + kv * ax, vy + kv * ay, vz + kv * az)
@@ -893,13 +897,9 @@ def closest_approach(mu, dx0, dv0, dx1, dv1, h):
     ----------
     mu : float
         ``G (m_i + m_j)`` [length^3 / time^2], ``>= 0``.
-    dx0, dv0 : ndarray, shape (3,)
-        Relative position ``x_i - x_j`` [length] and velocity
-        [length / time] at the start of the step.
-    dx1, dv1 : ndarray, shape (3,)
-        The same at the end of the step.
-    h : float
-        The step [time], either sign.
+    dx0, dv0, dx1, dv1, h
+        The relative states at the step's two ends and the step, as
+        :func:`hermite_closest` takes them.
 
     Returns
     -------
@@ -922,8 +922,8 @@ def closest_approach(mu, dx0, dv0, dx1, dv1, h):
     radii from a Jupiter-mass planet its error is below 7e-7 and 3e-9 of the
     separation at a step of P/200 (P the planet's period), 9e-9 and 4e-11
     at P/600.  Otherwise the pair is in an encounter, and neither simple
-    estimate will do, nor their minimum: measured on the encounters below,
-    the cubic cannot turn with a close encounter, and its minimum ranged
+    estimate will do, nor their minimum: on the encounters below, the cubic
+    cannot turn with a close encounter, and its minimum ranged
     from 0.13 to 800 times the true separation at P/200 (so a minimum of the
     estimates would take it when it undershoots); and the two-body orbit
     through either end carries the perturbation of the other bodies
@@ -950,7 +950,7 @@ def closest_approach(mu, dx0, dv0, dx1, dv1, h):
     field fits (the fit does not converge, or an orbit crosses the origin)
     the smaller of the two one-sided two-body estimates is returned.
 
-    *Accuracy, measured* against DOP853 at ``rtol = 1e-13`` for a massless
+    *Accuracy*, against DOP853 at ``rtol = 1e-13`` for a massless
     body passing a Jupiter-mass planet on a circular orbit at 5 au around a
     solar-mass star (P = 11.2 yr), at pericentre distances 1e-4 to 0.1 au,
     speeds at infinity 0.5 to 6 au/yr, two inclinations and the encounter
@@ -976,10 +976,11 @@ def closest_approach(mu, dx0, dv0, dx1, dv1, h):
     to steps of P/600 or less around an encounter.  An Earth-mass body in
     place of the massless one gives the same figures.
 
-    Cost on the reference machine: about 2 us for the Hermite estimate,
-    50-70 us for an encounter (the fit's passes, 32 drifts each, then the
-    arcs), up to 2 ms where no field fits (end states that no orbit joins,
-    or a bound pair drifted over many of its periods in one step).
+    Cost: the Hermite estimate alone outside encounters; in an encounter,
+    the fit's passes (32 drifts each) and the arcs, some thirty times more,
+    and up to a thousand times more where no field fits (end states that
+    no orbit joins, or a bound pair drifted over many of its periods in one
+    step); the figures are in benchmarks/RESULTS.md.
     """
     x0, y0, z0, u0, v0, w0, x1, y1, z1, u1, v1, w1 = _ends(dx0, dv0, dx1, dv1)
     total = x0 + y0 + z0 + u0 + v0 + w0 + x1 + y1 + z1 + u1 + v1 + w1

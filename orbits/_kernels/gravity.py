@@ -41,23 +41,17 @@ __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_re
 #: Up to this many massive bodies the plain double loop
 #: (:func:`accelerate_pairwise_small`) is used; from here on gathering pairs
 #: into vectorised batches (:func:`accelerate_pairwise`) pays
-#: (benchmarks/bench_gravity.py: plain 18 ns against batched 41 ns at N = 2,
-#: 213 ns against 168 ns at N = 9).
+#: (benchmarks/bench_gravity.py; the figures in benchmarks/RESULTS.md).
 SMALL_N = 8
 
 #: Massive bodies from which the pairs' pulls are summed in vector lanes
 #: (:func:`accelerate_pairwise_lanes`) on one thread.  It evaluates each pair
 #: twice (once per body), one vector pass per source, so it pays where the
-#: lanes are full.  Measured (CPU time a leapfrog step, AVX-512 machine,
-#: against the plain double loop up to 8 massive bodies and the batched
-#: kernel beyond): the Sun and its first n - 1 planets, n = 5 0.067 -> 0.074
-#: us, 6 0.084-0.090 -> 0.083-0.105, 7 0.108-0.118 -> 0.090, 8 0.141-0.151
-#: -> 0.094-0.099, 9 0.128-0.138 -> 0.107-0.108; Plummer spheres, n = 12
-#: 0.204-0.213 -> 0.189-0.204, 16 0.34 -> 0.22-0.23, 32 1.16-1.19 ->
-#: 0.77-0.80, 64 4.2-4.3 -> 2.3; whole steps of 512 and 1000 bodies on one
-#: thread 257 -> 105-113 and 988 -> 420-424 us (benchmarks/bench_gravity.py,
-#: the batched kernel's pair rate 2.2e8 a second against 1.2e9 for the
-#: lanes).  So the batched kernel is left to where it is asked for.
+#: lanes are full: from seven massive bodies on it is quicker than the plain
+#: double loop and the batched kernel, and its pair rate on one thread is
+#: several times the batched kernel's (benchmarks/bench_gravity.py; the
+#: figures in benchmarks/RESULTS.md).  So the batched kernel is left to
+#: where it is asked for.
 LANES_FROM = 7
 
 #: Pairs handled per batch by the serial kernel: enough to fill the vector
@@ -157,22 +151,16 @@ def accelerate_pairwise(x, gm, n_active, eps2, acc, work):
 
 
 # A loop that LLVM vectorises over the lanes' columns runs its vector body
-# over whole registers and the rest in scalar code, so the columns are
-# padded to a multiple of the register's doubles.  How wide a register LLVM
-# fills depends on the processor it compiles for: 512 bits (8 doubles) on
-# AMD's Zen 4 with AVX-512, but 256 bits (4) on Intel's AVX-512 processors,
-# where LLVM prefers them, and on AVX2 machines.  Padded to 4 on the Zen 4
-# machine, the loops over 4 or 12 columns ran partly or wholly in scalar
-# code (a leapfrog step of 12 bodies 0.28 us against 0.19-0.20 with 8);
-# padded to 8 on the Intel AVX-512 machine, a third of the work of 3 or 9 to
-# 12 columns went to padding (CPU time a step, two alternating runs: wh
-# with the Sun and three planets 0.21-0.26 us with 4 against 0.35 with 8,
-# four planets 0.24-0.26 against 0.36-0.38; leapfrog of 12 bodies 0.33-0.40
-# against 0.49, 13 bodies 0.36-0.43 against 0.52-0.58).  So the width is
-# asked of LLVM itself, for the processor and features numba compiles for:
-# a one-line loop vectorised as numba would (10 ms at import).  The
-# results do not depend on it: each lane's arithmetic is its own, and the
-# padding's is never read.
+# over whole registers and the rest in scalar code, so the columns are padded
+# to a multiple of the register's doubles.  How wide a register LLVM fills
+# depends on the processor it compiles for: 512 bits (8 doubles) on AMD's
+# Zen 4 with AVX-512, but 256 bits (4) on Intel's AVX-512 processors, where LLVM
+# prefers them, and on AVX2 machines.  A width narrower than the register's
+# leaves loops partly or wholly in scalar code; a wider one spends work on
+# padding (both measured: benchmarks/RESULTS.md).  So the width is asked of
+# LLVM itself, for the processor and features numba compiles for: a one-line
+# loop vectorised as numba would (10 ms at import).  The results do not depend
+# on it: each lane's arithmetic is its own, and the padding's is never read.
 
 _PROBE = """
 define void @probe({p} noalias nocapture %a, {p} noalias nocapture readonly %b, i64 %n) {{
@@ -243,9 +231,8 @@ def aligned_zeros(shape):
     """``np.zeros(shape)`` whose first element starts a cache line (numpy
     aligns a small array to 16 bytes only).  The lanes' rows then start where
     their vector loads do not straddle two lines, whatever address a run's
-    scratch gets: with the Wisdom-Holman lanes' scratch 8 to 24 bytes past a
-    line, a drift and kick took up to 1.07 times as long (Intel AVX-512
-    machine)."""
+    scratch gets (a scratch that straddles lines slows the Wisdom-Holman
+    lanes' drift and kick: benchmarks/RESULTS.md)."""
     size = int(np.prod(shape))
     buf = np.zeros(size + _LINE // 8)
     start = (-buf.ctypes.data % _LINE) // 8
@@ -273,9 +260,9 @@ def lane_columns(n):
 # it is: its mass is replaced by 0 and its distance by 1 (a sum started at
 # +0 is never -0, so adding +0 or -0 changes nothing).  Two things decide
 # the speed of a pass: its sums must not go through masked stores (a masked
-# store cannot be forwarded to the next pass's load: 0.2 us for eight
-# planets' pulls instead of 0.065), and the pass must store nothing but its
-# sums (a further row written in the pass made LLVM keep the scalar form).
+# store cannot be forwarded to the next pass's load), and the pass must
+# store nothing but its sums (LLVM keeps the scalar form of a pass that
+# writes a further row).
 
 @njit(inline="always")
 def _separation(X, Y, Z, k, xs, ys, zs, own, real):
@@ -604,7 +591,7 @@ def accelerate_pairwise_parallel(x, gm, n_active, eps2, acc, work):
     order, so the result does not depend on how blocks were given to threads.
     The inner loops run over separate x, y, z arrays and vectorise.  Filling
     only row i per thread (no reaction terms) would also be race-free but does
-    every pair twice; measured here it was 3.5 times slower at N = 4000.
+    every pair twice, which is slower (benchmarks/RESULTS.md).
     """
     n = x.shape[0]
     xs = np.empty(n)

@@ -64,7 +64,8 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       first_record, must_return, step_epilogue, stop_info, work_kernels)
+                       first_record, mark_recorder, must_return, step_epilogue, stop_info,
+                       work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -100,15 +101,12 @@ PC_MAX_ITERATIONS = 12
 #: :data:`PC_TOLERANCE`).  The step follows ``epsilon**(1/7)`` and the error of a step
 #: its 16th power, so a run's truncation error falls as about ``epsilon**(15/7)``; a
 #: corrector tolerance that falls as ``epsilon**2`` keeps about the same ratio to it at
-#: every ``epsilon``.  The share 1e-2 is measured: on Kepler orbits of e = 0.5 to 0.99,
-#: the Earth and Moon, the Sun with eight planets and the outer solar system, at
-#: epsilon 1e-1 to 1e-6, the final positions moved by a small part of the run's own
-#: truncation error (0.1 to 7 %) or, where that error is rounding, within its scatter
-#: (the outer solar system over 1e4 yr at epsilon 1e-5: 1.7e-10 au, against 5e-12 to
-#: 2e-10 au for runs converged to rounding at epsilon 1e-5 to 1e-9), while the force
-#: evaluations fell by up to half (10 times this share made some errors 3 times
-#: larger).  At ``epsilon <= 1e-7`` (the default 1e-9 included) the corrector still
-#: runs to :data:`PC_TOLERANCE`, bit for bit as before.
+#: every ``epsilon``.  With the share 1e-2 the final positions of Kepler orbits, the
+#: Earth and Moon and planetary systems at epsilon 1e-1 to 1e-6 move by a small part
+#: of the run's own truncation error, or within its scatter where that error is
+#: rounding, for up to half the force evaluations (the runs are in
+#: benchmarks/RESULTS.md).  At ``epsilon <= 1e-7`` (the default 1e-9 included) the
+#: corrector runs to :data:`PC_TOLERANCE`.
 PC_EPSILON_SQUARED = 1e-2
 
 #: How much b6 = g6, the seventh divided difference of the accelerations at
@@ -122,8 +120,8 @@ _UNIT_ROUNDOFF = 2.0 ** -53
 #: b6 below this many times its rounding estimate counts as rounding: the
 #: estimate takes ``|da/dx|`` along the step, which in a close encounter is
 #: smaller than its norm by about the ratio of a body's speed to the speed of
-#: the encounter (measured 6 for Earth-mass planets meeting at 5 km/s, where
-#: the estimate came out at 0.2 to 1 times the b6 of tiny steps); 10 covers
+#: the encounter (6 for Earth-mass planets meeting at 5 km/s, where the
+#: estimate comes out at 0.2 to 1 times the b6 of tiny steps); 10 covers
 #: that, and lies far below the truncation error of any useful step
 ROUNDING_MARGIN = 10.0
 
@@ -346,8 +344,8 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     # mon_out (monitors and state, orbits._kernels.stepping.record_state) with
     # its time in mon_t and its step count in mark_steps; t_end is then the
     # last mark.  The rows count in n_mon.  Empty marks: the loop lands on
-    # t_end alone (the same compiled loop: a loop compiled for each use cost
-    # every new force two compilations).
+    # t_end alone (the same compiled loop, so that a new force compiles one
+    # loop for both uses).
     (dtp, info, a0, b, g, e, br, er, csx, csv, ref, tc, flags, xs, vs, acc, P,
      counts) = work
     epsilon, mode = control
@@ -632,15 +630,11 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
             if not has_marks:
                 return Status.OK, t, n_mon
             # an output: recorded as the driver would record it on return
-            mon_t[n_mon] = t
-            record_row(x, v, t, mon, n_mon, mon_t, mon_out)
-            work_note(fargs, mon_out, n_mon)
-            mark_steps[n_mon] = step0 + counts[0]
-            n_mon += 1
-            k_mark += 1
-            if k_mark == marks.shape[0]:
+            n_mon, k_mark, target, last = record_mark(
+                x, v, t, step0 + counts[0], mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
+                fargs)
+            if last:
                 return Status.OK, t, n_mon
-            target = marks[k_mark]
 
 
 def _first_step(x, a0, span):
@@ -671,8 +665,8 @@ def _first_step(x, a0, span):
 
 # the names _ias15_loop is written against, bound by ias15_loop (specialize);
 # the helpers default to their Python form, for a loop that runs as Python
-force, rows, step_end, record_row, PREDICT_V = slots(
-    "force", "rows", "step_end", "record_row", "PREDICT_V")
+force, rows, step_end, record_mark, PREDICT_V = slots(
+    "force", "rows", "step_end", "record_mark", "PREDICT_V")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 predict, g_from_b, b_from_g, first_step = slots(
     predict=_predict, g_from_b=_g_from_b, b_from_g=_b_from_g, first_step=_first_step)
@@ -700,5 +694,5 @@ def ias15_loop(force):
     return specialize(_ias15_loop, force.key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force), PREDICT_V=predict_v,
-                      record_row=force.recorder,
+                      record_mark=mark_recorder(force),
                       rows=measured_rows(force), **work_kernels(force), **helpers)

@@ -134,9 +134,9 @@ def monitor_row(x, v, m, G, n_active, eps2, which, row):
 # The relative errors of a run's monitor rows, one pass over the rows each.
 # The rows are wide (the monitors, then every body's position and
 # velocity), so every numpy operation on one of their columns reads a cache
-# line a row: the energy's error took five such passes and the angular
-# momentum's six, 0.045 us an output of a run kept in memory (10^5 rows of
-# the outer solar system), against 0.01 us here.  Each is the expression of
+# line a row, and the energy's error takes five such operations and the
+# angular momentum's six: one compiled pass is several times quicker
+# (benchmarks/RESULTS.md).  Each is the expression of
 # orbits.monitors.relative_error and vector_relative_error, in the same
 # order, so the floats are the same.
 

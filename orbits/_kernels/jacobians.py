@@ -19,11 +19,11 @@ import numpy as np
 from ._jit import njit, slots, specialize
 
 # the names the templates below are written against, bound by specialize
-force, VELOCITY, base_jacobian, extra, user_jac = slots(
-    "force", "VELOCITY", "base_jacobian", "extra", "user_jac")
+force, VELOCITY, base_jacobian, extra, user_jac, differences = slots(
+    "force", "VELOCITY", "base_jacobian", "extra", "user_jac", "differences")
 
 __all__ = ["gravity_jacobian", "user_jacobian", "finite_difference_jacobian", "jacobian_for",
-           "FD_STEP"]
+           "central_differences", "FD_STEP"]
 
 _EPS = 2.220446049250313e-16
 
@@ -105,46 +105,54 @@ def user_jacobian(jac, jit):
                       user_jac=jac)
 
 
-def _finite_difference_jacobian(x, v, t, fargs, jx, jv):
-    # central differences, column by column: component q of the state moves by
-    # +-delta with delta = FD_STEP * max(|y_q|, 1); the difference of the two
-    # perturbed values (exact in binary) is the divisor
+def central_differences(x, v, t, fargs, jx, jv, velocity, step, floor_x, floor_v, add):
+    """Central differences of ``force`` (a slot), column by column: component
+    q of the positions (then, with ``velocity``, of the velocities) moves by
+    ``+-delta``, ``delta = step * max(|y_q|, floor)`` with the positions' or
+    the velocities' ``floor``, and column q of ``jx`` (``jv``) becomes the
+    difference of the two accelerations over the difference of the two
+    perturbed values (exact in binary), or with ``add`` is added to it.  A
+    template: :func:`finite_difference_jacobian` binds a force, and
+    :func:`orbits._kernels.terms.row_difference_jacobian` one row of a
+    table of terms."""
     n = x.shape[0]
     m = 3 * n
     xp = x.copy()
     vp = v.copy()
-    # zeros: a user's force writes only its own components, not the padding
-    ap = np.zeros((n, 3))
-    am = np.zeros((n, 3))
-    for q in range(m):
-        i = q // 3
-        d = q % 3
-        delta = FD_STEP * max(abs(x[i, d]), 1.0)
-        hi = x[i, d] + delta
-        lo = x[i, d] - delta
-        xp[i, d] = hi
-        force(xp, v, t, fargs, ap)
-        xp[i, d] = lo
-        force(xp, v, t, fargs, am)
-        xp[i, d] = x[i, d]
-        inv = 1.0 / (hi - lo)
-        for p in range(m):
-            jx[p, q] = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
-    if VELOCITY:
+    ap = np.empty((n, 3))
+    am = np.empty((n, 3))
+    for half in range(2 if velocity else 1):
+        src = x if half == 0 else v
+        moved = xp if half == 0 else vp
+        out = jx if half == 0 else jv
+        floor = floor_x if half == 0 else floor_v
         for q in range(m):
             i = q // 3
             d = q % 3
-            delta = FD_STEP * max(abs(v[i, d]), 1.0)
-            hi = v[i, d] + delta
-            lo = v[i, d] - delta
-            vp[i, d] = hi
-            force(x, vp, t, fargs, ap)
-            vp[i, d] = lo
-            force(x, vp, t, fargs, am)
-            vp[i, d] = v[i, d]
+            delta = step * max(abs(src[i, d]), floor)
+            hi = src[i, d] + delta
+            lo = src[i, d] - delta
+            # zeros: a force may write only its own components (a user's,
+            # not the padding), or add to them (a table's terms)
+            ap[...] = 0.0
+            am[...] = 0.0
+            moved[i, d] = hi
+            force(xp, vp, t, fargs, ap)
+            moved[i, d] = lo
+            force(xp, vp, t, fargs, am)
+            moved[i, d] = src[i, d]
             inv = 1.0 / (hi - lo)
             for p in range(m):
-                jv[p, q] = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
+                diff = (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
+                if add:
+                    out[p, q] += diff
+                else:
+                    out[p, q] = diff
+
+
+def _finite_difference_jacobian(x, v, t, fargs, jx, jv):
+    # the relative step FD_STEP, of max(|y_q|, 1)
+    differences(x, v, t, fargs, jx, jv, VELOCITY, FD_STEP, 1.0, 1.0, False)
 
 
 def finite_difference_jacobian(force, velocity_dependent):
@@ -157,8 +165,10 @@ def finite_difference_jacobian(force, velocity_dependent):
     solution does not depend on it.
     """
     key = f"fd_{force.key}{'_v' if velocity_dependent else ''}"
+    differences = specialize(central_differences, force.key, jit=force.jit, cache=force.cache,
+                             inline=True, force=force.kernel)
     return specialize(_finite_difference_jacobian, key, jit=force.jit, cache=force.cache,
-                      force=force.kernel, VELOCITY=bool(velocity_dependent))
+                      differences=differences, VELOCITY=bool(velocity_dependent))
 
 
 #: keys of the gravity forces (stepping.gravity_force)

@@ -46,16 +46,10 @@ class Monitors(NamedTuple):
     eps2: float
 
 
-class MonitorsWithTerms(NamedTuple):
-    """:class:`Monitors` with the energy arguments of the force terms
-    (:func:`.stepping.with_terms`), whose potential the energy includes."""
-    every: int
-    which: int
-    masses: np.ndarray
-    G: float
-    n_active: int
-    eps2: float
-    terms: tuple
+MonitorsWithTerms = NamedTuple("MonitorsWithTerms",
+                               [*Monitors.__annotations__.items(), ("terms", tuple)])
+MonitorsWithTerms.__doc__ = """:class:`Monitors` with the energy arguments of the force
+terms (:func:`.stepping.with_terms`), whose potential the energy includes."""
 
 
 class Outputs(NamedTuple):

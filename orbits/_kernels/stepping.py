@@ -80,7 +80,7 @@ __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force
            "user_force", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
-           "clock_step", "add_compensated", "stop_info"]
+           "clock_step", "add_compensated", "stop_info", "mark_recorder"]
 
 #: operator codes of a splitting table
 DRIFT = 0
@@ -271,6 +271,32 @@ def epilogue(record, key, jit=True, cache=True, runtime=False, stop=None, work_n
                       record=record, stop_check=stop_check,
                       work_note=_no_work_note if work_note is None else work_note,
                       tangent_step=_no_tangent_step if tangent_step is None else tangent_step)
+
+
+def _record_mark(x, v, t, steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark, fargs):
+    # An adaptive loop's output at the mark k_mark it has landed on (t),
+    # recorded as the driver would record it on return: a row of mon_out
+    # (monitors and state) with its time in mon_t and its step count, steps
+    # from the run's start, in mark_steps.  Returns (the rows, the next
+    # mark's index, its time (t after the last), whether it was the last).
+    mon_t[n_mon] = t
+    record(x, v, t, mon, n_mon, mon_t, mon_out)
+    work_note(fargs, mon_out, n_mon)
+    mark_steps[n_mon] = steps
+    k_mark += 1
+    last = k_mark == marks.shape[0]
+    return n_mon + 1, k_mark, t if last else marks[k_mark], last
+
+
+def mark_recorder(force):
+    """The recording of an output at a mark (an output time an adaptive loop
+    lands on) for the loops compiled for a :class:`ForceKernel`: it takes
+    ``(x, v, t, steps, mon, n_mon, mon_t, mon_out, marks, mark_steps,
+    k_mark, fargs)`` and returns ``(n_mon, k_mark, target, last)``, the
+    rows, the next mark and its time, and whether the mark was the last."""
+    return specialize(_record_mark, force.key, jit=force.jit, inline=True, nrt=force.runtime,
+                      cache=force.cache, record=force.recorder,
+                      work_note=work_kernels(force)["work_note"])
 
 
 # -- forces ------------------------------------------------------------------------
@@ -601,11 +627,10 @@ def _splitting_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, output
     stopping = (sargs, check)
     n = x.shape[0]
     # flat views of the (N, 3) arrays: the drifts and kicks as loops LLVM
-    # turns into vector instructions, each component's operation as before
-    # (bit for bit).  Measured (CPU time a step, paired runs): leapfrog on the
-    # Sun and eight planets 0.148-0.151 -> 0.133-0.138 us, the outer solar
-    # system unchanged; two bodies 0.031 -> 0.033 us, too few for the vector
-    # loop's set-up, so below FLAT_FROM_BODIES the nested loops stay
+    # turns into vector instructions, each component's operation that of
+    # the nested loops (bit for bit); below FLAT_FROM_BODIES bodies the
+    # vector loop's set-up costs more than it saves, and the nested loops
+    # are faster (benchmarks/RESULTS.md)
     flat = n >= FLAT_FROM_BODIES
     m3 = 3 * n
     xF = x.reshape(m3)
@@ -692,8 +717,8 @@ def _implicit_kick_for(force):
     # Gravity alone never reads velocities: its loops leave the implicit kick
     # out.  For other forces (whose loops serve velocity-dependent ones and
     # others alike) the kick is a call: it iterates the force a few times, so
-    # a call costs nothing beside it, and an inlined copy of the force cost
-    # its compilation again in every loop
+    # a call costs nothing beside it, and an inlined copy of the force would
+    # cost its compilation again in every loop
     if force.jit and force.terms is None and force.inner is None and not force.opaque \
             and not force.velocity_dependent:
         return _no_implicit_kick

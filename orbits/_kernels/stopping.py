@@ -65,6 +65,7 @@ import numpy as np
 from numba.core import types as nbtypes
 
 from ._jit import njit, pointer
+from .coordinates import centre_of_mass
 from .encounters import closest_approach, kepler_contact
 from .status import Status
 
@@ -512,23 +513,7 @@ def check_stop(x, v, t, sargs):
         if close:
             return Status.CLOSE_ENCOUNTER
     if mask & ESCAPE:
-        mt = 0.0
-        cx = cy = cz = 0.0
-        ux = uy = uz = 0.0
-        for i in range(n):
-            mt += gm[i]
-            cx += gm[i] * x[i, 0]
-            cy += gm[i] * x[i, 1]
-            cz += gm[i] * x[i, 2]
-            ux += gm[i] * v[i, 0]
-            uy += gm[i] * v[i, 1]
-            uz += gm[i] * v[i, 2]
-        cx /= mt
-        cy /= mt
-        cz /= mt
-        ux /= mt
-        uy /= mt
-        uz /= mt
+        mt, cx, cy, cz, ux, uy, uz = centre_of_mass(x, v, gm, n)
         for i in range(n):
             r2 = (x[i, 0] - cx) ** 2 + (x[i, 1] - cy) ** 2 + (x[i, 2] - cz) ** 2
             if r2 > esc2:

@@ -51,10 +51,11 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       first_record, must_return, step_epilogue, stop_info, work_kernels)
+                       first_record, mark_recorder, must_return, step_epilogue, stop_info,
+                       work_kernels)
 
 # the names the templates below are written against, bound by specialize
-record_row, step_end = slots("record_row", "step_end")
+record_mark, step_end = slots("record_mark", "step_end")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["order_for", "pair_count", "padded_pairs", "Series", "series_arrays", "taylor_loop",
@@ -336,15 +337,12 @@ def _taylor_loop(x, v, t, order, series, work, fargs, outputs, landing, sargs, c
         if t == target:
             if not has_marks:
                 return Status.OK, t, n_mon
-            mon_t[n_mon] = t
-            record_row(x, v, t, mon, n_mon, mon_t, mon_out)
-            work_note(fargs, mon_out, n_mon)
-            mark_steps[n_mon] = step0 + counts[0]
-            n_mon += 1
-            k_mark += 1
-            if k_mark == marks.shape[0]:
+            # an output: recorded as the driver would record it on return
+            n_mon, k_mark, target, last = record_mark(
+                x, v, t, step0 + counts[0], mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
+                fargs)
+            if last:
                 return Status.OK, t, n_mon
-            target = marks[k_mark]
 
 
 def taylor_loop(force):
@@ -359,4 +357,4 @@ def taylor_loop(force):
     """
     return specialize(_taylor_loop, force.key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, step_end=step_epilogue(force),
-                      record_row=force.recorder, **work_kernels(force))
+                      record_mark=mark_recorder(force), **work_kernels(force))

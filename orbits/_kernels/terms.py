@@ -41,8 +41,9 @@ import numpy as np
 
 from numba.core import types as nbtypes
 
-from ._jit import njit
+from ._jit import njit, specialize
 from .invariants import _add
+from .jacobians import central_differences
 
 __all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "TABLE", "table",
            "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
@@ -72,6 +73,26 @@ def _pull(acc, i, src, w, ax, ay, az):
     acc[src, 0] -= w * ax
     acc[src, 1] -= w * ay
     acc[src, 2] -= w * az
+
+
+@njit(inline="always")
+def _add_block(jac, i, j, wi, wj, d):
+    # the 3x3 block d = d a_rel / dr (or du) of a_rel(r, u), r = x_i - x_j,
+    # u = v_i - v_j, into jac: body i takes wi a_rel, body j -wj a_rel
+    for a in range(3):
+        for c in range(3):
+            jac[3 * i + a, 3 * i + c] += wi * d[a, c]
+            jac[3 * i + a, 3 * j + c] -= wi * d[a, c]
+            if wj != 0.0:
+                jac[3 * j + a, 3 * i + c] -= wj * d[a, c]
+                jac[3 * j + a, 3 * j + c] += wj * d[a, c]
+
+
+@njit(inline="always")
+def _add_pair_block(jx, jv, i, j, wi, wj, dx, dv):
+    # both blocks of a_rel(r, u): dx = d a_rel / dr into jx, dv = d a_rel / du into jv
+    _add_block(jx, i, j, wi, wj, dx)
+    _add_block(jv, i, j, wi, wj, dv)
 
 
 # -- GR from one dominant body (Anderson et al. 1975) ------------------------------------
@@ -208,18 +229,7 @@ def gr_jacobian(x, v, t, args, jx, jv):
                     gv += B
                 dx[a, b] = k * gx
                 dv[a, b] = k * gv
-        w = gm[i] / mu
-        for a in range(3):
-            for b in range(3):
-                jx[3 * i + a, 3 * i + b] += dx[a, b]
-                jx[3 * i + a, 3 * src + b] -= dx[a, b]
-                jv[3 * i + a, 3 * i + b] += dv[a, b]
-                jv[3 * i + a, 3 * src + b] -= dv[a, b]
-                if w != 0.0:
-                    jx[3 * src + a, 3 * i + b] -= w * dx[a, b]
-                    jx[3 * src + a, 3 * src + b] += w * dx[a, b]
-                    jv[3 * src + a, 3 * i + b] -= w * dv[a, b]
-                    jv[3 * src + a, 3 * src + b] += w * dv[a, b]
+        _add_pair_block(jx, jv, i, src, 1.0, gm[i] / mu, dx, dv)
 
 
 # -- the GR potential (Nobili & Roxburgh 1986) ------------------------------------------
@@ -267,6 +277,7 @@ def gr_potential_jacobian(x, v, t, args, jx, jv):
     mu = gm[src]
     k = 6.0 * mu * mu * inv_c2
     r = np.empty(3)
+    dx = np.empty((3, 3))
     for i in range(x.shape[0]):
         if i == src:
             continue
@@ -274,17 +285,13 @@ def gr_potential_jacobian(x, v, t, args, jx, jv):
             r[d] = x[i, d] - x[src, d]
         r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
         inv4 = 1.0 / (r2 * r2)
-        w = gm[i] / mu
         for a in range(3):
             for b in range(3):
                 g = 4.0 * k * r[a] * r[b] * inv4 / r2
                 if a == b:
                     g -= k * inv4
-                jx[3 * i + a, 3 * i + b] += g
-                jx[3 * i + a, 3 * src + b] -= g
-                if w != 0.0:
-                    jx[3 * src + a, 3 * i + b] -= w * g
-                    jx[3 * src + a, 3 * src + b] += w * g
+                dx[a, b] = g
+        _add_block(jx, i, src, 1.0, gm[i] / mu, dx)
 
 
 # -- Einstein-Infeld-Hoffmann among all massive bodies ----------------------------------
@@ -506,14 +513,8 @@ def zonal_jacobian(x, v, t, args, jx, jv):
                                                                   + pole[a] * r[c])
                            + g_qq * pole[a] * pole[c])
             h[a, a] += 2.0 * g_s
-        w = gm[i] / gm[b]
-        for a in range(3):
-            for c in range(3):
-                jx[3 * i + a, 3 * i + c] -= h[a, c]
-                jx[3 * i + a, 3 * b + c] += h[a, c]
-                if w != 0.0:
-                    jx[3 * b + a, 3 * i + c] += w * h[a, c]
-                    jx[3 * b + a, 3 * b + c] -= w * h[a, c]
+        # d a / dr = -H: the weights' signs turned instead of H's
+        _add_block(jx, i, b, -1.0, -(gm[i] / gm[b]), h)
 
 
 # -- dissipative terms: no energy of their own ------------------------------------------
@@ -558,22 +559,6 @@ def migration_accel(x, v, t, args, acc):
     acc[p, 0] -= wp * ax
     acc[p, 1] -= wp * ay
     acc[p, 2] -= wp * az
-
-
-@njit(inline="always")
-def _add_pair_block(jx, jv, i, j, wi, wj, dx, dv):
-    # a_rel(r, u) with r = x_i - x_j, u = v_i - v_j: i takes wi a_rel, j takes -wj a_rel
-    for a in range(3):
-        for c in range(3):
-            jx[3 * i + a, 3 * i + c] += wi * dx[a, c]
-            jx[3 * i + a, 3 * j + c] -= wi * dx[a, c]
-            jv[3 * i + a, 3 * i + c] += wi * dv[a, c]
-            jv[3 * i + a, 3 * j + c] -= wi * dv[a, c]
-            if wj != 0.0:
-                jx[3 * j + a, 3 * i + c] -= wj * dx[a, c]
-                jx[3 * j + a, 3 * j + c] += wj * dx[a, c]
-                jv[3 * j + a, 3 * i + c] -= wj * dv[a, c]
-                jv[3 * j + a, 3 * j + c] += wj * dv[a, c]
 
 
 @njit
@@ -951,39 +936,26 @@ def table_energy(x, v, tab):
     return e
 
 
+@njit(inline="always")
+def _row_accel(x, v, t, row, acc):
+    # adds the accelerations of the table's row k alone, row = (tab, k)
+    tab, k = row
+    rows_accel(x, v, t, tab, k, k + 1, acc)
+
+
+_row_differences = specialize(central_differences, "term_row", inline=True, force=_row_accel)
+
+
 @njit
 def row_difference_jacobian(x, v, t, tab, k, velocity, jx, jv):
     """Adds the central-difference ``da/dx`` (and with ``velocity`` ``da/dv``)
-    of row ``k`` of ``tab`` to ``jx`` (``jv``), column by column: the
-    accelerations at ``x +- delta e_q`` with ``delta`` :data:`FD_STEP` of the
-    component (at least 1e-3 of the largest), for terms without an analytic
-    Jacobian (6N or 12N evaluations of the row)."""
-    n = x.shape[0]
-    m = 3 * n
-    xp = x.copy()
-    vp = v.copy()
-    ap = np.zeros((n, 3))
-    am = np.zeros((n, 3))
-    for half in range(2 if velocity else 1):
-        src = x if half == 0 else v
-        dst = xp if half == 0 else vp
-        out = jx if half == 0 else jv
-        for q in range(m):
-            i = q // 3
-            d = q % 3
-            delta = FD_STEP * max(abs(src[i, d]), 1e-3 * _scale(src))
-            hi = src[i, d] + delta
-            lo = src[i, d] - delta
-            ap[...] = 0.0
-            am[...] = 0.0
-            dst[i, d] = hi
-            rows_accel(xp, vp, t, tab, k, k + 1, ap)
-            dst[i, d] = lo
-            rows_accel(xp, vp, t, tab, k, k + 1, am)
-            dst[i, d] = src[i, d]
-            inv = 1.0 / (hi - lo)
-            for p in range(m):
-                out[p, q] += (ap[p // 3, p % 3] - am[p // 3, p % 3]) * inv
+    of row ``k`` of ``tab`` to ``jx`` (``jv``), column by column
+    (:func:`~.jacobians.central_differences`): the accelerations at ``x +-
+    delta e_q`` with ``delta`` :data:`FD_STEP` of the component (at least
+    1e-3 of the largest), for terms without an analytic Jacobian (6N or 12N
+    evaluations of the row)."""
+    _row_differences(x, v, t, (tab, k), jx, jv, velocity, FD_STEP, 1e-3 * _scale(x),
+                     1e-3 * _scale(v), True)
 
 
 @njit

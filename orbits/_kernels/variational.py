@@ -63,7 +63,7 @@ from .jacobians import jacobian_for
 
 __all__ = ["with_variations", "variation_args", "chaos_update", "chaos_rescaled",
            "chaos_values", "chaos_box", "measured_rows", "CHAOS", "RENORMALISE_EXPONENT",
-           "tangent_kernels"]
+           "tangent_kernels", "tangent_product"]
 
 #: slots of the chaos accumulator box
 CHAOS = dict(t0=0, t_prev=1, L_prev=2, offset=3, int_L=4, int_Y=5, Y_prev=6, fli=7, L=8,
@@ -150,6 +150,25 @@ def chaos_values(box):
 
 # -- the force of the augmented system ------------------------------------------------------
 
+@njit(inline="always")
+def tangent_product(jx, jv, x, v, o, n, acc, velocity):
+    """The accelerations' tangent vector in the rows ``o .. o + n - 1`` of
+    ``acc``: ``da/dx`` (``jx``, shape (3n, 3n)) times the positions' tangent
+    vector in those rows of ``x``, plus, with ``velocity``, ``da/dv``
+    (``jv``) times the velocities' in ``v``, summed body by body."""
+    for i in range(n):
+        for d in range(3):
+            r = 3 * i + d
+            s = 0.0
+            for c in range(n):
+                s += (jx[r, 3 * c] * x[o + c, 0] + jx[r, 3 * c + 1] * x[o + c, 1]
+                      + jx[r, 3 * c + 2] * x[o + c, 2])
+                if velocity:
+                    s += (jv[r, 3 * c] * v[o + c, 0] + jv[r, 3 * c + 1] * v[o + c, 1]
+                          + jv[r, 3 * c + 2] * v[o + c, 2])
+            acc[o + i, d] = s
+
+
 def _varied(x, v, t, fargs, acc):
     inner_args, vargs = fargs[0], fargs[1]
     n, dm, jx, jv = vargs[0], vargs[1], vargs[2], vargs[3]
@@ -163,17 +182,7 @@ def _varied(x, v, t, fargs, acc):
     k = dm.shape[0]
     for j in range(k):
         o = n * (j + 1)
-        for i in range(n):
-            for d in range(3):
-                r = 3 * i + d
-                s = 0.0
-                for c in range(n):
-                    s += (jx[r, 3 * c] * x[o + c, 0] + jx[r, 3 * c + 1] * x[o + c, 1]
-                          + jx[r, 3 * c + 2] * x[o + c, 2])
-                    if VELOCITY:
-                        s += (jv[r, 3 * c] * v[o + c, 0] + jv[r, 3 * c + 1] * v[o + c, 1]
-                              + jv[r, 3 * c + 2] * v[o + c, 2])
-                acc[o + i, d] = s
+        tangent_product(jx, jv, x, v, o, n, acc, VELOCITY)
         if MASSES:
             G, eps2 = vargs[5]
             for l in range(n):

@@ -21,10 +21,10 @@ so and are avoided: a loop whose index numba cannot prove non-negative (it
 then tests for negative indices, which Python allows, element by element:
 the loops over the systems use unsigned indices) and a branch inside the
 loop on a flag that is the same for every element (the drift's loops are
-written out once for each value of it).  Measured on the 2-core AVX2
-reference machine (``benchmarks/bench_batch.py``): the loops pay a fixed
-cost each time they start, so that batches of 16 systems or more gain most
-and a batch of one is several times slower than ``wh`` on its own.
+written out once for each value of it).  The loops pay a fixed cost each
+time they start, so that batches of 16 systems or more gain most and a
+batch of one is several times slower than ``wh`` on its own
+(``benchmarks/bench_batch.py``).
 
 Each system gets, bit for bit, the arithmetic of the scalar kernels of
 :mod:`orbits._kernels.wisdom_holman`: the same operations in the same order
@@ -44,13 +44,9 @@ select, never a branch per lane:
   decline go to the scalar drift where they are few (at most one in
   :data:`FEW`), else to the masked form below, which takes them all with
   their iterations (the Sun and eight planets at a day: Mercury in every
-  system).  The passes took the outer solar system's drift from 0.055 to
-  0.044-0.046 us a system and the batch of 16 from 1.31-1.41 to 1.20-1.24
-  times WHFast512's step (the batch of 8: 2.01 to 1.60; AMD machine); split
-  in three loops (starter, iteration, f and g; see ``wh_lanes``), the 80
-  columns of 16 outer solar systems take 7.7-8.1 ns each instead of 12.2,
-  and the batch of 16 0.53 instead of 0.67 times WHFast512's step (the
-  drift inlined into the step too; Intel AVX-512 machine).  The masked form:
+  system).  The passes, three loops (starter, iteration, f and g; see
+  ``wh_lanes``) inlined into the step, make the usual drift quicker than
+  the masked form's iterations (benchmarks/RESULTS.md).  The masked form:
   the third-order Taylor starter of the universal anomaly and Danby's quartic
   iteration, repeated until every lane has converged (at most
   ``_SHORT_STEP_ITER`` times; a lane that has converged keeps its anomaly
@@ -383,10 +379,8 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
 
 @njit(inline="always")
 def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
-    # kepler_drift_lanes, inlined into the loops that step: as a call of its
-    # own its passes took 27 ns a column for the batch of 4 outer solar
-    # systems, against 10 inlined (12 against 10 at 8 systems, 11 against 10
-    # at 16; the cause not found)
+    # kepler_drift_lanes, inlined into the loops that step: its passes are
+    # quicker inlined than as a call of its own (benchmarks/RESULTS.md)
     m = X.shape[1]
     X0 = X[0]
     X1 = X[1]
@@ -424,9 +418,9 @@ def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
         V2[k] = U2[k] if keep else V2[k]
         alone[k] = 1.0 if (LF[k] != 0.0) & (take[k] == 0.0) else 0.0
     # the live elements the passes declined (a step long against an orbit,
-    # more than one iteration), in a function of its own (inlined at both of
+    # more than one iteration), in a function of its own: inlined at both of
     # the loop's steps, with the scalar drift's solver inlined in it twice,
-    # they took the batch loop's compilation from 19 to 104 s)
+    # they would take most of the batch loop's compilation
     if declined:
         _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v)
 
@@ -515,7 +509,7 @@ def interaction_kick_lanes(X, V, XI, ACC, GM, MU, WQ, n_active, h, LF, nb, s3, a
     # every pair but (0, 1) (orbits._kernels.gravity.pair_accelerations):
     # three short loops over the systems a pair (the separation, the pull on
     # the later body, the reaction on the earlier one), which LLVM vectorises
-    # better than one loop with all three (measured)
+    # better than one loop with all three
     A0 = ACC[0]
     A1 = ACC[1]
     A2 = ACC[2]
@@ -774,28 +768,24 @@ advance_lanes = specialize(_advance_lanes, "any_size", lane_step=_any_size_step)
 # -- the kick unrolled for one size of system ---------------------------------------
 #
 # interaction_kick_lanes runs a few short loops over the B systems for every
-# pair of bodies, and each loop pays its start and its remainder: at B = 16
-# the kick took 0.13 us a system-step on the Intel AVX-512 machine, against
-# 0.09 us for the whole drift.  Written out for one number of bodies, one of
-# massive bodies and one of systems, every pair's arithmetic is straight-line
-# code inside a single loop over the systems, with the bodies' positions and
-# sums in registers; LLVM turns that loop into vector instructions only if it
-# can tell that the kick's stores (the velocities) never overlap its loads,
-# which it can where every load comes from one flat array and every store
-# goes to another at offsets that are constants of the code (a row length of
-# B N known when it compiles), and whose loop over the systems runs to a
-# bound it is handed (LLVM never vectorises a loop of fewer than 16
-# iterations known when it compiles).  Measured: 0.032 us a system-step at
-# B = 16 and 64 (the outer solar system), bit for bit the loops' kick; whole
-# batch steps at B = 4 / 8 / 16, 0.51 / 0.30 / 0.24 -> 0.23 / 0.21 / 0.14 us
-# a system-step.  numba does
-# not unroll loops of a size known only when a function is specialised, so
-# the source is generated (unrolled_kick) and compiled from a file, so that
-# numba caches it on disk like the package's own kernels.
+# pair of bodies, and each loop pays its start and its remainder, so that at
+# B = 16 the kick costs more than the whole drift.  Written out for one
+# number of bodies, one of massive bodies and one of systems, every pair's
+# arithmetic is straight-line code inside a single loop over the systems, with
+# the bodies' positions and sums in registers; LLVM turns that loop into vector
+# instructions only if it can tell that the kick's stores (the velocities)
+# never overlap its loads, which it can where every load comes from one flat
+# array and every store goes to another at offsets that are constants of the
+# code (a row length of B N known when it compiles), and whose loop over the
+# systems runs to a bound it is handed (LLVM never vectorises a loop of fewer
+# than 16 iterations known when it compiles).  The written-out kick is bit for
+# bit the loops' kick, and a fraction of its time (benchmarks/RESULTS.md).
+# numba does not unroll loops of a size known only when a function is
+# specialised, so the source is generated (unrolled_kick) and compiled from a
+# file, so that numba caches it on disk like the package's own kernels.
 
 #: the most bodies for which advance_loop unrolls the kick (the straight-line
-#: code grows as N^2: its compilation took 2 s at 6 bodies, 4 s at 9, 26 s
-#: at 17)
+#: code grows as N^2, and its compilation faster still: benchmarks/RESULTS.md)
 UNROLLED_KICK_BODIES = 10
 
 #: rows of the flat array the unrolled kick reads (rows of d, each B N long):

@@ -21,10 +21,8 @@ iterations, the f and g functions) with the four-term Stumpff series
 a planetary step (a few hundredths of a radian of anomaly, where the
 starter is good to 1e-6 and one iteration converges), and passes over all
 the planets let the processor overlap their long chains of dependent
-operations: the eight planets' drift took 0.19 µs in one pass against 0.39
-µs for the scalar drift (0.27 µs in an earlier split into three loops; the
-split now kept, and why it pays on the Intel AVX-512 machine, under "three
-passes" below).  A
+operations, which the scalar drift, one planet after another, cannot (see
+"three passes" below).  A
 lane is taken where the scalar path would have done exactly this
 (converged after one iteration, both Stumpff arguments within the
 four-term series, a positive radius at the end).  Every other planet (a
@@ -37,20 +35,15 @@ LLVM neither reorders nor fuses the operations, and a vector instruction
 rounds each lane as its scalar form does.  The fused multiply-adds of the
 shared Kepler helpers (:func:`orbits._kernels._jit.fma`, correctly rounded
 on every machine) are written out, so the scalar drift has them too; with
-them the drift's chains are shorter, and a step of the loop took 0.90-0.95
-of its time before (outer solar system and Sun with eight planets, against
-WHFast512 in the same runs: 1.10 / 1.44 and in democratic heliocentric
-coordinates 0.98 / 1.28, against 1.21-1.27 / 1.49-1.53 and 1.04-1.05 /
-1.31-1.33).
+them the drift's chains are shorter.
 
-A masked form of the whole short-step path in the lanes (the iteration
-repeated until every lane has converged, the general Stumpff form with a
-masked number of quarterings, as :mod:`orbits._kernels.wh_batch` does) was
-measured and dropped: where a step is long for some planets (the Sun and
-eight planets at 1 or 4 days) it was slower than the scalar drift
-(1.06-1.19 times the scalar loop's step), as the general Stumpff form then
-costs every lane; the lanes' single pass with the declined planets left to
-the scalar drift is faster there.  Where more than a quarter of the
+The lanes hold the short-step path's single pass, and the planets it
+declines go to the scalar drift: a masked form of the whole path (the
+iteration repeated until every lane has converged, the general Stumpff form
+with a masked number of quarterings, as :mod:`orbits._kernels.wh_batch`
+does) is slower than the scalar drift where a step is long for some planets
+(the Sun and eight planets at 1 or 4 days), as the general Stumpff form then
+costs every lane (benchmarks/RESULTS.md).  Where more than a quarter of the
 planets are declined, an output's synchronising drift leaves the drift
 to the scalar code for :data:`RETRY` drifts before trying the lanes again
 (:data:`MEMO`; ``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`);
@@ -61,30 +54,19 @@ The interaction kick's pulls
 vector pass per source body over all the lanes, each lane's pulls summed
 over the sources in ascending order, which is the scalar pair loop's order,
 so the kick too is bit for bit the scalar one.  It evaluates each pair
-twice (once per body).  Measured before, and slower than the scalar kick,
-on the AVX2 machine: the pairs' separations gathered in the scalar order
-into columns with the sums back in order (0.34 us against 0.31), a column
-of pairs per body (0.54 us), only the mass ratios and Kepler terms in lanes
-(0.33 us).  Two things decide the speed of a lanes pass: its sums must not
-go through masked stores (a masked store cannot be forwarded to the next
-pass's load: 0.2 us for the eight planets' pulls instead of 0.065; the lane
-a source skips adds an exact zero instead), and the pass must store nothing
-but its sums (a further row written in the pass made LLVM keep the scalar
-form).  Each pair's factor computed once (by diagonals of rotated lanes, as
-WHFast512 does, built as LLVM vector operations; the sums then in this order
-or in the diagonals') was measured on the Intel AVX-512 machine and dropped:
-0.005-0.02 µs quicker a step for the Sun and eight planets, 0.01 µs slower
-for the outer solar system in democratic heliocentric coordinates, as the
-step's chains of dependent sums, not the divider alone, set its pace
-(``benchmarks/RESULTS.md``, bench_wh, 2026-11-27 23:10).
+twice (once per body); the forms that evaluate it once (the separations
+gathered into columns, a column of pairs per body, each pair's factor by
+diagonals of rotated lanes as WHFast512 does) are no quicker, as the step's
+chains of dependent sums, not the divider alone, set its pace
+(benchmarks/RESULTS.md).  Two things decide the speed of a lanes pass: its
+sums must not go through masked stores (a masked store cannot be forwarded
+to the next pass's load; the lane a source skips adds an exact zero
+instead), and the pass must store nothing but its sums (LLVM keeps the
+scalar form of a pass that writes a further row).
 
 The loop keeps its state in the lanes between outputs (see "the state kept
-in the lanes" below): with the copies in and out of the (N, 3) arrays on
-every operator, the lanes' kick paid only from seven bodies on, and the
-step of the Sun and eight planets took 1.84 times WHFast512's (Jacobi
-coordinates; 1.52 in democratic heliocentric ones); with the state kept,
-1.45 and 1.22, and the outer solar system 1.17 and 1.05 (CPU time, paired
-runs, AVX-512 machine).
+in the lanes" below): copies in and out of the (N, 3) arrays on every
+operator would cost more than the lanes save below seven bodies.
 
 What keeps LLVM from vectorising a loop, learnt here and in
 :mod:`orbits._kernels.wh_batch`: a branch per element (``and`` between
@@ -273,16 +255,11 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
 # chain of dependent ones (a square root, three divisions, the polynomials
 # between them) is several hundred cycles long.  In one loop the processor
 # holds about two columns' vectors in flight, so that a pass over many
-# columns runs at about the chain's length per two vectors: 12.2 ns a column
-# on the Intel AVX-512 machine (4 columns a vector).  Split into loops with
-# shorter bodies, more of them overlap (repeated passes, paired in one
-# process): after the starter (two passes) 9.3-9.7 ns a column from 16
-# columns on; after the iteration too (three) 7.7-8.1 ns, and 11.0 against
-# 12.5 at 8 columns; the f and g functions apart from the new state (four)
-# 7.2-7.7 ns, but 14 at 8 columns.  So three: in the Wisdom-Holman loop (a
-# drift and a kick, paired in one process, CPU time) the outer solar system
-# took 0.907 and the Sun and eight planets 0.917 of the one pass's time
-# (0.228 against 0.252 us, 0.285 against 0.314).  The passes keep nine rows
+# columns runs at about the chain's length per two vectors.  Split into
+# loops with shorter bodies, more of them overlap: three passes (the
+# starter, the iteration, the f and g functions) are the quickest from the
+# outer solar system's few columns to many (two are slower from 16 columns
+# on, four at 8 columns; benchmarks/RESULTS.md).  The passes keep nine rows
 # (the start's s, r0, 1 / r0, eta, beta, zeta and verdict, the iterated s
 # and its verdict), the same floats the one pass kept in registers, so the
 # drift is the same bit for bit.
@@ -322,10 +299,10 @@ def drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t,
     .. t + 8`` of ``T`` (none of the others) keep the passes' results.
     The drift of :mod:`orbits._kernels.wh_batch`, whose columns are the
     bodies of many systems."""
-    # _pass_rows's loops with the one step h, written out again: as a call
-    # of _pass_rows_one (specialised with _one_step) the batch's step took
-    # 0.13 instead of 0.104-0.109 us a system at 16 systems, and 0.28
-    # instead of 0.165 at 4 (paired runs)
+    # _pass_rows's loops with the one step h, written out again: the
+    # batch's step is slower as a call of _pass_rows_one (specialised with
+    # _one_step), by a quarter at 16 systems and more at 4
+    # (benchmarks/RESULTS.md)
     for k in range(k0, P):
         _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h)
     for k in range(k0, P):
@@ -536,12 +513,11 @@ def resident_drift_twice(xj, vj, eta, h, xs, vs, h2, S):
     the step).  The copy's columns follow the state's padding, or, where
     that takes fewer lanes, the state's planets (columns ``N - 1 ..
     2 N - 3``), padded to a multiple of :data:`LANE_WIDTH`: with lanes of
-    8, four planets take the lanes of one drift instead of two (0.19
-    against 0.28 us for both drifts, CPU time, Intel AVX-512 machine
-    before its lanes became 4 wide; there, with lanes of 4, five planets
-    take 12 columns instead of 16: 0.24 against 0.255 us, two alternating
-    runs; the pass is bound by its operations, 0.05 us each four columns in
-    256-bit vectors).  Returns how many planets of the state were declined."""
+    8, four planets take the lanes of one drift instead of two, and with
+    lanes of 4, five planets take 12 columns instead of 16; the pass is
+    bound by its operations, so fewer columns are quicker
+    (benchmarks/RESULTS.md).  Returns how many planets of the state were
+    declined."""
     n = xj.shape[0]
     m = n - 1
     P = lane_columns(n)

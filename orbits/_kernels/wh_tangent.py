@@ -64,15 +64,15 @@ before the deferred half drift and the corrector, to inertial coordinates
 (a linear map, :func:`jacobi_inertial_tangent`) and hands it to
 :func:`~orbits._kernels.variational.chaos_update`.  Synchronising it fully,
 as an output does, would cost a Kepler drift of the bodies and of the
-vector every step and double the cost of a step with the indicators (0.56
-of 1.2 us on a test planet beside Jupiter and Saturn).  The vector at the
+vector every step, about doubling the cost of a step with the indicators
+(benchmarks/RESULTS.md).  The vector at the
 internal point is the fully synchronised one mapped back by the half drift
 (and corrector), a near-identity map the same every step, so ``|delta|``
 differs by a bounded factor: the Lyapunov exponent and MEGNO's limits (2 on
 regular orbits, slope ``lambda / 2`` on chaotic ones) are the same, and the
 finite-time ``<Y>`` differs by a transient that decays as ``ln(t) / t``
-(measured on Jupiter and Saturn with a 50-day step: 1.5e-2 after 2000
-steps, 2.6e-3 after 20000; tests/kernels/test_wh_tangent.py).  When
+(on Jupiter and Saturn with a 50-day step, 1.5e-2 after 2000 steps and
+2.6e-3 after 20000; tests/kernels/test_wh_tangent.py).  When
 ``|delta|`` has grown large the internal rows of vector 0 are scaled by an
 exact power of two inside the loop
 (:func:`~orbits._kernels.variational.renormalise`, its exponent from the
@@ -98,16 +98,16 @@ from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democrat
 from .kepler import short_step_anomaly
 from .kepler_tangent import advance_tangent_by_anomaly, kepler_drift_tangent
 from .stepping import epilogue, work_kernels
-from .variational import chaos_update, renormalise
+from .variational import chaos_update, renormalise, tangent_product
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels,
                             heliocentric_interaction_kick, interaction_kick, jump)
 
 # the names the templates below are written against, bound by specialize
-(TERMS, record, inertial_tangent, jacobian, note, synchronize, term_jacobian, term_kick,
- term_tangent) = slots(
-    "TERMS", "record", "inertial_tangent", "jacobian", "note", "synchronize", "term_jacobian",
-    "term_kick", "term_tangent")
+(TERMS, conversion, record, inertial_tangent, jacobian, note, synchronize, term_jacobian,
+ term_kick, term_tangent) = slots(
+    "TERMS", "conversion", "record", "inertial_tangent", "jacobian", "note", "synchronize",
+    "term_jacobian", "term_kick", "term_tangent")
 
 __all__ = ["drift_tangent", "interaction_kick_and_tangent",
            "jump_tangent",
@@ -314,10 +314,10 @@ def drift_tangent(xj, vj, eta, h, tp, w1, w2):
 
     As in ``kepler_drift_all``, the short steps' anomalies of all the bodies
     come first, then each body's state and tangent rows from its anomaly
-    and the same universal functions (1.6 times faster than each body
-    through :func:`~orbits._kernels.kepler_tangent.kepler_drift_tangent` on the
-    Sun, Jupiter, Saturn and a test planet); the other steps go through
-    that function's bracketed solver."""
+    and the same universal functions (quicker than each body through
+    :func:`~orbits._kernels.kepler_tangent.kepler_drift_tangent`, see
+    benchmarks/RESULTS.md); the other steps go through that function's
+    bracketed solver."""
     n = eta.shape[0]
     deta, k = tp[1], tp[2]
     xj[0, 0] += h * vj[0, 0]
@@ -413,10 +413,10 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
     """:func:`~orbits._kernels.wisdom_holman.interaction_kick` of the bodies (bit
     for bit) and its tangent for the first ``tp[2]`` tangent vectors, in one
     pass: each pair's distance and ``1 / r^3``, and each Jacobi Kepler
-    term's, serve both (a step with one tangent vector beside Jupiter and
-    Saturn: 0.63 -> 0.56 us against the kick and then its tangent).  ``x``
-    and ``acc`` (``n (1 + K)`` rows) are scratch: the inertial positions and
-    accelerations and their tangent rows."""
+    term's, serve both, which is quicker than the kick and then its tangent
+    (benchmarks/RESULTS.md).  ``x`` and ``acc`` (``n (1 + K)`` rows) are
+    scratch: the inertial positions and accelerations and their tangent
+    rows."""
     n = gm.shape[0]
     if n <= 2:
         return
@@ -571,20 +571,6 @@ def heliocentric_kick_tangent(xh, vb, acc, gm, n_active, h, tp):
             vb[o + i, 2] += h * acc[o + i, 2]
 
 
-@njit(inline="always")
-def _term_acc_tangent(x, acc, jx, n, j):
-    # acc's tangent block j = the terms' da/dx (jx) times x's tangent block j
-    o = n * (1 + j)
-    for i in range(n):
-        for a in range(3):
-            r = 3 * i + a
-            s = 0.0
-            for c in range(n):
-                s += (jx[r, 3 * c] * x[o + c, 0] + jx[r, 3 * c + 1] * x[o + c, 1]
-                      + jx[r, 3 * c + 2] * x[o + c, 2])
-            acc[o + i, a] = s
-
-
 def _terms_jacobian(x, targs):
     # the terms' da/dx at the bodies' inertial positions x[:n] into tp's jx
     tp = targs[1]
@@ -610,7 +596,8 @@ def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
     for j in range(k):
         o = n * (1 + j)
         _from_jacobi_block(xj, x, gm, eta, tp[0], tp[1], j, False)
-        _term_acc_tangent(x, acc, tp[4], n, j)
+        # acc's tangent block j: the terms' da/dx times x's
+        tangent_product(tp[4], tp[4], x, x, o, n, acc, False)
         tx = acc[o, 0]
         ty = acc[o, 1]
         tz = acc[o, 2]
@@ -651,7 +638,8 @@ def _heliocentric_term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs):
             x[o, d] = x0
             for i in range(1, n):
                 x[o + i, d] = xh[o + i, d] + x0
-        _term_acc_tangent(x, acc, tp[4], n, j)
+        # acc's tangent block j: the terms' da/dx times x's
+        tangent_product(tp[4], tp[4], x, x, o, n, acc, False)
         for d in range(3):
             f = 0.0
             for i in range(n_active):
@@ -697,24 +685,17 @@ def _drift(xj, vj, eta, h, w1, w2, targs):
     drift_tangent(xj, vj, eta, h, targs[1], w1, w2)
 
 
-@njit(inline="always")
-def _to_jacobi(x, v, gm, eta, xj, vj, targs):
-    to_jacobi_tangent(x, v, gm, eta, xj, vj, targs[1])
+def _conversion(a, b, gm, eta, c, d, targs):
+    # a change of coordinates of the bodies and their tangent vectors, in the
+    # Wisdom-Holman templates' form: (a, b) into (c, d), the tangent
+    # arguments targs[1]
+    conversion(a, b, gm, eta, c, d, targs[1])
 
 
-@njit(inline="always")
-def _from_jacobi(xj, vj, gm, eta, x, v, targs):
-    from_jacobi_tangent(xj, vj, gm, eta, x, v, targs[1])
-
-
-@njit(inline="always")
-def _to_heliocentric(x, v, gm, eta, xh, vb, targs):
-    to_heliocentric_tangent(x, v, gm, eta, xh, vb, targs[1])
-
-
-@njit(inline="always")
-def _from_heliocentric(xh, vb, gm, eta, x, v, targs):
-    from_heliocentric_tangent(xh, vb, gm, eta, x, v, targs[1])
+_to_jacobi, _from_jacobi, _to_heliocentric, _from_heliocentric = (
+    specialize(_conversion, kernel.__name__, inline=True, conversion=kernel)
+    for kernel in (to_jacobi_tangent, from_jacobi_tangent, to_heliocentric_tangent,
+                   from_heliocentric_tangent))
 
 
 @njit(inline="always")
@@ -778,7 +759,7 @@ def _kernels(coordinates, terms, key, cache):
     nrt = _runtime(terms, cache)
     # the tangent kernels are calls, not inlined: a step's tangent costs far
     # more than a call, and inlining them all into every loop and corrector
-    # took minutes to compile
+    # would take minutes to compile
     if terms is None:
         perturbation = specialize(pert, key, cache=cache, nrt=nrt, TERMS=False,
                                   term_kick=None, term_tangent=None)

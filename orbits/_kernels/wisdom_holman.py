@@ -104,7 +104,7 @@ import numpy as np
 
 from ._jit import called, njit, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
-                          to_democratic_heliocentric, to_jacobi)
+                          to_democratic_heliocentric, to_jacobi, weighted_sum)
 from .gravity import pair_accelerations
 from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
 from .status import Status
@@ -139,7 +139,7 @@ def kepler_drift_all(xj, vj, mu, h, w1, w2):
     operations, so they are done in two passes over the bodies (the
     universal anomaly of every short step, then every state from its
     anomaly) that the processor can overlap, rather than one body after
-    the other: 1.4 times faster for the four giant planets.  Steps that are
+    the other (benchmarks/RESULTS.md).  Steps that are
     not short take :func:`~orbits._kernels.kepler.kepler_drift`'s bracketed
     solver.
     """
@@ -220,13 +220,7 @@ def jacobi_velocity_kick(xj, vj, acc, gm, eta, h, kepler):
 def jump(xh, vb, gm, n_active, h):
     """Shift every heliocentric position ``xh[1:]`` by ``h`` times
     ``sum_i m_i V_i / m_0`` (the flow of ``H_jump``); ``vb`` barycentric."""
-    px = 0.0
-    py = 0.0
-    pz = 0.0
-    for i in range(1, n_active):
-        px += gm[i] * vb[i, 0]
-        py += gm[i] * vb[i, 1]
-        pz += gm[i] * vb[i, 2]
+    px, py, pz = weighted_sum(vb, gm, 1, n_active)
     s = h / gm[0]
     px *= s
     py *= s
@@ -289,7 +283,8 @@ def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
     step; ``x`` and ``acc`` (shape (N, 3)) are scratch.  See the module notes.
     ``inverse`` is a float (:data:`INVERSE` or :data:`FORWARD`): a constant
     True or False would be typed as a literal, and numba would compile the
-    corrector once for each (some 20 s of every loop's first compilation).
+    corrector once for each, a large part of every loop's first
+    compilation.
     """
     m = corr.shape[0]
     for k in range(m):
@@ -326,11 +321,8 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, ta
 # at the end of its step and made at the start of the next one: the copy's
 # owed drift beside that step's first drift, in one pass over the lanes
 # (wh_lanes.resident_drift_twice), so that the processor overlaps their
-# chains of dependent operations; on its own, the output's drift added its
-# whole latency to the step (the outer solar system, an output every step:
-# the synchronisation cost 0.23 us in the loop against 0.08 us for its drift
-# repeated apart from it; the whole output 0.42 us in the loop before, 0.28 to
-# 0.33 after).  Outputs every 10 steps gained nothing measurable.  The loop
+# chains of dependent operations; on its own, the output's drift would add
+# its whole latency to the step (benchmarks/RESULTS.md).  The loop
 # makes a noted output before it returns, whatever the reason.  The results
 # are those of the immediate synchronisation, bit for bit.  Other loops bind
 # none of this: the defaults below do nothing.
@@ -397,12 +389,9 @@ def _no_lanes_check(xj, vj, k, nsteps, until_check, check_every, until_record, t
 
 def _resident_drift(xj, vj, eta, h, targs):
     # the drift of the state kept in the lanes.  Unlike _lanes_drift it
-    # always tries the lanes first: leaving the next RETRY drifts to
-    # kepler_drift_all where more than a quarter of the planets were declined
-    # (the state written back and loaded again around it) was measured and
-    # dropped: the Sun and eight planets at 4 days 0.39 us a step against
-    # 0.34-0.35 without, the outer solar system at 400 days 0.378-0.380
-    # against 0.384-0.385 (CPU time, AVX-512 machine)
+    # always tries the lanes first: leaving drifts to kepler_drift_all would
+    # write the state back and load it again around them, which costs more
+    # than it saves (benchmarks/RESULTS.md)
     resident_drift_rows(xj, vj, eta, h, targs[0])
 
 
@@ -820,10 +809,7 @@ def _lanes_drift(xj, vj, eta, h, w1, w2, targs):
     # long against their orbits), the scalar drift takes the next RETRY
     # drifts: there the lanes' pass is wasted work on top of the declined
     # planets' scalar drifts, which, one at a time, overlap less than in
-    # kepler_drift_all.  Measured (CPU time a step against the scalar loop,
-    # the Sun and eight planets): 1 day, Mercury declined, 0.80-0.95; 4 days,
-    # Mercury, Venus and the Earth declined, 1.10-1.11 without this rule,
-    # 1.03-1.13 with it (the scalar drift then, in a loop compiled around both)
+    # kepler_drift_all (benchmarks/RESULTS.md)
     S = targs[0]
     if S[MEMO, 0] > 0.0:
         S[MEMO, 0] -= 1.0
@@ -900,9 +886,7 @@ def _kernels(coordinates, terms=None, lanes=False):
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
                            drift=called(_plain_drift, nrt), perturbation=called(perturbation, nrt))
     # an output's synchronisation drifts every planet by the owed half step:
-    # in lanes, bit for bit, where the loop drifts in lanes (the outer solar
-    # system, an output each step, no monitors: 0.56 us an output against
-    # 0.60, within this machine's scatter)
+    # in lanes, bit for bit, where the loop drifts in lanes
     sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
                       cache=cache, nrt=nrt,
                       drift=called(_lanes_drift if lanes else _plain_drift, nrt),
