@@ -64,7 +64,8 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       mark_recorder, must_return, step_epilogue, stop_info, work_kernels)
+                       first_record, mark_recorder, must_return, step_epilogue, stop_info,
+                       work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -368,9 +369,12 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     acc1 = acc.reshape(m3)
     # the step control measures the bodies' rows (not the tangent rows of variations)
     ne = rows(x, fargs)
+    every = mon[0]
+    cap = mon_t.shape[0]
     n_mon = 0
-    direction, ct, target, has_marks, every, cap, until_record = adaptive_start(
-        t, t_end, tc, marks, counts, info, mon, step0, mon_t)
+    until_record = first_record(every, step0, mon_t)
+    # an empty marks array: none (one compiled loop for both uses)
+    direction, ct, target, has_marks = adaptive_start(t, t_end, tc, marks, counts, info)
     if t == t_end:
         return Status.OK, t, n_mon
     k_mark = 0

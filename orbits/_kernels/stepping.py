@@ -126,15 +126,12 @@ GO = -1
 # -- the bookkeeping of the adaptive loops (orbits._kernels.ias15, .taylor) ---------
 
 @njit(inline="always")
-def adaptive_start(t, t_end, tc, marks, counts, info, mon, step0, mon_t):
+def adaptive_start(t, t_end, tc, marks, counts, info):
     """The counts and stop info of an adaptive loop's call reset, and its
-    ``(direction, ct, target, has_marks, every, cap, until_record)``: ``ct``
-    the time's compensation (``tc = (time reached, what t + dt rounded
-    away)``, used only when the call starts at the time the last one
-    reached), ``target`` the first time to land on (the first mark, else
-    ``t_end``; an empty marks array: none, so that one compiled loop serves
-    both uses), and the monitors' ``every``, the rows' capacity and the
-    steps to the first record (:func:`first_record`)."""
+    ``(direction, ct, target, has_marks)``: ``ct`` the time's compensation
+    (``tc = (time reached, what t + dt rounded away)``, used only when the
+    call starts at the time the last one reached), ``target`` the first
+    time to land on (the first mark, else ``t_end``)."""
     counts[0] = 0
     counts[1] = 0
     counts[2] = 0
@@ -144,9 +141,7 @@ def adaptive_start(t, t_end, tc, marks, counts, info, mon, step0, mon_t):
     ct = tc[1] if t == tc[0] else 0.0
     has_marks = marks.shape[0] > 0
     target = marks[0] if has_marks else t_end
-    every = mon[0]
-    return (direction, ct, target, has_marks, every, mon_t.shape[0],
-            first_record(every, step0, mon_t))
+    return direction, ct, target, has_marks
 
 
 @njit(inline="always")
