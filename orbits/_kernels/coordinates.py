@@ -77,14 +77,16 @@ def centre_of_mass(x, v, gm, n):
 
 
 @njit(inline="always")
-def jacobi_step(a, r, w, sx, sy, sz):
-    """One row of a Jacobi transform: row ``r`` of ``a`` less the running
-    centre ``(sx, sy, sz)`` of the rows before it, and that centre moved
-    by ``w = m_i / eta_i`` times the difference, ``(dx, dy, dz, sx, sy, sz)``."""
+def jacobi_step(a, r, gm, eta, i, sx, sy, sz):
+    """One row of a Jacobi transform: row ``r`` of ``a`` (body ``i``'s) less
+    the running centre ``(sx, sy, sz)`` of the rows before it, and that
+    centre moved by ``w = m_i / eta_i`` times the difference: ``(dx, dy,
+    dz, w, sx, sy, sz)``."""
     dx = a[r, 0] - sx
     dy = a[r, 1] - sy
     dz = a[r, 2] - sz
-    return dx, dy, dz, sx + w * dx, sy + w * dy, sz + w * dz
+    w = gm[i] / eta[i]
+    return dx, dy, dz, w, sx + w * dx, sy + w * dy, sz + w * dz
 
 
 @njit(inline="always")
@@ -97,10 +99,13 @@ def to_jacobi_one(a, gm, eta, out):
     sy = a[0, 1]
     sz = a[0, 2]
     for i in range(1, n):
-        dx, dy, dz, sx, sy, sz = jacobi_step(a, i, gm[i] / eta[i], sx, sy, sz)
-        out[i, 0] = dx
-        out[i, 1] = dy
-        out[i, 2] = dz
+        out[i, 0] = a[i, 0] - sx
+        out[i, 1] = a[i, 1] - sy
+        out[i, 2] = a[i, 2] - sz
+        w = gm[i] / eta[i]
+        sx += w * out[i, 0]
+        sy += w * out[i, 1]
+        sz += w * out[i, 2]
     out[0, 0] = sx
     out[0, 1] = sy
     out[0, 2] = sz

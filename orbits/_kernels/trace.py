@@ -180,19 +180,19 @@ def _kick_unflagged(xh, vb, acc, gm, n_active, enc, h):
         vb[i, 2] += h * acc[i, 2]
 
 
-@njit
+@njit(inline="always")
 def _interaction_kick(xh, vb, acc, gm, n_active, enc, flagged, h):
     """``V_i += h`` times the pull of the other non-central bodies, the
     flagged pairs left out where ``flagged`` (:func:`_kick_unflagged`);
     the kick of a step that an encounter begins or that is redone."""
     if flagged:
         _kick_unflagged(xh, vb, acc, gm, n_active, enc, h)
-        return
-    _pair_accelerations_call(xh, gm, n_active, 0.0, acc, 1, False)
-    for i in range(xh.shape[0]):
-        vb[i, 0] += h * acc[i, 0]
-        vb[i, 1] += h * acc[i, 1]
-        vb[i, 2] += h * acc[i, 2]
+    else:
+        _pair_accelerations_call(xh, gm, n_active, 0.0, acc, 1, False)
+        for i in range(xh.shape[0]):
+            vb[i, 0] += h * acc[i, 0]
+            vb[i, 1] += h * acc[i, 1]
+            vb[i, 2] += h * acc[i, 2]
 
 
 # -- the inner integrator ---------------------------------------------------------------

@@ -131,11 +131,16 @@ def _to_jacobi_block(a, out, gm, eta, dgm, deta, j, masses):
     sy = a[o, 1]
     sz = a[o, 2]
     for i in range(1, n):
-        w = gm[i] / eta[i]
-        dx, dy, dz, sx, sy, sz = jacobi_step(a, o + i, w, sx, sy, sz)
+        dx = a[o + i, 0] - sx
+        dy = a[o + i, 1] - sy
+        dz = a[o + i, 2] - sz
         out[o + i, 0] = dx
         out[o + i, 1] = dy
         out[o + i, 2] = dz
+        w = gm[i] / eta[i]
+        sx += w * dx
+        sy += w * dy
+        sz += w * dz
         if masses:
             dw = (dgm[j, i] - w * deta[j, i]) / eta[i]
             sx += dw * out[i, 0]
@@ -429,8 +434,7 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
     sy = acc[0, 1]
     sz = acc[0, 2]
     for i in range(1, n):
-        w = gm[i] / eta[i]
-        ax, ay, az, sx, sy, sz = jacobi_step(acc, i, w, sx, sy, sz)
+        ax, ay, az, w, sx, sy, sz = jacobi_step(acc, i, gm, eta, i, sx, sy, sz)
         rx = xj[i, 0]
         ry = xj[i, 1]
         rz = xj[i, 2]
@@ -556,7 +560,7 @@ def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
         ty = acc[o, 1]
         tz = acc[o, 2]
         for i in range(1, n):
-            bx, by, bz, tx, ty, tz = jacobi_step(acc, o + i, gm[i] / eta[i], tx, ty, tz)
+            bx, by, bz, _, tx, ty, tz = jacobi_step(acc, o + i, gm, eta, i, tx, ty, tz)
             vj[o + i, 0] += h * bx
             vj[o + i, 1] += h * by
             vj[o + i, 2] += h * bz

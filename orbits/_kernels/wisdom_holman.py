@@ -202,7 +202,7 @@ def jacobi_velocity_kick(xj, vj, acc, gm, eta, h, kepler):
     sy = acc[0, 1]
     sz = acc[0, 2]
     for i in range(1, n):
-        ax, ay, az, sx, sy, sz = jacobi_step(acc, i, gm[i] / eta[i], sx, sy, sz)
+        ax, ay, az, _, sx, sy, sz = jacobi_step(acc, i, gm, eta, i, sx, sy, sz)
         if kepler and i >= 2:
             rx = xj[i, 0]
             ry = xj[i, 1]
