@@ -29,8 +29,9 @@ more: ``x_0 = X - sum_i m_i Q_i / M`` and ``v_0 = V - sum_i m_i V_i / m_0``
 from ._jit import njit
 
 __all__ = ["interior_gm", "to_jacobi", "from_jacobi", "to_jacobi_one", "from_jacobi_one",
-           "to_democratic_heliocentric", "from_democratic_heliocentric", "weighted_sum",
-           "centre_of_mass"]
+           "to_democratic_heliocentric", "from_democratic_heliocentric", "jacobi_step",
+           "row_difference",
+           "weighted_sum", "centre_of_mass"]
 
 
 @njit
@@ -40,6 +41,13 @@ def interior_gm(gm, out):
     for i in range(gm.shape[0]):
         s += gm[i]
         out[i] = s
+
+
+@njit(inline="always")
+def row_difference(a, i, j):
+    """``a[i] - a[j]`` of the rows of ``a`` (shape (N, 3)), as three numbers: a
+    separation, or a relative velocity."""
+    return a[i, 0] - a[j, 0], a[i, 1] - a[j, 1], a[i, 2] - a[j, 2]
 
 
 @njit(inline="always")
@@ -66,6 +74,19 @@ def centre_of_mass(x, v, gm, n):
     cx, cy, cz = weighted_sum(x, gm, 0, n)
     cvx, cvy, cvz = weighted_sum(v, gm, 0, n)
     return mtot, cx / mtot, cy / mtot, cz / mtot, cvx / mtot, cvy / mtot, cvz / mtot
+
+
+@njit(inline="always")
+def jacobi_step(a, r, gm, eta, i, sx, sy, sz):
+    """One row of a Jacobi transform: row ``r`` of ``a`` (body ``i``'s) less
+    the running centre ``(sx, sy, sz)`` of the rows before it, and that
+    centre moved by ``w = m_i / eta_i`` times the difference: ``(dx, dy,
+    dz, w, sx, sy, sz)``."""
+    dx = a[r, 0] - sx
+    dy = a[r, 1] - sy
+    dz = a[r, 2] - sz
+    w = gm[i] / eta[i]
+    return dx, dy, dz, w, sx + w * dx, sy + w * dy, sz + w * dz
 
 
 @njit(inline="always")

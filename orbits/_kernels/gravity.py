@@ -32,7 +32,7 @@ from ._jit import njit, njit_parallel
 __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_reference",
            "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
            "accelerate_pairwise_small", "accelerate_pairwise_rebound", "pair_accelerations",
-           "aligned_zeros",
+           "aligned_zeros", "zero_rows", "pull_with_sums", "pull_pair", "add_pulls",
            "accelerate_pairwise_lanes", "pair_accelerations_lanes", "lane_columns",
            "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind", "pull_rows", "vector_doubles",
            "pull_factors", "pull_rows_factored"]
@@ -125,10 +125,7 @@ def accelerate_pairwise(x, gm, n_active, eps2, acc, work):
     ones, so the result is the same as a plain double loop's.
     """
     n = x.shape[0]
-    for i in range(n):
-        acc[i, 0] = 0.0
-        acc[i, 1] = 0.0
-        acc[i, 2] = 0.0
+    zero_rows(acc, 0, n)
     cap = work.shape[1]
     k = 0
     first = 1
@@ -410,6 +407,55 @@ def accelerate_pairwise_small(x, gm, n_active, eps2, acc, work):
 
 
 @njit(inline="always")
+def zero_rows(a, first, end):
+    """Rows ``first <= i < end`` of ``a`` (shape (N, 3)) set to zero."""
+    for i in range(first, end):
+        a[i, 0] = 0.0
+        a[i, 1] = 0.0
+        a[i, 2] = 0.0
+
+
+@njit(inline="always")
+def pull_with_sums(acc, j, gmi, gmj, inv_r3, dx, dy, dz, axi, ayi, azi, react):
+    """The pulls within a pair ``i > j``, with ``d = x_i - x_j`` and ``inv_r3 =
+    1 / r^3``: body i's sums ``(axi, ayi, azi)``, kept by the caller and
+    returned, less ``G m_j d / r^3``, and with ``react`` (body i massive)
+    row j of ``acc`` plus ``G m_i d / r^3``."""
+    sj = gmj * inv_r3
+    axi -= sj * dx
+    ayi -= sj * dy
+    azi -= sj * dz
+    if react:
+        si = gmi * inv_r3
+        acc[j, 0] += si * dx
+        acc[j, 1] += si * dy
+        acc[j, 2] += si * dz
+    return axi, ayi, azi
+
+
+@njit(inline="always")
+def pull_pair(acc, i, j, gmi, gmj, dx, dy, dz):
+    """Both pulls within the pair ``(i, j)`` into the rows of ``acc``, with
+    ``d = x_i - x_j`` (no softening): row i less ``G m_j d / r^3``, row j plus
+    ``G m_i d / r^3``."""
+    r2 = dx * dx + dy * dy + dz * dz
+    inv_r3 = 1.0 / (r2 * math.sqrt(r2))
+    add_pulls(acc, i, j, gmj * inv_r3, gmi * inv_r3, dx, dy, dz)
+
+
+@njit(inline="always")
+def add_pulls(acc, i, j, sj, si, dx, dy, dz):
+    """Row i of ``acc`` less ``sj d``, row j plus ``si d``: the pulls within a
+    pair, ``d = x_i - x_j`` and ``s`` each the other body's ``G m / r^3``."""
+    acc[i, 0] -= sj * dx
+    acc[i, 1] -= sj * dy
+    acc[i, 2] -= sj * dz
+    acc[j, 0] += si * dx
+    acc[j, 1] += si * dy
+    acc[j, 2] += si * dz
+
+
+@njit(inline="always")
 def pair_accelerations(x, gm, n_active, eps2, acc, first, skip_first_pair):
     """``acc`` = the pull within every pair ``first <= j < i`` (j active), each
     pair once (Newton's third law); bodies before ``first`` feel and exert
@@ -418,10 +464,7 @@ def pair_accelerations(x, gm, n_active, eps2, acc, first, skip_first_pair):
     interaction kicks of the Wisdom-Holman maps, which leave out the central
     body's pulls (democratic heliocentric) or the innermost pair (Jacobi)."""
     n = x.shape[0]
-    for i in range(n):
-        acc[i, 0] = 0.0
-        acc[i, 1] = 0.0
-        acc[i, 2] = 0.0
+    zero_rows(acc, 0, n)
     for i in range(first + 1, n):
         xi = x[i, 0]
         yi = x[i, 1]
@@ -437,15 +480,8 @@ def pair_accelerations(x, gm, n_active, eps2, acc, first, skip_first_pair):
             dz = zi - x[j, 2]
             r2 = dx * dx + dy * dy + dz * dz + eps2
             inv_r3 = 1.0 / (r2 * math.sqrt(r2))
-            sj = gm[j] * inv_r3
-            axi -= sj * dx
-            ayi -= sj * dy
-            azi -= sj * dz
-            if i < n_active:
-                si = gmi * inv_r3
-                acc[j, 0] += si * dx
-                acc[j, 1] += si * dy
-                acc[j, 2] += si * dz
+            axi, ayi, azi = pull_with_sums(acc, j, gmi, gm[j], inv_r3, dx, dy, dz, axi, ayi,
+                                           azi, i < n_active)
         acc[i, 0] += axi
         acc[i, 1] += ayi
         acc[i, 2] += azi
@@ -487,10 +523,7 @@ def accelerate_pairwise_rebound(x, G, m, n_active, eps2, acc):
     537, A128, sect. 4.1: direct summation over pairs).
     """
     n = x.shape[0]
-    for i in range(n):
-        acc[i, 0] = 0.0
-        acc[i, 1] = 0.0
-        acc[i, 2] = 0.0
+    zero_rows(acc, 0, n)
     # Row i's own sum can be kept in registers: nothing has been added to
     # acc[i] before row i (earlier rows only reach j < their own index), so
     # 0 + a_1 + a_2 ... in a register rounds exactly as in memory.

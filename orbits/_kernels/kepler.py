@@ -41,6 +41,8 @@ __all__ = [
     "advanced_state",
     "advance_by_anomaly",
     "bracketed_anomaly",
+    "row_state",
+    "straight_drift",
 ]
 
 _EPS = 2.220446049250313e-16
@@ -218,15 +220,26 @@ def _short_coefficients(mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta):
 
 
 @njit(inline="always")
+def straight_drift(xj, vj, i, h):
+    """Row ``i`` of ``xj`` moved by ``h`` times its velocity (the centre of
+    mass's drift)."""
+    xj[i, 0] += h * vj[i, 0]
+    xj[i, 1] += h * vj[i, 1]
+    xj[i, 2] += h * vj[i, 2]
+
+
+@njit(inline="always")
+def row_state(x, v, i):
+    """Row ``i`` of the positions ``x`` and velocities ``v`` as six numbers,
+    ``(x0, y0, z0, vx0, vy0, vz0)``."""
+    return x[i, 0], x[i, 1], x[i, 2], v[i, 0], v[i, 1], v[i, 2]
+
+
+@njit(inline="always")
 def _advance_row(mu, x, v, i, s, r0, ir0, beta, zeta):
     # advance_by_anomaly, returning besides whether it advanced the row's
     # start and what the drift's tangent reuses (_short_coefficients')
-    x0 = x[i, 0]
-    y0 = x[i, 1]
-    z0 = x[i, 2]
-    vx0 = v[i, 0]
-    vy0 = v[i, 1]
-    vz0 = v[i, 2]
+    x0, y0, z0, vx0, vy0, vz0 = row_state(x, v, i)
     c0, c1, c2, c3, sig, r, ir, fm1, g, fdot, gdm1 = _short_coefficients(
         mu, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0, beta, zeta)
     ok = r > 0.0
@@ -326,12 +339,7 @@ def _kepler_drift_bracketed(mu, x, v, i, dt):
     """:func:`kepler_drift` by the bracketed solver, for any step: the anomaly
     from :func:`bracketed_anomaly`, then f and g from the universal functions
     there (the same values its last iteration tested)."""
-    x0 = x[i, 0]
-    y0 = x[i, 1]
-    z0 = x[i, 2]
-    vx0 = v[i, 0]
-    vy0 = v[i, 1]
-    vz0 = v[i, 2]
+    x0, y0, z0, vx0, vy0, vz0 = row_state(x, v, i)
     s, turns = bracketed_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
     if not (s == s):
         for d in range(3):

@@ -16,7 +16,7 @@ sect. 6.9 (universal variables); Rein, H. & Tamayo, D. 2016, MNRAS 459,
 import math
 
 from ._jit import njit
-from .kepler import _advance_row, bracketed_anomaly, kepler_drift, short_step_anomaly
+from .kepler import _advance_row, bracketed_anomaly, kepler_drift, row_state, short_step_anomaly
 from .status import Status
 from .stumpff import _SIXTH, _stumpff45, _stumpff45_short, stumpff
 
@@ -39,12 +39,7 @@ def _tangent_rows(mu, x, v, i, n, dmu, k, x0, y0, z0, vx0, vy0, vz0, s, r0, ir0,
     sb = sig * b2 + zeta * b3
     for j in range(k):
         o = i + n * (1 + j)
-        dx0 = x[o, 0]
-        dy0 = x[o, 1]
-        dz0 = x[o, 2]
-        dvx0 = v[o, 0]
-        dvy0 = v[o, 1]
-        dvz0 = v[o, 2]
+        dx0, dy0, dz0, dvx0, dvy0, dvz0 = row_state(x, v, o)
         dm = dmu[j, i]
         dr0 = (x0 * dx0 + y0 * dy0 + z0 * dz0) * ir0
         dsig = x0 * dvx0 + y0 * dvy0 + z0 * dvz0 + vx0 * dx0 + vy0 * dy0 + vz0 * dz0
@@ -181,12 +176,7 @@ def kepler_drift_tangent(mu, x, v, i, dt, dmu, k):
     2275 (the tangent of the Wisdom-Holman map).
     """
     n = dmu.shape[1]
-    x0 = x[i, 0]
-    y0 = x[i, 1]
-    z0 = x[i, 2]
-    vx0 = v[i, 0]
-    vy0 = v[i, 1]
-    vz0 = v[i, 2]
+    x0, y0, z0, vx0, vy0, vz0 = row_state(x, v, i)
     s, r0, ir0, beta, zeta = short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt)
     if s == s and advance_tangent_by_anomaly(mu, x, v, i, n, dmu, k, s, r0, ir0, beta, zeta):
         return Status.OK

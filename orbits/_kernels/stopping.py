@@ -65,7 +65,7 @@ import numpy as np
 from numba.core import types as nbtypes
 
 from ._jit import njit, pointer
-from .coordinates import centre_of_mass
+from .coordinates import centre_of_mass, row_difference
 from .encounters import closest_approach, kepler_contact
 from .status import Status
 
@@ -171,12 +171,8 @@ def _pair_contact(x, v, t, sargs, i, j, inside, h):
     rs = radii[i] + radii[j]
     if rs <= 0.0:
         return False, 0.0, 0.0, 0.0
-    dx = x[i, 0] - x[j, 0]
-    dy = x[i, 1] - x[j, 1]
-    dz = x[i, 2] - x[j, 2]
-    ux = v[i, 0] - v[j, 0]
-    uy = v[i, 1] - v[j, 1]
-    uz = v[i, 2] - v[j, 2]
+    dx, dy, dz = row_difference(x, i, j)
+    ux, uy, uz = row_difference(v, i, j)
     # separations compared squared (a square root only for a contact)
     d1 = dx * dx + dy * dy + dz * dz
     rs2 = rs * rs
@@ -328,12 +324,8 @@ def encounter_log(x, v, t, sargs):
                 rj = math.sqrt((x[j, 0] - x[central, 0]) ** 2 + (x[j, 1] - x[central, 1]) ** 2
                                + (x[j, 2] - x[central, 2]) ** 2)
                 thr = k_hill * (mu * third_gmc) ** (1.0 / 3.0) * 0.5 * (ri + rj)
-            dx = x[i, 0] - x[j, 0]
-            dy = x[i, 1] - x[j, 1]
-            dz = x[i, 2] - x[j, 2]
-            ux = v[i, 0] - v[j, 0]
-            uy = v[i, 1] - v[j, 1]
-            uz = v[i, 2] - v[j, 2]
+            dx, dy, dz = row_difference(x, i, j)
+            ux, uy, uz = row_difference(v, i, j)
             if dx * ux + dy * uy + dz * uz < 0.0:
                 continue    # still closing at the end: no minimum inside the step
             mu = gm[i] + gm[j]
@@ -421,9 +413,7 @@ def encounter_check(x, v, t, sargs):
     far2 = max(4.0 * d2, reach2) if inside else d2
     for i in range(1, n):
         for j in range(i):
-            dx = x[i, 0] - x[j, 0]
-            dy = x[i, 1] - x[j, 1]
-            dz = x[i, 2] - x[j, 2]
+            dx, dy, dz = row_difference(x, i, j)
             r2 = dx * dx + dy * dy + dz * dz
             thr2 = d2
             lim2 = far2
@@ -438,9 +428,7 @@ def encounter_check(x, v, t, sargs):
                 lim2 = max(4.0 * thr2, reach2) if inside else thr2
             if r2 > lim2 or (r2 == lim2 and not inside) or not (thr2 > 0.0):
                 continue
-            ux = v[i, 0] - v[j, 0]
-            uy = v[i, 1] - v[j, 1]
-            uz = v[i, 2] - v[j, 2]
+            ux, uy, uz = row_difference(v, i, j)
             s2 = ux * ux + uy * uy + uz * uz
             if r2 < thr2:
                 _note(info, hit, j, i, t, math.sqrt(r2), math.sqrt(s2))

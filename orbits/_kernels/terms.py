@@ -41,9 +41,13 @@ import numpy as np
 
 from numba.core import types as nbtypes
 
-from ._jit import njit, specialize
+from ._jit import njit, slots, specialize
+from .coordinates import row_difference
 from .invariants import _add
 from .jacobians import central_differences
+
+# the name the energy template below is written against, bound by specialize
+body_energy, = slots("body_energy")
 
 __all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "TABLE", "table",
            "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
@@ -76,6 +80,14 @@ def _pull(acc, i, src, w, ax, ay, az):
 
 
 @njit(inline="always")
+def _apart(a, i, j, r):
+    # r = a_i - a_j (rows of a), and returns |r|^2
+    for d in range(3):
+        r[d] = a[i, d] - a[j, d]
+    return r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+
+
+@njit(inline="always")
 def _add_block(jac, i, j, wi, wj, d):
     # the 3x3 block d = d a_rel / dr (or du) of a_rel(r, u), r = x_i - x_j,
     # u = v_i - v_j, into jac: body i takes wi a_rel, body j -wj a_rel
@@ -93,6 +105,21 @@ def _add_pair_block(jx, jv, i, j, wi, wj, dx, dv):
     # both blocks of a_rel(r, u): dx = d a_rel / dr into jx, dv = d a_rel / du into jv
     _add_block(jx, i, j, wi, wj, dx)
     _add_block(jv, i, j, wi, wj, dv)
+
+
+def _energy_about_source(x, v, args):
+    # A term's energy about its source body args[0]: body_energy(x, v, i,
+    # args), each massive body's share (the masses are args' last item),
+    # summed with compensation.  A template (specialize binds body_energy).
+    src = args[0]
+    m = args[-1]
+    s = 0.0
+    c = 0.0
+    for i in range(x.shape[0]):
+        if i == src or m[i] == 0.0:
+            continue
+        s, c = _add(s, c, body_energy(x, v, i, args))
+    return s + c
 
 
 # -- GR from one dominant body (Anderson et al. 1975) ------------------------------------
@@ -154,9 +181,22 @@ def gr_accel(x, v, t, args, acc):
     acc[src, 2] -= sz
 
 
-@njit
-def gr_energy(x, v, args):
-    """The 1PN energy of each body's orbit about the source, from the
+@njit(inline="always")
+def _gr_energy_of(x, v, i, args):
+    # body i's share of gr_energy
+    src, gm, inv_c2, m = args
+    mu = gm[src]
+    rx, ry, rz = row_difference(x, i, src)
+    u2 = ((v[i, 0] - v[src, 0]) ** 2 + (v[i, 1] - v[src, 1]) ** 2
+          + (v[i, 2] - v[src, 2]) ** 2)
+    r = math.sqrt(rx * rx + ry * ry + rz * rz)
+    mu_i = mu + gm[i]
+    return (m[i] * (mu / mu_i) * inv_c2
+            * (0.375 * u2 * u2 + 1.5 * mu_i * u2 / r + 0.5 * mu_i * mu_i / (r * r)))
+
+
+gr_energy = specialize(_energy_about_source, "gr", body_energy=_gr_energy_of)
+gr_energy.__doc__ = """The 1PN energy of each body's orbit about the source, from the
     Lagrangian whose equations :func:`gr_accel` are: Schwarzschild's test-body
     energy about ``mu_i = G (m_src + m_i)`` in the relative coordinates, times
     the reduced mass ``m_i m_src / (m_src + m_i) = m_i mu / mu_i``::
@@ -170,23 +210,6 @@ def gr_energy(x, v, args):
     the others' pull on a body's relative orbit leaves terms of order their
     mass ratio to the source times the 1PN energy.
     """
-    src, gm, inv_c2, m = args
-    mu = gm[src]
-    s = 0.0
-    c = 0.0
-    for i in range(x.shape[0]):
-        if i == src or m[i] == 0.0:
-            continue
-        rx = x[i, 0] - x[src, 0]
-        ry = x[i, 1] - x[src, 1]
-        rz = x[i, 2] - x[src, 2]
-        u2 = ((v[i, 0] - v[src, 0]) ** 2 + (v[i, 1] - v[src, 1]) ** 2
-              + (v[i, 2] - v[src, 2]) ** 2)
-        r = math.sqrt(rx * rx + ry * ry + rz * rz)
-        mu_i = mu + gm[i]
-        s, c = _add(s, c, m[i] * (mu / mu_i) * inv_c2
-                    * (0.375 * u2 * u2 + 1.5 * mu_i * u2 / r + 0.5 * mu_i * mu_i / (r * r)))
-    return s + c
 
 
 @njit
@@ -203,10 +226,8 @@ def gr_jacobian(x, v, t, args, jx, jv):
     for i in range(n):
         if i == src:
             continue
-        for d in range(3):
-            r[d] = x[i, d] - x[src, d]
-            u[d] = v[i, d] - v[src, d]
-        r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        r2 = _apart(x, i, src, r)
+        _apart(v, i, src, u)
         rr = math.sqrt(r2)
         u2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
         rv = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
@@ -245,29 +266,26 @@ def gr_potential_accel(x, v, t, args, acc):
     for i in range(x.shape[0]):
         if i == src:
             continue
-        rx = x[i, 0] - x[src, 0]
-        ry = x[i, 1] - x[src, 1]
-        rz = x[i, 2] - x[src, 2]
+        rx, ry, rz = row_difference(x, i, src)
         r2 = rx * rx + ry * ry + rz * rz
         f = -k / (r2 * r2)
         _pull(acc, i, src, gm[i] / mu, f * rx, f * ry, f * rz)
 
 
-@njit
-def gr_potential_energy(x, v, args):
-    """``sum_i -3 mu^2 m_i / (c^2 r_i^2)``; ``args`` as :func:`gr_potential_accel`
-    plus the masses."""
+@njit(inline="always")
+def _gr_potential_energy_of(x, v, i, args):
+    # body i's share of gr_potential_energy
     src, gm, inv_c2, m = args
     mu = gm[src]
-    s = 0.0
-    c = 0.0
-    for i in range(x.shape[0]):
-        if i == src or m[i] == 0.0:
-            continue
-        r2 = ((x[i, 0] - x[src, 0]) ** 2 + (x[i, 1] - x[src, 1]) ** 2
-              + (x[i, 2] - x[src, 2]) ** 2)
-        s, c = _add(s, c, -3.0 * mu * mu * inv_c2 * m[i] / r2)
-    return s + c
+    r2 = ((x[i, 0] - x[src, 0]) ** 2 + (x[i, 1] - x[src, 1]) ** 2
+          + (x[i, 2] - x[src, 2]) ** 2)
+    return -3.0 * mu * mu * inv_c2 * m[i] / r2
+
+
+gr_potential_energy = specialize(_energy_about_source, "gr_potential",
+                                 body_energy=_gr_potential_energy_of)
+gr_potential_energy.__doc__ = """``sum_i -3 mu^2 m_i / (c^2 r_i^2)``; ``args`` as
+:func:`gr_potential_accel` plus the masses."""
 
 
 @njit
@@ -281,9 +299,7 @@ def gr_potential_jacobian(x, v, t, args, jx, jv):
     for i in range(x.shape[0]):
         if i == src:
             continue
-        for d in range(3):
-            r[d] = x[i, d] - x[src, d]
-        r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        r2 = _apart(x, i, src, r)
         inv4 = 1.0 / (r2 * r2)
         for a in range(3):
             for b in range(3):
@@ -308,9 +324,7 @@ def _newtonian_and_potential(x, gm, n_active, an, pot):
         pot[i] = 0.0
     for i in range(n):
         for j in range(min(i, n_active)):
-            dx = x[j, 0] - x[i, 0]
-            dy = x[j, 1] - x[i, 1]
-            dz = x[j, 2] - x[i, 2]
+            dx, dy, dz = row_difference(x, j, i)
             r2 = dx * dx + dy * dy + dz * dz
             r = math.sqrt(r2)
             inv3 = 1.0 / (r2 * r)
@@ -343,9 +357,7 @@ def gr_full_accel(x, v, t, args, acc):
         for j in range(n_active):
             if j == i:
                 continue
-            dx = x[j, 0] - x[i, 0]
-            dy = x[j, 1] - x[i, 1]
-            dz = x[j, 2] - x[i, 2]
+            dx, dy, dz = row_difference(x, j, i)
             r2 = dx * dx + dy * dy + dz * dz
             r = math.sqrt(r2)
             mu = gm[j]
@@ -398,9 +410,7 @@ def gr_full_energy(x, v, args):
         for b in range(n_active):
             if b == a:
                 continue
-            dx = x[a, 0] - x[b, 0]
-            dy = x[a, 1] - x[b, 1]
-            dz = x[a, 2] - x[b, 2]
+            dx, dy, dz = row_difference(x, a, b)
             r = math.sqrt(dx * dx + dy * dy + dz * dz)
             na = (dx * v[a, 0] + dy * v[a, 1] + dz * v[a, 2]) / r
             nb = (dx * v[b, 0] + dy * v[b, 1] + dz * v[b, 2]) / r
@@ -429,9 +439,7 @@ def zonal_accel(x, v, t, args, acc):
     for i in range(x.shape[0]):
         if i == b:
             continue
-        rx = x[i, 0] - x[b, 0]
-        ry = x[i, 1] - x[b, 1]
-        rz = x[i, 2] - x[b, 2]
+        rx, ry, rz = row_difference(x, i, b)
         r2 = rx * rx + ry * ry + rz * rz
         r = math.sqrt(r2)
         u = (rx * px + ry * py + rz * pz) / r
@@ -447,26 +455,22 @@ def zonal_accel(x, v, t, args, acc):
               fr * rz + fp * pz)
 
 
-@njit
-def zonal_energy(x, v, args):
-    """``sum_i m_i Phi(r_i)`` with ``Phi = k2 P2(u) / r^3 + k4 P4(u) / r^5`` (the
-    monopole is gravity's); ``args`` as :func:`zonal_accel` plus the masses."""
+@njit(inline="always")
+def _zonal_energy_of(x, v, i, args):
+    # body i's share of zonal_energy
     b, gm, k2, k4, pole, m = args
-    s = 0.0
-    c = 0.0
-    for i in range(x.shape[0]):
-        if i == b or m[i] == 0.0:
-            continue
-        rx = x[i, 0] - x[b, 0]
-        ry = x[i, 1] - x[b, 1]
-        rz = x[i, 2] - x[b, 2]
-        r = math.sqrt(rx * rx + ry * ry + rz * rz)
-        u = (rx * pole[0] + ry * pole[1] + rz * pole[2]) / r
-        u2 = u * u
-        p2 = 0.5 * (3.0 * u2 - 1.0)
-        p4 = 0.125 * ((35.0 * u2 - 30.0) * u2 + 3.0)
-        s, c = _add(s, c, m[i] * (k2 * p2 / (r * r * r) + k4 * p4 / (r ** 5)))
-    return s + c
+    rx, ry, rz = row_difference(x, i, b)
+    r = math.sqrt(rx * rx + ry * ry + rz * rz)
+    u = (rx * pole[0] + ry * pole[1] + rz * pole[2]) / r
+    u2 = u * u
+    p2 = 0.5 * (3.0 * u2 - 1.0)
+    p4 = 0.125 * ((35.0 * u2 - 30.0) * u2 + 3.0)
+    return m[i] * (k2 * p2 / (r * r * r) + k4 * p4 / (r ** 5))
+
+
+zonal_energy = specialize(_energy_about_source, "zonal", body_energy=_zonal_energy_of)
+zonal_energy.__doc__ = """``sum_i m_i Phi(r_i)`` with ``Phi = k2 P2(u) / r^3 + k4 P4(u) / r^5``
+(the monopole is gravity's); ``args`` as :func:`zonal_accel` plus the masses."""
 
 
 @njit
@@ -486,9 +490,7 @@ def zonal_jacobian(x, v, t, args, jx, jv):
     for i in range(x.shape[0]):
         if i == b:
             continue
-        for d in range(3):
-            r[d] = x[i, d] - x[b, d]
-        s = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        s = _apart(x, i, b, r)
         q = r[0] * pole[0] + r[1] * pole[1] + r[2] * pole[2]
         q2 = q * q
         s52 = s ** -2.5
@@ -542,12 +544,8 @@ def migration_accel(x, v, t, args, acc):
     time scale 0 for a time scale left out.
     """
     b, p, wb, wp, ia, ie, ii = args
-    rx = x[b, 0] - x[p, 0]
-    ry = x[b, 1] - x[p, 1]
-    rz = x[b, 2] - x[p, 2]
-    ux = v[b, 0] - v[p, 0]
-    uy = v[b, 1] - v[p, 1]
-    uz = v[b, 2] - v[p, 2]
+    rx, ry, rz = row_difference(x, b, p)
+    ux, uy, uz = row_difference(v, b, p)
     fu = -0.5 * ia
     fr = -2.0 * ie * (rx * ux + ry * uy + rz * uz) / (rx * rx + ry * ry + rz * rz)
     ax = fu * ux + fr * rx
@@ -573,10 +571,8 @@ def migration_jacobian(x, v, t, args, jx, jv):
     u = np.empty(3)
     dx = np.zeros((3, 3))
     dv = np.zeros((3, 3))
-    for d in range(3):
-        r[d] = x[b, d] - x[p, d]
-        u[d] = v[b, d] - v[p, d]
-    r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+    r2 = _apart(x, b, p, r)
+    _apart(v, b, p, u)
     ru = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
     for a in range(3):
         for c in range(3):
@@ -605,12 +601,8 @@ def tides_accel(x, v, t, args, acc):
     for j in range(x.shape[0]):
         if j == b or gm[j] == 0.0:
             continue
-        rx = x[j, 0] - x[b, 0]
-        ry = x[j, 1] - x[b, 1]
-        rz = x[j, 2] - x[b, 2]
-        ux = v[j, 0] - v[b, 0]
-        uy = v[j, 1] - v[b, 1]
-        uz = v[j, 2] - v[b, 2]
+        rx, ry, rz = row_difference(x, j, b)
+        ux, uy, uz = row_difference(v, j, b)
         r2 = rx * rx + ry * ry + rz * rz
         r8 = r2 * r2 * r2 * r2
         q = 2.0 * tau * (rx * ux + ry * uy + rz * uz) / r2
@@ -648,10 +640,8 @@ def tides_jacobian(x, v, t, args, jx, jv):
     for j in range(x.shape[0]):
         if j == b or gm[j] == 0.0:
             continue
-        for d in range(3):
-            r[d] = x[j, d] - x[b, d]
-            u[d] = v[j, d] - v[b, d]
-        s = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        s = _apart(x, j, b, r)
+        _apart(v, j, b, u)
         w = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
         q = 2.0 * tau * w / s
         gp[0] = r[0] * (1.0 + q) + tau * (u[0] + r[1] * om[2] - r[2] * om[1])
@@ -696,12 +686,8 @@ def radiation_accel(x, v, t, args, acc):
     for i in range(x.shape[0]):
         if beta[i] == 0.0:
             continue
-        rx = x[i, 0] - x[s, 0]
-        ry = x[i, 1] - x[s, 1]
-        rz = x[i, 2] - x[s, 2]
-        ux = v[i, 0] - v[s, 0]
-        uy = v[i, 1] - v[s, 1]
-        uz = v[i, 2] - v[s, 2]
+        rx, ry, rz = row_difference(x, i, s)
+        ux, uy, uz = row_difference(v, i, s)
         r2 = rx * rx + ry * ry + rz * rz
         r = math.sqrt(r2)
         k = beta[i] * mu / r2
@@ -730,10 +716,8 @@ def radiation_jacobian(x, v, t, args, jx, jv):
     for i in range(x.shape[0]):
         if beta[i] == 0.0:
             continue
-        for d in range(3):
-            r[d] = x[i, d] - x[s, d]
-            u[d] = v[i, d] - v[s, d]
-        r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+        r2 = _apart(x, i, s, r)
+        _apart(v, i, s, u)
         rr = math.sqrt(r2)
         w = r[0] * u[0] + r[1] * u[1] + r[2] * u[2]
         k = beta[i] * mu

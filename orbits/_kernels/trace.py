@@ -63,8 +63,9 @@ from typing import NamedTuple
 import numpy as np
 
 from ._jit import called, njit, slots, specialize
-from .coordinates import from_democratic_heliocentric, to_democratic_heliocentric
-from .gravity import pair_accelerations
+from .coordinates import (from_democratic_heliocentric, row_difference,
+                          to_democratic_heliocentric)
+from .gravity import pair_accelerations, pull_pair, zero_rows
 from .status import Status
 from .stepping import GO, _record, epilogue, first_record
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
@@ -128,9 +129,7 @@ def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, r_peri, enc):
         ri2 = r2[i]
         hi = hill[i]
         for j in range(1, min(i, n_active)):
-            dx = xh[i, 0] - xh[j, 0]
-            dy = xh[i, 1] - xh[j, 1]
-            dz = xh[i, 2] - xh[j, 2]
+            dx, dy, dz = row_difference(xh, i, j)
             d2 = dx * dx + dy * dy + dz * dz
             # (r_i + r_j) / 2 <= max(r_i, r_j) and ((m_i + m_j) / 3 m_0)^(1/3)
             # <= 2^(1/3) max(hill_i, hill_j): the exact radius only inside
@@ -138,9 +137,7 @@ def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, r_peri, enc):
             bound = kh2 * hmax * hmax * max(ri2, r2[j])
             flag = 0
             if d2 < reach2:
-                ux = vb[i, 0] - vb[j, 0]
-                uy = vb[i, 1] - vb[j, 1]
-                uz = vb[i, 2] - vb[j, 2]
+                ux, uy, uz = row_difference(vb, i, j)
                 if d2 < kv2 * (ux * ux + uy * uy + uz * uz):
                     flag = 1
             if flag == 0 and d2 < bound:
@@ -170,31 +167,32 @@ def _kick_unflagged(xh, vb, acc, gm, n_active, enc, h):
     """``V_i += h`` times the pull of the other non-central bodies, leaving out
     the flagged pairs (their pull is in the drift); ``acc`` is scratch."""
     n = xh.shape[0]
-    for i in range(n):
-        acc[i, 0] = 0.0
-        acc[i, 1] = 0.0
-        acc[i, 2] = 0.0
+    zero_rows(acc, 0, n)
     for i in range(2, n):
         for j in range(1, min(i, n_active)):
             if enc[i, j]:
                 continue
-            dx = xh[i, 0] - xh[j, 0]
-            dy = xh[i, 1] - xh[j, 1]
-            dz = xh[i, 2] - xh[j, 2]
-            r2 = dx * dx + dy * dy + dz * dz
-            inv_r3 = 1.0 / (r2 * math.sqrt(r2))
-            sj = gm[j] * inv_r3
-            si = gm[i] * inv_r3
-            acc[i, 0] -= sj * dx
-            acc[i, 1] -= sj * dy
-            acc[i, 2] -= sj * dz
-            acc[j, 0] += si * dx
-            acc[j, 1] += si * dy
-            acc[j, 2] += si * dz
+            dx, dy, dz = row_difference(xh, i, j)
+            pull_pair(acc, i, j, gm[i], gm[j], dx, dy, dz)
     for i in range(1, n):
         vb[i, 0] += h * acc[i, 0]
         vb[i, 1] += h * acc[i, 1]
         vb[i, 2] += h * acc[i, 2]
+
+
+@njit(inline="always")
+def _interaction_kick(xh, vb, acc, gm, n_active, enc, flagged, h):
+    """``V_i += h`` times the pull of the other non-central bodies, the
+    flagged pairs left out where ``flagged`` (:func:`_kick_unflagged`);
+    the kick of a step that an encounter begins or that is redone."""
+    if flagged:
+        _kick_unflagged(xh, vb, acc, gm, n_active, enc, h)
+    else:
+        _pair_accelerations_call(xh, gm, n_active, 0.0, acc, 1, False)
+        for i in range(xh.shape[0]):
+            vb[i, 0] += h * acc[i, 0]
+            vb[i, 1] += h * acc[i, 1]
+            vb[i, 2] += h * acc[i, 2]
 
 
 # -- the inner integrator ---------------------------------------------------------------
@@ -244,40 +242,17 @@ def _accel(mode, y, ns, idx, gm, n_active, enc, out):
                     dx -= y[m, 0]
                     dy -= y[m, 1]
                     dz -= y[m, 2]
-                r2 = dx * dx + dy * dy + dz * dz
-                inv_r3 = 1.0 / (r2 * math.sqrt(r2))
-                sm = gm[bm] * inv_r3
-                sk = gm[bk] * inv_r3
-                out[k, 0] -= sm * dx
-                out[k, 1] -= sm * dy
-                out[k, 2] -= sm * dz
-                out[m, 0] += sk * dx
-                out[m, 1] += sk * dy
-                out[m, 2] += sk * dz
+                pull_pair(out, k, m, gm[bk], gm[bm], dx, dy, dz)
         for k in range(1, ns):
             out[k, 0] -= out[0, 0]
             out[k, 1] -= out[0, 1]
             out[k, 2] -= out[0, 2]
     else:
-        for i in range(ns):
-            out[i, 0] = 0.0
-            out[i, 1] = 0.0
-            out[i, 2] = 0.0
+        zero_rows(out, 0, ns)
         for i in range(1, ns):
             for j in range(min(i, n_active)):
-                dx = y[i, 0] - y[j, 0]
-                dy = y[i, 1] - y[j, 1]
-                dz = y[i, 2] - y[j, 2]
-                r2 = dx * dx + dy * dy + dz * dz
-                inv_r3 = 1.0 / (r2 * math.sqrt(r2))
-                sj = gm[j] * inv_r3
-                si = gm[i] * inv_r3
-                out[i, 0] -= sj * dx
-                out[i, 1] -= sj * dy
-                out[i, 2] -= sj * dz
-                out[j, 0] += si * dx
-                out[j, 1] += si * dy
-                out[j, 2] += si * dz
+                dx, dy, dz = row_difference(y, i, j)
+                pull_pair(out, i, j, gm[i], gm[j], dx, dy, dz)
 
 
 @njit
@@ -713,14 +688,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                 if state[2] and HAS_TERMS:
                     term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)
                 if state[2] and not peri:
-                    if flagged:
-                        _kick_unflagged(xh, vb, acc, gm, n_active, enc, owed)
-                    else:
-                        _pair_accelerations_call(xh, gm, n_active, 0.0, acc, 1, False)
-                        for i in range(n):
-                            vb[i, 0] += owed * acc[i, 0]
-                            vb[i, 1] += owed * acc[i, 1]
-                            vb[i, 2] += owed * acc[i, 2]
+                    _interaction_kick(xh, vb, acc, gm, n_active, enc, flagged, owed)
                     _jump_call(xh, vb, gm, n_active, owed)
                 continue
             break
@@ -773,14 +741,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                     term_kick(xh, vb, w1, w2, gm, eta, n_active, dt, targs)
             else:
                 _copy(vs, vb)
-                if new_flagged:
-                    _kick_unflagged(xh, vb, acc, gm, n_active, enc, half)
-                else:
-                    _pair_accelerations_call(xh, gm, n_active, 0.0, acc, 1, False)
-                    for i in range(n):
-                        vb[i, 0] += half * acc[i, 0]
-                        vb[i, 1] += half * acc[i, 1]
-                        vb[i, 2] += half * acc[i, 2]
+                _interaction_kick(xh, vb, acc, gm, n_active, enc, new_flagged, half)
                 if HAS_TERMS:
                     term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
             jump(xh, vb, gm, n_active, half)

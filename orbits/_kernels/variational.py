@@ -52,6 +52,7 @@ import math
 import numpy as np
 
 from ._jit import njit, slots, specialize
+from .coordinates import row_difference
 from .invariants import MONITOR_COLUMNS
 from .jacobians import jacobian_for
 
@@ -192,9 +193,7 @@ def _varied(x, v, t, fargs, acc):
                 for i in range(n):
                     if i == l:
                         continue
-                    d0 = x[l, 0] - x[i, 0]
-                    d1 = x[l, 1] - x[i, 1]
-                    d2 = x[l, 2] - x[i, 2]
+                    d0, d1, d2 = row_difference(x, l, i)
                     s2 = d0 * d0 + d1 * d1 + d2 * d2 + eps2
                     f = g / (s2 * math.sqrt(s2))
                     acc[o + i, 0] += f * d0

@@ -96,7 +96,7 @@ from ._jit import njit, slots, specialize
 from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pull_rows,
                       pull_rows_factored)
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, advanced_state, f_and_g, kepler_drift,
-                     quartic_step, short_start)
+                     quartic_step, short_start, straight_drift)
 from .stumpff import _STUMPFF_SHORT_Z, stumpff_lane
 
 # the names the templates below are written against, bound by specialize
@@ -373,9 +373,7 @@ def kepler_drift_lanes(xj, vj, mu, h, S):
     -----
     See the module notes.
     """
-    xj[0, 0] += h * vj[0, 0]
-    xj[0, 1] += h * vj[0, 1]
-    xj[0, 2] += h * vj[0, 2]
+    straight_drift(xj, vj, 0, h)
     P = lane_columns(xj.shape[0])
     _load(S, xj, vj, mu, h, 0, P)
     _single_pass(S, h, np.uint64(P))
@@ -455,9 +453,7 @@ def resident_drift(xj, vj, eta, h, S):
     """:func:`kepler_drift_lanes` of the lanes' state (row 0 of ``xj`` in a
     straight line); a declined planet goes to the scalar drift, with its row
     of ``xj``, ``vj`` as scratch.  Returns how many planets were declined."""
-    xj[0, 0] += h * vj[0, 0]
-    xj[0, 1] += h * vj[0, 1]
-    xj[0, 2] += h * vj[0, 2]
+    straight_drift(xj, vj, 0, h)
     n = xj.shape[0]
     P = lane_columns(n)
     rejected = drift_columns(S[_RX], S[_RX + 1], S[_RX + 2], S[_RX + 3], S[_RX + 4],

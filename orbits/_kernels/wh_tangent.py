@@ -93,15 +93,17 @@ References
 import math
 
 from ._jit import called, njit, slots, specialize
-from .coordinates import (from_democratic_heliocentric, from_jacobi, to_democratic_heliocentric,
-                          to_jacobi)
-from .kepler import short_step_anomaly
+from .coordinates import (from_democratic_heliocentric, from_jacobi, jacobi_step,
+                          row_difference, to_democratic_heliocentric, to_jacobi)
+from .gravity import add_pulls, pull_with_sums, zero_rows
+from .kepler import straight_drift
 from .kepler_tangent import advance_tangent_by_anomaly, kepler_drift_tangent
 from .stepping import epilogue, work_kernels
 from .variational import chaos_update, renormalise, tangent_product
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels,
-                            heliocentric_interaction_kick, interaction_kick, jump)
+                            heliocentric_interaction_kick, interaction_kick, jump,
+                            short_step_anomalies)
 
 # the names the templates below are written against, bound by specialize
 (TERMS, conversion, record, inertial_tangent, jacobian, note, synchronize, term_jacobian,
@@ -320,22 +322,10 @@ def drift_tangent(xj, vj, eta, h, tp, w1, w2):
     bracketed solver."""
     n = eta.shape[0]
     deta, k = tp[1], tp[2]
-    xj[0, 0] += h * vj[0, 0]
-    xj[0, 1] += h * vj[0, 1]
-    xj[0, 2] += h * vj[0, 2]
+    straight_drift(xj, vj, 0, h)
     for j in range(k):
-        o = n * (1 + j)
-        xj[o, 0] += h * vj[o, 0]
-        xj[o, 1] += h * vj[o, 1]
-        xj[o, 2] += h * vj[o, 2]
-    for i in range(1, n):
-        s, r0, ir0, beta, zeta = short_step_anomaly(
-            eta[i], xj[i, 0], xj[i, 1], xj[i, 2], vj[i, 0], vj[i, 1], vj[i, 2], h)
-        w1[i, 0] = s
-        w1[i, 1] = r0
-        w1[i, 2] = ir0
-        w2[i, 0] = beta
-        w2[i, 1] = zeta
+        straight_drift(xj, vj, n * (1 + j), h)
+    short_step_anomalies(xj, vj, eta, h, n, w1, w2)
     for i in range(1, n):
         s = w1[i, 0]
         if not (s == s and advance_tangent_by_anomaly(eta[i], xj, vj, i, n, deta, k, s,
@@ -356,9 +346,7 @@ def _pair_block_tangent(x, acc, gm, n_active, i, l, dx, dy, dz, ir3, ir5, dgm, k
     for j in range(k):
         oi = i + n * (1 + j)
         ol = l + n * (1 + j)
-        ex = x[oi, 0] - x[ol, 0]
-        ey = x[oi, 1] - x[ol, 1]
-        ez = x[oi, 2] - x[ol, 2]
+        ex, ey, ez = row_difference(x, oi, ol)
         p = (dx * ex + dy * ey + dz * ez) * ir5
         tx = ir3 * ex - p * dx
         ty = ir3 * ey - p * dy
@@ -372,14 +360,7 @@ def _pair_block_tangent(x, acc, gm, n_active, i, l, dx, dy, dz, ir3, ir5, dgm, k
             acc[ol, 1] += gm[i] * ty
             acc[ol, 2] += gm[i] * tz
         if masses:
-            ql = dgm[j, l] * ir3
-            qi = dgm[j, i] * ir3
-            acc[oi, 0] -= ql * dx
-            acc[oi, 1] -= ql * dy
-            acc[oi, 2] -= ql * dz
-            acc[ol, 0] += qi * dx
-            acc[ol, 1] += qi * dy
-            acc[ol, 2] += qi * dz
+            add_pulls(acc, oi, ol, dgm[j, l] * ir3, dgm[j, i] * ir3, dx, dy, dz)
 
 
 @njit(inline="always")
@@ -389,18 +370,13 @@ def _pair_tangent(x, acc, gm, n_active, first, skip_first_pair, dgm, k, masses):
     n = gm.shape[0]
     for j in range(k):
         o = n * (1 + j)
-        for i in range(n):
-            acc[o + i, 0] = 0.0
-            acc[o + i, 1] = 0.0
-            acc[o + i, 2] = 0.0
+        zero_rows(acc, o, o + n)
     for i in range(first + 1, n):
         # a mass variation of a test particle pulls too (the derivative of the
         # map in which every body is active, which at zero mass is this one)
         for l in range(first + 1 if (skip_first_pair and i == first + 1) else first,
                        i if masses else min(i, n_active)):
-            dx = x[i, 0] - x[l, 0]
-            dy = x[i, 1] - x[l, 1]
-            dz = x[i, 2] - x[l, 2]
+            dx, dy, dz = row_difference(x, i, l)
             r2 = dx * dx + dy * dy + dz * dz
             ir3 = 1.0 / (r2 * math.sqrt(r2))
             ir5 = 3.0 * ir3 / r2
@@ -426,10 +402,7 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
     _from_jacobi_block(xj, x, gm, eta, dgm, deta, -1, False)
     for j in range(k):
         _from_jacobi_block(xj, x, gm, eta, dgm, deta, j, masses)
-    for i in range(n * (1 + k)):
-        acc[i, 0] = 0.0
-        acc[i, 1] = 0.0
-        acc[i, 2] = 0.0
+    zero_rows(acc, 0, n * (1 + k))
     # every pair but (0, 1): pair_accelerations' arithmetic for the bodies,
     # and each pair's share of the tangent rows
     for i in range(1, n):
@@ -447,15 +420,8 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
             r2 = dx * dx + dy * dy + dz * dz
             ir3 = 1.0 / (r2 * math.sqrt(r2))
             if l < n_active:
-                sj = gm[l] * ir3
-                axi -= sj * dx
-                ayi -= sj * dy
-                azi -= sj * dz
-                if i < n_active:
-                    si = gmi * ir3
-                    acc[l, 0] += si * dx
-                    acc[l, 1] += si * dy
-                    acc[l, 2] += si * dz
+                axi, ayi, azi = pull_with_sums(acc, l, gmi, gm[l], ir3, dx, dy, dz, axi, ayi,
+                                               azi, i < n_active)
             _pair_block_tangent(x, acc, gm, n_active, i, l, dx, dy, dz, ir3, 3.0 * ir3 / r2,
                                 dgm, k, masses)
         acc[i, 0] += axi
@@ -468,13 +434,7 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
     sy = acc[0, 1]
     sz = acc[0, 2]
     for i in range(1, n):
-        ax = acc[i, 0] - sx
-        ay = acc[i, 1] - sy
-        az = acc[i, 2] - sz
-        w = gm[i] / eta[i]
-        sx += w * ax
-        sy += w * ay
-        sz += w * az
+        ax, ay, az, w, sx, sy, sz = jacobi_step(acc, i, gm, eta, i, sx, sy, sz)
         rx = xj[i, 0]
         ry = xj[i, 1]
         rz = xj[i, 2]
@@ -500,9 +460,7 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
         vj[i, 2] += h * kz
         for j in range(k):
             o = n * (1 + j)
-            bx = acc[o + i, 0] - acc[o, 0]
-            by = acc[o + i, 1] - acc[o, 1]
-            bz = acc[o + i, 2] - acc[o, 2]
+            bx, by, bz = row_difference(acc, o + i, o)
             acc[o, 0] += w * bx
             acc[o, 1] += w * by
             acc[o, 2] += w * bz
@@ -602,13 +560,7 @@ def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
         ty = acc[o, 1]
         tz = acc[o, 2]
         for i in range(1, n):
-            bx = acc[o + i, 0] - tx
-            by = acc[o + i, 1] - ty
-            bz = acc[o + i, 2] - tz
-            w = gm[i] / eta[i]
-            tx += w * bx
-            ty += w * by
-            tz += w * bz
+            bx, by, bz, _, tx, ty, tz = jacobi_step(acc, o + i, gm, eta, i, tx, ty, tz)
             vj[o + i, 0] += h * bx
             vj[o + i, 1] += h * by
             vj[o + i, 2] += h * bz

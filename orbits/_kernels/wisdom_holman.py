@@ -104,9 +104,10 @@ import numpy as np
 
 from ._jit import called, njit, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
-                          to_democratic_heliocentric, to_jacobi, weighted_sum)
+                          jacobi_step, to_democratic_heliocentric, to_jacobi,
+                          weighted_sum)
 from .gravity import pair_accelerations
-from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly
+from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly, straight_drift
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
 from .stopping import no_stop
@@ -130,6 +131,22 @@ __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick"
 
 
 @njit(inline="always")
+def short_step_anomalies(xj, vj, mu, h, n, w1, w2):
+    """The first pass of :func:`kepler_drift_all`: the short-step universal
+    anomaly of rows ``1 .. n - 1`` (:func:`~orbits._kernels.kepler.short_step_anomaly`,
+    NaN where the step is not short) with what the second pass takes with
+    it, ``(s, r0, 1 / r0)`` into ``w1[i]`` and ``(beta, zeta)`` into ``w2[i]``."""
+    for i in range(1, n):
+        s, r0, ir0, beta, zeta = short_step_anomaly(
+            mu[i], xj[i, 0], xj[i, 1], xj[i, 2], vj[i, 0], vj[i, 1], vj[i, 2], h)
+        w1[i, 0] = s
+        w1[i, 1] = r0
+        w1[i, 2] = ir0
+        w2[i, 0] = beta
+        w2[i, 1] = zeta
+
+
+@njit(inline="always")
 def kepler_drift_all(xj, vj, mu, h, w1, w2):
     """Drift every row by ``h``: row i >= 1 on its orbit about ``mu[i]``, the
     centre of mass (row 0) in a straight line.  ``w1``, ``w2`` (shape (N, 3))
@@ -143,18 +160,9 @@ def kepler_drift_all(xj, vj, mu, h, w1, w2):
     not short take :func:`~orbits._kernels.kepler.kepler_drift`'s bracketed
     solver.
     """
-    xj[0, 0] += h * vj[0, 0]
-    xj[0, 1] += h * vj[0, 1]
-    xj[0, 2] += h * vj[0, 2]
+    straight_drift(xj, vj, 0, h)
     n = xj.shape[0]
-    for i in range(1, n):
-        s, r0, ir0, beta, zeta = short_step_anomaly(
-            mu[i], xj[i, 0], xj[i, 1], xj[i, 2], vj[i, 0], vj[i, 1], vj[i, 2], h)
-        w1[i, 0] = s
-        w1[i, 1] = r0
-        w1[i, 2] = ir0
-        w2[i, 0] = beta
-        w2[i, 1] = zeta
+    short_step_anomalies(xj, vj, mu, h, n, w1, w2)
     for i in range(1, n):
         s = w1[i, 0]
         if not (s == s and advance_by_anomaly(mu[i], xj, vj, i, s, w1[i, 1], w1[i, 2],
@@ -194,13 +202,7 @@ def jacobi_velocity_kick(xj, vj, acc, gm, eta, h, kepler):
     sy = acc[0, 1]
     sz = acc[0, 2]
     for i in range(1, n):
-        ax = acc[i, 0] - sx
-        ay = acc[i, 1] - sy
-        az = acc[i, 2] - sz
-        w = gm[i] / eta[i]
-        sx += w * ax
-        sy += w * ay
-        sz += w * az
+        ax, ay, az, _, sx, sy, sz = jacobi_step(acc, i, gm, eta, i, sx, sy, sz)
         if kepler and i >= 2:
             rx = xj[i, 0]
             ry = xj[i, 1]
