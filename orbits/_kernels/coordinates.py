@@ -30,8 +30,7 @@ from ._jit import njit
 
 __all__ = ["interior_gm", "to_jacobi", "from_jacobi", "to_jacobi_one", "from_jacobi_one",
            "to_democratic_heliocentric", "from_democratic_heliocentric", "jacobi_step",
-           "row_difference",
-           "weighted_sum", "centre_of_mass"]
+           "row_difference", "set_row", "weighted_sum", "centre_of_mass"]
 
 
 @njit
@@ -41,6 +40,14 @@ def interior_gm(gm, out):
     for i in range(gm.shape[0]):
         s += gm[i]
         out[i] = s
+
+
+@njit(inline="always")
+def set_row(a, i, x, y, z):
+    """Row ``i`` of ``a`` set to ``(x, y, z)``."""
+    a[i, 0] = x
+    a[i, 1] = y
+    a[i, 2] = z
 
 
 @njit(inline="always")
@@ -106,9 +113,7 @@ def to_jacobi_one(a, gm, eta, out):
         sx += w * out[i, 0]
         sy += w * out[i, 1]
         sz += w * out[i, 2]
-    out[0, 0] = sx
-    out[0, 1] = sy
-    out[0, 2] = sz
+    set_row(out, 0, sx, sy, sz)
 
 
 @njit(inline="always")
@@ -127,9 +132,7 @@ def from_jacobi_one(aj, gm, eta, out):
         out[i, 0] = aj[i, 0] + sx
         out[i, 1] = aj[i, 1] + sy
         out[i, 2] = aj[i, 2] + sz
-    out[0, 0] = sx
-    out[0, 1] = sy
-    out[0, 2] = sz
+    set_row(out, 0, sx, sy, sz)
 
 
 @njit
@@ -190,12 +193,8 @@ def to_democratic_heliocentric(x, v, gm, xh, vb):
         vb[i, 0] = v[i, 0] - cvx
         vb[i, 1] = v[i, 1] - cvy
         vb[i, 2] = v[i, 2] - cvz
-    xh[0, 0] = cx
-    xh[0, 1] = cy
-    xh[0, 2] = cz
-    vb[0, 0] = cvx
-    vb[0, 1] = cvy
-    vb[0, 2] = cvz
+    set_row(xh, 0, cx, cy, cz)
+    set_row(vb, 0, cvx, cvy, cvz)
 
 
 @njit
@@ -215,9 +214,7 @@ def from_democratic_heliocentric(xh, vb, gm, x, v):
         x[i, 0] = xh[i, 0] + x0
         x[i, 1] = xh[i, 1] + y0
         x[i, 2] = xh[i, 2] + z0
-    x[0, 0] = x0
-    x[0, 1] = y0
-    x[0, 2] = z0
+    set_row(x, 0, x0, y0, z0)
     px, py, pz = weighted_sum(vb, gm, 1, n)
     for i in range(1, n):
         v[i, 0] = vb[i, 0] + vb[0, 0]

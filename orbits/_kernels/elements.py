@@ -233,12 +233,8 @@ def state_to_elements(mu, pos, vel, out):
     """
     if pos.shape[0] < 3 or vel.shape[0] < 3 or out.shape[0] < 7:
         return Status.BAD_SHAPE
-    x = pos[0]
-    y = pos[1]
-    z = pos[2]
-    vx = vel[0]
-    vy = vel[1]
-    vz = vel[2]
+    x, y, z = pos[0], pos[1], pos[2]
+    vx, vy, vz = vel[0], vel[1], vel[2]
     r = math.sqrt(x * x + y * y + z * z)
     v2 = vx * vx + vy * vy + vz * vz
     if (not (mu > 0.0) or not math.isfinite(mu) or not math.isfinite(r)
@@ -296,13 +292,8 @@ def state_to_elements(mu, pos, vel, out):
     else:
         M = mean_from_true(f, e)
 
-    out[0] = 1.0 / alpha
-    out[1] = e
-    out[2] = inc
-    out[3] = Omega
-    out[4] = omega
-    out[5] = f
-    out[6] = M
+    out[0], out[1], out[2], out[3] = 1.0 / alpha, e, inc, Omega
+    out[4], out[5], out[6] = omega, f, M
     return status
 
 

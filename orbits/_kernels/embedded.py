@@ -27,7 +27,8 @@ import numpy as np
 
 from ._jit import njit, slots, specialize
 from .status import Status
-from .stepping import (GO, WORK_SLOTS, first_record, mark_recorder, rk_stage, rk_sums,
+from .stepping import (GO, WORK_SLOTS, accept_fsal, dop853_error, first_record, flat_rows,
+                       flat_stages, mark_recorder, rk_stage, rk_sums, stage_errors,
                        step_epilogue, stop_info, work_kernels)
 from .variational import measured_rows
 
@@ -130,14 +131,10 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
     # flat views of the (N, 3) arrays: the stages run over every component in
     # loops that LLVM turns into vector instructions (stepping.rk_stage)
     m3 = 3 * n
-    xF = x.reshape(m3)
-    vF = v.reshape(m3)
-    xsF = xs.reshape(m3)
-    vsF = vs.reshape(m3)
-    x1F = x1.reshape(m3)
-    v1F = v1.reshape(m3)
-    kxF = kx.reshape((kx.shape[0], m3))
-    kvF = kv.reshape((kv.shape[0], m3))
+    xF, vF = flat_rows(x, v)
+    xsF, vsF = flat_rows(xs, vs)
+    x1F, v1F = flat_rows(x1, v1)
+    kxF, kvF = flat_stages(kx, kv)
     every = mon[0]
     n_mon = 0
     until_record = first_record(every, step0, mon_t)
@@ -200,33 +197,19 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
         err3 = 0.0
         for i in range(ne):
             for d in range(3):
-                ex = 0.0
-                ev = 0.0
-                fx = 0.0
-                fv = 0.0
-                for j in range(s + 1):
-                    ex += e[j] * kx[j, i, d]
-                    ev += e[j] * kv[j, i, d]
-                    fx += e3[j] * kx[j, i, d]
-                    fv += e3[j] * kv[j, i, d]
+                ex, ev, fx, fv = stage_errors(kx, kv, e, e3, s + 1, i, d)
                 sx = atol + rtol * max(abs(x[i, d]), abs(x1[i, d]))
                 sv = atol + rtol * max(abs(v[i, d]), abs(v1[i, d]))
                 err5 += (ex / sx) ** 2 + (ev / sv) ** 2
                 err3 += (fx / sx) ** 2 + (fv / sv) ** 2
         if has_e3:
-            denom = err5 + 0.01 * err3
-            err = 0.0 if denom == 0.0 else abs(h) * err5 / math.sqrt(denom * ncomp)
+            err = dop853_error(err5, err3, abs(h), ncomp)
         else:
             err = abs(h) * math.sqrt(err5 / ncomp)
         if not math.isfinite(err):
             err = math.inf  # a step that overflowed is rejected and shrunk
         if err <= 1.0:
-            for i in range(n):
-                for d in range(3):
-                    x[i, d] = x1[i, d]
-                    v[i, d] = v1[i, d]
-                    kx[0, i, d] = kx[s, i, d]
-                    kv[0, i, d] = kv[s, i, d]
+            accept_fsal(x, v, x1, v1, kx, kv, s, n)
             t = target if shortened else t + h
             steps += 1
             if not shortened:

@@ -63,8 +63,8 @@ import numpy as np
 
 from ._jit import njit, slots, specialize
 from .status import Status
-from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       first_record, mark_recorder, must_return, step_epilogue, stop_info,
+from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step, flat_rows,
+                       flat_stages, mark_recorder, must_return, step_epilogue, stop_info,
                        work_kernels)
 from .variational import measured_rows
 
@@ -240,26 +240,30 @@ def _predict(b, e, br, er, u, q, P):
                 uk *= u
             else:
                 P[m, k] = 0.0
+    _upper_times(P, br, e)
     n = b.shape[1]
+    for i in range(n):
+        for d in range(3):
+            for m in range(7):
+                b[m, i, d] = e[m, i, d] + (br[m, i, d] - er[m, i, d])
+
+
+def _g_from_b(b, g):
+    _upper_times(_D, b, g)
+
+
+@njit(inline="always")
+def _upper_times(M, src, out):
+    # out[m] = sum_{k >= m} M[m, k] src[k] for each body's component: the
+    # products of the upper triangle of a 7 x 7 table with the coefficients
+    n = src.shape[1]
     for i in range(n):
         for d in range(3):
             for m in range(7):
                 s = 0.0
                 for k in range(m, 7):
-                    s += P[m, k] * br[k, i, d]
-                e[m, i, d] = s
-                b[m, i, d] = s + (br[m, i, d] - er[m, i, d])
-
-
-def _g_from_b(b, g):
-    n = b.shape[1]
-    for i in range(n):
-        for d in range(3):
-            for k in range(7):
-                s = 0.0
-                for m in range(k, 7):
-                    s += _D[k, m] * b[m, i, d]
-                g[k, i, d] = s
+                    s += M[m, k] * src[k, i, d]
+                out[m, i, d] = s
 
 
 def _b_from_g(g, b):
@@ -357,24 +361,16 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     # these flat views (loops that LLVM turns into vector instructions, not N
     # loops of three)
     m3 = 3 * n
-    x1 = x.reshape(m3)
-    v1 = v.reshape(m3)
-    a01 = a0.reshape(m3)
-    csx1 = csx.reshape(m3)
-    csv1 = csv.reshape(m3)
-    xs1 = xs.reshape(m3)
-    vs1 = vs.reshape(m3)
-    b1 = b.reshape((7, m3))
-    g1 = g.reshape((7, m3))
-    acc1 = acc.reshape(m3)
+    x1, v1 = flat_rows(x, v)
+    a01, acc1 = flat_rows(a0, acc)
+    csx1, csv1 = flat_rows(csx, csv)
+    xs1, vs1 = flat_rows(xs, vs)
+    b1, g1 = flat_stages(b, g)
     # the step control measures the bodies' rows (not the tangent rows of variations)
     ne = rows(x, fargs)
-    every = mon[0]
-    cap = mon_t.shape[0]
     n_mon = 0
-    until_record = first_record(every, step0, mon_t)
-    # an empty marks array: none (one compiled loop for both uses)
-    direction, ct, target, has_marks = adaptive_start(t, t_end, tc, marks, counts, info)
+    direction, ct, target, has_marks, every, cap, until_record = adaptive_start(
+        t, t_end, tc, marks, counts, info, mon, step0, mon_t)
     if t == t_end:
         return Status.OK, t, n_mon
     k_mark = 0

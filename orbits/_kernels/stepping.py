@@ -80,7 +80,8 @@ __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force
            "user_force", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
-           "clock_step", "add_compensated", "stop_info", "mark_recorder"]
+           "clock_step", "add_compensated", "stop_info", "mark_recorder", "flat_rows",
+           "flat_stages", "stage_errors", "dop853_error", "accept_fsal"]
 
 #: operator codes of a splitting table
 DRIFT = 0
@@ -95,6 +96,20 @@ def state_is_finite(x, v):
         s += x[i, 0] + x[i, 1] + x[i, 2] + v[i, 0] + v[i, 1] + v[i, 2]
     # a sum with a NaN or an inf term is itself NaN or inf
     return math.isfinite(s)
+
+
+@njit(inline="always")
+def flat_rows(a, b):
+    """Views of two (N, 3) arrays as rows of their 3N components, for loops
+    over every component that LLVM turns into vector instructions."""
+    return a.reshape(a.size), b.reshape(b.size)
+
+
+@njit(inline="always")
+def flat_stages(a, b):
+    """Views of two (S, N, 3) arrays of stages as (S, 3N), as :func:`flat_rows`."""
+    m = a.shape[0]
+    return a.reshape((m, a.size // m)), b.reshape((m, b.size // m))
 
 
 @njit(inline="always")
@@ -126,12 +141,15 @@ GO = -1
 # -- the bookkeeping of the adaptive loops (orbits._kernels.ias15, .taylor) ---------
 
 @njit(inline="always")
-def adaptive_start(t, t_end, tc, marks, counts, info):
+def adaptive_start(t, t_end, tc, marks, counts, info, mon, step0, mon_t):
     """The counts and stop info of an adaptive loop's call reset, and its
-    ``(direction, ct, target, has_marks)``: ``ct`` the time's compensation
-    (``tc = (time reached, what t + dt rounded away)``, used only when the
-    call starts at the time the last one reached), ``target`` the first
-    time to land on (the first mark, else ``t_end``)."""
+    ``(direction, ct, target, has_marks, every, cap, until_record)``: ``ct``
+    the time's compensation (``tc = (time reached, what t + dt rounded
+    away)``, used only when the call starts at the time the last one
+    reached), ``target`` the first time to land on (the first mark, else
+    ``t_end``; an empty marks array: none, so that one compiled loop serves
+    both uses), and the monitors' ``every``, the rows' capacity and the
+    steps to the first record (:func:`first_record`)."""
     counts[0] = 0
     counts[1] = 0
     counts[2] = 0
@@ -141,7 +159,9 @@ def adaptive_start(t, t_end, tc, marks, counts, info):
     ct = tc[1] if t == tc[0] else 0.0
     has_marks = marks.shape[0] > 0
     target = marks[0] if has_marks else t_end
-    return direction, ct, target, has_marks
+    every = mon[0]
+    return (direction, ct, target, has_marks, every, mon_t.shape[0],
+            first_record(every, step0, mon_t))
 
 
 @njit(inline="always")
@@ -633,8 +653,7 @@ def _splitting_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, output
     # are faster (benchmarks/RESULTS.md)
     flat = n >= FLAT_FROM_BODIES
     m3 = 3 * n
-    xF = x.reshape(m3)
-    vF = v.reshape(m3)
+    xF, vF = flat_rows(x, v)
     aF = acc.reshape(m3)
     every = mon[0]
     n_mon = 0
@@ -783,6 +802,46 @@ def rk_sums(sx, sv, kxF, kvF, b, count):
             sv[q] += bs * kvF[s, q]
 
 
+@njit(inline="always")
+def stage_errors(kx, kv, e, e3, count, i, d):
+    """An embedded pair's two error estimates of component ``(i, d)``:
+    ``sum_s e[s] k_s`` and ``sum_s e3[s] k_s`` of the position and velocity
+    stages (arrays of shape (S, N, 3)) over the first ``count``, in stage
+    order; returns ``(e_x, e_v, e3_x, e3_v)``."""
+    ex = 0.0
+    ev = 0.0
+    fx = 0.0
+    fv = 0.0
+    for j in range(count):
+        ex += e[j] * kx[j, i, d]
+        ev += e[j] * kv[j, i, d]
+        fx += e3[j] * kx[j, i, d]
+        fv += e3[j] * kv[j, i, d]
+    return ex, ev, fx, fv
+
+
+@njit(inline="always")
+def dop853_error(err5, err3, h, ncomp):
+    """The error of a step of DOP853 (Hairer, Norsett & Wanner 1993, II.10)
+    from the scaled sums of squares of its fifth- and third-order estimates
+    over ``ncomp`` components."""
+    denom = err5 + 0.01 * err3
+    return 0.0 if denom == 0.0 else h * err5 / math.sqrt(denom * ncomp)
+
+
+@njit(inline="always")
+def accept_fsal(x, v, x1, v1, kx, kv, last, n):
+    """An accepted step of a method whose last stage is the next step's
+    first (FSAL): rows below ``n`` of the state set to the step's end
+    ``x1``, ``v1``, and of stage 0 to stage ``last``."""
+    for i in range(n):
+        for d in range(3):
+            x[i, d] = x1[i, d]
+            v[i, d] = v1[i, d]
+            kx[0, i, d] = kx[last, i, d]
+            kv[0, i, d] = kv[last, i, d]
+
+
 class Tableau(NamedTuple):
     """An explicit Runge-Kutta method's Butcher tableau."""
     A: np.ndarray
@@ -813,12 +872,9 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, tableau, work, fargs, outputs, checks
     n_stages = b.shape[0]
     # flat views of the (N, 3) arrays, for loops LLVM turns into vector instructions
     m3 = 3 * n
-    xF = x.reshape(m3)
-    vF = v.reshape(m3)
-    xsF = xs.reshape(m3)
-    vsF = vs.reshape(m3)
-    kxF = kx.reshape((kx.shape[0], m3))
-    kvF = kv.reshape((kv.shape[0], m3))
+    xF, vF = flat_rows(x, v)
+    xsF, vsF = flat_rows(xs, vs)
+    kxF, kvF = flat_stages(kx, kv)
     every = mon[0]
     n_mon = 0
     until_check = check_every

@@ -229,11 +229,8 @@ def collision_check(x, v, t, sargs):
         for j in range(i):
             found, tc, d, s = _pair_contact(x, v, t, sargs, i, j, inside, h)
             if found:
-                info[0] = j
-                info[1] = i
-                hit[0] = tc
-                hit[1] = d
-                hit[2] = s
+                info[0], info[1] = j, i
+                hit[0], hit[1], hit[2] = tc, d, s
                 return True
     return False
 

@@ -51,8 +51,7 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       first_record, mark_recorder, must_return, step_epilogue, stop_info,
-                       work_kernels)
+                       mark_recorder, must_return, step_epilogue, stop_info, work_kernels)
 
 # the names the templates below are written against, bound by specialize
 record_mark, step_end = slots("record_mark", "step_end")
@@ -279,11 +278,9 @@ def _taylor_loop(x, v, t, order, series, work, fargs, outputs, landing, sargs, c
     n_active = fargs[1]
     eps2 = fargs[2]
     npair = pairs_and_padding(n, n_active, PI, PJ, D)
-    every = mon[0]
-    cap = mon_t.shape[0]
     n_mon = 0
-    until_record = first_record(every, step0, mon_t)
-    direction, ct, target, has_marks = adaptive_start(t, t_end, tc, marks, counts, info)
+    direction, ct, target, has_marks, every, cap, until_record = adaptive_start(
+        t, t_end, tc, marks, counts, info, mon, step0, mon_t)
     if t == t_end:
         return Status.OK, t, n_mon
     k_mark = 0

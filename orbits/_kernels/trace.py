@@ -67,7 +67,8 @@ from .coordinates import (from_democratic_heliocentric, row_difference,
                           to_democratic_heliocentric)
 from .gravity import pair_accelerations, pull_pair, zero_rows
 from .status import Status
-from .stepping import GO, _record, epilogue, first_record
+from .stepping import (GO, _record, accept_fsal, dop853_error, epilogue, first_record,
+                       stage_errors)
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 # the names the templates below are written against, bound by specialize
@@ -335,19 +336,10 @@ def _dop853(mode, y, u, ns, idx, gm, n_active, enc, span, rtol, A, b, c, e5, e3,
             sy = rtol * max(_row_norm(y, i), _row_norm(y1, i)) + _TINY
             su = rtol * max(_row_norm(u, i), _row_norm(u1, i)) + _TINY
             for d in range(3):
-                ey = 0.0
-                eu = 0.0
-                fy = 0.0
-                fu = 0.0
-                for j in range(s + 1):
-                    ey += e5[j] * ky[j, i, d]
-                    eu += e5[j] * ku[j, i, d]
-                    fy += e3[j] * ky[j, i, d]
-                    fu += e3[j] * ku[j, i, d]
+                ey, eu, fy, fu = stage_errors(ky, ku, e5, e3, s + 1, i, d)
                 err5 += (ey / sy) ** 2 + (eu / su) ** 2
                 err3 += (fy / sy) ** 2 + (fu / su) ** 2
-        denom = err5 + 0.01 * err3
-        err = 0.0 if denom == 0.0 else hs * err5 / math.sqrt(denom * ncomp)
+        err = dop853_error(err5, err3, hs, ncomp)
         if not math.isfinite(err):
             err = math.inf
         if err == 0.0:
@@ -357,12 +349,7 @@ def _dop853(mode, y, u, ns, idx, gm, n_active, enc, span, rtol, A, b, c, e5, e3,
         else:
             fac = min(FAC_MAX, max(FAC_MIN, SAFETY * err ** (-1.0 / 8.0)))
         if err <= 1.0:
-            for i in range(ns):
-                for d in range(3):
-                    y[i, d] = y1[i, d]
-                    u[i, d] = u1[i, d]
-                    ky[0, i, d] = ky[s, i, d]
-                    ku[0, i, d] = ku[s, i, d]
+            accept_fsal(y, u, y1, u1, ky, ku, s, ns)
             counts[2] += 1
             if last:
                 break

@@ -196,6 +196,12 @@ def lanes_workspace(n, b):
 
 
 @njit(inline="always")
+def _components(A):
+    # the rows 0, 1 and 2 of A (views): a state's x, y and z over the lanes
+    return A[0], A[1], A[2]
+
+
+@njit(inline="always")
 def _needs_general(beta, s, ok, live, k0, m):
     # whether some element that iterates has a Stumpff argument beyond the
     # four-term series
@@ -212,11 +218,7 @@ def _iterate(s_, r0_, et_, be_, ze_, ok_, cv_, LF, h, nb, m, general):
     # kepler_drift_lanes); returns how many have not converged
     pending = 0
     for k in range(np.uint64(nb), np.uint64(m)):
-        s = s_[k]
-        r0 = r0_[k]
-        et = et_[k]
-        beta = be_[k]
-        zeta = ze_[k]
+        s, r0, et, beta, zeta = s_[k], r0_[k], et_[k], be_[k], ze_[k]
         c0, c1, c2, c3, inside = _stumpff_lane(beta * s * s, general)
         dd = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
         sn = s + dd
@@ -237,18 +239,8 @@ def _advance(X0, X1, X2, V0, V1, V2, MU, s_, r0_, ir0_, be_, ze_, ok_, cv_, LF, 
     # scalar drift
     n_alone = 0
     for k in range(np.uint64(nb), np.uint64(m)):
-        mu = MU[k]
-        s = s_[k]
-        r0 = r0_[k]
-        ir0 = ir0_[k]
-        beta = be_[k]
-        zeta = ze_[k]
-        x0 = X0[k]
-        y0 = X1[k]
-        z0 = X2[k]
-        vx0 = V0[k]
-        vy0 = V1[k]
-        vz0 = V2[k]
+        mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
+        s, r0, ir0, beta, zeta = s_[k], r0_[k], ir0_[k], be_[k], ze_[k]
         sig = dot3(x0, y0, z0, vx0, vy0, vz0)
         c0, c1, c2, c3, inside = _stumpff_lane(beta * s * s, general)
         _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, sig, zeta, c1, c2)
@@ -291,21 +283,12 @@ def _masked_drift(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     # argument needs it; the elements it declines in fl[2], drifted by the
     # scalar kepler_drift from the same start
     m = X.shape[1]
-    X0 = X[0]
-    X1 = X[1]
-    X2 = X[2]
-    V0 = V[0]
-    V1 = V[1]
-    V2 = V[2]
-    s_ = d[0]
-    r0_ = d[1]
-    ir0_ = d[2]
-    et_ = d[3]
-    be_ = d[4]
-    ze_ = d[5]
-    ok_ = fl[0]
-    cv_ = fl[1]
-    alone = fl[2]
+    X0, X1, X2 = _components(X)
+    V0, V1, V2 = _components(V)
+    # the passes' rows: the anomaly, the start's radius and its inverse,
+    # eta, beta and zeta; the verdicts (in the domain, converged, left alone)
+    s_, r0_, ir0_, et_, be_, ze_ = d[0], d[1], d[2], d[3], d[4], d[5]
+    ok_, cv_, alone = fl[0], fl[1], fl[2]
     # the starter (orbits._kernels.kepler.short_step_anomaly)
     for k in range(np.uint64(nb), np.uint64(m)):
         mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
@@ -382,12 +365,8 @@ def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     # kepler_drift_lanes, inlined into the loops that step: its passes are
     # quicker inlined than as a call of its own (benchmarks/RESULTS.md)
     m = X.shape[1]
-    X0 = X[0]
-    X1 = X[1]
-    X2 = X[2]
-    V0 = V[0]
-    V1 = V[1]
-    V2 = V[2]
+    X0, X1, X2 = _components(X)
+    V0, V1, V2 = _components(V)
     for k in range(nb):
         if LF[k] != 0.0:
             X0[k] += h * V0[k]
@@ -398,9 +377,7 @@ def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     # operations in its order), into rows 0 to 5 of d with the verdicts in
     # fl[0] (the passes' results in rows _DT on); the others, and frozen
     # lanes, keep their start
-    Y0 = d[0]
-    Y1 = d[1]
-    Y2 = d[2]
+    Y0, Y1, Y2 = _components(d)
     U0 = d[3]
     U1 = d[4]
     U2 = d[5]
@@ -478,15 +455,9 @@ def interaction_kick_lanes(X, V, XI, ACC, GM, MU, WQ, n_active, h, LF, nb, s3, a
     # would keep LLVM from vectorising the loops over the systems
     unb = np.uint64(nb)
     # inertial positions (orbits._kernels.coordinates.from_jacobi_one)
-    J0 = X[0]
-    J1 = X[1]
-    J2 = X[2]
-    X0 = XI[0]
-    X1 = XI[1]
-    X2 = XI[2]
-    S0 = s3[0]
-    S1 = s3[1]
-    S2 = s3[2]
+    J0, J1, J2 = _components(X)
+    X0, X1, X2 = _components(XI)
+    S0, S1, S2 = _components(s3)
     for b in range(unb):
         S0[b] = J0[b]
         S1[b] = J1[b]
@@ -510,19 +481,13 @@ def interaction_kick_lanes(X, V, XI, ACC, GM, MU, WQ, n_active, h, LF, nb, s3, a
     # three short loops over the systems a pair (the separation, the pull on
     # the later body, the reaction on the earlier one), which LLVM vectorises
     # better than one loop with all three
-    A0 = ACC[0]
-    A1 = ACC[1]
-    A2 = ACC[2]
+    A0, A1, A2 = _components(ACC)
     for k in range(m):
         A0[k] = 0.0
         A1[k] = 0.0
         A2[k] = 0.0
-    p0 = a3[0]
-    p1 = a3[1]
-    p2 = a3[2]
-    t0 = t4[0]
-    t1 = t4[1]
-    t2 = t4[2]
+    p0, p1, p2 = _components(a3)
+    t0, t1, t2 = _components(t4)
     q = t4[3]
     for i in range(1, n):
         oi = np.uint64(i * nb)
@@ -562,9 +527,7 @@ def interaction_kick_lanes(X, V, XI, ACC, GM, MU, WQ, n_active, h, LF, nb, s3, a
         S0[b] = A0[b]
         S1[b] = A1[b]
         S2[b] = A2[b]
-    W0 = V[0]
-    W1 = V[1]
-    W2 = V[2]
+    W0, W1, W2 = _components(V)
     for i in range(1, n):
         o = np.uint64(i * nb)
         for b in range(unb):
