@@ -30,7 +30,7 @@ from ._jit import njit
 
 __all__ = ["interior_gm", "to_jacobi", "from_jacobi", "to_jacobi_one", "from_jacobi_one",
            "to_democratic_heliocentric", "from_democratic_heliocentric", "jacobi_step",
-           "row_difference", "set_row", "weighted_sum", "centre_of_mass"]
+           "row_difference", "row", "set_row", "weighted_sum", "centre_of_mass"]
 
 
 @njit
@@ -40,6 +40,12 @@ def interior_gm(gm, out):
     for i in range(gm.shape[0]):
         s += gm[i]
         out[i] = s
+
+
+@njit(inline="always")
+def row(a, i):
+    """Row ``i`` of ``a`` as ``(x, y, z)``."""
+    return a[i, 0], a[i, 1], a[i, 2]
 
 
 @njit(inline="always")
@@ -102,9 +108,7 @@ def to_jacobi_one(a, gm, eta, out):
     accelerations), shape (N, 3); ``eta`` from :func:`interior_gm`."""
     n = a.shape[0]
     # running centre of mass of bodies 0..i-1
-    sx = a[0, 0]
-    sy = a[0, 1]
-    sz = a[0, 2]
+    sx, sy, sz = row(a, 0)
     for i in range(1, n):
         out[i, 0] = a[i, 0] - sx
         out[i, 1] = a[i, 1] - sy
@@ -120,9 +124,7 @@ def to_jacobi_one(a, gm, eta, out):
 def from_jacobi_one(aj, gm, eta, out):
     """Inverse of :func:`to_jacobi_one`."""
     n = aj.shape[0]
-    sx = aj[0, 0]
-    sy = aj[0, 1]
-    sz = aj[0, 2]
+    sx, sy, sz = row(aj, 0)
     for i in range(n - 1, 0, -1):
         # X_{i-1} = X_i - (m_i / eta_i) x'_i,  x_i = x'_i + X_{i-1}
         w = gm[i] / eta[i]

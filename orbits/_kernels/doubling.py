@@ -22,13 +22,11 @@ import numpy as np
 from ._jit import slots, specialize
 from .embedded import initial_step, next_step, step_underflow
 from .status import Status
-from .stepping import (GO, WORK_SLOTS, first_record, mark_recorder, step_epilogue, stop_info,
-                       work_kernels)
+from .stepping import GO, WORK_SLOTS, first_record, step_lander, work_kernels
 from .variational import measured_rows
 
 # the names the templates below are written against, bound by specialize
-force, record_mark, rk4_step, rows, step_end = slots(
-    "force", "record_mark", "rk4_step", "rows", "step_end")
+force, land, rk4_step, rows = slots("force", "land", "rk4_step", "rows")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["doubling_loop"]
@@ -189,20 +187,12 @@ def _doubling_loop(x, v, t, tolerances, work, fargs, outputs, landing, sargs, ch
             if HAS_WORK:
                 work_add(fargs, -0.5 * h * (pa + pb))
                 p0 = work_rate(x, v, t, fargs)
-            stop, _, _, until_record, n_mon = step_end(
-                x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-                stopping, fargs)
-            if stop != GO:
-                stop_info(stopping, info)
-                status = stop
+            code, target, k_mark, until_record, n_mon = land(
+                x, v, t, steps, False, 0, has_marks, target, k_mark, until_record, n_mon,
+                outputs, marks, mark_steps, stopping, info, fargs)
+            if code != GO:
+                status = code
                 break
-            if has_marks and t == target:
-                # an output: recorded as the driver would record it on return
-                n_mon, k_mark, target, last = record_mark(
-                    x, v, t, step0 + steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
-                    fargs)
-                if last:
-                    break
         else:
             rejected += 1
             h_prop = next_step(h, err, 4.0)
@@ -224,5 +214,4 @@ def doubling_loop(force):
                       HAS_WORK=work["HAS_WORK"], work_rate=work["work_rate"])
     return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, rk4_step=step,
-                      step_end=step_epilogue(force), rows=measured_rows(force),
-                      record_mark=mark_recorder(force), **work)
+                      land=step_lander(force), rows=measured_rows(force), **work)

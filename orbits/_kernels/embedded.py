@@ -28,13 +28,11 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, accept_fsal, dop853_error, first_record, flat_rows,
-                       flat_stages, mark_recorder, rk_stage, rk_sums, stage_errors,
-                       step_epilogue, stop_info, work_kernels)
+                       flat_stages, rk_stage, rk_sums, stage_errors, step_lander, work_kernels)
 from .variational import measured_rows
 
 # the names the templates below are written against, bound by specialize
-force, has_e3, record_mark, rows, step_end = slots(
-    "force", "has_e3", "record_mark", "rows", "step_end")
+force, has_e3, land, rows = slots("force", "has_e3", "land", "rows")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
@@ -217,20 +215,12 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
             if HAS_WORK:
                 work_add(fargs, -h * pw)
                 p0 = work_rate(x, v, t, fargs)
-            stop, _, _, until_record, n_mon = step_end(
-                x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-                stopping, fargs)
-            if stop != GO:
-                stop_info(stopping, info)
-                status = stop
+            code, target, k_mark, until_record, n_mon = land(
+                x, v, t, steps, False, 0, has_marks, target, k_mark, until_record, n_mon,
+                outputs, marks, mark_steps, stopping, info, fargs)
+            if code != GO:
+                status = code
                 break
-            if has_marks and t == target:
-                # an output: recorded as the driver would record it on return
-                n_mon, k_mark, target, last = record_mark(
-                    x, v, t, step0 + steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
-                    fargs)
-                if last:
-                    break
         else:
             rejected += 1
             h_prop = next_step(h, err, q)
@@ -250,5 +240,5 @@ def embedded_loop(force, has_e3):
     key = f"{force.key}{'_e3' if has_e3 else ''}"
     return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),
-                      step_end=step_epilogue(force), rows=measured_rows(force),
-                      record_mark=mark_recorder(force), **work_kernels(force))
+                      land=step_lander(force), rows=measured_rows(force),
+                      **work_kernels(force))

@@ -64,8 +64,7 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step, flat_rows,
-                       flat_stages, mark_recorder, must_return, step_epilogue, stop_info,
-                       work_kernels)
+                       flat_stages, must_return, step_lander, work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -613,24 +612,11 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
         else:
             ref[1] += dt
 
-        stop, _, _, until_record, n_mon = step_end(
-            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-            stopping, fargs)
-        if stop != GO:
-            stop_info(stopping, info)
-            return stop, t, n_mon
-        if abs(proposed) < min_dt:
-            info[0] = worst
-            return Status.STEP_UNDERFLOW, t, n_mon
-        if t == target:
-            if not has_marks:
-                return Status.OK, t, n_mon
-            # an output: recorded as the driver would record it on return
-            n_mon, k_mark, target, last = record_mark(
-                x, v, t, step0 + counts[0], mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
-                fargs)
-            if last:
-                return Status.OK, t, n_mon
+        code, target, k_mark, until_record, n_mon = land(
+            x, v, t, counts[0], abs(proposed) < min_dt, worst, has_marks, target, k_mark,
+            until_record, n_mon, outputs, marks, mark_steps, stopping, info, fargs)
+        if code != GO:
+            return code, t, n_mon
 
 
 def _first_step(x, a0, span):
@@ -661,8 +647,7 @@ def _first_step(x, a0, span):
 
 # the names _ias15_loop is written against, bound by ias15_loop (specialize);
 # the helpers default to their Python form, for a loop that runs as Python
-force, rows, step_end, record_mark, PREDICT_V = slots(
-    "force", "rows", "step_end", "record_mark", "PREDICT_V")
+force, rows, land, PREDICT_V = slots("force", "rows", "land", "PREDICT_V")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 predict, g_from_b, b_from_g, first_step = slots(
     predict=_predict, g_from_b=_g_from_b, b_from_g=_b_from_g, first_step=_first_step)
@@ -689,6 +674,5 @@ def ias15_loop(force):
     helpers = _JITTED if force.jit else {}
     return specialize(_ias15_loop, force.key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,
-                      step_end=step_epilogue(force), PREDICT_V=predict_v,
-                      record_mark=mark_recorder(force),
+                      land=step_lander(force), PREDICT_V=predict_v,
                       rows=measured_rows(force), **work_kernels(force), **helpers)

@@ -72,16 +72,18 @@ from .variational import tangent_kernels, variational_work_kernels
 WORK_SLOTS = ("HAS_WORK", "work_rate", "work_add", "work_note")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 (force, step_end, implicit_kick, KINDS, COEFS, pair_kernel, base, extra, extra_energy,
- nc_accel, user_accel, stop_check, tangent_step, record) = slots(
+ nc_accel, user_accel, stop_check, tangent_step, record, record_mark) = slots(
     "force", "step_end", "implicit_kick", "KINDS", "COEFS", "pair_kernel", "base", "extra",
-    "extra_energy", "nc_accel", "user_accel", "stop_check", "tangent_step", "record")
+    "extra_energy", "nc_accel", "user_accel", "stop_check", "tangent_step", "record",
+    "record_mark")
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
            "user_force", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
            "clock_step", "add_compensated", "stop_info", "mark_recorder", "flat_rows",
-           "flat_stages", "stage_errors", "dop853_error", "accept_fsal"]
+           "flat_stages", "stage_errors", "dop853_error", "accept_fsal",
+           "step_lander"]
 
 #: operator codes of a splitting table
 DRIFT = 0
@@ -291,6 +293,44 @@ def epilogue(record, key, jit=True, cache=True, runtime=False, stop=None, work_n
                       record=record, stop_check=stop_check,
                       work_note=_no_work_note if work_note is None else work_note,
                       tangent_step=_no_tangent_step if tangent_step is None else tangent_step)
+
+
+def step_lander(force):
+    """What an adaptive loop compiled for a :class:`ForceKernel` does after
+    each accepted step (:func:`_land`): the step epilogue, a stop, a step
+    below the smallest allowed, and landing on the next mark or the end."""
+    return specialize(_land, force.key, jit=force.jit, inline=True, nrt=force.runtime,
+                      cache=force.cache, step_end=step_epilogue(force),
+                      record_mark=mark_recorder(force))
+
+
+def _land(x, v, t, steps, underflow, worst, has_marks, target, k_mark, until_record, n_mon,
+          outputs, marks, mark_steps, stopping, info, fargs):
+    # after an accepted step that reached t, the call's steps-th: the step
+    # epilogue (monitor rows, stopping conditions), then the step control's
+    # underflow (worst: the body that set the step, into info[0]), then the
+    # landing on target, a mark recorded as the driver would record it on
+    # return; returns (GO or the status to return with, target, k_mark,
+    # until_record, n_mon)
+    mon, step0, mon_t, mon_out = outputs
+    stop, _, _, until_record, n_mon = step_end(
+        x, v, t, 0, 0, False, 0, 0, until_record, mon[0], mon, n_mon, mon_t, mon_out,
+        stopping, fargs)
+    if stop != GO:
+        stop_info(stopping, info)
+        return stop, target, k_mark, until_record, n_mon
+    if underflow:
+        info[0] = worst
+        return Status.STEP_UNDERFLOW, target, k_mark, until_record, n_mon
+    if t == target:
+        if not has_marks:
+            return Status.OK, target, k_mark, until_record, n_mon
+        n_mon, k_mark, target, last = record_mark(
+            x, v, t, step0 + steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
+            fargs)
+        if last:
+            return Status.OK, target, k_mark, until_record, n_mon
+    return GO, target, k_mark, until_record, n_mon
 
 
 def _record_mark(x, v, t, steps, mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark, fargs):

@@ -51,10 +51,10 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       mark_recorder, must_return, step_epilogue, stop_info, work_kernels)
+                       must_return, step_lander, work_kernels)
 
 # the names the templates below are written against, bound by specialize
-record_mark, step_end = slots("record_mark", "step_end")
+land, = slots("land")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["order_for", "pair_count", "padded_pairs", "Series", "series_arrays", "taylor_loop",
@@ -325,21 +325,11 @@ def _taylor_loop(x, v, t, order, series, work, fargs, outputs, landing, sargs, c
         tc[1] = ct
         counts[0] += 1
         dtp[0] = proposed
-        stop, _, _, until_record, n_mon = step_end(
-            x, v, t, 0, 0, False, 0, 0, until_record, every, mon, n_mon, mon_t, mon_out,
-            stopping, fargs)
-        if stop != GO:
-            stop_info(stopping, info)
-            return stop, t, n_mon
-        if t == target:
-            if not has_marks:
-                return Status.OK, t, n_mon
-            # an output: recorded as the driver would record it on return
-            n_mon, k_mark, target, last = record_mark(
-                x, v, t, step0 + counts[0], mon, n_mon, mon_t, mon_out, marks, mark_steps, k_mark,
-                fargs)
-            if last:
-                return Status.OK, t, n_mon
+        code, target, k_mark, until_record, n_mon = land(
+            x, v, t, counts[0], False, 0, has_marks, target, k_mark, until_record, n_mon,
+            outputs, marks, mark_steps, stopping, info, fargs)
+        if code != GO:
+            return code, t, n_mon
 
 
 def taylor_loop(force):
@@ -353,5 +343,4 @@ def taylor_loop(force):
     t_reached, n_monitor_rows)`` and leaves the counts in ``counts``.
     """
     return specialize(_taylor_loop, force.key, jit=force.jit, cache=force.cache,
-                      nrt=force.runtime, step_end=step_epilogue(force),
-                      record_mark=mark_recorder(force), **work_kernels(force))
+                      nrt=force.runtime, land=step_lander(force), **work_kernels(force))

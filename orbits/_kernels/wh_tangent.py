@@ -93,8 +93,8 @@ References
 import math
 
 from ._jit import called, njit, slots, specialize
-from .coordinates import (from_democratic_heliocentric, from_jacobi, jacobi_step,
-                          row_difference, to_democratic_heliocentric, to_jacobi)
+from .coordinates import (from_democratic_heliocentric, from_jacobi, jacobi_step, row,
+                          row_difference, set_row, to_democratic_heliocentric, to_jacobi)
 from .gravity import add_pulls, pull_with_sums, zero_rows
 from .kepler import straight_drift
 from .kepler_tangent import advance_tangent_by_anomaly, kepler_drift_tangent
@@ -102,7 +102,7 @@ from .stepping import epilogue, work_kernels
 from .variational import chaos_update, renormalise, tangent_product
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels,
-                            heliocentric_interaction_kick, interaction_kick, jump,
+                            heliocentric_interaction_kick, jump,
                             short_step_anomalies)
 
 # the names the templates below are written against, bound by specialize
@@ -127,9 +127,7 @@ def _to_jacobi_block(a, out, gm, eta, dgm, deta, j, masses):
     # mass derivative
     n = gm.shape[0]
     o = n * (1 + j)
-    sx = a[o, 0]
-    sy = a[o, 1]
-    sz = a[o, 2]
+    sx, sy, sz = row(a, o)
     for i in range(1, n):
         dx = a[o + i, 0] - sx
         dy = a[o + i, 1] - sy
@@ -146,9 +144,7 @@ def _to_jacobi_block(a, out, gm, eta, dgm, deta, j, masses):
             sx += dw * out[i, 0]
             sy += dw * out[i, 1]
             sz += dw * out[i, 2]
-    out[o, 0] = sx
-    out[o, 1] = sy
-    out[o, 2] = sz
+    set_row(out, o, sx, sy, sz)
 
 
 @njit(inline="always")
@@ -156,9 +152,7 @@ def _from_jacobi_block(aj, out, gm, eta, dgm, deta, j, masses):
     # tangent block j of from_jacobi_one, with the bodies' Jacobi aj[:n]
     n = gm.shape[0]
     o = n * (1 + j)
-    sx = aj[o, 0]
-    sy = aj[o, 1]
-    sz = aj[o, 2]
+    sx, sy, sz = row(aj, o)
     for i in range(n - 1, 0, -1):
         w = gm[i] / eta[i]
         sx -= w * aj[o + i, 0]
@@ -172,9 +166,7 @@ def _from_jacobi_block(aj, out, gm, eta, dgm, deta, j, masses):
         out[o + i, 0] = aj[o + i, 0] + sx
         out[o + i, 1] = aj[o + i, 1] + sy
         out[o + i, 2] = aj[o + i, 2] + sz
-    out[o, 0] = sx
-    out[o, 1] = sy
-    out[o, 2] = sz
+    set_row(out, o, sx, sy, sz)
 
 
 @njit
@@ -406,9 +398,7 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
     # every pair but (0, 1): pair_accelerations' arithmetic for the bodies,
     # and each pair's share of the tangent rows
     for i in range(1, n):
-        xi = x[i, 0]
-        yi = x[i, 1]
-        zi = x[i, 2]
+        xi, yi, zi = row(x, i)
         gmi = gm[i]
         axi = 0.0
         ayi = 0.0
@@ -430,14 +420,10 @@ def interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp):
     # the Jacobi transform of the accelerations with the Kepler terms i >= 2
     # (jacobi_velocity_kick's arithmetic for the bodies) and its tangent; the
     # tangent's running sums in the rows o of acc
-    sx = acc[0, 0]
-    sy = acc[0, 1]
-    sz = acc[0, 2]
+    sx, sy, sz = row(acc, 0)
     for i in range(1, n):
         ax, ay, az, w, sx, sy, sz = jacobi_step(acc, i, gm, eta, i, sx, sy, sz)
-        rx = xj[i, 0]
-        ry = xj[i, 1]
-        rz = xj[i, 2]
+        rx, ry, rz = row(xj, i)
         ir3 = 0.0
         if i >= 2:
             r2 = rx * rx + ry * ry + rz * rz
@@ -556,9 +542,7 @@ def _jacobi_term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs):
         _from_jacobi_block(xj, x, gm, eta, tp[0], tp[1], j, False)
         # acc's tangent block j: the terms' da/dx times x's
         tangent_product(tp[4], tp[4], x, x, o, n, acc, False)
-        tx = acc[o, 0]
-        ty = acc[o, 1]
-        tz = acc[o, 2]
+        tx, ty, tz = row(acc, o)
         for i in range(1, n):
             bx, by, bz, _, tx, ty, tz = jacobi_step(acc, o + i, gm, eta, i, tx, ty, tz)
             vj[o + i, 0] += h * bx
