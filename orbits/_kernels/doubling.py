@@ -20,7 +20,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ._jit import slots, specialize
-from .embedded import initial_step, next_step, step_underflow
+from .embedded import call_start, next_step, step_underflow, trial_step
 from .status import Status
 from .stepping import GO, WORK_SLOTS, first_record, step_lander, work_kernels
 from .variational import measured_rows
@@ -124,29 +124,15 @@ def _doubling_loop(x, v, t, tolerances, work, fargs, outputs, landing, sargs, ch
                 k0x[i, d] = v[i, d]
         fsal[0] = 1
     # dtbox holds the step's size; the steps carry the direction of time
-    direction = 1.0 if t_end > t else -1.0
-    h_prop = dtbox[0]
-    if h_prop <= 0.0:
-        h_prop = initial_step(x[:ne], v[:ne], k0x[:ne], k0v[:ne], rtol, atol, abs(t_end - t))
-    h_prop *= direction
+    direction, h_prop, target, has_marks = call_start(x, v, k0x, k0v, ne, t, t_end, dtbox,
+                                                      rtol, atol, marks)
     status = Status.OK
-    p0 = 0.0
-    if HAS_WORK:
-        p0 = work_rate(x, v, t, fargs)
-    target = t_end
+    p0 = work_rate(x, v, t, fargs) if HAS_WORK else 0.0
     k_mark = 0
-    # an empty marks array: none (one compiled loop for both uses)
-    has_marks = marks.shape[0] > 0
-    if has_marks:
-        target = marks[0]
     while steps < max_steps and (t_end - t) * direction > 0.0:
         if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
-        h = h_prop
-        shortened = False
-        if (t + 1.01 * h - target) * direction >= 0.0:
-            h = target - t
-            shortened = True
+        h, shortened = trial_step(t, h_prop, target, direction)
         rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, UNTRACKED)
         pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,
                       fargs, p0, TRACKED)

@@ -28,7 +28,7 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, accept_fsal, dop853_error, first_record, flat_rows,
-                       flat_stages, rk_stage, rk_sums, stage_errors, step_lander, work_kernels)
+                       rk_stage, rk_sums, stage_errors, stage_views, step_lander, work_kernels)
 from .variational import measured_rows
 
 # the names the templates below are written against, bound by specialize
@@ -81,6 +81,33 @@ def step_underflow(h, t, t_end):
     return h <= 4.0 * _EPS * max(abs(t), abs(t_end))
 
 
+@njit(inline="always")
+def call_start(x, v, fx, fv, ne, t, t_end, dtbox, rtol, atol, marks):
+    """An adaptive Runge-Kutta loop's call set up: ``(direction, h_prop,
+    target, has_marks)``, the direction of time, the first step to try (the
+    last call's, kept in ``dtbox[0]``, else :func:`initial_step`'s from the
+    state ``x``, ``v`` and its derivative ``fx``, ``fv``, rows below
+    ``ne``), and the first time to land on (the first mark, else
+    ``t_end``; an empty marks array: none, so that one compiled loop serves
+    both uses)."""
+    direction = 1.0 if t_end > t else -1.0
+    h_prop = dtbox[0]
+    if h_prop <= 0.0:
+        h_prop = initial_step(x[:ne], v[:ne], fx[:ne], fv[:ne], rtol, atol, abs(t_end - t))
+    has_marks = marks.shape[0] > 0
+    return direction, h_prop * direction, marks[0] if has_marks else t_end, has_marks
+
+
+@njit(inline="always")
+def trial_step(t, h_prop, target, direction):
+    """The step to try from ``t``, ``(h, shortened)``: the proposal, or what
+    is left to ``target`` when the proposal would reach within 1 % of it
+    (landing also when only a sliver would be left, as HNW's DOPRI5 does)."""
+    if (t + 1.01 * h_prop - target) * direction >= 0.0:
+        return target - t, True
+    return h_prop, False
+
+
 class Method(NamedTuple):
     """An embedded pair: its Butcher tableau ``A``, ``b``, ``c``, the
     weights' difference ``e`` of the error estimate (and ``e3``, a second
@@ -129,10 +156,8 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
     # flat views of the (N, 3) arrays: the stages run over every component in
     # loops that LLVM turns into vector instructions (stepping.rk_stage)
     m3 = 3 * n
-    xF, vF = flat_rows(x, v)
-    xsF, vsF = flat_rows(xs, vs)
+    xF, vF, xsF, vsF, kxF, kvF = stage_views(x, v, xs, vs, kx, kv)
     x1F, v1F = flat_rows(x1, v1)
-    kxF, kvF = flat_stages(kx, kv)
     every = mon[0]
     n_mon = 0
     until_record = first_record(every, step0, mon_t)
@@ -152,30 +177,15 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
                 kx[0, i, d] = v[i, d]
         fsal[0] = 1
     # dtbox holds the step's size; the steps carry the direction of time
-    direction = 1.0 if t_end > t else -1.0
-    h_prop = dtbox[0]
-    if h_prop <= 0.0:
-        h_prop = initial_step(x[:ne], v[:ne], kx[0, :ne], kv[0, :ne], rtol, atol, abs(t_end - t))
-    h_prop *= direction
+    direction, h_prop, target, has_marks = call_start(x, v, kx[0], kv[0], ne, t, t_end, dtbox,
+                                                      rtol, atol, marks)
     status = Status.OK
-    p0 = 0.0
-    if HAS_WORK:
-        p0 = work_rate(x, v, t, fargs)
-    target = t_end
+    p0 = work_rate(x, v, t, fargs) if HAS_WORK else 0.0
     k_mark = 0
-    # an empty marks array: none (one compiled loop for both uses)
-    has_marks = marks.shape[0] > 0
-    if has_marks:
-        target = marks[0]
     while steps < max_steps and (t_end - t) * direction > 0.0:
         if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
-        h = h_prop
-        shortened = False
-        if (t + 1.01 * h - target) * direction >= 0.0:
-            # land on the target, also when only a sliver would be left (HNW's DOPRI5)
-            h = target - t
-            shortened = True
+        h, shortened = trial_step(t, h_prop, target, direction)
         pw = b[0] * p0
         for st in range(1, s):
             rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, st, h)

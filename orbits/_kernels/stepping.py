@@ -82,7 +82,7 @@ __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
            "clock_step", "add_compensated", "stop_info", "mark_recorder", "flat_rows",
-           "flat_stages", "stage_errors", "dop853_error", "accept_fsal",
+           "flat_stages", "stage_views", "stage_errors", "dop853_error", "accept_fsal",
            "step_lander"]
 
 #: operator codes of a splitting table
@@ -105,6 +105,17 @@ def flat_rows(a, b):
     """Views of two (N, 3) arrays as rows of their 3N components, for loops
     over every component that LLVM turns into vector instructions."""
     return a.reshape(a.size), b.reshape(b.size)
+
+
+@njit(inline="always")
+def stage_views(x, v, xs, vs, kx, kv):
+    """A Runge-Kutta loop's flat views (:func:`flat_rows`, :func:`flat_stages`)
+    of the state, a stage's state and the stages: ``(xF, vF, xsF, vsF,
+    kxF, kvF)``."""
+    xF, vF = flat_rows(x, v)
+    xsF, vsF = flat_rows(xs, vs)
+    kxF, kvF = flat_stages(kx, kv)
+    return xF, vF, xsF, vsF, kxF, kvF
 
 
 @njit(inline="always")
@@ -912,9 +923,7 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, tableau, work, fargs, outputs, checks
     n_stages = b.shape[0]
     # flat views of the (N, 3) arrays, for loops LLVM turns into vector instructions
     m3 = 3 * n
-    xF, vF = flat_rows(x, v)
-    xsF, vsF = flat_rows(xs, vs)
-    kxF, kvF = flat_stages(kx, kv)
+    xF, vF, xsF, vsF, kxF, kvF = stage_views(x, v, xs, vs, kx, kv)
     every = mon[0]
     n_mon = 0
     until_check = check_every
