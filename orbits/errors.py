@@ -64,13 +64,21 @@ class OrbitsWarning(UserWarning):
     """
 
 
-def _where(body, field):
-    parts = []
-    if body is not None:
-        parts.append(f"body {body!r}")
-    if field is not None:
-        parts.append(f"field {field!r}")
-    return ", ".join(parts)
+def _named(kind, value):
+    """``"kind 'value'"``, or None where there is no value."""
+    return None if value is None else f"{kind} {value!r}"
+
+
+def _where(*places):
+    """The places a message concerns, those not None or empty, joined:
+    ``"body 'comet', field 'mass'"``."""
+    return ", ".join(p for p in places if p)
+
+
+def _located(message, *places):
+    """``message`` after the places it concerns: ``"body 'comet', field 'mass': message"``."""
+    where = _where(*places)
+    return f"{where}: {message}" if where else message
 
 
 class BodyError(OrbitsError, ValueError):
@@ -95,8 +103,7 @@ class BodyError(OrbitsError, ValueError):
     def __init__(self, message, body=None, field=None):
         self.body = body
         self.field = field
-        where = _where(body, field)
-        super().__init__(f"{where}: {message}" if where else message)
+        super().__init__(_located(message, _named("body", body), _named("field", field)))
 
 
 class BodyUnitsError(BodyError, u.UnitsError):
@@ -104,11 +111,12 @@ class BodyUnitsError(BodyError, u.UnitsError):
 
     Examples
     --------
-    >>> try:
-    ...     orbits.scenes.kepler().add("moon", mass=1 * u.au)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.body, exc.field)
-    BodyUnitsError moon mass
+    >>> orbits.scenes.kepler().add("moon", mass=1 * u.au)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.BodyUnitsError: body 'moon', field 'mass': expected a mass ...
+    >>> issubclass(orbits.errors.BodyUnitsError, u.UnitsError)
+    True
     """
 
 
@@ -117,11 +125,10 @@ class ElementsError(BodyError):
 
     Examples
     --------
-    >>> try:
-    ...     orbits.scenes.kepler().add("comet", mass=0 * u.kg, a=1 * u.au, e=1.5)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.field)
-    ElementsError e
+    >>> orbits.scenes.kepler().add("comet", mass=0 * u.kg, a=1 * u.au, e=1.5)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.ElementsError: body 'comet', field 'e': e = 1.5 >= 1 needs a < 0 ...
     """
 
 
@@ -130,11 +137,10 @@ class UnknownBodyError(BodyError, KeyError):
 
     Examples
     --------
-    >>> try:
-    ...     orbits.scenes.kepler().index("Moon")
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc)
-    UnknownBodyError body 'Moon': no such body; known: Star, Planet
+    >>> orbits.scenes.kepler().index("Moon")
+    Traceback (most recent call last):
+        ...
+    orbits.errors.UnknownBodyError: body 'Moon': no such body; known: Star, Planet
     >>> issubclass(orbits.errors.UnknownBodyError, KeyError)
     True
     """
@@ -148,11 +154,10 @@ class DuplicateBodyError(BodyError):
 
     Examples
     --------
-    >>> try:
-    ...     orbits.scenes.kepler().add("Star", mass=1 * u.Msun)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.body)
-    DuplicateBodyError Star
+    >>> orbits.scenes.kepler().add("Star", mass=1 * u.Msun)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.DuplicateBodyError: body 'Star', field 'name': a body of this name ...
     """
 
 
@@ -163,11 +168,10 @@ class CoincidentBodiesError(BodyError):
     --------
     >>> bodies = orbits.scenes.kepler()
     >>> bodies.add("twin", mass=1 * u.Mearth, position=bodies.positions[1])
-    >>> try:
-    ...     bodies.check()
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.body)
-    CoincidentBodiesError Planet
+    >>> bodies.check()
+    Traceback (most recent call last):
+        ...
+    orbits.errors.CoincidentBodiesError: body 'Planet', field 'position': is at the same ...
     """
 
 
@@ -178,11 +182,10 @@ class NoMassiveBodyError(OrbitsError, ValueError):
     --------
     >>> bodies = orbits.BodySet()
     >>> bodies.add("dust", mass=0 * u.kg)
-    >>> try:
-    ...     bodies.check()
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__)
-    NoMassiveBodyError
+    >>> bodies.check()
+    Traceback (most recent call last):
+        ...
+    orbits.errors.NoMassiveBodyError: the body set has no body with positive mass ...
     """
 
 
@@ -191,11 +194,10 @@ class UnknownIntegratorError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> try:
-    ...     orbits.integrators.get("rk45")
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, str(exc).split("; valid")[0])
-    UnknownIntegratorError unknown integrator 'rk45'; did you mean 'rk4'?
+    >>> orbits.integrators.get("rk45")
+    Traceback (most recent call last):
+        ...
+    orbits.errors.UnknownIntegratorError: unknown integrator 'rk45'; did you mean 'rk4'?; ...
     """
 
 
@@ -204,11 +206,10 @@ class IntegratorOptionError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> try:
-    ...     orbits.integrators.get("ias15", eps=1e-9)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, str(exc).split(';')[0])
-    IntegratorOptionError integrator 'ias15' has no option 'eps'
+    >>> orbits.integrators.get("ias15", eps=1e-9)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.IntegratorOptionError: integrator 'ias15' has no option 'eps'; valid options: ...
     """
 
 
@@ -220,11 +221,10 @@ class EpochError(OrbitsError, ValueError):
     Examples
     --------
     >>> bodies = orbits.scenes.kepler()
-    >>> try:
-    ...     bodies.epoch = "2000-01-01"
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, str(exc).split(";")[0])
-    EpochError epoch must be an astropy.time.Time, got str
+    >>> bodies.epoch = "2000-01-01"
+    Traceback (most recent call last):
+        ...
+    orbits.errors.EpochError: epoch must be an astropy.time.Time, got str; ...
     """
 
 
@@ -236,11 +236,10 @@ class NoEpochError(EpochError):
     --------
     >>> result = orbits.Simulation(orbits.scenes.kepler(), "leapfrog",
     ...                            dt=1 * u.day).run(until=2 * u.day, progress=False)
-    >>> try:
-    ...     result.epochs
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__)
-    NoEpochError
+    >>> result.epochs
+    Traceback (most recent call last):
+        ...
+    orbits.errors.NoEpochError: this run's bodies carried no epoch, ...
     """
 
 
@@ -271,9 +270,8 @@ class ForceTermError(OrbitsError, ValueError):
         self.term = term
         self.field = field
         self.body = body
-        where = ", ".join(p for p in (term, f"body {body!r}" if body is not None else None,
-                                      f"parameter {field!r}" if field else None) if p)
-        super().__init__(f"{where}: {message}" if where else message)
+        super().__init__(_located(message, term, _named("body", body),
+                                  _named("parameter", field or None)))
 
 
 class RunError(OrbitsError, RuntimeError):
@@ -316,13 +314,14 @@ class SimulationStopped(RunError):
 
     Examples
     --------
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
-    ...                         encounter_distance=2 * u.au)
-    >>> try:
-    ...     sim.run(until=10 * u.day, outputs=2, progress=False)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.bodies)
+    >>> for stop in ({"encounter_distance": 2 * u.au}, {"escape_distance": 0.5 * u.au}):
+    ...     sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day, **stop)
+    ...     try:
+    ...         sim.run(until=10 * u.day, outputs=2, progress=False)
+    ...     except orbits.errors.SimulationStopped as exc:
+    ...         print(type(exc).__name__, exc.bodies)
     CloseEncounter ('Star', 'Planet')
+    Escape ('Planet',)
     """
 
     def __init__(self, message, time=None, step=None, result=None, bodies=()):
@@ -339,11 +338,10 @@ class NonFiniteState(RunError):
     >>> bodies.add("A", mass=1 * u.Msun)
     >>> bodies.add("B", mass=1 * u.Msun, position=[1e-200, 0, 0] * u.au)   # r**3 underflows
     >>> sim = orbits.Simulation(bodies, "leapfrog", dt=1 * u.day)
-    >>> try:
-    ...     sim.run(until=2 * u.day, outputs=2, progress=False)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.step, exc.time)
-    NonFiniteState 0 0.0 d
+    >>> sim.run(until=2 * u.day, outputs=2, progress=False)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.NonFiniteState: the state became non-finite in step 1 (from t = 0 d); ...
     """
 
 
@@ -354,11 +352,10 @@ class StepSizeUnderflow(RunError):
     --------
     >>> ias15 = orbits.integrators.get("ias15", min_dt=1e4)   # days: above any step it takes
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), ias15)
-    >>> try:
-    ...     sim.run(until=100 * u.day, outputs=2, progress=False)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.time < 100 * u.day)
-    StepSizeUnderflow True
+    >>> sim.run(until=100 * u.day, outputs=2, progress=False)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.StepSizeUnderflow: the step size of 'ias15' collapsed at t = 0 d (step 0); ...
     """
 
 
@@ -371,11 +368,12 @@ class ConvergenceFailure(RunError):
     Examples
     --------
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "implicit-midpoint", dt=100 * u.day)
-    >>> try:
-    ...     sim.run(until=1000 * u.day, outputs=2, progress=False)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.step, sim.time)
-    ConvergenceFailure 0 0.0 d
+    >>> sim.run(until=1000 * u.day, outputs=2, progress=False)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.ConvergenceFailure: the Newton iteration of 'implicit-midpoint' did not ...
+    >>> sim.time                                    # left at the last good state
+    <Quantity 0. d>
     """
 
 
@@ -387,11 +385,12 @@ class WallTimeExceeded(RunError):
 
     Examples
     --------
-    >>> try:
-    ...     sim.run(until=1000 * u.day, progress=False, wall_limit=1e-9)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.time == sim.time, exc.step > 0)
-    WallTimeExceeded True True
+    >>> sim.run(until=1000 * u.day, progress=False, wall_limit=1e-9)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.WallTimeExceeded: the run passed its wall-time limit of 1e-09 s at t = ...
+    >>> bool(sim.time > 0 * u.day)                  # left at the last state reached
+    True
     """
 
 
@@ -402,11 +401,10 @@ class CloseEncounter(SimulationStopped):
     --------
     >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
     ...                         encounter_distance=2 * u.au)
-    >>> try:
-    ...     sim.run(until=10 * u.day, outputs=2, progress=False)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.bodies, exc.time)
-    CloseEncounter ('Star', 'Planet') 1.0 d
+    >>> sim.run(until=10 * u.day, outputs=2, progress=False)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.CloseEncounter: close encounter of 'Star' and 'Planet' (closest at t = 1 d, ...
     """
 
 
@@ -455,11 +453,10 @@ class SimulationOptionError(OrbitsError, ValueError):
 
     Examples
     --------
-    >>> try:
-    ...     orbits.Simulation(orbits.scenes.kepler(), "ias15", collisions="explode")
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__)
-    SimulationOptionError
+    >>> orbits.Simulation(orbits.scenes.kepler(), "ias15", collisions="explode")
+    Traceback (most recent call last):
+        ...
+    orbits.errors.SimulationOptionError: collisions='explode' is not a resolution; ...
     """
 
 
@@ -468,13 +465,13 @@ class Escape(SimulationStopped):
 
     Examples
     --------
-    >>> sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
-    ...                         escape_distance=0.5 * u.au)
-    >>> try:
-    ...     sim.run(until=10 * u.day, outputs=2, progress=False)
-    ... except orbits.OrbitsError as exc:
-    ...     print(type(exc).__name__, exc.bodies)
-    Escape ('Planet',)
+    >>> bodies = orbits.scenes.kepler()
+    >>> bodies.add("comet", mass=0 * u.kg, a=-1 * u.au, e=1.5)      # on a hyperbola
+    >>> sim = orbits.Simulation(bodies, "leapfrog", dt=1 * u.day, escape_distance=3 * u.au)
+    >>> sim.run(until=1 * u.yr, outputs=2, progress=False)
+    Traceback (most recent call last):
+        ...
+    orbits.errors.Escape: 'comet' escaped at t = 120 d (step 120); ...
     """
 
 
@@ -546,6 +543,4 @@ class SystemFileError(BodyError):
         super().__init__(message, body=body, field=field)
         self.path = path
         self.line = line
-        where = ", ".join(p for p in (path, None if line is None else f"line {line}") if p)
-        if where:
-            self.args = (f"{where}: {self.args[0]}",)
+        self.args = (_located(self.args[0], path, None if line is None else f"line {line}"),)

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import epochs as _epochs
 from ..bodies import BodySet
-from ..errors import BodyError, EpochError, SystemFileError, _where
+from ..errors import BodyError, EpochError, SystemFileError, _named, _where
 from ..units import UnitSystem
 from ._schema import (_EXAMPLE_UNIT, _VECTORS, BODY_FIELDS, UNIT_FIELDS, _example, _toml_text,
                       _unknown)
@@ -213,7 +213,7 @@ class _Reader:
             field = exc.field if exc.field in fields else (
                 "a" if exc.field == "elements" and "a" in fields else None)
             message = str(exc)
-            prefix = _where(exc.body, exc.field) + ": "
+            prefix = _where(_named("body", exc.body), _named("field", exc.field)) + ": "
             if message.startswith(prefix):
                 message = message[len(prefix):]
             raise self.error(message, line_of(field), name, exc.field) from exc
