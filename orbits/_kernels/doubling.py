@@ -20,17 +20,14 @@ from typing import NamedTuple
 import numpy as np
 
 from ._jit import slots, specialize
-from .embedded import call_start, next_step, step_underflow, trial_step
-from .status import Status
-from .stepping import GO, WORK_SLOTS, first_record, step_lander, work_kernels
-from .variational import measured_rows
+from .embedded import adaptive_loop
+from .stepping import WORK_SLOTS, work_kernels
 
 # the names the templates below are written against, bound by specialize
-force, land, rk4_step, rows = slots("force", "land", "rk4_step", "rows")
+force, rk4_step = slots("force", "rk4_step")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
-__all__ = ["doubling_loop"]
-
+__all__ = ["doubling_loop", "Method", "METHOD"]
 
 
 #: ``track`` of :func:`_rk4_step`: floats, not booleans, so that numba compiles
@@ -97,107 +94,77 @@ class Work(NamedTuple):
     info: np.ndarray
 
 
-def _doubling_loop(x, v, t, tolerances, work, fargs, outputs, landing, sargs, check):
-    # marks: outputs recorded in the loop, as in orbits._kernels.embedded
-    k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2, dtbox, fsal, info = work
+class Method(NamedTuple):
+    """Step doubling's record for the adaptive loop: the order ``q`` of its
+    error estimate."""
+    q: float
+
+
+#: RK4 with step doubling: the two half steps' error is of fourth order
+METHOD = Method(4.0)
+
+
+def _doubling_step(x, v, t, h, method, tolerances, work, fargs, p0, ne):
+    # a step of h and two of h / 2 from (x, v), the latter into work's x2,
+    # v2: (error, the work of non-conservative terms over the two halves,
+    # force evaluations)
+    k0x, k0v, kmx, kmv, kx, kv, xs, vs, xf, vf, xh, vh, x2, v2, _, _, _ = work
     rtol, atol = tolerances
-    mon, step0, mon_t, mon_out = outputs
-    t_end, max_steps, _, marks, mark_steps = landing
-    stopping = (sargs, check)
     n = x.shape[0]
-    every = mon[0]
-    n_mon = 0
-    until_record = first_record(every, step0, mon_t)
-    steps = 0
-    rejected = 0
-    fev = 0
-    info[0] = -1
-    info[1] = -1
-    # the error measures the bodies' rows (not the tangent rows of variations)
-    ne = rows(x, fargs)
-    ncomp = 6 * ne
-    if fsal[0] == 0:
-        force(x, v, t, fargs, k0v)
-        fev += 1
-        for i in range(n):
-            for d in range(3):
-                k0x[i, d] = v[i, d]
-        fsal[0] = 1
-    # dtbox holds the step's size; the steps carry the direction of time
-    direction, h_prop, target, has_marks = call_start(x, v, k0x, k0v, ne, t, t_end, dtbox,
-                                                      rtol, atol, marks)
-    status = Status.OK
-    p0 = work_rate(x, v, t, fargs) if HAS_WORK else 0.0
-    k_mark = 0
-    while steps < max_steps and (t_end - t) * direction > 0.0:
-        if has_marks and n_mon >= mon_out.shape[0]:
-            break                                    # caller collects the rows first
-        h, shortened = trial_step(t, h_prop, target, direction)
-        rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, UNTRACKED)
-        pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,
-                      fargs, p0, TRACKED)
-        for i in range(n):
-            for d in range(3):
-                kmx[i, d] = vh[i, d]
-        force(xh, vh, t + 0.5 * h, fargs, kmv)
-        pm = 0.0
-        if HAS_WORK:
-            pm = work_rate(xh, vh, t + 0.5 * h, fargs)
-        pb = rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs,
-                      x2, v2, fargs, pm, TRACKED)
-        fev += 10
-        err = 0.0
-        for i in range(ne):
-            for d in range(3):
-                sx = atol + rtol * max(abs(x[i, d]), abs(x2[i, d]))
-                sv = atol + rtol * max(abs(v[i, d]), abs(v2[i, d]))
-                err += ((x2[i, d] - xf[i, d]) / (15.0 * sx)) ** 2 \
-                    + ((v2[i, d] - vf[i, d]) / (15.0 * sv)) ** 2
-        err = math.sqrt(err / ncomp)
-        if not math.isfinite(err):
-            err = math.inf
-        if err <= 1.0:
-            for i in range(n):
-                for d in range(3):
-                    x[i, d] = x2[i, d]
-                    v[i, d] = v2[i, d]
-            t = target if shortened else t + h
-            force(x, v, t, fargs, k0v)
-            fev += 1
-            for i in range(n):
-                for d in range(3):
-                    k0x[i, d] = v[i, d]
-            steps += 1
-            if not shortened:
-                h_prop = next_step(h, err, 4.0)
-            if HAS_WORK:
-                work_add(fargs, -0.5 * h * (pa + pb))
-                p0 = work_rate(x, v, t, fargs)
-            code, target, k_mark, until_record, n_mon = land(
-                x, v, t, steps, False, 0, has_marks, target, k_mark, until_record, n_mon,
-                outputs, marks, mark_steps, stopping, info, fargs)
-            if code != GO:
-                status = code
-                break
-        else:
-            rejected += 1
-            h_prop = next_step(h, err, 4.0)
-            if step_underflow(abs(h_prop), t, t_end):
-                status = Status.STEP_UNDERFLOW
-                break
-    dtbox[0] = abs(h_prop)
-    return status, t, steps, rejected, fev, n_mon
+    rk4_step(x, v, t, h, k0x, k0v, kx, kv, xs, vs, xf, vf, fargs, p0, UNTRACKED)
+    pa = rk4_step(x, v, t, 0.5 * h, k0x, k0v, kx, kv, xs, vs, xh, vh,
+                  fargs, p0, TRACKED)
+    for i in range(n):
+        for d in range(3):
+            kmx[i, d] = vh[i, d]
+    force(xh, vh, t + 0.5 * h, fargs, kmv)
+    pm = 0.0
+    if HAS_WORK:
+        pm = work_rate(xh, vh, t + 0.5 * h, fargs)
+    pb = rk4_step(xh, vh, t + 0.5 * h, 0.5 * h, kmx, kmv, kx, kv, xs, vs,
+                  x2, v2, fargs, pm, TRACKED)
+    err = 0.0
+    for i in range(ne):
+        for d in range(3):
+            sx = atol + rtol * max(abs(x[i, d]), abs(x2[i, d]))
+            sv = atol + rtol * max(abs(v[i, d]), abs(v2[i, d]))
+            err += ((x2[i, d] - xf[i, d]) / (15.0 * sx)) ** 2 \
+                + ((v2[i, d] - vf[i, d]) / (15.0 * sv)) ** 2
+    return math.sqrt(err / (6 * ne)), 0.5 * h * (pa + pb), 10
+
+
+def _doubling_accept(x, v, t, method, work, fargs):
+    # the two half steps' end becomes the state, with its derivative
+    k0x, k0v, x2, v2 = work.k0x, work.k0v, work.x2, work.v2
+    for i in range(x.shape[0]):
+        for d in range(3):
+            x[i, d] = x2[i, d]
+            v[i, d] = v2[i, d]
+    force(x, v, t, fargs, k0v)
+    for i in range(x.shape[0]):
+        for d in range(3):
+            k0x[i, d] = v[i, d]
+    return 1
+
+
+def _doubling_first(work):
+    return work.k0x, work.k0v
 
 
 def doubling_loop(force):
-    """The RK4 step-doubling loop compiled for a force: it takes ``(x, v, t,
+    """The RK4 step-doubling loop compiled for a force: the adaptive loop of
+    :func:`~.embedded.adaptive_loop`, which takes ``(x, v, t, METHOD,
     tolerances, work, fargs, outputs, landing, sargs, check)``, a
     :class:`Work`, the records of :mod:`.records` and the stopping
     conditions (:func:`~.stopping.stop_record`)."""
-    key = force.key
+    key = f"doubling_{force.key}"
     work = work_kernels(force)
-    step = specialize(_rk4_step, key, jit=force.jit, cache=force.cache, force=force.kernel,
-                      HAS_WORK=work["HAS_WORK"], work_rate=work["work_rate"])
-    return specialize(_doubling_loop, key, jit=force.jit, cache=force.cache,
-                      nrt=force.runtime, force=force.kernel, rk4_step=step,
-                      land=step_lander(force), rows=measured_rows(force), **work)
+    options = dict(jit=force.jit, cache=force.cache)
+    rk4 = specialize(_rk4_step, key, force=force.kernel, HAS_WORK=work["HAS_WORK"],
+                     work_rate=work["work_rate"], **options)
+    bound = dict(force=force.kernel, rk4_step=rk4, HAS_WORK=work["HAS_WORK"],
+                 work_rate=work["work_rate"], **options)
+    inlined = dict(inline=True, nrt=force.runtime)
+    return adaptive_loop(force, key, specialize(_doubling_step, key, **inlined, **bound),
+                         specialize(_doubling_accept, key, **inlined, **bound),
+                         specialize(_doubling_first, key, **inlined, **options))

@@ -1,6 +1,10 @@
-"""The compiled adaptive loop of the embedded Runge-Kutta pairs (dopri5, dop853).
+"""The compiled adaptive loop of the Runge-Kutta methods with error control:
+the embedded pairs (dopri5, dop853) and, with a step of its own, RK4 with
+step doubling (:mod:`.doubling`).
 
-One loop serves every pair: the method is its Butcher table ``A``, ``b``,
+The loop (:func:`adaptive_loop`) holds the step control, the landing on
+output times and the stops; a method gives it its step and error.  One
+step serves every pair: the method is its Butcher table ``A``, ``b``,
 ``c`` and error weights ``e`` (and, for DOP853, ``e3``), all over the last
 stage being the first stage of the next step ("first same as last"), so a step
 costs ``s`` force evaluations.  The state is ``y = (x, v)`` with
@@ -28,14 +32,15 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, accept_fsal, dop853_error, first_record, flat_rows,
-                       rk_stage, rk_sums, stage_errors, stage_views, step_lander, work_kernels)
+                       rk_stages, rk_sums, stage_errors, stage_views, step_lander, work_kernels)
 from .variational import measured_rows
 
 # the names the templates below are written against, bound by specialize
-force, has_e3, land, rows = slots("force", "has_e3", "land", "rows")
+force, has_e3, land, rows, attempt, accept, first_stage, stages = slots(
+    "force", "has_e3", "land", "rows", "attempt", "accept", "first_stage", "stages")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
-__all__ = ["embedded_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
+__all__ = ["embedded_loop", "adaptive_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
            "FAC_MIN", "FAC_MAX"]
 
 SAFETY = 0.9   # step-size safety factor (HNW II.4)
@@ -137,30 +142,23 @@ class Work(NamedTuple):
     info: np.ndarray
 
 
-def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, sargs, check):
+def _adaptive_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, sargs, check):
     # marks (outputs recorded in the loop): the loop lands on each of these
     # times in turn, as it lands on t_end, and records there a row of
     # mon_out (monitors and state) with its time in mon_t and its step count
     # in mark_steps; t_end is then the last mark.  Landing on a mark in the
     # loop is landing on it at the end of a call: the same steps, bit for
     # bit.  Empty marks: the loop lands on t_end alone (the same compiled
-    # loop for both uses).
-    A, b, c, e, e3, q = method
+    # loop for both uses).  The method's step and error are attempt's, what
+    # an accepted step leaves for the next accept's.
     rtol, atol = tolerances
-    kx, kv, xs, vs, x1, v1, dtbox, fsal, info = work
+    dtbox, fsal, info = work.dt, work.fsal, work.info
     mon, step0, mon_t, mon_out = outputs
     t_end, max_steps, _, marks, mark_steps = landing
     stopping = (sargs, check)
     n = x.shape[0]
-    s = b.shape[0]
-    # flat views of the (N, 3) arrays: the stages run over every component in
-    # loops that LLVM turns into vector instructions (stepping.rk_stage)
-    m3 = 3 * n
-    xF, vF, xsF, vsF, kxF, kvF = stage_views(x, v, xs, vs, kx, kv)
-    x1F, v1F = flat_rows(x1, v1)
-    every = mon[0]
     n_mon = 0
-    until_record = first_record(every, step0, mon_t)
+    until_record = first_record(mon[0], step0, mon_t)
     steps = 0
     rejected = 0
     fev = 0
@@ -168,16 +166,17 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
     info[1] = -1
     # the error measures the bodies' rows (not the tangent rows of variations)
     ne = rows(x, fargs)
-    ncomp = 6 * ne
+    # the derivative at the start, unless the last call left it (FSAL)
+    fx, fv = first_stage(work)
     if fsal[0] == 0:
-        force(x, v, t, fargs, kv[0])
+        force(x, v, t, fargs, fv)
         fev += 1
         for i in range(n):
             for d in range(3):
-                kx[0, i, d] = v[i, d]
+                fx[i, d] = v[i, d]
         fsal[0] = 1
     # dtbox holds the step's size; the steps carry the direction of time
-    direction, h_prop, target, has_marks = call_start(x, v, kx[0], kv[0], ne, t, t_end, dtbox,
+    direction, h_prop, target, has_marks = call_start(x, v, fx, fv, ne, t, t_end, dtbox,
                                                       rtol, atol, marks)
     status = Status.OK
     p0 = work_rate(x, v, t, fargs) if HAS_WORK else 0.0
@@ -186,44 +185,18 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
         if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
         h, shortened = trial_step(t, h_prop, target, direction)
-        pw = b[0] * p0
-        for st in range(1, s):
-            rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, st, h)
-            force(xs, vs, t + c[st] * h, fargs, kv[st])
-            if HAS_WORK and b[st] != 0.0:
-                pw += b[st] * work_rate(xs, vs, t + c[st] * h, fargs)
-        fev += s - 1
-        # the step's sums b . k, gathered in x1, v1, then the new state
-        rk_sums(x1F, v1F, kxF, kvF, b, s)
-        for k in range(m3):
-            x1F[k] = xF[k] + h * x1F[k]
-            v1F[k] = vF[k] + h * v1F[k]
-            kxF[s, k] = v1F[k]
-        force(x1, v1, t + h, fargs, kv[s])
-        fev += 1
-        err5 = 0.0
-        err3 = 0.0
-        for i in range(ne):
-            for d in range(3):
-                ex, ev, fx, fv = stage_errors(kx, kv, e, e3, s + 1, i, d)
-                sx = atol + rtol * max(abs(x[i, d]), abs(x1[i, d]))
-                sv = atol + rtol * max(abs(v[i, d]), abs(v1[i, d]))
-                err5 += (ex / sx) ** 2 + (ev / sv) ** 2
-                err3 += (fx / sx) ** 2 + (fv / sv) ** 2
-        if has_e3:
-            err = dop853_error(err5, err3, abs(h), ncomp)
-        else:
-            err = abs(h) * math.sqrt(err5 / ncomp)
+        err, spent, evaluations = attempt(x, v, t, h, method, tolerances, work, fargs, p0, ne)
+        fev += evaluations
         if not math.isfinite(err):
             err = math.inf  # a step that overflowed is rejected and shrunk
         if err <= 1.0:
-            accept_fsal(x, v, x1, v1, kx, kv, s, n)
             t = target if shortened else t + h
+            fev += accept(x, v, t, method, work, fargs)
             steps += 1
             if not shortened:
-                h_prop = next_step(h, err, q)
+                h_prop = next_step(h, err, method.q)
             if HAS_WORK:
-                work_add(fargs, -h * pw)
+                work_add(fargs, -spent)
                 p0 = work_rate(x, v, t, fargs)
             code, target, k_mark, until_record, n_mon = land(
                 x, v, t, steps, False, 0, has_marks, target, k_mark, until_record, n_mon,
@@ -233,12 +206,60 @@ def _embedded_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
                 break
         else:
             rejected += 1
-            h_prop = next_step(h, err, q)
+            h_prop = next_step(h, err, method.q)
             if step_underflow(abs(h_prop), t, t_end):
                 status = Status.STEP_UNDERFLOW
                 break
     dtbox[0] = abs(h_prop)
     return status, t, steps, rejected, fev, n_mon
+
+
+def _embedded_step(x, v, t, h, method, tolerances, work, fargs, p0, ne):
+    # one step of the pair from (x, v) into work's x1, v1 with its stages:
+    # (error, the work of non-conservative terms over it, force evaluations)
+    A, b, c, e, e3, q = method
+    rtol, atol = tolerances
+    kx, kv, xs, vs, x1, v1 = work.kx, work.kv, work.xs, work.vs, work.x1, work.v1
+    n = x.shape[0]
+    s = b.shape[0]
+    # flat views of the (N, 3) arrays: the stages run over every component in
+    # loops that LLVM turns into vector instructions (stepping.rk_stage)
+    m3 = 3 * n
+    xF, vF, xsF, vsF, kxF, kvF = stage_views(x, v, xs, vs, kx, kv)
+    x1F, v1F = flat_rows(x1, v1)
+    pw = stages(xF, vF, xsF, vsF, kxF, kvF, xs, vs, kv, (A, b, c), t, h, 1, s, b[0] * p0,
+                fargs)
+    # the step's sums b . k, gathered in x1, v1, then the new state
+    rk_sums(x1F, v1F, kxF, kvF, b, s)
+    for k in range(m3):
+        x1F[k] = xF[k] + h * x1F[k]
+        v1F[k] = vF[k] + h * v1F[k]
+        kxF[s, k] = v1F[k]
+    force(x1, v1, t + h, fargs, kv[s])
+    err5 = 0.0
+    err3 = 0.0
+    for i in range(ne):
+        for d in range(3):
+            ex, ev, fx, fv = stage_errors(kx, kv, e, e3, s + 1, i, d)
+            sx = atol + rtol * max(abs(x[i, d]), abs(x1[i, d]))
+            sv = atol + rtol * max(abs(v[i, d]), abs(v1[i, d]))
+            err5 += (ex / sx) ** 2 + (ev / sv) ** 2
+            err3 += (fx / sx) ** 2 + (fv / sv) ** 2
+    if has_e3:
+        err = dop853_error(err5, err3, abs(h), 6 * ne)
+    else:
+        err = abs(h) * math.sqrt(err5 / (6 * ne))
+    return err, h * pw, s
+
+
+def _embedded_accept(x, v, t, method, work, fargs):
+    # the step's end becomes the state, its last stage the next step's first
+    accept_fsal(x, v, work.x1, work.v1, work.kx, work.kv, method.b.shape[0], x.shape[0])
+    return 0
+
+
+def _embedded_first(work):
+    return work.kx[0], work.kv[0]
 
 
 def embedded_loop(force, has_e3):
@@ -247,8 +268,25 @@ def embedded_loop(force, has_e3):
     landing, sargs, check)``, a :class:`Method`, a :class:`Work`, the records
     of :mod:`.records` and the stopping conditions
     (:func:`~.stopping.stop_record`)."""
-    key = f"{force.key}{'_e3' if has_e3 else ''}"
-    return specialize(_embedded_loop, key, jit=force.jit, cache=force.cache,
-                      nrt=force.runtime, force=force.kernel, has_e3=bool(has_e3),
-                      land=step_lander(force), rows=measured_rows(force),
-                      **work_kernels(force))
+    key = f"embedded_{force.key}{'_e3' if has_e3 else ''}"
+    options = dict(jit=force.jit, cache=force.cache, inline=True, nrt=force.runtime)
+    step = specialize(_embedded_step, key, force=force.kernel, has_e3=bool(has_e3),
+                      stages=rk_stages(force), **options)
+    return adaptive_loop(force, key, step, specialize(_embedded_accept, key, **options),
+                         specialize(_embedded_first, key, **options))
+
+
+def adaptive_loop(force, key, step, accept, first_stage):
+    """The adaptive loop (:func:`_adaptive_loop`) compiled for a force and a
+    method under ``key``, with the method's compiled kernels: ``step(x, v,
+    t, h, method, tolerances, work, fargs, p0, rows) -> (error, work, force
+    evaluations)`` tries a step, ``accept(x, v, t, method, work, fargs) ->
+    force evaluations`` makes its end the state, and ``first_stage(work) ->
+    (fx, fv)`` are the arrays of the derivative at the state.  It takes ``(x, v, t, method, tolerances,
+    work, fargs, outputs, landing, sargs, check)``: the method's record
+    (with its error estimator's order ``q``), the records of :mod:`.records`
+    and the stopping conditions (:func:`~.stopping.stop_record`)."""
+    return specialize(_adaptive_loop, key, jit=force.jit, cache=force.cache,
+                      nrt=force.runtime, force=force.kernel, land=step_lander(force),
+                      rows=measured_rows(force), attempt=step, accept=accept,
+                      first_stage=first_stage, **work_kernels(force))

@@ -64,7 +64,7 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step, flat_rows,
-                       flat_stages, must_return, step_lander, work_kernels)
+                       flat_stages, landing_step, must_return, step_lander, work_kernels)
 from .variational import measured_rows
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
@@ -370,14 +370,13 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     n_mon = 0
     direction, ct, target, has_marks, every, cap, until_record = adaptive_start(
         t, t_end, tc, marks, counts, info, mon, step0, mon_t)
-    if t == t_end:
-        return Status.OK, t, n_mon
     k_mark = 0
     eps7 = epsilon ** (1.0 / 7.0)
     pc_tol = max(PC_TOLERANCE, PC_EPSILON_SQUARED * epsilon * epsilon)
     prs7 = (_FACT7 * epsilon) ** (1.0 / 7.0)
     while True:
-        if must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap):
+        if must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap, t,
+                       t_end):
             return Status.OK, t, n_mon
         if flags[0] == 0:
             force(x, v, t, fargs, a0)
@@ -393,10 +392,8 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
         if proposed == 0.0 or not math.isfinite(proposed):
             proposed = first_step(x[:ne], a0[:ne], target - t)
         proposed = abs(proposed) * direction
-        remaining = (target - t) - ct
-        trimmed = abs(proposed) >= abs(remaining)
-        dt = remaining if trimmed else proposed
-        if not trimmed and (abs(dt) < min_dt or t + dt == t):
+        dt, trimmed, underflow = landing_step(t, ct, target, proposed, min_dt)
+        if underflow:
             dtp[0] = proposed
             return Status.STEP_UNDERFLOW, t, n_mon
 

@@ -76,14 +76,15 @@ HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
     "force", "step_end", "implicit_kick", "KINDS", "COEFS", "pair_kernel", "base", "extra",
     "extra_energy", "nc_accel", "user_accel", "stop_check", "tangent_step", "record",
     "record_mark")
+stages, = slots("stages")
 
 __all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
            "user_force", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
-           "clock_step", "add_compensated", "stop_info", "mark_recorder", "flat_rows",
+           "clock_step", "landing_step", "add_compensated", "stop_info", "mark_recorder", "flat_rows",
            "flat_stages", "stage_views", "stage_errors", "dop853_error", "accept_fsal",
-           "step_lander"]
+           "step_lander", "rk_stages"]
 
 #: operator codes of a splitting table
 DRIFT = 0
@@ -178,11 +179,25 @@ def adaptive_start(t, t_end, tc, marks, counts, info, mon, step0, mon_t):
 
 
 @njit(inline="always")
-def must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap):
-    """Whether an adaptive loop returns before its next step: its steps for
-    this call taken, or its rows full (the caller collects them first)."""
-    return (counts[0] >= max_steps or (has_marks and n_mon >= mon_out.shape[0])
+def must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap, t, t_end):
+    """Whether an adaptive loop returns before its next step: at ``t_end``
+    (a call that starts there takes no step), its steps for this call
+    taken, or its rows full (the caller collects them first)."""
+    return (t == t_end or counts[0] >= max_steps or (has_marks and n_mon >= mon_out.shape[0])
             or (until_record == 1 and n_mon >= cap))
+
+
+@njit(inline="always")
+def landing_step(t, ct, target, proposed, min_dt):
+    """The step an adaptive loop takes from ``t``: the proposal, or what is
+    left to ``target`` (less the time's compensation ``ct``, see
+    :func:`clock_step`) when the proposal reaches it; ``(dt, trimmed,
+    underflow)``, underflow when a step that is not trimmed is below
+    ``min_dt`` or too small to move ``t``."""
+    remaining = (target - t) - ct
+    trimmed = abs(proposed) >= abs(remaining)
+    dt = remaining if trimmed else proposed
+    return dt, trimmed, not trimmed and (abs(dt) < min_dt or t + dt == t)
 
 
 @njit(inline="always")
@@ -893,6 +908,29 @@ def accept_fsal(x, v, x1, v1, kx, kv, last, n):
             kv[0, i, d] = kv[last, i, d]
 
 
+def _stages(xF, vF, xsF, vsF, kxF, kvF, xs, vs, kv, tableau, t, h, first, count, pw, fargs):
+    # stages first .. count - 1 of a Runge-Kutta step of h from t (flat views
+    # and their (N, 3) forms xs, vs, kv as in rk_stage): each stage's state,
+    # then its acceleration; returns pw plus the stages' work rates weighted
+    # by b (with HAS_WORK)
+    A, b, c = tableau
+    for st in range(first, count):
+        rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, st, h)
+        force(xs, vs, t + c[st] * h, fargs, kv[st])
+        if HAS_WORK and b[st] != 0.0:
+            pw += b[st] * work_rate(xs, vs, t + c[st] * h, fargs)
+    return pw
+
+
+def rk_stages(force):
+    """The stages of an explicit Runge-Kutta step for a :class:`ForceKernel`
+    (:func:`_stages`), inlined where they are called."""
+    work = work_kernels(force)
+    return specialize(_stages, force.key, jit=force.jit, cache=force.cache, inline=True,
+                      nrt=force.runtime, force=force.kernel, HAS_WORK=work["HAS_WORK"],
+                      work_rate=work["work_rate"])
+
+
 class Tableau(NamedTuple):
     """An explicit Runge-Kutta method's Butcher tableau."""
     A: np.ndarray
@@ -930,12 +968,8 @@ def _runge_kutta_loop(x, v, t, dt, nsteps, tableau, work, fargs, outputs, checks
     until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         tk = t + k * dt
-        pw = 0.0
-        for s in range(n_stages):
-            rk_stage(xF, vF, xsF, vsF, kxF, kvF, A, s, dt)
-            force(xs, vs, tk + c[s] * dt, fargs, kv[s])
-            if HAS_WORK and b[s] != 0.0:
-                pw += b[s] * work_rate(xs, vs, tk + c[s] * dt, fargs)
+        pw = stages(xF, vF, xsF, vsF, kxF, kvF, xs, vs, kv, tableau, tk, dt, 0, n_stages, 0.0,
+                    fargs)
         # the step's sums b . k, gathered in xs, vs (free until the next step)
         rk_sums(xsF, vsF, kxF, kvF, b, n_stages)
         for q in range(m3):
@@ -959,4 +993,5 @@ def runge_kutta_loop(force):
     (:func:`~.stopping.stop_record`)."""
     return specialize(_runge_kutta_loop, force.key,
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
-                      step_end=step_epilogue(force), **work_kernels(force))
+                      step_end=step_epilogue(force), stages=rk_stages(force),
+                      **work_kernels(force))

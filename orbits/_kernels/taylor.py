@@ -51,7 +51,7 @@ import numpy as np
 from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step,
-                       must_return, step_lander, work_kernels)
+                       landing_step, must_return, step_lander, work_kernels)
 
 # the names the templates below are written against, bound by specialize
 land, = slots("land")
@@ -281,11 +281,10 @@ def _taylor_loop(x, v, t, order, series, work, fargs, outputs, landing, sargs, c
     n_mon = 0
     direction, ct, target, has_marks, every, cap, until_record = adaptive_start(
         t, t_end, tc, marks, counts, info, mon, step0, mon_t)
-    if t == t_end:
-        return Status.OK, t, n_mon
     k_mark = 0
     while True:
-        if must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap):
+        if must_return(counts, max_steps, has_marks, n_mon, mon_out, until_record, cap, t,
+                       t_end):
             return Status.OK, t, n_mon
         finite = expand(x, v, X, V, D, R2, S, W, IR, A, PI, PJ, npair, gm, eps2, order)
         counts[2] += order
@@ -295,10 +294,8 @@ def _taylor_loop(x, v, t, order, series, work, fargs, outputs, landing, sargs, c
         if proposed == 0.0:
             proposed = math.inf
         proposed *= direction
-        remaining = (target - t) - ct
-        trimmed = abs(proposed) >= abs(remaining)
-        dt = remaining if trimmed else proposed
-        if not trimmed and (abs(dt) < min_dt or t + dt == t):
+        dt, trimmed, underflow = landing_step(t, ct, target, proposed, min_dt)
+        if underflow:
             dtp[0] = proposed
             return Status.STEP_UNDERFLOW, t, n_mon
         # the increments in Horner's form, first, so that a non-finite one

@@ -294,8 +294,7 @@ def gr_potential_jacobian(x, v, t, args, jx, jv):
     src, gm, inv_c2 = args[0], args[1], args[2]
     mu = gm[src]
     k = 6.0 * mu * mu * inv_c2
-    r = np.empty(3)
-    dx = np.empty((3, 3))
+    r, dx = np.empty(3), np.empty((3, 3))
     for i in range(x.shape[0]):
         if i == src:
             continue
@@ -485,8 +484,7 @@ def zonal_jacobian(x, v, t, args, jx, jv):
     ``k4 (35 q^4 s^-9/2 - 30 q^2 s^-7/2 + 3 s^-5/2) / 8``.
     """
     b, gm, k2, k4, pole = args[0], args[1], args[2], args[3], args[4]
-    r = np.empty(3)
-    h = np.empty((3, 3))
+    r, h = np.empty(3), np.empty((3, 3))
     for i in range(x.shape[0]):
         if i == b:
             continue

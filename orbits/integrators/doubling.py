@@ -46,4 +46,5 @@ class RK4Doubling(CompiledToleranceControlled):
                 "info": np.full(2, -1, dtype=np.int64)}
 
     def _loop_call(self, ws, force):
-        return loop_for(_doubling.doubling_loop, force), (), records.work(_doubling.Work, ws)
+        return (loop_for(_doubling.doubling_loop, force), (_doubling.METHOD,),
+                records.work(_doubling.Work, ws))

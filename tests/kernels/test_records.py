@@ -11,7 +11,7 @@ from orbits._kernels import (doubling, embedded, ias15, implicit, records, stepp
                              trace, wh_batch, wisdom_holman)
 
 LOOPS = [stepping._splitting_loop, stepping._runge_kutta_loop, implicit._implicit_loop,
-         embedded._embedded_loop, doubling._doubling_loop, ias15._ias15_loop,
+         embedded._adaptive_loop, ias15._ias15_loop,
          taylor._taylor_loop, trace._trace_loop, wisdom_holman._wh_loop,
          wh_batch._advance_lanes]
 
