@@ -104,7 +104,7 @@ class Method(NamedTuple):
 METHOD = Method(4.0)
 
 
-def _doubling_step(x, v, t, h, method, tolerances, work, fargs, p0, ne):
+def _doubling_step(x, v, t, h, method, tolerances, work, views, fargs, p0, ne):
     # a step of h and two of h / 2 from (x, v), the latter into work's x2,
     # v2: (error, the work of non-conservative terms over the two halves,
     # force evaluations)
@@ -147,8 +147,8 @@ def _doubling_accept(x, v, t, method, work, fargs):
     return 1
 
 
-def _doubling_first(work):
-    return work.k0x, work.k0v
+def _doubling_first(x, v, work):
+    return work.k0x, work.k0v, ()
 
 
 def doubling_loop(force):

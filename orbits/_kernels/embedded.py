@@ -166,8 +166,9 @@ def _adaptive_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
     info[1] = -1
     # the error measures the bodies' rows (not the tangent rows of variations)
     ne = rows(x, fargs)
-    # the derivative at the start, unless the last call left it (FSAL)
-    fx, fv = first_stage(work)
+    # the derivative at the start, unless the last call left it (FSAL), and
+    # the views the method's step works on, made once a call
+    fx, fv, views = first_stage(x, v, work)
     if fsal[0] == 0:
         force(x, v, t, fargs, fv)
         fev += 1
@@ -185,7 +186,8 @@ def _adaptive_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
         if has_marks and n_mon >= mon_out.shape[0]:
             break                                    # caller collects the rows first
         h, shortened = trial_step(t, h_prop, target, direction)
-        err, spent, evaluations = attempt(x, v, t, h, method, tolerances, work, fargs, p0, ne)
+        err, spent, evaluations = attempt(x, v, t, h, method, tolerances, work, views, fargs,
+                                          p0, ne)
         fev += evaluations
         if not math.isfinite(err):
             err = math.inf  # a step that overflowed is rejected and shrunk
@@ -214,19 +216,15 @@ def _adaptive_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
     return status, t, steps, rejected, fev, n_mon
 
 
-def _embedded_step(x, v, t, h, method, tolerances, work, fargs, p0, ne):
+def _embedded_step(x, v, t, h, method, tolerances, work, views, fargs, p0, ne):
     # one step of the pair from (x, v) into work's x1, v1 with its stages:
     # (error, the work of non-conservative terms over it, force evaluations)
     A, b, c, e, e3, q = method
     rtol, atol = tolerances
     kx, kv, xs, vs, x1, v1 = work.kx, work.kv, work.xs, work.vs, work.x1, work.v1
-    n = x.shape[0]
+    xF, vF, xsF, vsF, kxF, kvF, x1F, v1F = views
+    m3 = xF.shape[0]
     s = b.shape[0]
-    # flat views of the (N, 3) arrays: the stages run over every component in
-    # loops that LLVM turns into vector instructions (stepping.rk_stage)
-    m3 = 3 * n
-    xF, vF, xsF, vsF, kxF, kvF = stage_views(x, v, xs, vs, kx, kv)
-    x1F, v1F = flat_rows(x1, v1)
     pw = stages(xF, vF, xsF, vsF, kxF, kvF, xs, vs, kv, (A, b, c), t, h, 1, s, b[0] * p0,
                 fargs)
     # the step's sums b . k, gathered in x1, v1, then the new state
@@ -258,8 +256,14 @@ def _embedded_accept(x, v, t, method, work, fargs):
     return 0
 
 
-def _embedded_first(work):
-    return work.kx[0], work.kv[0]
+def _embedded_first(x, v, work):
+    # the first stage, and flat views of the (N, 3) arrays: the stages run
+    # over every component in loops that LLVM turns into vector
+    # instructions (stepping.rk_stage)
+    kx, kv = work.kx, work.kv
+    xF, vF, xsF, vsF, kxF, kvF = stage_views(x, v, work.xs, work.vs, kx, kv)
+    x1F, v1F = flat_rows(work.x1, work.v1)
+    return kx[0], kv[0], (xF, vF, xsF, vsF, kxF, kvF, x1F, v1F)
 
 
 def embedded_loop(force, has_e3):
@@ -279,10 +283,12 @@ def embedded_loop(force, has_e3):
 def adaptive_loop(force, key, step, accept, first_stage):
     """The adaptive loop (:func:`_adaptive_loop`) compiled for a force and a
     method under ``key``, with the method's compiled kernels: ``step(x, v,
-    t, h, method, tolerances, work, fargs, p0, rows) -> (error, work, force
-    evaluations)`` tries a step, ``accept(x, v, t, method, work, fargs) ->
-    force evaluations`` makes its end the state, and ``first_stage(work) ->
-    (fx, fv)`` are the arrays of the derivative at the state.  It takes ``(x, v, t, method, tolerances,
+    t, h, method, tolerances, work, views, fargs, p0, rows) -> (error, work,
+    force evaluations)`` tries a step, ``accept(x, v, t, method, work,
+    fargs) -> force evaluations`` makes its end the state, and
+    ``first_stage(x, v, work) -> (fx, fv, views)`` gives the arrays of the
+    derivative at the state and what the step takes as ``views`` (made once
+    a call).  It takes ``(x, v, t, method, tolerances,
     work, fargs, outputs, landing, sargs, check)``: the method's record
     (with its error estimator's order ``q``), the records of :mod:`.records`
     and the stopping conditions (:func:`~.stopping.stop_record`)."""
