@@ -15,7 +15,9 @@ The rows: the integrator alone (its loop compiled), then with ``GR``
 other combinations of built-in terms, then a :class:`~orbits.forces.UserForce`
 from an importable module (its pointer compiled once), then the same again in
 a new process (loaded), then each stopping condition, collision mode,
-``encounter_log`` and a chaos monitor (MEGNO) added to the integrator alone.
+``encounter_log`` and a chaos monitor (MEGNO) added to the integrator alone;
+for ``wh``, an ensemble in batch mode of 4 systems (the batch loop
+compiled) and then of 8 (a new size: the kick written out for it alone).
 Goals (issue "Start in seconds"): a combination of built-in terms after the
 first, a user force in a new process, and each of the later rows cost <= 1 s.
 
@@ -68,6 +70,17 @@ _CHILD = textwrap.dedent("""
         "monitors megno": dict(monitors=("energy", "megno")),
     }
     options = all_options.get(combo, {})
+    if combo.startswith("batch"):
+        # an ensemble of B copies in batch mode (integrator wh): its loop,
+        # then, at a new B, the kick written out for that size
+        nb = int(combo.split()[1])
+        t0 = time.process_time()
+        ens = orbits.Ensemble(
+            lambda k: orbits.Simulation(orbits.scenes.outer_solar_system(), "wh",
+                                        dt=30 * u.day), [{"k": k} for k in range(nb)])
+        ens.run(until=300 * u.day, client="serial", progress=False, outputs=3, batch=nb)
+        print(json.dumps({"cpu": time.process_time() - t0}))
+        sys.exit(0)
     if combo.startswith("UserForce") or combo in all_options:
         import benchuser
         terms = ([F.UserForce(benchuser.drag, velocity_dependent=True)]
@@ -91,6 +104,8 @@ _CHILD = textwrap.dedent("""
 ROWS = ["none", "GR", "GRPotential + J2", "GR + migration", "UserForce",
         "UserForce (new process)", "encounter_distance", "escape_distance", "collisions merge",
         "encounter_log", "monitors megno"]
+#: the rows of wh alone: batch mode at one size of ensemble, then at another
+BATCH_ROWS = ["batch 4", "batch 8"]
 #: rows held to the goal of <= 1 s: the combinations after the first, the user force loaded
 GOAL_ROWS = {"GRPotential + J2": 1.0, "GR + migration": 1.0, "UserForce (new process)": 1.0,
              "encounter_distance": 1.0, "escape_distance": 1.0, "collisions merge": 1.0,
@@ -119,6 +134,8 @@ def main(argv=None):
             env = dict(os.environ, NUMBA_CACHE_DIR=cache,
                        PYTHONPATH=mod + os.pathsep + os.environ.get("PYTHONPATH", ""))
             rows = ROWS if not args.rows else ["none"] + args.rows.split(",")
+            if integrator == "wh" and not args.rows:
+                rows = rows + BATCH_ROWS
             for row in rows:
                 out = subprocess.run([sys.executable, "-c", _CHILD, integrator, row], env=env,
                                      capture_output=True, text=True)

@@ -90,7 +90,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._jit import KERNEL_STAMP, njit, slots, specialize
+from numba import types as nbtypes
+
+from ._jit import KERNEL_STAMP, njit, pointer, slots, specialize
 from .coordinates import interior_gm, to_jacobi
 from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
@@ -104,7 +106,7 @@ from .wh_lanes import column_start, drift_columns
 from .wisdom_holman import synchronize
 
 # the names the templates below are written against, bound by specialize
-kick, flat_kick, KICK_SYSTEMS, lane_step = slots("kick", "flat_kick", "KICK_SYSTEMS", "lane_step")
+kick, lane_step = slots("kick", "lane_step")
 
 __all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "Lanes", "Scratch", "lanes_workspace", "kepler_drift_lanes",
            "interaction_kick_lanes", "advance_lanes", "advance_loop", "unrolled_kick",
@@ -555,18 +557,18 @@ def interaction_kick_lanes(X, V, XI, ACC, GM, MU, WQ, n_active, h, LF, nb, s3, a
 
 
 def _step(X, V, GM, MU, n_active, dt, owed, LF, nb, XI, ACC, d, fl, s3, a3, t4, one_x,
-          one_v):
+          one_v, unrolled):
     # one step of K(h/2) I(h) K(h/2) with the closing half drift deferred (as
     # orbits._kernels.wisdom_holman's loop does with the table WH_DKD):
-    # returns the drift now owed.  kick: bound by specialize (_any_size_kick
-    # or an unrolled_kick)
+    # returns the drift now owed.  kick: bound by specialize (_any_size_kick,
+    # or _pointer_kick, which calls the unrolled kick it is handed)
     _drift_lanes(X, V, MU, 0.5 * dt + owed, LF, nb, d, fl, one_x, one_v)
-    kick(X, V, XI, ACC, GM, MU, n_active, 1.0 * dt, LF, nb, d, s3, a3, t4)
+    kick(X, V, XI, ACC, GM, MU, n_active, 1.0 * dt, LF, nb, d, s3, a3, t4, unrolled)
     return 0.5 * dt
 
 
 @njit(inline="always")
-def _any_size_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4):
+def _any_size_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4, unrolled):
     interaction_kick_lanes(X, V, XI, ACC, GM, MU, d[6], n_active, h, LF, nb, s3, a3, t4)
 
 
@@ -585,7 +587,7 @@ def _lane_finite(X, V, nb, b):
     return math.isfinite(s)
 
 
-def _advance_lanes(lanes, n_active, dt, nsteps, scratch):
+def _advance_lanes(lanes, n_active, dt, nsteps, scratch, unrolled=None):
     """Advance every live system ``nsteps`` steps of the Wisdom-Holman map.
 
     Parameters
@@ -605,6 +607,10 @@ def _advance_lanes(lanes, n_active, dt, nsteps, scratch):
         :func:`lanes_workspace`'s arrays.  The loop works on the state laid
         out as :func:`kepler_drift_lanes` says, copied in at the start of
         the call and out at its end.
+    unrolled : Pointer, optional
+        The kick written out for these systems' size (:func:`advance_loop`),
+        for the loop compiled to call it; the loop of systems of any size
+        (:data:`advance_lanes`) takes none.
 
     Returns
     -------
@@ -670,7 +676,7 @@ def _advance_lanes(lanes, n_active, dt, nsteps, scratch):
         ow0 = ow
         for _ in range(blk):
             ow = lane_step(X, V, GM, MU, n_active, dt, ow, LF, nb, XI, ACC, d, fl, s3, a3,
-                           t4, one_x, one_v)
+                           t4, one_x, one_v, unrolled)
         for b in range(nb):
             if live[b] == 0.0 or _lane_finite(X, V, nb, b):
                 continue
@@ -693,7 +699,7 @@ def _advance_lanes(lanes, n_active, dt, nsteps, scratch):
                         px[i, c] = X[c, k]
                         pv[i, c] = V[c, k]
                 nxt = lane_step(X, V, GM, MU, n_active, dt, owr, lf1, nb, XI, ACC, d, fl, s3,
-                                a3, t4, one_x, one_v)
+                                a3, t4, one_x, one_v, unrolled)
                 if not _lane_finite(X, V, nb, b):
                     for i in range(n):
                         k = i * nb + b
@@ -745,7 +751,10 @@ advance_lanes = specialize(_advance_lanes, "any_size", lane_step=_any_size_step)
 # bit the loops' kick, and a fraction of its time (benchmarks/RESULTS.md).
 # numba does not unroll loops of a size known only when a function is
 # specialised, so the source is generated (unrolled_kick) and compiled from a
-# file, so that numba caches it on disk like the package's own kernels.
+# file, so that numba caches it on disk like the package's own kernels.  It is
+# compiled as a C callable of one signature, which one compiled batch loop
+# calls through its pointer: a new size of system compiles its kick alone
+# (a second or two), not a loop of its own.
 
 #: the most bodies for which advance_loop unrolls the kick (the straight-line
 #: code grows as N^2, and its compilation faster still: benchmarks/RESULTS.md)
@@ -836,7 +845,8 @@ def _kernel_dir():
 
 
 def unrolled_kick(n, n_active, nb):
-    """The compiled ``kick(K, OUT, h, nb)`` of :func:`_kick_source`, made once
+    """The ``kick(K, OUT, h, nb)`` of :func:`_kick_source` compiled as a C
+    callable of :data:`KICK_SIGNATURE` (a :class:`~._jit.Pointer`), made once
     a process (and cached on disk by numba)."""
     key = (n, n_active, nb)
     if key not in _UNROLLED:
@@ -864,11 +874,18 @@ def unrolled_kick(n, n_active, nb):
             module = importlib.util.module_from_spec(spec)
             sys.modules[modname] = module
             spec.loader.exec_module(module)
-        _UNROLLED[key] = module.kick
+        _UNROLLED[key] = pointer(module.kick, KICK_SIGNATURE)
     return _UNROLLED[key]
 
 
-def _unrolled_step_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4):
+#: the unrolled kick's signature, ``kick(K, OUT, h, nb)``: one loop
+#: (:data:`_unrolled_lanes`) calls the kick of every size through it
+KICK_SIGNATURE = nbtypes.void(nbtypes.float64[::1], nbtypes.float64[::1], nbtypes.float64,
+                              nbtypes.int64)
+
+
+@njit(inline="always")
+def _pointer_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4, unrolled):
     # the rows the unrolled kick reads that change from step to step (the
     # positions; the live flags, which are lf1 when a lane is replayed) into
     # rows of d that are the drift's scratch, free until the next drift
@@ -881,32 +898,49 @@ def _unrolled_step_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t
     F = d[_KLF]
     for k in range(np.uint64(m)):
         F[k] = LF[k]
-    if nb != KICK_SYSTEMS:
-        raise ValueError("wh_batch: a loop of advance_loop takes the number of systems "
-                         "it was made for")
     # the number of systems as a value known only when the kick runs: a loop
     # of a trip count below 16 known when it compiles is never vectorised
     # (at 4 and 8 systems the kick would stay scalar)
-    flat_kick(d.ravel(), V.ravel(), h, nb)
+    unrolled(d.ravel(), V.ravel(), h, nb)
+
+
+#: the batch loop that calls an unrolled kick through its pointer, for
+#: systems of every size (see :func:`advance_loop`)
+_unrolled_lanes = specialize(
+    _advance_lanes, "unrolled",
+    lane_step=specialize(_step, "unrolled", inline=True, kick=_pointer_kick))
+
+
+class _UnrolledLoop:
+    # advance_lanes's call for nb systems of one size, with their unrolled kick
+    __slots__ = ("nb", "kick")
+
+    def __init__(self, nb, kick):
+        self.nb = nb
+        self.kick = kick
+
+    def __call__(self, lanes, n_active, dt, nsteps, scratch):
+        if lanes.owed.shape[0] != self.nb:
+            raise ValueError("wh_batch: a loop of advance_loop takes the number of systems "
+                             "it was made for")
+        return _unrolled_lanes(lanes, n_active, dt, nsteps, scratch, self.kick)
 
 
 def advance_loop(n, n_active, nb):
     """:func:`advance_lanes` for ``nb`` systems of ``n`` bodies (``n_active``
     massive), with the kick unrolled for that size (bit for bit the same
     steps) where ``3 <= n <= UNROLLED_KICK_BODIES``; else (or where the
-    generated kernel's file cannot be written) advance_lanes itself."""
+    generated kernel's file cannot be written) advance_lanes itself.  One
+    compiled loop serves every size: it calls the size's kick through its
+    pointer, so a new size compiles only its kick."""
     if not 3 <= n <= UNROLLED_KICK_BODIES:
         return advance_lanes
     try:
-        flat = unrolled_kick(n, n_active, nb)
+        kick_ = unrolled_kick(n, n_active, nb)
     except OSError:
         # no folder to write the generated kernel to: the loops' kick
         return advance_lanes
-    key = f"{n}_{n_active}_{nb}"
-    kick_ = specialize(_unrolled_step_kick, key, inline=True, flat_kick=flat,
-                       KICK_SYSTEMS=nb)
-    step_ = specialize(_step, f"unrolled_{key}", inline=True, kick=kick_)
-    return specialize(_advance_lanes, f"unrolled_{key}", lane_step=step_)
+    return _UnrolledLoop(nb, kick_)
 
 
 def to_lanes(x, v, gm):
