@@ -42,7 +42,7 @@ from numba.extending import intrinsic
 from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
-           "cfunc", "pointer", "Pointer", "fma", "KERNEL_STAMP", "NUMBA_OPTIONS"]
+           "cfunc", "pointer", "Pointer", "fma", "data_pointer", "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -149,6 +149,19 @@ def fma(typingctx, a, b, c):
 
     def codegen(context, builder, signature, args):
         return builder.fma(*args)
+
+    return sig, codegen
+
+
+@intrinsic
+def data_pointer(typingctx, address):
+    """The address of a float64 array's data (``a.ctypes.data``) as a
+    pointer to float64, to hand a C callable (:class:`Pointer`) that takes
+    one; in compiled code only, while the array lives."""
+    sig = nbtypes.CPointer(nbtypes.float64)(address)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(signature.return_type))
 
     return sig, codegen
 

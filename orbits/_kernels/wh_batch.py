@@ -92,7 +92,7 @@ import numpy as np
 
 from numba import types as nbtypes
 
-from ._jit import KERNEL_STAMP, njit, pointer, slots, specialize
+from ._jit import KERNEL_STAMP, data_pointer, njit, pointer, slots, specialize
 from .coordinates import interior_gm, to_jacobi
 from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
@@ -878,10 +878,12 @@ def unrolled_kick(n, n_active, nb):
     return _UNROLLED[key]
 
 
-#: the unrolled kick's signature, ``kick(K, OUT, h, nb)``: one loop
-#: (:data:`_unrolled_lanes`) calls the kick of every size through it
-KICK_SIGNATURE = nbtypes.void(nbtypes.float64[::1], nbtypes.float64[::1], nbtypes.float64,
-                              nbtypes.int64)
+#: the unrolled kick's signature, ``kick(K, OUT, h, nb)`` with ``K`` and
+#: ``OUT`` the data of the flat arrays (contiguous rows of d and of the
+#: velocities): one loop (:data:`_unrolled_lanes`) calls the kick of every
+#: size through it
+KICK_SIGNATURE = nbtypes.void(nbtypes.CPointer(nbtypes.float64),
+                              nbtypes.CPointer(nbtypes.float64), nbtypes.float64, nbtypes.int64)
 
 
 @njit(inline="always")
@@ -901,7 +903,7 @@ def _pointer_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4, unr
     # the number of systems as a value known only when the kick runs: a loop
     # of a trip count below 16 known when it compiles is never vectorised
     # (at 4 and 8 systems the kick would stay scalar)
-    unrolled(d.ravel(), V.ravel(), h, nb)
+    unrolled(data_pointer(d.ctypes.data), data_pointer(V.ctypes.data), h, nb)
 
 
 #: the batch loop that calls an unrolled kick through its pointer, for
