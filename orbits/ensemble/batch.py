@@ -137,7 +137,7 @@ def run_batched(build, params, indices, spec, paths, batch):
 
 def lane_width(runs, batch):
     """The lanes a batch of ``runs`` runs in: the smallest power of two that
-    holds them, or ``batch`` where that is smaller.  The batch loop is
+    holds them, or ``batch`` where that is smaller.  The batch loop's kick is
     compiled for its number of lanes, so a sweep's last, partial batch (and a
     group of few runs) takes one of a few widths instead of a width of its
     own; the lanes beyond the runs stay idle.
