@@ -737,7 +737,7 @@ def tangent_synchronizer(coordinates, terms, force):
     return _kernels(coordinates, terms, _key(coordinates, force), force.cache)[3]
 
 
-def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
+def wh_tangent_loop(coordinates, terms, force):
     """The Wisdom-Holman loop of :func:`orbits._kernels.wisdom_holman.wh_loop`
     compiled with the tangent of every operator, for a force with variations
     ``force`` (its ``inner`` the gravity, with ``terms``); with the chaos
@@ -762,9 +762,8 @@ def wh_tangent_loop(name, kinds, coefs, coordinates, terms, force):
     bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,
                         synchronize=sync)
     stop_args, stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
-    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
-                      KINDS=tuple(int(k) for k in kinds),
-                      COEFS=tuple(float(c) for c in coefs), to_internal=called(to_internal, nrt),
+    return specialize(_wh_loop, f"wh_{key}", nrt=nrt, cache=cache,
+                      to_internal=called(to_internal, nrt),
                       drift=_drift, owed_drift=called(_drift, nrt), perturbation=perturbation,
                       corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache,

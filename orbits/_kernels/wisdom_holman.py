@@ -50,8 +50,9 @@ treated alike whatever its order, but a lone massive companion is no
 longer integrated exactly (its jump is part of the perturbation), and on
 the outer solar system the position errors are a few times larger.
 
-A step is a table of Kepler drifts and interaction kicks, bound as constant
-tuples (``KINDS``, ``COEFS``) by :func:`orbits._kernels._jit.specialize`.  A
+A step is a table of Kepler drifts and interaction kicks, data of the
+loop's :class:`System` record (``kinds``, ``coefs``), so that one compiled
+loop serves every table (wh, the SABA family) in a coordinate system.  A
 table that ends with a drift defers it: the next step's first drift absorbs
 it (the leapfrog's two half drifts become one), and :func:`synchronize` applies
 it to a copy when the inertial state is wanted.  The internal state and the
@@ -117,10 +118,10 @@ from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, resident_drift_
 from .wh_lanes import resident_drift as resident_drift_rows
 
 # the names the templates below are written against, bound by specialize
-(COEFS, HELIOCENTRIC, KINDS, convert, drift, escape_check, extra, from_internal, owed_drift,
+(HELIOCENTRIC, convert, drift, escape_check, extra, from_internal, owed_drift,
  perturbation, step, step_end, synchronize_bodies, term_kick, to_internal, sync_kernel,
  corrector_kernel, record) = slots(
-    "COEFS", "HELIOCENTRIC", "KINDS", "convert", "drift", "escape_check", "extra",
+    "HELIOCENTRIC", "convert", "drift", "escape_check", "extra",
     "from_internal", "owed_drift", "perturbation", "step", "step_end", "synchronize_bodies",
     "term_kick", "to_internal", "sync_kernel", "corrector_kernel", "record")
 
@@ -472,13 +473,17 @@ def _lanes_note(xj, vj, t, mon, n_mon, mon_t, mon_out):
 
 
 class System(NamedTuple):
-    """What the map needs of the bodies: ``G`` times each mass, ``eta`` (``G``
-    times the mass each row's Kepler drift orbits), the number of massive
-    bodies, and the corrector's coefficients (no rows without corrector)."""
+    """What the map needs of the bodies and of the method: ``G`` times each
+    mass, ``eta`` (``G`` times the mass each row's Kepler drift orbits), the
+    number of massive bodies, the corrector's coefficients (no rows without
+    corrector), and the step's table: each operator's kind (:data:`DRIFT` or
+    :data:`KICK`) and its fraction of the step."""
     gm: np.ndarray
     eta: np.ndarray
     n_active: int
     corrector: np.ndarray
+    kinds: np.ndarray
+    coefs: np.ndarray
 
 
 class Work(NamedTuple):
@@ -528,7 +533,7 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, targs):
     # record (orbits._kernels.records) and the stopping conditions' pointer,
     # whose escape conditions the loops without lanes check (see
     # escape_kernels)
-    gm, eta, n_active, corr = system
+    gm, eta, n_active, corr, kinds, coefs = system
     xj, vj, acc, xs, vs, state, owed_box, cdt = work
     mon, step0, mon_t, mon_out = outputs
     check_every, sargs = checks
@@ -554,14 +559,14 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, targs):
         cdt[0] = abs(dt)
     owed = owed_box[0]
     lanes_in(xj, vj, gm, eta, targs)
-    n_ops = len(KINDS)
-    defer = KINDS[n_ops - 1] == DRIFT
+    n_ops = kinds.shape[0]
+    defer = kinds[n_ops - 1] == DRIFT
     until_check = check_every
     until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         for op in range(n_ops):
-            h = COEFS[op] * dt
-            if KINDS[op] == DRIFT:
+            h = coefs[op] * dt
+            if kinds[op] == DRIFT:
                 if op == 0:
                     if output_pending(targs):
                         # the output noted at the end of the last step
@@ -902,11 +907,10 @@ def synchronizer(coordinates, terms=None, lanes=False):
     return _kernels(coordinates, terms, lanes)[3]
 
 
-def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record,
-            lanes=False):
-    """The Wisdom-Holman loop compiled for one table of Kepler drifts (DRIFT) and
-    perturbation steps (KICK) in ``coordinates`` (a key of
-    :data:`COORDINATE_SYSTEMS`); ``name`` names the table.  ``terms`` (a
+def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
+    """The Wisdom-Holman loop compiled for ``coordinates`` (a key of
+    :data:`COORDINATE_SYSTEMS`), for every table of Kepler drifts (DRIFT) and
+    perturbation steps (KICK), which the :class:`System` record carries.  ``terms`` (a
     :class:`~orbits._kernels.terms.TermKernel` of position-only terms) join
     the perturbation step, and ``record`` records the monitors.  ``lanes``
     (without terms only): the steps' operators with the planets in vector
@@ -958,9 +962,8 @@ def wh_loop(name, kinds, coefs, coordinates="jacobi", terms=None, record=_record
         bodies = specialize(_synchronize_bodies, key, cache=cache, inline=True, nrt=nrt,
                             sync_kernel=sync)
         outputs["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
-    return specialize(_wh_loop, f"wh_{name}_{key}", nrt=nrt, cache=cache,
-                      KINDS=tuple(int(k) for k in kinds),
-                      COEFS=tuple(float(c) for c in coefs), to_internal=called(to_internal, nrt),
+    return specialize(_wh_loop, f"wh_{key}", nrt=nrt, cache=cache,
+                      to_internal=called(to_internal, nrt),
                       drift=drift, owed_drift=called(drift, nrt), perturbation=perturbation,
                       corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),

@@ -316,8 +316,8 @@ class WisdomHolman(Integrator):
             raise TypeError(f"{cls.__name__}: a Kepler-split table must be a palindrome "
                             "that starts and ends with a drift")
         codes = {"drift": DRIFT, "kick": KICK}
-        cls._kinds = tuple(codes[k] for k, _ in ops)
-        cls._coefs = tuple(float(c) for _, c in ops)
+        cls._kinds = np.array([codes[k] for k, _ in ops], dtype=np.int64)
+        cls._coefs = np.array([float(c) for _, c in ops])
         cls.forces_per_step = sum(1 for k, _ in ops if k == "kick")
 
     def _check_options(self):
@@ -413,10 +413,9 @@ class WisdomHolman(Integrator):
             targs, lanes = (), False
         gravity = fargs if terms is None else fargs[0]
         gm, n_active = gravity[0], gravity[1]
-        loop = _wh.wh_loop(self.name, self._kinds, self._coefs, self.config["coordinates"],
-                           terms, force.recorder, lanes)
+        loop = _wh.wh_loop(self.config["coordinates"], terms, force.recorder, lanes)
         sargs, check = stop_record(stop)
-        system = _wh.System(gm, ws["eta"], int(n_active), self._corr)
+        system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
         return with_status(*loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
                                  records.outputs(mon, step0, mon_t, mon_out),
                                  records.checks(check_every, sargs), check, targs))
@@ -458,10 +457,10 @@ class WisdomHolman(Integrator):
         terms, targs = ws.get("terms", (None, ()))
         gravity = fargs[0] if terms is None else fargs[0][0]
         gm, n_active = gravity[0], gravity[1]
-        loop = _wht.wh_tangent_loop(self.name, self._kinds, self._coefs,
-                                    self.config["coordinates"], terms, force)
+        loop = _wht.wh_tangent_loop(self.config["coordinates"], terms, force)
         sargs, check = stop_record(stop)
-        system = _wh.System(gm, ws["eta"][:n], int(n_active), self._corr)
+        system = _wh.System(gm, ws["eta"][:n], int(n_active), self._corr, self._kinds,
+                            self._coefs)
         return with_status(*loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
                                  records.outputs(mon, step0, mon_t, mon_out),
                                  records.checks(check_every, sargs), check, (targs, tp)))
