@@ -71,14 +71,13 @@ from .variational import tangent_kernels, variational_work_kernels
 #: the work of non-conservative terms declares (:func:`~._jit.slots`)
 WORK_SLOTS = ("HAS_WORK", "work_rate", "work_add", "work_note")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
-(force, step_end, implicit_kick, KINDS, COEFS, pair_kernel, base, extra, extra_energy,
- nc_accel, user_accel, stop_check, tangent_step, record, record_mark) = slots(
-    "force", "step_end", "implicit_kick", "KINDS", "COEFS", "pair_kernel", "base", "extra",
-    "extra_energy", "nc_accel", "user_accel", "stop_check", "tangent_step", "record",
-    "record_mark")
+(force, step_end, implicit_kick, pair_kernel, base, extra, extra_energy, nc_accel,
+ user_accel, stop_check, tangent_step, record, record_mark) = slots(
+    "force", "step_end", "implicit_kick", "pair_kernel", "base", "extra", "extra_energy",
+    "nc_accel", "user_accel", "stop_check", "tangent_step", "record", "record_mark")
 stages, = slots("stages")
 
-__all__ = ["DRIFT", "KICK", "splitting_loop", "runge_kutta_loop", "gravity_force",
+__all__ = ["DRIFT", "KICK", "Splitting", "splitting_loop", "runge_kutta_loop", "gravity_force",
            "user_force", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
@@ -694,11 +693,18 @@ class SplittingWork(NamedTuple):
     cache: np.ndarray
 
 
-def _splitting_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, outputs, checks,
-                    check):
+class Splitting(NamedTuple):
+    """A splitting method's table: each operator's kind (:data:`DRIFT` or
+    :data:`KICK`) and its fraction of the step."""
+    kinds: np.ndarray
+    coefs: np.ndarray
+
+
+def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent, outputs,
+                    checks, check):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
-    # (v += c dt a(x)), the table KINDS/COEFS bound by specialize as constant
-    # tuples, so that the compiler unrolls it.  The acceleration depends only
+    # (v += c dt a(x)), the method's table (a Splitting record), data of the
+    # one loop every method shares.  The acceleration depends only
     # on positions (unless velocity_dependent), so it is recomputed only after
     # a drift: velocity Verlet's closing kick and the next step's opening kick
     # share one force evaluation.  `fresh` (kept in cache[0] between calls)
@@ -707,6 +713,7 @@ def _splitting_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, output
     # the kick stays symmetric; vm is its scratch.  A kick v' = v + h a changes
     # the kinetic energy by exactly h sum m a . (v + v') / 2: the
     # non-conservative terms' part of it is their work (HAS_WORK).
+    kinds, coefs = table
     acc, vm, cache = work
     mon, step0, mon_t, mon_out = outputs
     check_every, sargs = checks
@@ -728,9 +735,9 @@ def _splitting_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, output
     until_record = first_record(every, step0, mon_t)
     for k in range(nsteps):
         tx = t + k * dt
-        for op in range(len(KINDS)):
-            h = COEFS[op] * dt
-            if KINDS[op] == DRIFT:
+        for op in range(kinds.shape[0]):
+            h = coefs[op] * dt
+            if kinds[op] == DRIFT:
                 add_scaled(x, xF, h, v, vF, flat)
                 tx += h
                 fresh = False
@@ -812,21 +819,20 @@ def _implicit_kick_for(force):
     return called(kick, nrt=force.runtime) if force.jit else kick
 
 
-def splitting_loop(force, name, kinds, coefs):
-    """The splitting loop compiled for a :class:`ForceKernel` and one method's table.
+def splitting_loop(force):
+    """The splitting loop compiled for a :class:`ForceKernel`, for every
+    splitting method.
 
-    ``kinds`` (DRIFT or KICK) and ``coefs`` are tuples; ``name`` names the method.
-    The loop takes ``(x, v, t, dt, nsteps, work, fargs, velocity_dependent,
-    outputs, checks, check)``: a :class:`SplittingWork`, the records of
+    The loop takes ``(x, v, t, dt, nsteps, table, work, fargs,
+    velocity_dependent, outputs, checks, check)``: the method's
+    :class:`Splitting` table, a :class:`SplittingWork`, the records of
     :mod:`.records` and the stopping conditions' pointer
     (:func:`~.stopping.stop_record`).
     """
-    return specialize(_splitting_loop, f"{name}_{force.key}",
+    return specialize(_splitting_loop, f"splitting_{force.key}",
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
                       step_end=step_epilogue(force),
-                      implicit_kick=_implicit_kick_for(force),
-                      KINDS=tuple(int(k) for k in kinds),
-                      COEFS=tuple(float(c) for c in coefs), **work_kernels(force))
+                      implicit_kick=_implicit_kick_for(force), **work_kernels(force))
 
 
 # -- explicit Runge-Kutta ---------------------------------------------------------------

@@ -391,8 +391,8 @@ class SplittingMethod(Integrator):
         super().__init_subclass__(**kwargs)
         if cls.operators:
             codes = {"drift": stepping.DRIFT, "kick": stepping.KICK}
-            cls._kinds = tuple(codes[k] for k, _ in cls.operators)
-            cls._coefs = tuple(float(c) for _, c in cls.operators)
+            cls._kinds = np.array([codes[k] for k, _ in cls.operators], dtype=np.int64)
+            cls._coefs = np.array([float(c) for _, c in cls.operators])
             kinds = [k for k, _ in cls.operators]
             cls.time_symmetric = tuple(cls.operators) == tuple(cls.operators)[::-1]
             # a closing kick shares its force with the next step's opening kick
@@ -415,11 +415,12 @@ class SplittingMethod(Integrator):
                 velocity_dependent=False, check_every=1, stop=None):
         """Apply the operator table ``nsteps`` times in the compiled loop (see
         :meth:`Integrator.advance`)."""
-        loop = stepping.splitting_loop(force, self.name, self._kinds, self._coefs)
+        loop = stepping.splitting_loop(force)
         fargs = stepping.work_bound(force, fargs, ws)
         sargs, check = stop_record(stop)
         work = stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"])
-        return with_status(*loop(x, v, t, dt, nsteps, work, fargs,
+        return with_status(*loop(x, v, t, dt, nsteps,
+                                 stepping.Splitting(self._kinds, self._coefs), work, fargs,
                                  velocity_dependent or force.velocity_dependent,
                                  outputs(mon, step0, mon_t, mon_out),
                                  checks(check_every, sargs), check))
