@@ -393,6 +393,7 @@ class SplittingMethod(Integrator):
             codes = {"drift": stepping.DRIFT, "kick": stepping.KICK}
             cls._kinds = np.array([codes[k] for k, _ in cls.operators], dtype=np.int64)
             cls._coefs = np.array([float(c) for _, c in cls.operators])
+            cls._table = stepping.Splitting(cls._kinds, cls._coefs)
             kinds = [k for k, _ in cls.operators]
             cls.time_symmetric = tuple(cls.operators) == tuple(cls.operators)[::-1]
             # a closing kick shares its force with the next step's opening kick
@@ -415,15 +416,12 @@ class SplittingMethod(Integrator):
                 velocity_dependent=False, check_every=1, stop=None):
         """Apply the operator table ``nsteps`` times in the compiled loop (see
         :meth:`Integrator.advance`)."""
-        loop = stepping.splitting_loop(force)
-        fargs = stepping.work_bound(force, fargs, ws)
         sargs, check = stop_record(stop)
-        work = stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"])
-        return with_status(*loop(x, v, t, dt, nsteps,
-                                 stepping.Splitting(self._kinds, self._coefs), work, fargs,
-                                 velocity_dependent or force.velocity_dependent,
-                                 outputs(mon, step0, mon_t, mon_out),
-                                 checks(check_every, sargs), check))
+        return with_status(*stepping.splitting_loop(force)(
+            x, v, t, dt, nsteps, self._table,
+            stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"]),
+            stepping.work_bound(force, fargs, ws), velocity_dependent or force.velocity_dependent,
+            outputs(mon, step0, mon_t, mon_out), checks(check_every, sargs), check))
 
     def invalidate(self, ws):
         """Drop the cached force: the next kick evaluates it again.
