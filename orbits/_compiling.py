@@ -30,18 +30,19 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "lo
 
 #: Seconds a loop's first compile takes on an empty cache: the compiling
 #: inside the first ``Simulation.run`` of the outer solar system, on the
-#: reference machine (2-core AMD EPYC, AVX2, a busy host, where the same
+#: reference machine (2-core AMD EPYC, Zen 4 with AVX-512, a busy host, where the same
 #: figure scatters by up to a factor of two from run to run; measured with
 #: ``benchmarks/bench_first_compile.py``, which prints this table anew, and
 #: recorded in benchmarks/RESULTS.md).  Keyed by :func:`loop_label`; only the
-#: notice's estimate reads it.
+#: notice's estimate reads it.  The methods of a family share their loop
+#: (the SABA methods wh's), so a family's first method compiles it.
 FIRST_COMPILE_SECONDS = {
     "euler": 4.0, "symplectic-euler": 5.0, "verlet": 4.0, "leapfrog": 2.0,
     "rk2": 3.0, "rk4": 4.0, "yoshida4": 4.0, "yoshida6": 4.0, "yoshida8": 4.0,
     "wh": 31.0, "wh democratic-heliocentric": 31.0,
-    "saba2": 35.0, "saba2 democratic-heliocentric": 40.0,
-    "saba3": 45.0, "saba3 democratic-heliocentric": 35.0,
-    "saba4": 35.0, "saba4 democratic-heliocentric": 45.0,
+    "saba2": 31.0, "saba2 democratic-heliocentric": 31.0,
+    "saba3": 31.0, "saba3 democratic-heliocentric": 31.0,
+    "saba4": 31.0, "saba4 democratic-heliocentric": 31.0,
     "dopri5": 5.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 9.0, "taylor": 6.0,
     "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 28.0,
 }
