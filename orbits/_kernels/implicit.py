@@ -61,7 +61,7 @@ from .status import Status
 from .stepping import GO, WORK_SLOTS, first_record, state_is_finite, step_epilogue, work_kernels
 
 # the names the templates below are written against, bound by specialize
-THETA, force, jacobian, step_end = slots("THETA", "force", "jacobian", "step_end")
+force, jacobian, step_end = slots("force", "jacobian", "step_end")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["implicit_loop", "lu_factor", "lu_solve", "NEWTON_MAX_ITER", "NEWTON_ULPS",
@@ -162,9 +162,9 @@ class Work(NamedTuple):
     newton_iterations: np.ndarray
 
 
-def _implicit_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, outputs, checks,
-                   check):
-    # theta bound by specialize: 1.0 implicit Euler, 0.5 implicit midpoint;
+def _implicit_loop(x, v, t, dt, nsteps, theta, work, fargs, velocity_dependent, outputs,
+                   checks, check):
+    # theta: 1.0 implicit Euler, 0.5 implicit midpoint (one loop for both);
     # work: a Work record
     w, dw, xs, vs, acc, cache, jx, jv, lu, piv, newton = work
     mon, step0, mon_t, mon_out = outputs
@@ -172,7 +172,7 @@ def _implicit_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, outputs
     stopping = (sargs, check)
     n = x.shape[0]
     m = 3 * n
-    th = THETA
+    th = theta
     cx = th * th * dt * dt
     cv = th * dt
     dwf = dw.reshape(m)
@@ -258,19 +258,20 @@ def _implicit_loop(x, v, t, dt, nsteps, work, fargs, velocity_dependent, outputs
     return Status.OK, nsteps, n_mon
 
 
-def implicit_loop(force, name, theta, velocity_dependent):
-    """The Newton loop of a one-leg theta-method compiled for a :class:`~.stepping.ForceKernel`.
+def implicit_loop(force, velocity_dependent):
+    """The Newton loop of the one-leg theta-methods compiled for a
+    :class:`~.stepping.ForceKernel`, for every theta.
 
-    ``theta`` is 1.0 (implicit Euler) or 0.5 (implicit midpoint); ``name``
-    names the method; the Jacobian is :func:`~.jacobians.jacobian_for`'s.  The
-    loop takes ``(x, v, t, dt, nsteps, work, fargs, velocity_dependent,
-    outputs, checks, check)``: a :class:`Work`, the records of :mod:`.records`
-    and the stopping conditions' pointer (:func:`~.stopping.stop_record`).
+    The Jacobian is :func:`~.jacobians.jacobian_for`'s.  The loop takes
+    ``(x, v, t, dt, nsteps, theta, work, fargs, velocity_dependent, outputs,
+    checks, check)``: theta 1.0 (implicit Euler) or 0.5 (implicit midpoint),
+    a :class:`Work`, the records of :mod:`.records` and the stopping
+    conditions' pointer (:func:`~.stopping.stop_record`).
     """
     jac, jkey = jacobian_for(force, velocity_dependent)
     if jkey == "fd" and velocity_dependent:
         jkey = "fd_v"
-    return specialize(_implicit_loop, f"{name}_{force.key}_{jkey}",
+    return specialize(_implicit_loop, f"theta_{force.key}_{jkey}",
                       jit=force.jit, cache=force.cache and not jkey.startswith("own"),
                       force=force.kernel, jacobian=jac, step_end=step_epilogue(force),
-                      THETA=float(theta), **work_kernels(force))
+                      **work_kernels(force))

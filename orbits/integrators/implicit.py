@@ -54,10 +54,11 @@ class ImplicitOneLeg(Integrator):
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         velocity_dependent = bool(velocity_dependent or force.velocity_dependent)
-        loop = implicit.implicit_loop(force, self.name, self.theta, velocity_dependent)
+        loop = implicit.implicit_loop(force, velocity_dependent)
         fargs = stepping.work_bound(force, fargs, ws)
         sargs, check = stop_record(stop)
-        status, done, n_mon = loop(x, v, t, dt, nsteps, records.work(implicit.Work, ws), fargs,
+        status, done, n_mon = loop(x, v, t, dt, nsteps, float(self.theta),
+                                   records.work(implicit.Work, ws), fargs,
                                    bool(velocity_dependent),
                                    records.outputs(mon, step0, mon_t, mon_out),
                                    records.checks(check_every, sargs), check)
