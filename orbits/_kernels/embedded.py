@@ -36,8 +36,8 @@ from .stepping import (GO, WORK_SLOTS, accept_fsal, dop853_error, first_record, 
 from .variational import measured_rows
 
 # the names the templates below are written against, bound by specialize
-force, has_e3, land, rows, attempt, accept, first_stage, stages = slots(
-    "force", "has_e3", "land", "rows", "attempt", "accept", "first_stage", "stages")
+force, land, rows, attempt, accept, first_stage, stages = slots(
+    "force", "land", "rows", "attempt", "accept", "first_stage", "stages")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 
 __all__ = ["embedded_loop", "adaptive_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
@@ -116,13 +116,15 @@ def trial_step(t, h_prop, target, direction):
 class Method(NamedTuple):
     """An embedded pair: its Butcher tableau ``A``, ``b``, ``c``, the
     weights' difference ``e`` of the error estimate (and ``e3``, a second
-    estimate's, or zeros) and the estimator's order ``q``."""
+    estimate's, or zeros), the estimator's order ``q``, and whether the
+    error combines the two estimates as DOP853's does (``has_e3``)."""
     A: np.ndarray
     b: np.ndarray
     c: np.ndarray
     e: np.ndarray
     e3: np.ndarray
     q: float
+    has_e3: bool
 
 
 class Work(NamedTuple):
@@ -219,7 +221,7 @@ def _adaptive_loop(x, v, t, method, tolerances, work, fargs, outputs, landing, s
 def _embedded_step(x, v, t, h, method, tolerances, work, views, fargs, p0, ne):
     # one step of the pair from (x, v) into work's x1, v1 with its stages:
     # (error, the work of non-conservative terms over it, force evaluations)
-    A, b, c, e, e3, q = method
+    A, b, c, e, e3, q, has_e3 = method
     rtol, atol = tolerances
     kx, kv, xs, vs, x1, v1 = work.kx, work.kv, work.xs, work.vs, work.x1, work.v1
     xF, vF, xsF, vsF, kxF, kvF, x1F, v1F = views
@@ -234,20 +236,32 @@ def _embedded_step(x, v, t, h, method, tolerances, work, views, fargs, p0, ne):
         v1F[k] = vF[k] + h * v1F[k]
         kxF[s, k] = v1F[k]
     force(x1, v1, t + h, fargs, kv[s])
+    # the error's sums written for each estimator (a constant of each call),
+    # so that a pair without the second estimate computes none of it
+    if has_e3:
+        err5, err3 = _scaled_errors(x, v, x1, v1, kx, kv, e, e3, s + 1, ne, rtol, atol, True)
+        err = dop853_error(err5, err3, abs(h), 6 * ne)
+    else:
+        err5, _ = _scaled_errors(x, v, x1, v1, kx, kv, e, e3, s + 1, ne, rtol, atol, False)
+        err = abs(h) * math.sqrt(err5 / (6 * ne))
+    return err, h * pw, s
+
+
+@njit(inline="always")
+def _scaled_errors(x, v, x1, v1, kx, kv, e, e3, count, ne, rtol, atol, both):
+    # the sums of squares of the error estimates (e's, and e3's if both)
+    # scaled by atol + rtol max(|y0|, |y1|), over the rows below ne
     err5 = 0.0
     err3 = 0.0
     for i in range(ne):
         for d in range(3):
-            ex, ev, fx, fv = stage_errors(kx, kv, e, e3, s + 1, i, d)
+            ex, ev, fx, fv = stage_errors(kx, kv, e, e3, count, i, d)
             sx = atol + rtol * max(abs(x[i, d]), abs(x1[i, d]))
             sv = atol + rtol * max(abs(v[i, d]), abs(v1[i, d]))
             err5 += (ex / sx) ** 2 + (ev / sv) ** 2
-            err3 += (fx / sx) ** 2 + (fv / sv) ** 2
-    if has_e3:
-        err = dop853_error(err5, err3, abs(h), 6 * ne)
-    else:
-        err = abs(h) * math.sqrt(err5 / (6 * ne))
-    return err, h * pw, s
+            if both:
+                err3 += (fx / sx) ** 2 + (fv / sv) ** 2
+    return err5, err3
 
 
 def _embedded_accept(x, v, t, method, work, fargs):
@@ -266,16 +280,16 @@ def _embedded_first(x, v, work):
     return kx[0], kv[0], (xF, vF, xsF, vsF, kxF, kvF, x1F, v1F)
 
 
-def embedded_loop(force, has_e3):
-    """The adaptive embedded Runge-Kutta loop compiled for a force and an
-    estimator: it takes ``(x, v, t, method, tolerances, work, fargs, outputs,
+def embedded_loop(force):
+    """The adaptive embedded Runge-Kutta loop compiled for a force, for every
+    pair: it takes ``(x, v, t, method, tolerances, work, fargs, outputs,
     landing, sargs, check)``, a :class:`Method`, a :class:`Work`, the records
     of :mod:`.records` and the stopping conditions
     (:func:`~.stopping.stop_record`)."""
-    key = f"embedded_{force.key}{'_e3' if has_e3 else ''}"
+    key = f"embedded_{force.key}"
     options = dict(jit=force.jit, cache=force.cache, inline=True, nrt=force.runtime)
-    step = specialize(_embedded_step, key, force=force.kernel, has_e3=bool(has_e3),
-                      stages=rk_stages(force), **options)
+    step = specialize(_embedded_step, key, force=force.kernel, stages=rk_stages(force),
+                      **options)
     return adaptive_loop(force, key, step, specialize(_embedded_accept, key, **options),
                          specialize(_embedded_first, key, **options))
 

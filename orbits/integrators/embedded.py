@@ -37,9 +37,9 @@ class EmbeddedRungeKutta(CompiledToleranceControlled):
 
     def _loop_call(self, ws, force):
         e3 = self.E3 if self.E3 is not None else np.zeros_like(self.E)
-        loop = loop_for(_embedded.embedded_loop, force, self.E3 is not None)
+        loop = loop_for(_embedded.embedded_loop, force)
         method = _embedded.Method(self.A, self.B, self.C, self.E, e3,
-                                  float(self.error_estimator_order))
+                                  float(self.error_estimator_order), self.E3 is not None)
         return loop, (method,), records.work(_embedded.Work, ws)
 
 
