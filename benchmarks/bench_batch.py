@@ -97,14 +97,10 @@ def main(argv=None):
         rebs["whfast512"] = bench_wh.rebound_sim(bodies, dt_v, "whfast512")
     batches = {b: lanes(bodies, b) for b in BATCHES}
 
-    def vzeroupper():
-        clear.run(until=clear.time + clear.dt, outputs=1, progress=False)
+    vzeroupper = bench_wh.one_step(clear)
 
     def time_ours(n):
-        until = ours.time + n * ours.dt
-        t0 = clock()
-        ours.run(until=until, outputs=2, progress=False)
-        return (clock() - t0) / n
+        return bench_wh.our_step_time(ours, n, clock)
 
     def time_batch(b, n):
         t0 = clock()

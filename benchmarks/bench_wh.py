@@ -178,6 +178,20 @@ def rebound_step_time(sim, n, clock, before=None):
     return elapsed / max(1, round((sim.t - t_start) / sim.dt))
 
 
+def one_step(sim):
+    """A function that runs ``sim`` (ours) one step, untimed: the
+    ``vzeroupper`` of the module notes, before each REBOUND run."""
+    return lambda: sim.run(until=sim.time + sim.dt, outputs=1, progress=False)
+
+
+def our_step_time(sim, n, clock):
+    """Seconds a step of ``n`` steps of ``sim`` (ours), by ``clock``."""
+    until = sim.time + n * sim.dt
+    t0 = clock()
+    sim.run(until=until, outputs=2, progress=False)
+    return (clock() - t0) / n
+
+
 def measure(label, bodies, dt, coords, rebound_names, args, clock):
     """One row: median us per step of ours and of each REBOUND integrator
     that runs, and the median paired ratios."""
@@ -193,14 +207,10 @@ def measure(label, bodies, dt, coords, rebound_names, args, clock):
         except Exception:
             pass
 
-    def vzeroupper():
-        clear.run(until=clear.time + clear.dt, outputs=1, progress=False)
+    vzeroupper = one_step(clear)
 
     def time_ours(n):
-        until = ours.time + n * ours.dt
-        t0 = clock()
-        ours.run(until=until, outputs=2, progress=False)
-        return (clock() - t0) / n
+        return our_step_time(ours, n, clock)
 
     def time_reb(sim, n):
         return rebound_step_time(sim, n, clock, vzeroupper)
