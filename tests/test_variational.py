@@ -121,8 +121,7 @@ def _gr_terms():
 TERMS = [
     pytest.param(lambda: [forces.GR("Sun", c=0.2 * u.au / u.day)], id="GR"),
     pytest.param(lambda: [forces.GRPotential("Sun", c=0.2 * u.au / u.day)], id="GRPotential"),
-    pytest.param(lambda: [forces.GRFull(c=0.2 * u.au / u.day)], id="GRFull",
-                 marks=pytest.mark.slow),
+    pytest.param(lambda: [forces.GRFull(c=0.2 * u.au / u.day)], id="GRFull"),
     pytest.param(lambda: [forces.ZonalHarmonics("Sun", radius=1 * u.au, J2=1e-2)], id="J2"),
     pytest.param(lambda: [forces.Migration("Jupiter", tau_a=100 * u.yr, tau_e=50 * u.yr)],
                  id="Migration", marks=pytest.mark.slow),

@@ -22,6 +22,8 @@ from .._kernels import records
 from .._kernels import wisdom_holman as _wh
 from .._kernels import wh_lanes as _lanes
 from .._kernels import wh_tangent as _wht
+from .._kernels.kepler import _SHORT_STEP
+from .._kernels.stumpff import _STUMPFF_SHORT_Z
 from .._kernels.stepping import DRIFT, KICK, work_bound
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
@@ -49,6 +51,40 @@ COORDINATES = ("jacobi", "democratic-heliocentric")
 #: the AVX2 machine and about as long on the AVX-512 machine, less from four
 #: (benchmarks/RESULTS.md).
 LANES_FROM_BODIES = 4
+
+#: What a planet outside the lanes' short-step domain costs a lanes' step,
+#: against what the lanes save, which grows as the square of the number of
+#: bodies N (the kick's pairs): the lanes are taken while
+#: ``LANES_COST_OF_DECLINED * declined < N**2`` (:func:`lanes_pay`).  A
+#: declined planet is drifted by the scalar solver after the lanes' pass:
+#: measured (benchmarks/RESULTS.md), the outer solar system (N = 6) gains
+#: from the lanes with one planet declined and loses 20 % with two (100-day
+#: steps, Jupiter and Saturn out), the Sun and eight planets (N = 9) gain
+#: 15 % with three (4.4-day steps) and 5 % with four or five.  The results
+#: are the same either way.
+LANES_COST_OF_DECLINED = 18
+
+def lanes_pay(x, v, gm, dt):
+    """Whether the lanes pay for a run of the bodies ``x``, ``v`` (row 0
+    the central body, ``gm`` G times each mass) at the step ``dt``: few
+    enough planets outside their short-step domain
+    (:data:`LANES_COST_OF_DECLINED`).  Each planet's heliocentric orbit
+    gives the Stumpff argument its drift's starter would have,
+    ``(mu / a) (dt / r)^2`` (the square of the step's eccentric anomaly,
+    the universal anomaly being about ``dt / r``), against the lanes' bound,
+    and ``|dt| |v| < r / 2``.  An estimate from the first state: it chooses
+    between two loops with the same results, not what a step computes."""
+    n = len(x)
+    r = np.sqrt(np.sum((x[1:] - x[0]) ** 2, axis=1))
+    v2 = np.sum((v[1:] - v[0]) ** 2, axis=1)
+    mu = gm[0] + gm[1:n]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = (2.0 * mu / r - v2) * (dt / r) ** 2
+        inside = ((np.abs(z) <= _STUMPFF_SHORT_Z) & (dt * dt * v2 < (_SHORT_STEP * r) ** 2)
+                  & (mu > 0.0))
+    declined = (n - 1) - int(np.count_nonzero(inside))
+    return LANES_COST_OF_DECLINED * declined < n * n
+
 
 #: Spacing of the corrector stages: stage i is ``Z(a_i h, b_i h)`` with
 #: ``a_i = i * CORRECTOR_SPACING`` (Wisdom, Holman & Touma 1996; Wisdom 2006).
@@ -211,7 +247,10 @@ class WisdomHolman(Integrator):
     AVX2 or AVX-512, :mod:`orbits._kernels.wh_lanes`), bit for bit the
     scalar drift: a planet outside the branch-free solver's domain (a high
     eccentricity near pericentre, a hyperbola, a long step) is drifted by
-    the scalar solver.  The interaction kick's pulls are summed in the
+    the scalar solver.  Where the step is long enough for so many planets
+    to leave that domain that the lanes would cost more than they save
+    (:func:`lanes_pay`, decided at the first step), the run takes the
+    scalar loop, with the same results.  The interaction kick's pulls are summed in the
     lanes too, bit for bit the scalar sums, and between outputs the state
     stays in the lanes, as WHFast512 keeps it in its registers (written
     back to the workspace for an output, a non-finite state and the end of
@@ -406,13 +445,17 @@ class WisdomHolman(Integrator):
                                          mon_t, mon_out, check_every, stop)
         if ws["state"][1] == 0:
             self._check_system(ws, force, fargs)
+        gravity = fargs if ws.get("terms", (None,))[0] is None else fargs[0]
+        gm, n_active = gravity[0], gravity[1]
+        if "lanes_pay" not in ws:
+            # chosen once for the workspace, at its first step: a shorter
+            # last step does not switch loops
+            ws["lanes_pay"] = lanes_pay(x, v, gm, dt)
         terms, targs, lanes = self._loop_terms(ws, x.shape[0])
         if stop is not None and lanes:
             # the lanes' state is not in xj, vj between steps: the scalar
             # loop, bit for bit the same steps
             targs, lanes = (), False
-        gravity = fargs if terms is None else fargs[0]
-        gm, n_active = gravity[0], gravity[1]
         loop = _wh.wh_loop(self.config["coordinates"], terms, force.recorder, lanes)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
@@ -424,14 +467,14 @@ class WisdomHolman(Integrator):
     def _loop_terms(ws, n):
         # (terms, the loop's targs, whether it drifts in lanes) for n rows: the
         # added terms' kernel and arguments, or, from LANES_FROM_BODIES bodies
-        # without terms, the lanes' scratch; the loop and the synchronisation
+        # without terms where the lanes pay (lanes_pay), the lanes' scratch; the loop and the synchronisation
         # take the same targs, so that what they share compiles once.  The
         # scratch is kept in the workspace as a tuple: not an array, so neither
         # saved nor restored (what it carries from step to step, a count of
         # drifts left to the scalar solver, only chooses between two paths
         # with the same results)
         terms, targs = ws.get("terms", (None, ()))
-        lanes = terms is None and n >= LANES_FROM_BODIES
+        lanes = terms is None and n >= LANES_FROM_BODIES and ws.get("lanes_pay", True)
         if lanes:
             targs = ws.get("lanes")
             if targs is None or targs[0].shape != _lanes.lanes_scratch_shape(n):

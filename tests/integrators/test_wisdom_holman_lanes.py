@@ -8,7 +8,8 @@ drift (see tests/kernels/test_wh_lanes.py), so nothing may differ by even an
 ulp; the kick's pulls are summed in the lanes in the scalar order, and the
 state stays in the lanes between outputs (tests/kernels/test_wh_lanes.py).
 Which loop a run takes is chosen by the number of bodies
-(``LANES_FROM_BODIES``), set here to force one or the other.
+(``LANES_FROM_BODIES``) and of planets outside the lanes' short-step domain
+(``LANES_COST_OF_DECLINED``), set here to force one or the other.
 """
 
 import astropy.units as u
@@ -20,6 +21,12 @@ from orbits._kernels import wh_lanes as _lanes
 from orbits.integrators import wisdom_holman as IW
 
 DH = "democratic-heliocentric"
+
+
+def take_lanes(monkeypatch, lanes):
+    """Make the runs that follow take the lanes' loop, or the scalar one."""
+    monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
+    monkeypatch.setattr(IW, "LANES_COST_OF_DECLINED", 0)
 
 
 def with_odd_orbits():
@@ -37,7 +44,7 @@ def with_odd_orbits():
 
 
 def final_state(monkeypatch, bodies, lanes, spec, until, dt=10 * u.day, **options):
-    monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
+    take_lanes(monkeypatch, lanes)
     name, _, coords = spec.partition(":")
     integ = orbits.integrators.get(name, coordinates=coords or "jacobi", **options)
     sim = orbits.Simulation(bodies, integrator=integ, dt=dt, monitors=())
@@ -73,7 +80,7 @@ def test_long_steps_left_to_the_scalar_drift_bit_for_bit(monkeypatch, spec):
 
 
 def every_output(monkeypatch, bodies, lanes, spec, until, dt, **options):
-    monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
+    take_lanes(monkeypatch, lanes)
     name, _, coords = spec.partition(":")
     integ = orbits.integrators.get(name, coordinates=coords or "jacobi", **options)
     sim = orbits.Simulation(bodies, integrator=integ, dt=dt)
@@ -120,7 +127,7 @@ def test_a_state_that_turns_non_finite_stops_as_the_scalar_loop_does(
     from orbits.errors import NonFiniteState
     got = []
     for lanes in (False, True):
-        monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
+        take_lanes(monkeypatch, lanes)
         sim = orbits.Simulation(orbits.scenes.outer_solar_system(),
                                 integrator=orbits.integrators.get("wh", coordinates=coordinates),
                                 dt=10 * u.day)
@@ -149,3 +156,19 @@ def test_lanes_are_chosen_by_the_number_of_bodies(monkeypatch):
         sim = orbits.Simulation(bodies, integrator="wh", dt=1 * u.day, monitors=())
         sim.run(until=10 * u.day, outputs=2, progress=False)
         assert ("lanes" in sim._ws) == lanes
+
+
+@pytest.mark.parametrize("scene, step_days, lanes", [
+    # the estimate's Stumpff argument z, the square of a step's eccentric
+    # anomaly, against the lanes' 2e-3: Jupiter out from about 50 days,
+    # Saturn from 100 days, so 18 * 2 = 36 is not below 6**2 at 100 days
+    # (RESULTS: scalar 0.295 against lanes 0.366 us a step there)
+    ("outer", 10, True), ("outer", 50, True), ("outer", 100, False), ("outer", 216.6, False),
+    # Mercury, Venus and Earth out at 4.4 days: 54 < 81
+    ("inner", 4.398, True), ("inner", 0.5, True)])
+def test_the_lanes_are_taken_where_few_planets_leave_their_domain(scene, step_days, lanes):
+    bodies = (orbits.scenes.outer_solar_system() if scene == "outer"
+              else orbits.scenes.solar_system(moon=False))
+    sim = orbits.Simulation(bodies, integrator="wh", dt=step_days * u.day, monitors=())
+    sim.run(until=2 * step_days * u.day, progress=False)
+    assert sim._ws["lanes_pay"] is lanes
