@@ -246,6 +246,29 @@ def bound_globals(template, bindings):
     return bound
 
 
+def _sign(value):
+    # what names a bound value in a copy's name: a kernel by its module and
+    # qualified name (a specialised copy's carries its own bindings' digest),
+    # a constant by its repr; anything else by its identity, which is correct
+    # but differs from process to process (no binding of the package's is
+    # such: a test run that raised here instead passed)
+    func = getattr(value, "py_func", value)
+    if isinstance(func, (types.FunctionType, types.BuiltinFunctionType, type)):
+        return f"{func.__module__}.{func.__qualname__}"
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return repr(value)
+    if isinstance(value, tuple):
+        return tuple(_sign(v) for v in value)
+    return f"{type(value).__qualname__}@{id(value)}"
+
+
+def _binding_signs(template, glob):
+    used = _used_names(template.__code__)
+    return tuple(sorted((k, _sign(v.default if isinstance(v, Slot) else v))
+                        for k, v in glob.items()
+                        if k in used and isinstance(template.__globals__.get(k), Slot)))
+
+
 def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, **bindings):
     """Compile a copy of ``template`` whose global names are bound to ``bindings``.
 
@@ -277,12 +300,18 @@ def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, *
         error, as is a slot the template uses that is left unbound without
         a default.
     """
-    key = (template, suffix, jit, cache, inline, nrt)
+    glob = bound_globals(template, bindings)
+    # the copy is named by what its slots are bound to as well as by the
+    # suffix: two copies under one suffix with different bindings (a loop
+    # for a force that reads velocities and one for a force that does not)
+    # are two functions, in this process and in the cache on disk
+    signs = _binding_signs(template, glob)
+    key = (template, suffix, jit, cache, inline, nrt, signs)
     if key in _SPECIALISED:
         return _SPECIALISED[key]
-    glob = bound_globals(template, bindings)
     safe = "".join(ch if ch.isalnum() else "_" for ch in suffix)
-    name = f"{template.__name__}__{safe}__{KERNEL_STAMP}"
+    digest = hashlib.sha1(repr(signs).encode()).hexdigest()[:8]
+    name = f"{template.__name__}__{safe}__{digest}__{KERNEL_STAMP}"
     func = types.FunctionType(template.__code__, glob, name,
                               template.__defaults__, template.__closure__)
     func.__qualname__ = name

@@ -91,6 +91,33 @@ def test_specialize_binds_a_declared_slot_and_a_default():
     assert triple(-2.0) == 6.0
 
 
+def test_one_suffix_with_other_bindings_is_another_copy_with_another_name():
+    # a loop for a force that reads velocities and one for a force that does
+    # not once shared a suffix: the second run took the first one's copy, in
+    # the process and from the cache on disk, and stepped with stale
+    # velocities.  The bindings name the copy too.
+    neg = _jit.specialize(_template, "test_same", jit=False, _kernel=abs)
+    assert _jit.specialize(_template, "test_same", jit=False, _kernel=abs) is neg
+    other = _jit.specialize(_template, "test_same", jit=False, _kernel=abs, _scale=3.0)
+    assert other is not neg and other.__qualname__ != neg.__qualname__
+    assert (neg(-2.0), other(-2.0)) == (4.0, 6.0)
+
+
+def test_the_loops_of_forces_that_do_and_do_not_read_velocities_are_two():
+    import astropy.units as u
+    import orbits
+    from orbits import forces
+    from orbits._kernels import ias15
+
+    def loop(term):
+        sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "ias15", forces=[term])
+        return ias15.ias15_loop(sim._force)
+
+    gr, potential = loop(forces.GR("Sun")), loop(forces.GRPotential("Sun", c=1 * u.au / u.day))
+    assert gr is not potential
+    assert gr.py_func.__globals__["PREDICT_V"] and not potential.py_func.__globals__["PREDICT_V"]
+
+
 def test_specialize_refuses_a_name_that_is_not_a_slot():
     with pytest.raises(TypeError, match="has no slot 'kernel'.*'_kernel', '_scale'"):
         _jit.specialize(_template, "test_typo", jit=False, kernel=abs)
