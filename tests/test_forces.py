@@ -886,3 +886,26 @@ def test_a_user_term_that_allocates_is_freed_in_the_wisdom_holman_loop():
     assert out.returncode == 0, out.stderr
     allocs, frees = map(int, out.stdout.split())
     assert allocs >= 2000 and frees == allocs
+
+
+@pytest.mark.parametrize("term", [
+    lambda: forces.GR("Sun"), lambda: forces.GRPotential("Sun"), lambda: forces.GRFull(),
+    lambda: forces.ZonalHarmonics("Sun", radius=1 * u.au, J2=1e-3),
+    lambda: forces.Migration("Jupiter", tau_a=1e4 * u.yr),
+    lambda: forces.TidesConstantTimeLag("Jupiter", k2=0.5, time_lag=1e3 * u.s,
+                                        radius=0.05 * u.au),
+    lambda: forces.RadiationPressure("Sun", beta={"Pluto": 0.1}),
+    lambda: forces.UserForce(_drag_for_table, velocity_dependent=True),
+    lambda: forces.UserForce(_drag_for_table, velocity_dependent=False)])
+def test_the_table_says_whether_its_terms_read_velocities_as_each_term_does(term):
+    # the loops ask the table at run time (IAS15's velocity predictor, the
+    # variational equations' velocity Jacobian): its answer is the term's flag
+    from orbits._kernels.terms import table_reads_velocities
+    t = term()
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "ias15", forces=[t])
+    assert table_reads_velocities(sim._fargs[1]) is t.velocity_dependent
+
+
+@numba.njit(cache=True)
+def _drag_for_table(x, v, t, m):
+    return -1e-12 * v

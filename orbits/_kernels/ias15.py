@@ -65,7 +65,7 @@ from ._jit import njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step, flat_rows,
                        flat_stages, landing_step, must_return, step_lander, work_kernels)
-from .variational import measured_rows
+from .variational import measured_rows, velocity_reader
 
 __all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
            "PC_MAX_ITERATIONS", "PC_EPSILON_SQUARED", "MODE_GLOBAL", "MODE_PRS24",
@@ -360,6 +360,9 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     # these flat views (loops that LLVM turns into vector instructions, not N
     # loops of three)
     m3 = 3 * n
+    # velocities at the substeps: for a force that reads them, and for the
+    # work of non-conservative terms
+    predict_v = PREDICT_V or reads_velocities(fargs)
     x1, v1 = flat_rows(x, v)
     a01, acc1 = flat_rows(a0, acc)
     csx1, csv1 = flat_rows(csx, csv)
@@ -427,7 +430,8 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
                             b1[1, k] * _X1 + h * (b1[2, k] * _X2 + h * (
                                 b1[3, k] * _X3 + h * (b1[4, k] * _X4 + h * (
                                     b1[5, k] * _X5 + h * b1[6, k] * _X6)))))))))
-                    if PREDICT_V:
+                if predict_v:
+                    for k in range(m3):
                         vs1[k] = v1[k] + (csv1[k] + hdt * (a01[k] + h * (
                             b1[0, k] * _V0 + h * (b1[1, k] * _V1 + h * (
                                 b1[2, k] * _V2 + h * (b1[3, k] * _V3 + h * (
@@ -644,7 +648,8 @@ def _first_step(x, a0, span):
 
 # the names _ias15_loop is written against, bound by ias15_loop (specialize);
 # the helpers default to their Python form, for a loop that runs as Python
-force, rows, land, PREDICT_V = slots("force", "rows", "land", "PREDICT_V")
+force, rows, land, PREDICT_V, reads_velocities = slots("force", "rows", "land", "PREDICT_V",
+                                                      "reads_velocities")
 HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
 predict, g_from_b, b_from_g, first_step = slots(
     predict=_predict, g_from_b=_g_from_b, b_from_g=_b_from_g, first_step=_first_step)
@@ -666,10 +671,13 @@ def ias15_loop(force):
     (:func:`~orbits._kernels.stopping.stop_record`); it returns ``(status,
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
-    # the work rate P = sum m a . v needs the velocities at the nodes
-    predict_v = force.velocity_dependent or force.opaque or force.work is not None
+    # the work rate P = sum m a . v needs the velocities at the nodes; whether
+    # the force reads them is its arguments' to say (velocity_reader), so
+    # that one loop serves terms that do and terms that do not
+    predict_v = force.opaque or force.work is not None
     helpers = _JITTED if force.jit else {}
     return specialize(_ias15_loop, force.key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,
                       land=step_lander(force), PREDICT_V=predict_v,
+                      reads_velocities=velocity_reader(force),
                       rows=measured_rows(force), **work_kernels(force), **helpers)

@@ -19,8 +19,8 @@ import numpy as np
 from ._jit import njit, slots, specialize
 
 # the names the templates below are written against, bound by specialize
-force, VELOCITY, base_jacobian, extra, user_jac, differences = slots(
-    "force", "VELOCITY", "base_jacobian", "extra", "user_jac", "differences")
+force, VELOCITY, base_jacobian, extra, extra_reads, user_jac, differences = slots(
+    "force", "VELOCITY", "base_jacobian", "extra", "extra_reads", "user_jac", "differences")
 
 __all__ = ["gravity_jacobian", "user_jacobian", "finite_difference_jacobian", "jacobian_for",
            "central_differences", "FD_STEP"]
@@ -176,8 +176,10 @@ _GRAVITY_KEYS = ("gravity_small", "gravity_serial", "gravity_parallel")
 
 
 def _jacobian_with_terms(x, v, t, fargs, jx, jv):
+    # whether the terms read velocities is their table's (data): one
+    # Jacobian for every table
     base_jacobian(x, v, t, fargs[0], jx, jv)
-    if VELOCITY:
+    if extra_reads(fargs[1]):
         for p in range(jv.shape[0]):
             for q in range(jv.shape[1]):
                 jv[p, q] = 0.0
@@ -196,7 +198,7 @@ def jacobian_for(force, velocity_dependent):
         key = f"{bkey}+{force.terms.key}"
         return specialize(_jacobian_with_terms, key, cache=force.cache, base_jacobian=base,
                           extra=force.terms.jacobian,
-                          VELOCITY=bool(velocity_dependent)), key
+                          extra_reads=force.terms.reads_velocities), key
     own = getattr(force, "jacobian", None)
     if own is not None:
         return own, f"own{id(own)}"

@@ -66,6 +66,9 @@ class TermKernel(NamedTuple):
     jacobian: Callable
     key: str          # names the loops compiled for it
     cache: bool = True  # False for a user's function, which numba cannot cache
+    # reads_velocities(args) -> bool: whether the terms of these arguments read
+    # the velocities (data, so that one loop serves terms that do and do not)
+    reads_velocities: Callable = None
 
 
 @njit(inline="always")
@@ -758,6 +761,8 @@ def _scale(a):
 
 #: the term codes of a table row
 GR, GR_POTENTIAL, GR_FULL, ZONAL, MIGRATION, TIDES, RADIATION, USER = range(1, 9)
+#: the codes of the terms that read the velocities (a user's term says itself)
+VELOCITY_CODES = (GR, GR_FULL, MIGRATION, TIDES, RADIATION)
 #: the integers and reals of a table row
 INTS = 2
 REALS = 5
@@ -859,6 +864,19 @@ def _user_energy(u, x):
 def _user_velocity_dependent(u):
     if u is not None:
         return u.velocity_dependent
+    return False
+
+
+@njit
+def table_reads_velocities(tab):
+    """Whether a term of the table ``tab`` reads the velocities
+    (:data:`VELOCITY_CODES`, or a user's term that says so)."""
+    for k in range(tab.codes.shape[0]):
+        c = tab.codes[k]
+        if c == GR or c == GR_FULL or c == MIGRATION or c == TIDES or c == RADIATION:
+            return True
+        if c == USER and _user_velocity_dependent(tab.user):
+            return True
     return False
 
 
@@ -972,4 +990,5 @@ def table_jacobian(x, v, t, tab, jx, jv):
 
 
 #: the kernels of every table of terms: one key, so one loop for any combination
-TABLE = TermKernel(table_accel, table_energy, table_jacobian, "terms")
+TABLE = TermKernel(table_accel, table_energy, table_jacobian, "terms",
+                   reads_velocities=table_reads_velocities)

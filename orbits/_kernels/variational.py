@@ -57,10 +57,10 @@ from .invariants import MONITOR_COLUMNS
 from .jacobians import jacobian_for
 
 # the names the templates below are written against, bound by specialize
-(CHAOS_ON, MASSES, MEGNO_COLUMN, VELOCITY, inner, inner_add, inner_note, inner_rate,
- inner_record, jacobian) = slots(
-    "CHAOS_ON", "MASSES", "MEGNO_COLUMN", "VELOCITY", "inner", "inner_add", "inner_note",
-    "inner_rate", "inner_record", "jacobian")
+(CHAOS_ON, MASSES, MEGNO_COLUMN, inner, inner_add, inner_note, inner_rate,
+ inner_record, jacobian, reads, inner_reads, table_reads) = slots(
+    "CHAOS_ON", "MASSES", "MEGNO_COLUMN", "inner", "inner_add", "inner_note",
+    "inner_rate", "inner_record", "jacobian", "reads", "inner_reads", "table_reads")
 
 __all__ = ["with_variations", "variation_args", "chaos_update", "chaos_rescaled",
            "chaos_values", "chaos_box", "measured_rows", "CHAOS", "RENORMALISE_EXPONENT",
@@ -174,16 +174,17 @@ def _varied(x, v, t, fargs, acc):
     inner_args, vargs = fargs[0], fargs[1]
     n, dm, jx, jv = vargs[0], vargs[1], vargs[2], vargs[3]
     inner(x[:n], v[:n], t, inner_args, acc[:n])
+    velocity = reads(inner_args)
     for p in range(3 * n):
         for q in range(3 * n):
             jx[p, q] = 0.0
-            if VELOCITY:
+            if velocity:
                 jv[p, q] = 0.0
     jacobian(x[:n], v[:n], t, inner_args, jx, jv)
     k = dm.shape[0]
     for j in range(k):
         o = n * (j + 1)
-        tangent_product(jx, jv, x, v, o, n, acc, VELOCITY)
+        tangent_product(jx, jv, x, v, o, n, acc, velocity)
         if MASSES:
             G, eps2 = vargs[5]
             for l in range(n):
@@ -313,6 +314,44 @@ def variational_work_kernels(force, inner_kernels):
                              MEGNO_COLUMN=MONITOR_COLUMNS.index("megno")))
 
 
+@njit(inline="always")
+def _never_reads(fargs):
+    return False
+
+
+@njit(inline="always")
+def _always_reads(fargs):
+    return True
+
+
+def _terms_read(fargs):
+    return table_reads(fargs[1])
+
+
+def _inner_reads_of(fargs):
+    return inner_reads(fargs[0])
+
+
+def velocity_reader(force):
+    """``reads(fargs) -> bool``: whether ``force`` (a
+    :class:`~orbits._kernels.stepping.ForceKernel`) with the arguments
+    ``fargs`` reads the velocities.  For gravity with terms it is their
+    table's to say, at run time, so that one loop serves terms that do and
+    terms that do not; a force with variations asks its inner force.  A
+    loop that runs as Python (a user's Python function) gets the answer of
+    the force's flag as a plain function."""
+    if not force.jit:
+        flag = bool(force.velocity_dependent or force.opaque)
+        return (_always_reads if flag else _never_reads).py_func
+    if force.inner is not None:
+        return specialize(_inner_reads_of, force.key, cache=force.cache, inline=True,
+                          inner_reads=velocity_reader(force.inner))
+    if force.terms is not None:
+        return specialize(_terms_read, force.terms.key, cache=force.cache, inline=True,
+                          table_reads=force.terms.reads_velocities)
+    return _always_reads if (force.velocity_dependent or force.opaque) else _never_reads
+
+
 def with_variations(force, masses, chaos):
     """The force of the augmented system (see the module notes) for ``force``
     (a :class:`~orbits._kernels.stepping.ForceKernel`), with its arguments
@@ -323,7 +362,8 @@ def with_variations(force, masses, chaos):
     jac, jkey = jacobian_for(force, vd)
     key = f"var{'m' if masses else ''}{'c' if chaos else ''}({force.key};{jkey})"
     kernel = specialize(_varied, key, jit=force.jit, cache=force.cache, inline=True,
-                        inner=force.kernel, jacobian=jac, VELOCITY=vd, MASSES=bool(masses))
+                        inner=force.kernel, jacobian=jac, reads=velocity_reader(force),
+                        MASSES=bool(masses))
     jacobian = specialize(_varied_jacobian, key, jit=force.jit, cache=force.cache,
                           jacobian=jac)
     record = specialize(_varied_record, key, jit=force.jit, cache=force.cache,
