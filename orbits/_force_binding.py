@@ -74,10 +74,11 @@ def bind_gravity(sim, gravity, parallel_threshold):
 def bind_terms(sim, bodies):
     """Compile gravity and the added terms into one force (see :mod:`orbits.forces`).
 
-    The non-conservative terms (``conservative = False``) are chained once
-    more on their own: the loops integrate their work from that chain
+    The non-conservative terms (``conservative = False``) are tabled once
+    more on their own: the loops integrate their work from that table
     (:func:`orbits._kernels.stepping.with_terms`), so that the energy
-    monitor can report ``E + W``.
+    monitor can report ``E + W``.  Without such terms the table is empty
+    and the loops do no work: the same loops serve both.
     """
     ctx = _forces.Context([sim._names[k] for k in sim._order], sim._m, sim._gm,
                           sim._n_active, sim.units, sim._bare_ok, sim._order,
@@ -87,11 +88,10 @@ def bind_terms(sim, bodies):
     terms = _kterms.TABLE
     sim._force = _stepping.with_terms(sim._force, terms,
                                        any(t.velocity_dependent for t in sim._terms),
-                                       work=terms if dissipative else None)
+                                       work=terms, dissipative=bool(dissipative))
     table = _term_table(sim, bound, ctx)
-    sim._fargs = (sim._fargs, table)
-    if dissipative:
-        sim._fargs += (_stepping.work_args(_term_table(sim, dissipative, ctx), sim._m),)
+    sim._fargs = (sim._fargs, table,
+                  _stepping.work_args(_term_table(sim, dissipative, ctx), sim._m))
     sim._eargs = table
 
 

@@ -69,4 +69,4 @@ def has_work(sim):
     """Whether the energy monitor carries a work column: non-conservative force
     terms, whose work the loops integrate, or collisions that take energy out
     of the bodies."""
-    return sim._base_force.work is not None or sim._resolves_collisions
+    return sim._base_force.dissipative or sim._resolves_collisions

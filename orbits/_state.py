@@ -45,7 +45,7 @@ def workspace(sim):
     integ = sim.integrator
     ws = integ.workspace(rows, sim._dt) if integ.adaptive else integ.workspace(rows)
     integ.bind(ws, sim._force, sim._fargs)
-    if sim._base_force.work is not None:
+    if sim._base_force.dissipative:
         ws["work"] = sim._base_fargs[2][3]
     if sim._chaos_box is not None:
         ws["chaos"] = sim._chaos_box

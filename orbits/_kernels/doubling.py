@@ -25,7 +25,7 @@ from .stepping import WORK_SLOTS, work_kernels
 
 # the names the templates below are written against, bound by specialize
 force, rk4_step = slots("force", "rk4_step")
-HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
 
 __all__ = ["doubling_loop", "Method", "METHOD"]
 

@@ -38,7 +38,7 @@ from .variational import measured_rows
 # the names the templates below are written against, bound by specialize
 force, land, rows, attempt, accept, first_stage, stages = slots(
     "force", "land", "rows", "attempt", "accept", "first_stage", "stages")
-HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
 
 __all__ = ["embedded_loop", "adaptive_loop", "initial_step", "next_step", "step_underflow", "SAFETY",
            "FAC_MIN", "FAC_MAX"]

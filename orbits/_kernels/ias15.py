@@ -362,7 +362,8 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     m3 = 3 * n
     # velocities at the substeps: for a force that reads them, and for the
     # work of non-conservative terms
-    predict_v = PREDICT_V or reads_velocities(fargs)
+    has_work = HAS_WORK and work_on(fargs)
+    predict_v = PREDICT_V or has_work or reads_velocities(fargs)
     x1, v1 = flat_rows(x, v)
     a01, acc1 = flat_rows(a0, acc)
     csx1, csv1 = flat_rows(csx, csv)
@@ -411,7 +412,7 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
 
         # the work rate at the start of the step, the Radau rule's node h = 0
         p0 = 0.0
-        if HAS_WORK:
+        if has_work:
             p0 = work_rate(x, v, t, fargs)
 
         # predictor-corrector
@@ -438,7 +439,7 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
                                     b1[4, k] * _V4 + h * (b1[5, k] * _V5 + h * (
                                         b1[6, k] * _V6)))))))))
                 force(xs, vs, t + (ct + hdt), fargs, acc)
-                if HAS_WORK:
+                if has_work:
                     pw += _WR[sub] * work_rate(xs, vs, t + (ct + hdt), fargs)
                 # the corrector, a pass over every component at a time (each
                 # a loop LLVM vectorises; each component's operations in the
@@ -588,7 +589,7 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
         add_compensated(x, xs, csx)
         add_compensated(v, vs, csv)
         flags[0] = 0
-        if HAS_WORK:
+        if has_work:
             work_add(fargs, -dt * pw)
         t, ct = clock_step(t, ct, dt, trimmed, target)
         tc[0] = t
@@ -650,7 +651,7 @@ def _first_step(x, a0, span):
 # the helpers default to their Python form, for a loop that runs as Python
 force, rows, land, PREDICT_V, reads_velocities = slots("force", "rows", "land", "PREDICT_V",
                                                       "reads_velocities")
-HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
 predict, g_from_b, b_from_g, first_step = slots(
     predict=_predict, g_from_b=_g_from_b, b_from_g=_b_from_g, first_step=_first_step)
 _JITTED = {"predict": njit(_predict), "g_from_b": njit(_g_from_b),
@@ -672,9 +673,10 @@ def ias15_loop(force):
     t_reached, n_monitor_rows)`` and leaves the step counts in ``counts``.
     """
     # the work rate P = sum m a . v needs the velocities at the nodes; whether
-    # the force reads them is its arguments' to say (velocity_reader), so
-    # that one loop serves terms that do and terms that do not
-    predict_v = force.opaque or force.work is not None
+    # the force reads them and whether its terms do work are its arguments'
+    # to say (velocity_reader, work_on), so that one loop serves terms that
+    # do and terms that do not
+    predict_v = force.opaque
     helpers = _JITTED if force.jit else {}
     return specialize(_ias15_loop, force.key, jit=force.jit, cache=force.cache,
                       nrt=force.runtime, force=force.kernel,

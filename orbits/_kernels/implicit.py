@@ -62,7 +62,7 @@ from .stepping import GO, WORK_SLOTS, first_record, state_is_finite, step_epilog
 
 # the names the templates below are written against, bound by specialize
 force, jacobian, step_end = slots("force", "jacobian", "step_end")
-HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
 
 __all__ = ["implicit_loop", "lu_factor", "lu_solve", "NEWTON_MAX_ITER", "NEWTON_ULPS",
            "ROUNDOFF_ULPS", "REFRESH"]

@@ -38,8 +38,10 @@ with ``every = -1``, ``mon_t`` holds on entry the steps after which to record
 (:func:`first_record`).
 
 The work of non-conservative force terms.  A force built by :func:`with_terms`
-with non-conservative terms (``work``) carries a third item in ``fargs``, the
-work arguments ``(their args, m, scratch, box)``: the loops integrate
+carries a third item in ``fargs``, the work arguments ``(their args, m,
+scratch, box)``, whose table holds the non-conservative terms among its
+terms, maybe none (``work_on`` says at run time, so that one loop serves
+terms with and without work): the loops integrate
 ``W = -int P dt``, ``P = sum_i m_i a_i . v_i`` over those terms' accelerations
 alone, each with its own quadrature (the splitting kicks with the kick's
 midpoint velocity, Runge-Kutta methods with their weights ``b``, IAS15 with
@@ -47,9 +49,10 @@ the Radau rule of its nodes), and add it to ``box[0]`` (``box[1]`` keeps what
 rounding lost, Neumaier's compensation), so that ``E + W`` is conserved up to
 the integration error; a monitor row records ``W`` in its work column.  The
 box is the workspace's ``"work"`` array (:func:`work_bound`), so that the
-state and its work are saved, restored and checkpointed together.  Loops
-compiled for other forces bind ``HAS_WORK = False`` and no-op kernels, and
-compile to what they were without it.
+state and its work are saved, restored and checkpointed together (for a
+force with such terms, ``ForceKernel.dissipative``).  Loops compiled for
+gravity alone bind ``HAS_WORK = False`` and no-op kernels, and compile to
+what they were without it.
 """
 
 import math
@@ -69,8 +72,8 @@ from .variational import tangent_kernels, variational_work_kernels
 # the names the templates below are written against, bound by specialize
 #: the slots that :func:`work_kernels` binds, which every loop that integrates
 #: the work of non-conservative terms declares (:func:`~._jit.slots`)
-WORK_SLOTS = ("HAS_WORK", "work_rate", "work_add", "work_note")
-HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+WORK_SLOTS = ("HAS_WORK", "work_rate", "work_add", "work_note", "work_on")
+HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
 (force, step_end, implicit_kick, pair_kernel, base, extra, extra_energy, nc_accel,
  user_accel, stop_check, tangent_step, record, record_mark) = slots(
     "force", "step_end", "implicit_kick", "pair_kernel", "base", "extra", "extra_energy",
@@ -447,8 +450,10 @@ class ForceKernel(NamedTuple):
     # it needs numba's runtime although it is the package's own (the threaded
     # gravity kernel, whose thread pool does)
     allocates: bool = False
-    # for gravity with non-conservative terms (with_terms): their TermKernel,
-    # whose work the loops integrate; fargs then has the work arguments third
+    # for gravity with terms (with_terms): the TermKernel of the work
+    # arguments, whose non-conservative terms' work the loops integrate (none
+    # among them: no work, at run time); fargs then has the work arguments
+    # third
     work: object = None
     # for a force with variations (orbits._kernels.variational.with_variations):
     # the force whose variational equations it integrates alongside (fargs
@@ -457,6 +462,9 @@ class ForceKernel(NamedTuple):
     # indicators
     inner: "ForceKernel" = None
     chaos: bool = False
+    # whether non-conservative terms are among the terms: the monitors then
+    # report their work, and the workspace keeps it
+    dissipative: bool = False
 
     @property
     def runtime(self):
@@ -510,16 +518,16 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
     record_state(x, v, m, row)
 
 
-def with_terms(base, terms, velocity_dependent, work=None):
+def with_terms(base, terms, velocity_dependent, work=None, dissipative=False):
     """Gravity ``base`` (a :class:`ForceKernel`) plus the terms of a
     :class:`~orbits._kernels.terms.TermKernel`: ``fargs = (base fargs, terms' args)``,
     and monitors ``mon`` with the terms' energy arguments as a seventh item.
 
     ``work``, the :class:`~orbits._kernels.terms.TermKernel` of the
-    non-conservative terms among them (a chain of their own), makes the loops
-    integrate their work (see the module notes); ``fargs`` is then
-    ``(base fargs, terms' args, work args)`` with the work arguments of
-    :func:`work_args`.
+    work arguments (a table of the non-conservative terms among them, maybe
+    none), makes the loops integrate their work (see the module notes);
+    ``fargs`` is then ``(base fargs, terms' args, work args)`` with the work
+    arguments of :func:`work_args`.  ``dissipative``: the table holds some.
     """
     key = f"{base.key}+{terms.key}"
     cache = base.cache and terms.cache
@@ -531,15 +539,18 @@ def with_terms(base, terms, velocity_dependent, work=None):
         cache = cache and work.cache
     return ForceKernel(kernel, key, True, cache, velocity_dependent=bool(velocity_dependent),
                        record=record, base=base, terms=terms, allocates=base.allocates,
-                       work=work)
+                       work=work, dissipative=bool(dissipative))
 
 
 # -- the work of the non-conservative terms -----------------------------------------
 
 def _work_rate(x, v, t, fargs):
-    # P = sum_i m_i a_i . v_i, a the non-conservative terms' accelerations alone
+    # P = sum_i m_i a_i . v_i, a the non-conservative terms' accelerations
+    # alone (none: 0, at once)
     wargs = fargs[2]
     nargs, m, scratch = wargs[0], wargs[1], wargs[2]
+    if not work_on(fargs):
+        return 0.0
     n = x.shape[0]
     for i in range(n):
         scratch[i, 0] = 0.0
@@ -580,6 +591,17 @@ def _no_work_rate(x, v, t, fargs):
 
 
 @njit(inline="always")
+def _table_work_on(fargs):
+    # whether the terms' work arguments hold non-conservative terms
+    return fargs[2][0].codes.shape[0] > 0
+
+
+@njit(inline="always")
+def _no_work_on(fargs):
+    return False
+
+
+@njit(inline="always")
 def _no_work_add(fargs, dw):
     pass
 
@@ -606,10 +628,11 @@ def work_kernels(force):
         return variational_work_kernels(force, work_kernels(force.inner))
     if force.work is None:
         return dict(HAS_WORK=False, work_rate=_no_work_rate, work_add=_no_work_add,
-                    work_note=_no_work_note)
+                    work_note=_no_work_note, work_on=_no_work_on)
     rate = specialize(_work_rate, force.work.key, cache=force.work.cache, inline=True,
-                      nc_accel=force.work.accel)
-    return dict(HAS_WORK=True, work_rate=rate, work_add=_work_add, work_note=_work_note)
+                      nc_accel=force.work.accel, work_on=_table_work_on)
+    return dict(HAS_WORK=True, work_rate=rate, work_add=_work_add, work_note=_work_note,
+                work_on=_table_work_on)
 
 
 def work_args(args, m):
@@ -633,7 +656,7 @@ def work_bound(force, fargs, ws):
         vargs = fargs[1]
         box = ws.get("chaos", vargs[4])
         return (inner, vargs[:4] + (box,) + vargs[5:])
-    if force.work is None:
+    if not force.dissipative:
         return fargs
     box = ws.get("work")
     if box is None:
@@ -733,6 +756,9 @@ def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent,
     fresh = cache[0] != 0
     until_check = check_every
     until_record = first_record(every, step0, mon_t)
+    # terms without non-conservative ones among them do no work (data: the
+    # loop serves both)
+    has_work = HAS_WORK and work_on(fargs)
     for k in range(nsteps):
         tx = t + k * dt
         for op in range(kinds.shape[0]):
@@ -744,7 +770,7 @@ def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent,
             elif velocity_dependent:
                 implicit_kick(x, v, tx, h, fargs, acc, vm)
                 fresh = False
-                if HAS_WORK:
+                if has_work:
                     # vm is the kick's midpoint velocity (v + v') / 2
                     work_add(fargs, -h * work_rate(x, vm, tx, fargs))
             else:
@@ -752,7 +778,7 @@ def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent,
                     force(x, v, tx, fargs, acc)
                     fresh = True
                 add_scaled(v, vF, h, acc, aF, flat)
-                if HAS_WORK:
+                if has_work:
                     for i in range(n):
                         for d in range(3):
                             vm[i, d] = v[i, d] - 0.5 * h * acc[i, d]

@@ -55,7 +55,7 @@ from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_st
 
 # the names the templates below are written against, bound by specialize
 land, = slots("land")
-HAS_WORK, work_rate, work_add, work_note = slots(*WORK_SLOTS)
+HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
 
 __all__ = ["order_for", "pair_count", "padded_pairs", "Series", "series_arrays", "taylor_loop",
            "expand", "PAD"]

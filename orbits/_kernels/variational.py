@@ -58,9 +58,10 @@ from .jacobians import jacobian_for
 
 # the names the templates below are written against, bound by specialize
 (CHAOS_ON, MASSES, MEGNO_COLUMN, inner, inner_add, inner_note, inner_rate,
- inner_record, jacobian, reads, inner_reads, table_reads) = slots(
+ inner_record, jacobian, reads, inner_reads, table_reads, inner_on) = slots(
     "CHAOS_ON", "MASSES", "MEGNO_COLUMN", "inner", "inner_add", "inner_note",
-    "inner_rate", "inner_record", "jacobian", "reads", "inner_reads", "table_reads")
+    "inner_rate", "inner_record", "jacobian", "reads", "inner_reads", "table_reads",
+    "inner_on")
 
 __all__ = ["with_variations", "variation_args", "chaos_update", "chaos_rescaled",
            "chaos_values", "chaos_box", "measured_rows", "CHAOS", "RENORMALISE_EXPONENT",
@@ -296,6 +297,10 @@ def tangent_kernels(force):
                                         inline=True, CHAOS_ON=True))
 
 
+def _varied_work_on(fargs):
+    return inner_on(fargs[0])
+
+
 def variational_work_kernels(force, inner_kernels):
     """The work and note kernels (see :func:`orbits._kernels.stepping.work_kernels`)
     of a force with variations, from its inner force's ``inner_kernels``: on
@@ -308,6 +313,8 @@ def variational_work_kernels(force, inner_kernels):
                              inner_rate=inner_kernels["work_rate"]),
         work_add=specialize(_varied_work_add, key, cache=cache, inline=True,
                             inner_add=inner_kernels["work_add"]),
+        work_on=specialize(_varied_work_on, key, cache=cache, inline=True,
+                           inner_on=inner_kernels["work_on"]),
         work_note=specialize(_varied_note, key, cache=cache, inline=True,
                              inner_note=inner_kernels["work_note"],
                              CHAOS_ON=bool(force.chaos),
@@ -372,7 +379,8 @@ def with_variations(force, masses, chaos):
     # imports this one for the epilogue's tangent step and the work kernels)
     return type(force)(kernel, key, force.jit, force.cache, jacobian=jacobian,
                        velocity_dependent=vd, record=record, allocates=True,
-                       work=force.work, inner=force, chaos=bool(chaos))
+                       work=force.work, inner=force, chaos=bool(chaos),
+                       dissipative=force.dissipative)
 
 
 def variation_args(fargs, n, dm, box, G, eps2):

@@ -57,7 +57,7 @@ class ScipyIntegrator(ToleranceControlled):
                                         "monitors; drop monitor_every")
         n = x.shape[0]
         acc = np.zeros((n, 3))      # a user state pads its last row: those entries stay 0
-        work = force.work is not None
+        work = force.dissipative
         if work:
             fargs = _stepping.work_bound(force, fargs, ws)
             rate = _stepping.work_kernels(force)["work_rate"]
