@@ -601,9 +601,6 @@ def test_terms_round_trip_through_dicts(term):
     assert back.velocity_dependent is True
 
 
-# 27 s of compiling on a fresh clone; test_terms_rebuilt_from_dicts_bind_the_same_floats
-# (what the runs are made of) and the restart test below (a run from a file) cover it
-@pytest.mark.slow
 def test_simulation_runs_and_terms_rebuilt_from_dicts_run_bit_identically():
     # what a restart or an ensemble rebuilds from the dictionaries binds to the same
     # floats: the two runs agree bit for bit.  Migration with its default primary
@@ -697,7 +694,6 @@ def _migrating(a):
         forces.RadiationPressure("Star", beta=0.0)])
 
 
-@pytest.mark.slow  # 27 s: the workers compile their loops; test_forces checks the mechanism
 def test_ensemble_rows_with_dissipative_terms_serial_and_two_workers():
     # the workers rebuild the terms from the configuration: identical rows
     pytest.importorskip("distributed")
