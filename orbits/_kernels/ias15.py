@@ -334,6 +334,16 @@ class Control(NamedTuple):
     mode: int
 
 
+@njit(inline="always")
+def _predicted_x(x1, csx1, v1, a01, b1, k, h, hdt):
+    # component k of the position predicted at the substep h (of the step)
+    return x1[k] + (csx1[k] + hdt * (v1[k] + hdt * (
+        a01[k] * 0.5 + h * (b1[0, k] * _X0 + h * (
+            b1[1, k] * _X1 + h * (b1[2, k] * _X2 + h * (
+                b1[3, k] * _X3 + h * (b1[4, k] * _X4 + h * (
+                    b1[5, k] * _X5 + h * b1[6, k] * _X6)))))))))
+
+
 def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
     # flags[0]: a0 belongs to (x, v); flags[1]: a reference step (br, er, ref) exists.
     # ref = (length of the reference step, time from its start to now).
@@ -425,19 +435,20 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
             for sub in range(1, 8):
                 h = _H[sub - 1]
                 hdt = h * dt
-                for k in range(m3):
-                    xs1[k] = x1[k] + (csx1[k] + hdt * (v1[k] + hdt * (
-                        a01[k] * 0.5 + h * (b1[0, k] * _X0 + h * (
-                            b1[1, k] * _X1 + h * (b1[2, k] * _X2 + h * (
-                                b1[3, k] * _X3 + h * (b1[4, k] * _X4 + h * (
-                                    b1[5, k] * _X5 + h * b1[6, k] * _X6)))))))))
+                # the positions (and the velocities, where predicted) at the
+                # substep: one loop for each case, so that LLVM vectorises
+                # each without a branch inside
                 if predict_v:
                     for k in range(m3):
+                        xs1[k] = _predicted_x(x1, csx1, v1, a01, b1, k, h, hdt)
                         vs1[k] = v1[k] + (csv1[k] + hdt * (a01[k] + h * (
                             b1[0, k] * _V0 + h * (b1[1, k] * _V1 + h * (
                                 b1[2, k] * _V2 + h * (b1[3, k] * _V3 + h * (
                                     b1[4, k] * _V4 + h * (b1[5, k] * _V5 + h * (
                                         b1[6, k] * _V6)))))))))
+                else:
+                    for k in range(m3):
+                        xs1[k] = _predicted_x(x1, csx1, v1, a01, b1, k, h, hdt)
                 force(xs, vs, t + (ct + hdt), fargs, acc)
                 if has_work:
                     pw += _WR[sub] * work_rate(xs, vs, t + (ct + hdt), fargs)
