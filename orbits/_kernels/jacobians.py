@@ -81,8 +81,9 @@ def gravity_jacobian(x, v, t, fargs, jx, jv):
 
 def _user_jacobian(x, v, t, fargs, jx, jv):
     # the user's (size, size) matrices fill the top-left of the (3N, 3N)
-    # arrays; rows and columns of the padding stay zero
-    size, shape = fargs
+    # arrays; rows and columns of the padding stay zero.  fargs are the user
+    # force's (size, shape, ...) (orbits._user_functions.force_args)
+    size, shape = fargs[0], fargs[1]
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
     dadx, dadv = user_jac(xu, vu, t)

@@ -176,7 +176,6 @@ def test_gravity_jacobian_against_central_differences():
     assert np.all(jv == 0.0)
 
 
-@pytest.mark.slow  # ~18 s: a user force's loops are compiled afresh in every session
 def test_user_jacobian_and_finite_differences_give_the_same_solution():
     # the Jacobian only steers Newton's method: with the exact one (user) and
     # with central differences the converged steps agree to rounding
