@@ -761,8 +761,6 @@ def _scale(a):
 
 #: the term codes of a table row
 GR, GR_POTENTIAL, GR_FULL, ZONAL, MIGRATION, TIDES, RADIATION, USER = range(1, 9)
-#: the codes of the terms that read the velocities (a user's term says itself)
-VELOCITY_CODES = (GR, GR_FULL, MIGRATION, TIDES, RADIATION)
 #: the integers and reals of a table row
 INTS = 2
 REALS = 5
@@ -869,8 +867,9 @@ def _user_velocity_dependent(u):
 
 @njit
 def table_reads_velocities(tab):
-    """Whether a term of the table ``tab`` reads the velocities
-    (:data:`VELOCITY_CODES`, or a user's term that says so)."""
+    """Whether a term of the table ``tab`` reads the velocities: GR, GRFull
+    and the dissipative terms do, a user's term says (each term class's
+    ``velocity_dependent``, which tests/test_forces.py holds this to)."""
     for k in range(tab.codes.shape[0]):
         c = tab.codes[k]
         if c == GR or c == GR_FULL or c == MIGRATION or c == TIDES or c == RADIATION:
