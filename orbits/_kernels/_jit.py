@@ -184,6 +184,7 @@ def _stamp():
 KERNEL_STAMP = _stamp()
 
 _SPECIALISED = {}
+_BY_IDENTITY = {}
 
 
 class Slot:
@@ -300,6 +301,14 @@ def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, *
         error, as is a slot the template uses that is left unbound without
         a default.
     """
+    # the loops are fetched at every call of an integrator's advance: a copy
+    # already made is found by the identity of its bindings first (the memo
+    # keeps them, so no identity is reused), without naming them
+    quick = (template, suffix, jit, cache, inline, nrt,
+             tuple(sorted((k, id(v)) for k, v in bindings.items())))
+    found = _BY_IDENTITY.get(quick)
+    if found is not None:
+        return found[0]
     glob = bound_globals(template, bindings)
     # the copy is named by what its slots are bound to as well as by the
     # suffix: two copies under one suffix with different bindings (a loop
@@ -308,6 +317,7 @@ def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, *
     signs = _binding_signs(template, glob)
     key = (template, suffix, jit, cache, inline, nrt, signs)
     if key in _SPECIALISED:
+        _BY_IDENTITY[quick] = (_SPECIALISED[key], bindings)
         return _SPECIALISED[key]
     safe = "".join(ch if ch.isalnum() else "_" for ch in suffix)
     digest = hashlib.sha1(repr(signs).encode()).hexdigest()[:8]
@@ -324,6 +334,7 @@ def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, *
         options["_nrt"] = False
     result = numba.njit(**options)(func) if jit else func
     _SPECIALISED[key] = result
+    _BY_IDENTITY[quick] = (result, bindings)
     return result
 
 
