@@ -66,7 +66,7 @@ _DRIFT_STEP_TOL = 2.0 * _EPS
 # root.  After _SHORT_STEP_ITER iterations without that the bracketed solver
 # starts again from the beginning (it has never been needed on the
 # benchmark scenes, where the starter is good to 1e-6 and one iteration does).
-_SHORT_STEP = 0.5
+_SHORT_STEP = 1.0
 _SHORT_STEP_Z = 1.0
 _SHORT_STEP_TOL = 3e-5
 _SHORT_STEP_ITER = 3

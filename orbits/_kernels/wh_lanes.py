@@ -97,7 +97,7 @@ from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pul
                       pull_rows_factored)
 from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, advanced_state, f_and_g, kepler_drift,
                      quartic_step, short_start, straight_drift)
-from .stumpff import _STUMPFF_SHORT_Z, stumpff_lane
+from .stumpff import _STUMPFF_MEDIUM_Z, _STUMPFF_SHORT_Z, stumpff_lane, stumpff_medium_lane
 
 # the names the templates below are written against, bound by specialize
 step_of, = slots("step_of")
@@ -190,16 +190,17 @@ def column_start(X0, X1, X2, V0, V1, V2, MU, k):
 
 
 @njit(inline="always")
-def _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h):
+def _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h, zmax=_STUMPFF_SHORT_Z):
     # the first pass of column k's drift by h (see _pass_rows): the start's
     # invariants and the starter of the anomaly, into rows t .. t + 6 of T
     # (s, r0, 1 / r0, eta, beta, zeta, and 1.0 where the column is in the
-    # short-step domain with its starter in the four-term series)
+    # short-step domain with its starter's Stumpff argument within zmax: the
+    # four-term series, or the medium passes' nine-term one)
     mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
     r2, v2, r0, ir0, et, beta, zeta, s = short_start(mu, x0, y0, z0, vx0, vy0, vz0, h)
     z = beta * s * s
     good = ((h * h * v2 < (_SHORT_STEP * _SHORT_STEP) * r2) & (mu > 0.0) & (h != 0.0)
-            & (abs(z) <= _STUMPFF_SHORT_Z))
+            & (abs(z) <= zmax))
     T[t, k] = s
     T[t + 1, k] = r0
     T[t + 2, k] = ir0
@@ -249,6 +250,83 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
             & (r > 0.0))
     tk_[k] = 1.0 if take else 0.0
     return 0 if take else 1
+
+
+@njit(inline="always")
+def _iterate_column_medium(T, t, k, h):
+    # the medium passes' second: up to two quartic iterations, as the scalar
+    # path (kepler.short_step_anomaly) takes them, with _stumpff_short's
+    # four- or nine-term series; both are made in every lane, and a lane
+    # converged after the first keeps that anomaly (the scalar path stops
+    # there).  Row t + 8: 1.0 where the anomaly kept has converged with every
+    # Stumpff argument it used within the series
+    s = T[t, k]
+    r0 = T[t + 1, k]
+    et = T[t + 3, k]
+    beta = T[t + 4, k]
+    zeta = T[t + 5, k]
+    c0, c1, c2, c3, in0 = stumpff_medium_lane(beta * s * s)
+    d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
+    s1 = s + d
+    done1 = abs(d) <= _SHORT_STEP_TOL * abs(s1)
+    c0, c1, c2, c3, in1 = stumpff_medium_lane(beta * s1 * s1)
+    d = quartic_step(s1, r0, et, beta, zeta, c0, c1, c2, c3, h)
+    s2 = s1 + d
+    done2 = abs(d) <= _SHORT_STEP_TOL * abs(s2)
+    T[t + 7, k] = s1 if done1 else s2
+    ok = in0 & (done1 | (in1 & done2))
+    T[t + 8, k] = 1.0 if ok else 0.0
+
+
+@njit(inline="always")
+def _finish_column_medium(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k):
+    # _finish_column with _stumpff_short's four- or nine-term series
+    mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
+    s = T[t + 7, k]
+    r0 = T[t + 1, k]
+    ir0 = T[t + 2, k]
+    et = T[t + 3, k]
+    zeta = T[t + 5, k]
+    c0, c1, c2, c3, inside = stumpff_medium_lane(T[t + 4, k] * s * s)
+    _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, et, zeta, c1, c2)
+    Y0[k], Y1[k], Y2[k], U0[k], U1[k], U2[k] = advanced_state(x0, y0, z0, vx0, vy0, vz0, fm1,
+                                                              g, fdot, gdm1)
+    take = (T[t + 6, k] != 0.0) & (T[t + 8, k] != 0.0) & inside & (r > 0.0)
+    tk_[k] = 1.0 if take else 0.0
+    return 0 if take else 1
+
+
+@njit(inline="always")
+def medium_columns(S, src, mu, dst, take, t, h, column_steps, P):
+    """:func:`drift_columns` for the steps people take with Wisdom-Holman (a
+    twentieth to a sixth of an orbit, up to a radian of eccentric anomaly),
+    which the short-step passes decline: the same three passes with up to
+    two quartic iterations and the nine-term Stumpff series where the
+    four-term one does not hold, each lane bit for bit the scalar drift's
+    short-step path (:func:`~orbits._kernels.kepler.short_step_anomaly`),
+    which takes the same series and stops at the same iteration.  The rows
+    of the scratch ``S``: the start ``src .. src + 5`` with ``mu``, the end
+    ``dst .. dst + 5``, the verdict ``take``, the passes' ``t .. t + 8``;
+    each column's step is row :data:`_H`'s where ``column_steps``, else
+    ``h``.  Returns how many of the ``P`` columns are left to the scalar
+    drift.  Not inlined: one compilation serves every loop, and it is called
+    only where the short passes declined a planet."""
+    X0, X1, X2, V0, V1, V2 = S[src], S[src + 1], S[src + 2], S[src + 3], S[src + 4], S[src + 5]
+    Y0, Y1, Y2, U0, U1, U2 = S[dst], S[dst + 1], S[dst + 2], S[dst + 3], S[dst + 4], S[dst + 5]
+    MU = S[mu]
+    H = S[_H]
+    tk_ = S[take]
+    for k in range(P):
+        hk = H[k] if column_steps else h
+        _start_column(X0, X1, X2, V0, V1, V2, MU, S, t, k, hk, _STUMPFF_MEDIUM_Z)
+    for k in range(P):
+        hk = H[k] if column_steps else h
+        _iterate_column_medium(S, t, k, hk)
+    rejected = 0
+    for k in range(P):
+        rejected += _finish_column_medium(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2,
+                                          tk_, S, t, k)
+    return rejected
 
 
 # Three passes.  The drift of one column is some 250 vector operations whose
@@ -331,19 +409,51 @@ _pass_rows_steps = specialize(_pass_rows, "column_steps", inline=True, step_of=_
 
 
 @njit(inline="always")
+def _medium_pass(S, src, mu, dst, take, h0, column_steps, P):
+    # medium_columns over every column of the scratch's rows src .. (start),
+    # mu, dst .. (end) and take
+    return medium_columns(S, src, mu, dst, take, _T, h0, column_steps, np.uint64(P))
+
+
+@njit(inline="always")
+def _medium_first(S):
+    # whether the drift goes straight to the medium passes: for RETRY drifts
+    # after the short-step passes last declined a planet (a scene whose steps
+    # are long for some planet declines one at every step, and the short
+    # passes would be wasted there); counts the drift
+    if S[MEMO, 1] > 0.0:
+        S[MEMO, 1] -= 1.0
+        return True
+    return False
+
+
+@njit(inline="always")
 def _single_pass(S, h0, P):
-    # every column of the scratch by the step h0
-    return _pass_rows_one(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
-                          S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
-                          S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
+    # every column of the scratch by the step h0: the short-step passes, and
+    # the medium ones where those declined a planet (_medium_first)
+    if _medium_first(S):
+        return _medium_pass(S, _X, _MU, _Y, _TAKE, h0, False, P)
+    rejected = _pass_rows_one(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
+                              S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
+                              S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
+    if rejected:
+        S[MEMO, 1] = RETRY
+        rejected = _medium_pass(S, _X, _MU, _Y, _TAKE, h0, False, P)
+    return rejected
 
 
 @njit(inline="always")
 def _single_pass_steps(S, h0, P):
-    # every column of the scratch by its own step (row _H)
-    return _pass_rows_steps(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
-                            S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
-                            S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
+    # every column of the scratch by its own step (row _H), as _single_pass
+    if _medium_first(S):
+        return _medium_pass(S, _X, _MU, _Y, _TAKE, h0, True, P)
+    rejected = _pass_rows_steps(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
+                                S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
+                                S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
+    if rejected:
+        S[MEMO, 1] = RETRY
+        rejected = _medium_pass(S, _X, _MU, _Y, _TAKE, h0, True, P)
+    return rejected
 
 
 @njit
@@ -456,10 +566,16 @@ def resident_drift(xj, vj, eta, h, S):
     straight_drift(xj, vj, 0, h)
     n = xj.shape[0]
     P = lane_columns(n)
-    rejected = drift_columns(S[_RX], S[_RX + 1], S[_RX + 2], S[_RX + 3], S[_RX + 4],
-                             S[_RX + 5], S[_RMU], S[_RY], S[_RY + 1], S[_RY + 2], S[_RY + 3],
-                             S[_RY + 4], S[_RY + 5], S[_RTAKE], S, _T, h, np.uint64(0),
-                             np.uint64(P))
+    if _medium_first(S):
+        rejected = _medium_pass(S, _RX, _RMU, _RY, _RTAKE, h, False, np.uint64(P))
+    else:
+        rejected = drift_columns(S[_RX], S[_RX + 1], S[_RX + 2], S[_RX + 3], S[_RX + 4],
+                                 S[_RX + 5], S[_RMU], S[_RY], S[_RY + 1], S[_RY + 2],
+                                 S[_RY + 3], S[_RY + 4], S[_RY + 5], S[_RTAKE], S, _T, h,
+                                 np.uint64(0), np.uint64(P))
+        if rejected:
+            S[MEMO, 1] = RETRY
+            rejected = _medium_pass(S, _RX, _RMU, _RY, _RTAKE, h, False, np.uint64(P))
     declined = 0
     if rejected:
         declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)

@@ -23,7 +23,7 @@ from .._kernels import wisdom_holman as _wh
 from .._kernels import wh_lanes as _lanes
 from .._kernels import wh_tangent as _wht
 from .._kernels.kepler import _SHORT_STEP
-from .._kernels.stumpff import _STUMPFF_SHORT_Z
+from .._kernels.stumpff import _STUMPFF_MEDIUM_Z
 from .._kernels.stepping import DRIFT, KICK, work_bound
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
@@ -52,27 +52,28 @@ COORDINATES = ("jacobi", "democratic-heliocentric")
 #: (benchmarks/RESULTS.md).
 LANES_FROM_BODIES = 4
 
-#: What a planet outside the lanes' short-step domain costs a lanes' step,
-#: against what the lanes save, which grows as the square of the number of
-#: bodies N (the kick's pairs): the lanes are taken while
-#: ``LANES_COST_OF_DECLINED * declined < N**2`` (:func:`lanes_pay`).  A
-#: declined planet is drifted by the scalar solver after the lanes' pass:
-#: measured (benchmarks/RESULTS.md), the outer solar system (N = 6) gains
-#: from the lanes with one planet declined and loses 20 % with two (100-day
-#: steps, Jupiter and Saturn out), the Sun and eight planets (N = 9) gain
-#: 15 % with three (4.4-day steps) and 5 % with four or five.  The results
-#: are the same either way.
-LANES_COST_OF_DECLINED = 18
+#: What a planet outside the lanes' domain costs a lanes' step, against what
+#: the lanes save, which grows as the square of the number of bodies N (the
+#: kick's pairs): the lanes are taken while ``LANES_COST_OF_DECLINED *
+#: declined < N**2`` (:func:`lanes_pay`).  A declined planet (a step of more
+#: than a radian of its orbit) is drifted by the scalar solver after the
+#: lanes' passes.  Measured (benchmarks/RESULTS.md), the outer solar system
+#: (N = 6) still gains 3-6 % from the lanes with two or three planets
+#: declined (3000- and 6000-day steps) and breaks even with four (12000
+#: days); the Sun and eight planets (N = 9) gain 23 % with two declined (40
+#: days).  The results are the same either way.
+LANES_COST_OF_DECLINED = 9
+
 
 def lanes_pay(x, v, gm, dt):
     """Whether the lanes pay for a run of the bodies ``x``, ``v`` (row 0
     the central body, ``gm`` G times each mass) at the step ``dt``: few
-    enough planets outside their short-step domain
+    enough planets outside the lanes' domain
     (:data:`LANES_COST_OF_DECLINED`).  Each planet's heliocentric orbit
     gives the Stumpff argument its drift's starter would have,
     ``(mu / a) (dt / r)^2`` (the square of the step's eccentric anomaly,
     the universal anomaly being about ``dt / r``), against the lanes' bound,
-    and ``|dt| |v| < r / 2``.  An estimate from the first state: it chooses
+    and ``|dt| |v| < r``.  An estimate from the first state: it chooses
     between two loops with the same results, not what a step computes."""
     n = len(x)
     r = np.sqrt(np.sum((x[1:] - x[0]) ** 2, axis=1))
@@ -80,7 +81,7 @@ def lanes_pay(x, v, gm, dt):
     mu = gm[0] + gm[1:n]
     with np.errstate(divide="ignore", invalid="ignore"):
         z = (2.0 * mu / r - v2) * (dt / r) ** 2
-        inside = ((np.abs(z) <= _STUMPFF_SHORT_Z) & (dt * dt * v2 < (_SHORT_STEP * r) ** 2)
+        inside = ((np.abs(z) <= _STUMPFF_MEDIUM_Z) & (dt * dt * v2 < (_SHORT_STEP * r) ** 2)
                   & (mu > 0.0))
     declined = (n - 1) - int(np.count_nonzero(inside))
     return LANES_COST_OF_DECLINED * declined < n * n

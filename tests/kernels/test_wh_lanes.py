@@ -93,12 +93,41 @@ def test_eccentric_and_hyperbolic_orbits_beside_circular_ones(f):
         assert not took[2]
 
 
-@pytest.mark.parametrize("ratio", [1 / 50, 1 / 20, 1 / 5, 1.0, 7.3])
+@pytest.mark.parametrize("ratio", [1 / 50, 1 / 20, 1 / 15, 1 / 10])
+def test_the_steps_people_take_stay_in_the_lanes(ratio):
+    # a fiftieth to a tenth of the innermost period, with an eccentric orbit
+    # at its pericentre: Stumpff arguments beyond the four-term series, which
+    # the short-step passes decline, and within the nine-term one, converged
+    # after one iteration (a fiftieth) or two: the medium passes take every
+    # planet, and after the first drift go first (the memo counts down)
+    xj, vj, mu = system(CIRCULAR + [(1.0, 0.2, 0.0)])
+    S, declined = both(xj, vj, mu, ratio * 2 * math.pi, steps=20)
+    assert declined == 0
+    assert S[L.MEMO, 1] == L.RETRY - 19
+
+
+def test_the_medium_passes_return_to_the_short_ones_bit_for_bit():
+    # a step long enough for the medium passes, then short ones: the medium
+    # passes take those first (their four-term series where the short passes
+    # would take it), for RETRY drifts, then the short passes again
+    xj, vj, mu = system(CIRCULAR)
+    a, b = xj.copy(), vj.copy()
+    c, d = xj.copy(), vj.copy()
+    w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
+    S = L.lanes_scratch(len(xj))
+    for k in range(L.RETRY + 5):
+        h = 2 * math.pi / (20 if k == 0 else 400)
+        W.kepler_drift_all(a, b, mu, h, w1, w2)
+        assert L.kepler_drift_lanes(c, d, mu, h, S) == 0
+        assert np.array_equal(a, c) and np.array_equal(b, d), k
+        assert S[L.MEMO, 1] == max(L.RETRY - k, 0), k
+
+
+@pytest.mark.parametrize("ratio", [1 / 5, 1.0, 7.3])
 def test_longer_steps_are_left_to_the_scalar_drift(ratio):
-    # 1/50 and 1/20 of the innermost period: Stumpff arguments beyond the
-    # four-term series, which the lanes decline; 1/5 and beyond: outside the
-    # short-step domain (the bracketed solver, with the period reduced for
-    # the longest)
+    # a fifth of the innermost period and beyond: more than a radian of its
+    # orbit, outside the lanes' domain (the bracketed solver, with the period
+    # reduced for the longest)
     xj, vj, mu = system(CIRCULAR + [(0.7, 0.3, 1.0)])
     S, declined = both(xj, vj, mu, ratio * 2 * math.pi, steps=20)
     assert not lanes_took(S, len(xj))[0]
