@@ -57,15 +57,18 @@ DRIFT_MAX_ITER = 200
 # stop when a correction is below this many ulps of the iterate
 _DRIFT_STEP_TOL = 2.0 * _EPS
 
-# The short-step path of the drift (the steps of a planetary integration):
-# taken when |dt| |v0| < _SHORT_STEP r0 and the starter spans |beta s^2| <=
-# _SHORT_STEP_Z (an eccentric anomaly of at most 1 rad), else the bracketed
-# solver.  From the third-order Taylor starter Danby's quartic iteration runs
-# without a bracket; a correction d with |d| <= _SHORT_STEP_TOL |s| leaves an
-# error ~(d/s)^4 <= 1e-18 relative, below rounding, so s + d is taken as the
-# root.  After _SHORT_STEP_ITER iterations without that the bracketed solver
-# starts again from the beginning (it has never been needed on the
-# benchmark scenes, where the starter is good to 1e-6 and one iteration does).
+# The short-step path of the drift (the steps of a planetary integration, up
+# to a sixth of an orbit): taken when |dt| |v0| < _SHORT_STEP r0 and the
+# starter spans |beta s^2| <= _SHORT_STEP_Z (an eccentric anomaly of at most
+# 1 rad), else the bracketed solver.  From the third-order Taylor starter
+# (good to 1e-6 at a hundredth of an orbit, to a few per cent at a sixth)
+# Danby's quartic iteration runs without a bracket; a correction d with |d|
+# <= _SHORT_STEP_TOL |s| leaves an error ~(d/s)^4 <= 1e-18 relative, below
+# rounding, so s + d is taken as the root.  One iteration does at a
+# fiftieth of an orbit, two at a sixth; after _SHORT_STEP_ITER iterations
+# without that the bracketed solver starts again from the beginning.
+# Kepler's equation is increasing in s (its derivative is r > 0), so a small
+# correction means a nearby root.
 _SHORT_STEP = 1.0
 _SHORT_STEP_Z = 1.0
 _SHORT_STEP_TOL = 3e-5
@@ -174,7 +177,7 @@ def short_step_anomaly(mu, x0, y0, z0, vx0, vy0, vz0, dt):
 
     The first half of :func:`kepler_drift`'s short-step path (see there):
     for the relative state ``x0 .. vz0`` and a step ``dt`` with ``|dt| |v0|
-    < r0 / 2`` and less than a radian of eccentric anomaly, the root ``s``
+    < r0`` and less than a radian of eccentric anomaly, the root ``s``
     of the universal Kepler equation from the third-order Taylor starter
     and at most three unbracketed quartic iterations; with it ``r0``, ``1 /
     r0``, ``beta`` and ``zeta`` for :func:`advance_by_anomaly`.  ``s`` is
@@ -301,17 +304,17 @@ def kepler_drift(mu, x, v, i, dt):
     hyperbolae.  On an ellipse ``dt`` is first reduced modulo the period, so
     that a step of many periods costs no more than one.  The equation is
     solved by Danby's quartic iteration (Newton with the second and third
-    derivatives).  A step short against the orbit (``|dt| |v0| < r0 / 2``
-    and less than a radian of eccentric anomaly) starts from the Taylor
-    series ::
+    derivatives).  A step short against the orbit (``|dt| |v0| < r0`` and
+    less than a radian of eccentric anomaly) starts from the Taylor series ::
 
         s = w (1 - w eta / (2 r0) + w^2 (3 eta^2 / r0^2 - zeta / r0) / 6),  w = dt / r0
 
     (``ds/dt = 1/r``, ``d^2s/dt^2 = -eta / r^3``, ``d^3s/dt^3 = 3 eta^2 /
     r^5 - zeta / r^4``), whose error is of fourth order in the step, and
     stops as soon as a correction is below ``3e-5`` of ``s``, which leaves
-    ``(3e-5)^4`` after it: one iteration and two evaluations of the
-    Stumpff functions on the steps of a planetary integration.  Any other
+    ``(3e-5)^4`` after it: one or two iterations on the steps of a
+    planetary integration, with the Stumpff functions from four or nine
+    terms of their series.  Any other
     step, or a short one that has not converged in three iterations, is
     solved inside a bracket that shrinks with every residual evaluated, with
     bisection when an iterate would leave it; ``f`` is increasing in ``s``,

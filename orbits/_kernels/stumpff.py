@@ -4,10 +4,11 @@
 sqrt(z) / sqrt(z)``, ``c2 = (1 - c0) / z``, ``c3 = (1 - c1) / z`` (hyperbolic
 functions of ``sqrt(-z)`` for ``z < 0``), continuous through ``z = 0``.
 :func:`stumpff` is the general form; the Kepler drift (:mod:`.kepler`) takes
-the inlined short-step forms, the planets' and systems' lanes
-(:mod:`.wh_lanes`, :mod:`.wh_batch`) the branch-free :func:`stumpff_lane`, bit
-for bit the same inside its domain, and the drift's tangent
-(:mod:`.kepler_tangent`) ``c4`` and ``c5`` as well.
+the inlined short-step forms (four or nine terms of the series for the
+steps of a planetary integration), the planets' and systems' lanes
+(:mod:`.wh_lanes`, :mod:`.wh_batch`) the branch-free :func:`stumpff_lane`
+and :func:`stumpff_medium_lane`, bit for bit the same inside their domain,
+and the drift's tangent (:mod:`.kepler_tangent`) ``c4`` and ``c5`` as well.
 
 References
 ----------
@@ -193,8 +194,9 @@ def stumpff_lane(z, general):
     if not general:
         return e0, e1, e2, e3, True
     m0, m1, m2, m3 = _estrin_medium(z)
-    # stumpff: quarter until |z| <= 0.1 (masked), the seven-term series
-    # there, and the quarter-argument identities back
+    # beyond the nine-term series, stumpff: quarter until |z| <= 0.1
+    # (masked), the seven-term series there, and the quarter-argument
+    # identities back
     zq = z
     n = 0
     for _ in range(_LANE_QUARTERINGS):

@@ -53,10 +53,11 @@ select, never a branch per lane:
   while the others go on, as the scalar loop would have stopped there).
   The Stumpff functions take the same branch-free form: the four-term
   series everywhere and, only when some lane's argument is beyond it, the
-  seven-term series after a masked number of quarterings of the argument
-  (at most three, which covers ``|z| <= 4``).
+  nine-term series (``|z| <= 1``) and the seven-term series after a masked
+  number of quarterings of the argument (at most three, which covers ``|z|
+  <= 4``), each lane taking the scalar form's.
 * A lane outside that domain (a step long against its orbit, ``|dt| |v| >=
-  r / 2`` or more than a radian of eccentric anomaly; no convergence in
+  r`` or more than a radian of eccentric anomaly; no convergence in
   three iterations; a Stumpff argument beyond 4; a non-positive radius at
   the end) is drifted by the scalar
   :func:`~orbits._kernels.kepler.kepler_drift` on its own, from the same

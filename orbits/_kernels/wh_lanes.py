@@ -13,41 +13,52 @@ result back.
 
 :func:`kepler_drift_lanes` drifts every planet, bit for bit as
 :func:`~orbits._kernels.wisdom_holman.kepler_drift_all` does, in three
-passes over the columns (:func:`drift_columns`): the scalar drift's
-short-step path (:func:`~orbits._kernels.kepler.kepler_drift`: the
-third-order starter of the universal anomaly, one of Danby's quartic
-iterations, the f and g functions) with the four-term Stumpff series
-(:func:`~orbits._kernels.stumpff.stumpff_lane`).  This is the whole drift of
-a planetary step (a few hundredths of a radian of anomaly, where the
-starter is good to 1e-6 and one iteration converges), and passes over all
-the planets let the processor overlap their long chains of dependent
-operations, which the scalar drift, one planet after another, cannot (see
-"three passes" below).  A
-lane is taken where the scalar path would have done exactly this
-(converged after one iteration, both Stumpff arguments within the
-four-term series, a positive radius at the end).  Every other planet (a
-step long against its orbit, more than 0.045 rad of eccentric anomaly, a
-high eccentricity near pericentre, a hyperbola close in) is drifted by the
-scalar :func:`~orbits._kernels.kepler.kepler_drift` from the same start,
-which is what the scalar loop does for it too.  So no accuracy is lost, and
-the results are those of the scalar loop bit for bit: fastmath is off, so
-LLVM neither reorders nor fuses the operations, and a vector instruction
-rounds each lane as its scalar form does.  The fused multiply-adds of the
-shared Kepler helpers (:func:`orbits._kernels._jit.fma`, correctly rounded
-on every machine) are written out, so the scalar drift has them too; with
+passes over the columns: the scalar drift's short-step path
+(:func:`~orbits._kernels.kepler.kepler_drift`: the third-order starter of
+the universal anomaly, Danby's quartic iterations, the f and g functions),
+and passes over all the planets let the processor overlap their long chains
+of dependent operations, which the scalar drift, one planet after another,
+cannot (see "three passes" below).  The passes come in two forms:
+
+* the short-step passes (:func:`drift_columns`): one iteration and the
+  four-term Stumpff series (:func:`~orbits._kernels.stumpff.stumpff_lane`),
+  the whole drift of a short step (a few hundredths of a radian of anomaly,
+  where the starter is good to 1e-6 and one iteration converges);
+* the medium passes (:func:`medium_columns`), for the steps people take
+  with Wisdom-Holman (a twentieth of the innermost period, up to a radian of
+  an orbit): up to two iterations, each lane with the four- or the nine-term
+  series (:func:`~orbits._kernels.stumpff.stumpff_medium_lane`), both made
+  in every lane and the scalar path's taken by a select.  They cost about
+  1.5 times the short passes, and run where the short ones declined a
+  planet, and then first for the next :data:`RETRY` drifts (row
+  :data:`MEMO`, column 1), as a scene whose step is long for some planet
+  declines it at every step.
+
+A lane is taken where the scalar path would have done exactly what its
+passes did (converged after the iterations they make, every Stumpff
+argument within their series, a positive radius at the end).  Every other
+planet (a step of more than a radian of its orbit, a high eccentricity near
+pericentre, a hyperbola close in) is drifted by the scalar
+:func:`~orbits._kernels.kepler.kepler_drift` from the same start, which is
+what the scalar loop does for it too.  So no accuracy is lost, and the
+results are those of the scalar loop bit for bit: fastmath is off, so LLVM
+neither reorders nor fuses the operations, and a vector instruction rounds
+each lane as its scalar form does.  The fused multiply-adds of the shared
+Kepler helpers (:func:`orbits._kernels._jit.fma`, correctly rounded on
+every machine) are written out, so the scalar drift has them too; with
 them the drift's chains are shorter.
 
-The lanes hold the short-step path's single pass, and the planets it
-declines go to the scalar drift: a masked form of the whole path (the
-iteration repeated until every lane has converged, the general Stumpff form
-with a masked number of quarterings, as :mod:`orbits._kernels.wh_batch`
-does) is slower than the scalar drift where a step is long for some planets
-(the Sun and eight planets at 1 or 4 days), as the general Stumpff form then
-costs every lane (benchmarks/RESULTS.md).  Where more than a quarter of the
-planets are declined, an output's synchronising drift leaves the drift
-to the scalar code for :data:`RETRY` drifts before trying the lanes again
-(:data:`MEMO`; ``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`);
-the steps' drift of the state kept in the lanes always tries them.
+A masked form of the whole path (the iteration repeated until every lane
+has converged, the general Stumpff form with a masked number of
+quarterings, as :mod:`orbits._kernels.wh_batch` does) is slower than the
+scalar drift where a step is long for some planets, as the general Stumpff
+form then costs every lane (benchmarks/RESULTS.md); the medium passes'
+fixed polynomial and two iterations cover the planetary steps without it.
+Where more than a quarter of the planets are declined, an output's
+synchronising drift leaves the drift to the scalar code for :data:`RETRY`
+drifts before trying the lanes again (row :data:`MEMO`, column 0;
+``_lanes_drift`` in :mod:`orbits._kernels.wisdom_holman`); the steps'
+drift of the state kept in the lanes always tries them.
 
 The interaction kick's pulls
 (:func:`orbits._kernels.gravity.pull_rows`) go to the lanes as well: one
@@ -111,13 +122,14 @@ __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns
 
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
-#: the verdict, a memo for the caller (:data:`MEMO`), each column's step, and
+#: the verdict, memos (:data:`MEMO`), each column's step, and
 #: an output the loop has yet to finish (:data:`PENDING`)
 DRIFT_ROWS = 17
 _X, _MU, _Y, _TAKE = 0, 6, 7, 13
-#: the scratch's row whose column 0 the loop keeps from drift to drift (see
-#: orbits._kernels.wisdom_holman._lanes_drift): the drifts left before the
-#: lanes are tried again after they declined too many planets
+#: the scratch's row whose first columns are kept from drift to drift:
+#: column 0 (orbits._kernels.wisdom_holman._lanes_drift) the drifts left
+#: before the lanes are tried again after they declined too many planets,
+#: column 1 the drifts left that go straight to the medium passes
 MEMO = 14
 _H = 15
 #: the scratch's row where the loop notes an output due at the end of a step
@@ -128,7 +140,8 @@ PENDING = 16
 #: drifts that the loop leaves to the scalar drift after the lanes have
 #: declined more than a quarter of the planets (a scene whose steps are long
 #: against several orbits, where the lanes would be wasted every time),
-#: before it tries them again
+#: before it tries them again; and drifts that go straight to the medium
+#: passes after the short ones declined a planet
 RETRY = 64
 
 
@@ -408,11 +421,20 @@ _pass_rows_one = specialize(_pass_rows, "one_step", inline=True, step_of=_one_st
 _pass_rows_steps = specialize(_pass_rows, "column_steps", inline=True, step_of=_column_step)
 
 
+@njit
+def _medium_scratch(S, h0, column_steps, P):
+    # medium_columns over the drift's rows of the scratch (_X .., _MU, _Y ..,
+    # _TAKE); not inlined, so that one compilation serves every loop
+    return medium_columns(S, _X, _MU, _Y, _TAKE, _T, h0, column_steps, P)
+
+
 @njit(inline="always")
-def _medium_pass(S, src, mu, dst, take, h0, column_steps, P):
-    # medium_columns over every column of the scratch's rows src .. (start),
-    # mu, dst .. (end) and take
-    return medium_columns(S, src, mu, dst, take, _T, h0, column_steps, np.uint64(P))
+def _medium_resident(S, h, P):
+    # medium_columns over the rows of the state kept in the lanes (_RX ..,
+    # _RMU, _RY .., _RTAKE), inlined into the steps' drift: called there, it
+    # made the outer solar system's step at 216.6 days 0.36 us against 0.23
+    # (benchmarks/RESULTS.md); the outputs' drifts call _medium_scratch
+    return medium_columns(S, _RX, _RMU, _RY, _RTAKE, _T, h, False, P)
 
 
 @njit(inline="always")
@@ -432,13 +454,13 @@ def _single_pass(S, h0, P):
     # every column of the scratch by the step h0: the short-step passes, and
     # the medium ones where those declined a planet (_medium_first)
     if _medium_first(S):
-        return _medium_pass(S, _X, _MU, _Y, _TAKE, h0, False, P)
+        return _medium_scratch(S, h0, False, P)
     rejected = _pass_rows_one(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
                               S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
                               S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
     if rejected:
         S[MEMO, 1] = RETRY
-        rejected = _medium_pass(S, _X, _MU, _Y, _TAKE, h0, False, P)
+        rejected = _medium_scratch(S, h0, False, P)
     return rejected
 
 
@@ -446,13 +468,13 @@ def _single_pass(S, h0, P):
 def _single_pass_steps(S, h0, P):
     # every column of the scratch by its own step (row _H), as _single_pass
     if _medium_first(S):
-        return _medium_pass(S, _X, _MU, _Y, _TAKE, h0, True, P)
+        return _medium_scratch(S, h0, True, P)
     rejected = _pass_rows_steps(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
                                 S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
                                 S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
     if rejected:
         S[MEMO, 1] = RETRY
-        rejected = _medium_pass(S, _X, _MU, _Y, _TAKE, h0, True, P)
+        rejected = _medium_scratch(S, h0, True, P)
     return rejected
 
 
@@ -567,7 +589,7 @@ def resident_drift(xj, vj, eta, h, S):
     n = xj.shape[0]
     P = lane_columns(n)
     if _medium_first(S):
-        rejected = _medium_pass(S, _RX, _RMU, _RY, _RTAKE, h, False, np.uint64(P))
+        rejected = _medium_resident(S, h, np.uint64(P))
     else:
         rejected = drift_columns(S[_RX], S[_RX + 1], S[_RX + 2], S[_RX + 3], S[_RX + 4],
                                  S[_RX + 5], S[_RMU], S[_RY], S[_RY + 1], S[_RY + 2],
@@ -575,7 +597,7 @@ def resident_drift(xj, vj, eta, h, S):
                                  np.uint64(0), np.uint64(P))
         if rejected:
             S[MEMO, 1] = RETRY
-            rejected = _medium_pass(S, _RX, _RMU, _RY, _RTAKE, h, False, np.uint64(P))
+            rejected = _medium_resident(S, h, np.uint64(P))
     declined = 0
     if rejected:
         declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)

@@ -17,7 +17,7 @@ from orbits._kernels.anomalies import true_from_mean
 from orbits._kernels.elements import elements_to_state
 from orbits._kernels.invariants import MONITOR_WIDTH
 from orbits._kernels.status import Status
-from orbits._kernels.stumpff import _stumpff_short
+from orbits._kernels.stumpff import _stumpff_short, stumpff_medium_lane
 
 # the 50-digit drift of the scalar Kepler tests (bisection on the universal
 # Kepler equation in mpmath)
@@ -167,6 +167,23 @@ def test_stumpff_lanes_are_the_scalar_stumpff_functions_bit_for_bit(sign):
             assert c == list(_stumpff_short(z)), z
     for z in (np.nextafter(4.0, 5), 10.0, -10.0):
         assert not W._stumpff_lane(z, True)[-1]     # beyond 4: the scalar drift
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_the_medium_lanes_stumpff_functions_are_the_scalar_ones_bit_for_bit(sign):
+    # the four-term and the nine-term series of stumpff._stumpff_short and
+    # the boundaries between them, taken without a branch (the planets'
+    # medium passes, orbits._kernels.wh_lanes)
+    for z in ZS + [0.7, np.nextafter(1.0, 0)]:
+        z = sign * z
+        if abs(z) > 1.0:
+            assert not stumpff_medium_lane(z)[-1], z       # beyond: the scalar drift
+            continue
+        *c, inside = stumpff_medium_lane(z)
+        assert inside
+        assert c == list(_stumpff_short(z)), z
+    assert not stumpff_medium_lane(sign * np.nextafter(1.0, 2))[-1]
+    assert not stumpff_medium_lane(np.nan)[-1]
 
 
 def systems(b, scale=1e-7, monitors=()):
