@@ -88,7 +88,7 @@ def notice(label):
     --------
     >>> from orbits._compiling import notice
     >>> notice("wh")
-    'orbits: compiling the wh loop for this CPU, once (about 31 s; `orbits compile` does it ahead)'
+    'orbits: compiling the wh loop for this CPU, once (about 41 s; `orbits compile` does it ahead)'
     """
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
