@@ -19,10 +19,16 @@ by an adaptive 8th-order Runge-Kutta method (Dormand & Prince's DOP853, with
 the error measured per body, relative to its position and speed in the
 group's own frame), in coordinates relative to the group's first body, so
 that a pass at 1e-8 au keeps its separation to 1e-16 relative.  A body whose
-heliocentric distance falls below ``k_peri (G m_0 h^2)^(1/3)`` (the radius at
-which the circular orbit turns one radian in a step) flags a close pericentre
-passage: the whole segment is then integrated, all bodies and all pulls, in
-inertial coordinates by the same method.
+step is long against its time scale about the central body flags a close
+pericentre passage, ``k_peri^2 h^2 ((v^2 + 3 rdot^2) / r^2 + G m_0 / r^3) >
+1`` (heliocentric distance ``r``, speed ``v`` and radial speed ``rdot``:
+the central pull's jerk over its size, ``sqrt(v^2 + 3 rdot^2) / r``, and
+the Kepler rate at the distance; a body falling straight in is flagged
+further out than one passing at the same distance, as in the time scale of
+Pham, Rein & Spiegel 2024 that the TRACE paper's criterion uses): the whole
+segment is then integrated, all bodies and all pulls, in inertial
+coordinates by the same method.  The criterion is even in the velocities, so
+a step and its reverse see the same flags.
 
 Where the criterion is evaluated.  The map is the Wisdom-Holman map of
 :mod:`.wisdom_holman`, ``K(h/2) [J(h/2) I(h) J(h/2)] K(h/2)`` a step, with the
@@ -96,27 +102,33 @@ _EPS = 2.220446049250313e-16
 
 
 @njit(inline="always")
-def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, r_peri, enc):
+def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, k_peri, enc):
     """Flag the pairs in a close encounter and say whether a pericentre is close.
 
     ``enc`` (uint8, shape (N, N)) gets 1 at ``[i, j]`` (``i > j >= 1``) for a
     flagged pair, 0 elsewhere below the diagonal; ``hill[i] = (m_i / 3
     m_0)^(1/3)``; ``r2`` (N,) is scratch (the squared heliocentric
-    distances).  Returns ``(pairs flagged, 1 if a body is closer to the
-    central one than r_peri)``.  Square roots and cube roots are taken only
+    distances).  Returns ``(pairs flagged, 1 if a body's step is long
+    against its time scale about the central one)``: ``k_peri^2 h^2 ((v^2 +
+    3 rdot^2) / r^2 + G m_0 / r^3) > 1`` (see the module notes; ``k_peri``
+    0 flags none).  Square roots and cube roots are taken only
     for the pairs that a bound on the switching radius leaves in doubt, so
     that a system far from encounters pays a few multiplications a pair.
     """
     n = xh.shape[0]
     peri = 0
-    rp2 = r_peri * r_peri
+    kp2 = (k_peri * h) ** 2
     vmax2 = 0.0
     for i in range(1, n):
         ri2 = xh[i, 0] * xh[i, 0] + xh[i, 1] * xh[i, 1] + xh[i, 2] * xh[i, 2]
         r2[i] = ri2
-        if ri2 < rp2:
+        vi2 = vb[i, 0] * vb[i, 0] + vb[i, 1] * vb[i, 1] + vb[i, 2] * vb[i, 2]
+        rv = xh[i, 0] * vb[i, 0] + xh[i, 1] * vb[i, 1] + xh[i, 2] * vb[i, 2]
+        # (v^2 + 3 rdot^2) / r^2 + G m_0 / r^3, with rdot^2 = (x . v)^2 / r^2
+        rate2 = (vi2 + 3.0 * rv * rv / ri2) / ri2 + gm[0] / (ri2 * math.sqrt(ri2))
+        if kp2 * rate2 > 1.0:
             peri = 1
-        vmax2 = max(vmax2, vb[i, 0] * vb[i, 0] + vb[i, 1] * vb[i, 1] + vb[i, 2] * vb[i, 2])
+        vmax2 = max(vmax2, vi2)
     count = 0
     kv = k_speed * abs(h)
     kv2 = kv * kv
@@ -607,7 +619,6 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
     n = xh.shape[0]
     every = mon[0]
     n_mon = 0
-    r_peri = k_peri * (gm[0] * dt * dt) ** (1.0 / 3.0)
     if state[0] == 0:
         to_democratic_heliocentric(x, v, gm, xh, vb)
         _copy(xh, xc)
@@ -616,7 +627,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
         state[2] = 0
         owed_box[0] = 0.0
         npairs, peri = _criterion_call(xh, vb, gm, hill, r2, n_active, k_hill, k_speed,
-                                 dt, r_peri, enc)
+                                 dt, k_peri, enc)
         state[3] = peri
         state[4] = 1 if npairs > 0 else 0
     owed = owed_box[0]
@@ -659,7 +670,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                 if HAS_TERMS:
                     term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
             npairs, peri_end = criterion(xh, vs, gm, hill, r2, n_active, k_hill,
-                                         k_speed, dt, r_peri, enc_new)
+                                         k_speed, dt, k_peri, enc_new)
             grew = npairs > 0 and _new_flags(enc, enc_new, n, n_active)
             if (grew or (peri_end and not peri)) and redo < MAX_REDO:
                 # the end flags what the start did not: the segment again from

@@ -24,15 +24,17 @@ HILL = 3.0
 #: fast for the Hill criterion to see at a step's end (it could cross the Hill
 #: sphere within one step) is flagged before it arrives.
 SPEED = 1.0
-#: A body closer to the central one than ``PERICENTRE (G m_0 h^2)^(1/3)`` makes
-#: the segment be integrated whole by the inner integrator: the jump's and the
-#: kicks' error grows as the Kepler time scale at the body falls towards the
-#: step.  2 flags a body whose circular orbit at its distance would take
-#: fewer than 18 steps: Jupiter's perihelion at P_J/20 (the usual
-#: Wisdom-Holman step) stays outside, and a sungrazing comet's energy error
-#: falls by more than three orders of magnitude against no criterion
-#: (benchmarks/RESULTS.md has the sweep of this factor).
-PERICENTRE = 2.0
+#: A body whose step is long against its time scale about the central one,
+#: ``PERICENTRE^2 h^2 ((v^2 + 3 rdot^2) / r^2 + G m_0 / r^3) > 1``, makes the
+#: segment be integrated whole by the inner integrator: the jump's and the
+#: kicks' error grows as that time scale falls towards the step.  1.5 flags a
+#: circular orbit turning more than 0.47 rad a step, and a body falling
+#: straight in further out: Mercury's perihelion at a twentieth of its
+#: period (the usual Wisdom-Holman step) stays outside, a sungrazing
+#: comet's energy error falls by more than two orders of magnitude against
+#: no criterion, and a radial plunge's is REBOUND's TRACE's to a factor of
+#: 2.4 (benchmarks/RESULTS.md has the sweep of this factor).
+PERICENTRE = 1.5
 #: The inner integrator's relative tolerance per step, per body, in the
 #: group's own frame (DOP853's error estimate): the stress suite's close
 #: encounters end with energy errors of at most about 1e-10 at it
@@ -63,9 +65,14 @@ class Trace(Integrator):
         closer than ``speed |v_i - v_j| |dt|`` is also in one (fast flybys).
         0 switches the term off.
     pericentre : float
-        A body closer to the central one than ``pericentre (G m_0
-        dt^2)^(1/3)`` makes the whole segment be integrated by the adaptive
-        integrator (default 2; 0 switches it off).
+        A body whose step is longer than ``1 / pericentre`` of its time
+        scale about the central one, ``pericentre^2 dt^2 ((v^2 + 3 rdot^2) /
+        r^2 + G m_0 / r^3) > 1`` (heliocentric distance, speed and radial
+        speed), makes the whole segment be integrated by the adaptive
+        integrator (default 1.5: a circular orbit turning more than 0.47 rad
+        a step, a body falling straight in from further out; Mercury's
+        perihelion at a twentieth of its period is not flagged; 0 switches
+        it off).
     rtol : float
         Relative tolerance of the adaptive integrator per step (default
         1e-12), measured per body in the frame of its group of encountering
@@ -90,7 +97,7 @@ class Trace(Integrator):
     integrates the bodies of each group of flagged pairs (Kepler motion plus
     their flagged pulls) with DOP853 in coordinates relative to the group's
     first body; the other bodies keep their Kepler drifts.  A body within the
-    pericentre radius of the central one makes the segment be integrated
+    pericentre criterion makes the segment be integrated
     whole (every body and every pull, inertial coordinates).  The criterion
     is evaluated again at the segment's end; if it flags something the start
     did not, the segment is redone from its start with the union flagged, so
@@ -170,9 +177,9 @@ class Trace(Integrator):
                sign="positive"),
         Option("speed", float, SPEED, "switching radius in steps of relative motion "
                "(0: off)", sign="non-negative"),
-        Option("pericentre", float, PERICENTRE, "a body closer to the central one than "
-               "pericentre (G m_0 dt^2)^(1/3) makes the segment be integrated whole "
-               "(0: off)", sign="non-negative"),
+        Option("pericentre", float, PERICENTRE, "a body whose step is longer than "
+               "1/pericentre of its time scale about the central one makes the segment "
+               "be integrated whole (0: off)", sign="non-negative"),
         Option("rtol", float, RTOL, "relative tolerance of the encounter integrator's step",
                sign="positive"),
     )
