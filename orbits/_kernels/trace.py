@@ -75,6 +75,7 @@ from .gravity import pair_accelerations, pull_pair, zero_rows
 from .status import Status
 from .stepping import (GO, _record, accept_fsal, dop853_error, epilogue, first_record,
                        stage_errors)
+from .wh_lanes import kepler_drift_lanes, lanes_scratch
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 # the names the templates below are written against, bound by specialize
@@ -416,7 +417,7 @@ def inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol):
     their integration with the group's pulls.  Returns False if the inner
     integrator failed (step-size underflow)."""
     A, b, c, e5, e3 = tabs
-    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts = inner
+    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts, _ = inner
     n = xh.shape[0]
     groups = _groups(enc, n, n_active, label)
     # the groups' starting rows, before the Kepler drift moves them
@@ -462,7 +463,7 @@ def exact_flow(xh, vb, gm, n_active, enc, h, x, v, inner, tabs, rtol):
     """Every body and every pull over ``h`` by the inner integrator, in inertial
     coordinates (a close pericentre passage); ``x``, ``v`` are scratch."""
     A, b, c, e5, e3 = tabs
-    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts = inner
+    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts, _ = inner
     n = xh.shape[0]
     from_democratic_heliocentric(xh, vb, gm, x, v)
     for i in range(n):
@@ -488,7 +489,12 @@ def _drift(xh, vb, gm, eta, n_active, enc, flagged, peri, h, w1, w2, x, v, inner
         return exact_flow(xh, vb, gm, n_active, enc, h, x, v, inner, tabs, rtol)
     if flagged:
         return inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol)
-    kepler_drift_all(xh, vb, eta, h, w1, w2)
+    S = inner.lanes[0]
+    if S.shape[1] > 0:
+        # the planets in vector lanes, bit for bit kepler_drift_all
+        kepler_drift_lanes(xh, vb, eta, h, S)
+    else:
+        kepler_drift_all(xh, vb, eta, h, w1, w2)
     return True
 
 
@@ -574,7 +580,11 @@ class Inner(NamedTuple):
     group ``label``, a group's rows ``idx``, the DOP853 stages ``ky``,
     ``ku``, the group's state ``y``, ``u`` and step result ``y1``, ``u1``,
     the rows at the segment's start ``ys``, ``us``, the step memory
-    ``hbox[0]`` and ``counts`` (segments with flags, redos, inner steps)."""
+    ``hbox[0]`` and ``counts`` (segments with flags, redos, inner steps);
+    and, as a tuple of one array (scratch, not part of the state a
+    checkpoint saves), the scratch of the planets' drift in vector lanes
+    ``lanes`` (:func:`~orbits._kernels.wh_lanes.lanes_scratch`; no columns
+    where the drift is the scalar one)."""
     label: np.ndarray
     idx: np.ndarray
     ky: np.ndarray
@@ -587,6 +597,7 @@ class Inner(NamedTuple):
     us: np.ndarray
     hbox: np.ndarray
     counts: np.ndarray
+    lanes: tuple
 
 
 def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, checks, check, ahead,
@@ -800,10 +811,12 @@ def trace_loop(record=_record, terms=None):
                       step_end=epilogue(record, key, cache=cache, runtime=not cache))
 
 
-def inner_arrays(n, stages):
+def inner_arrays(n, stages, lanes=False):
     """The inner integrator's arrays (:class:`Inner`) for ``n`` bodies and a
-    method of ``stages`` stages."""
+    method of ``stages`` stages; ``lanes``: the drift's planets in vector
+    lanes."""
     return Inner(np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
                  np.zeros((stages + 1, n, 3)), np.zeros((stages + 1, n, 3)),
                  np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)),
-                 np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(1), np.zeros(3, dtype=np.int64))
+                 np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(1), np.zeros(3, dtype=np.int64),
+                 (lanes_scratch(n) if lanes else np.zeros((1, 0)),))

@@ -10,6 +10,7 @@ from .._kernels.status import with_status
 from .._kernels.stopping import ahead_pointer, stop_record
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
+from . import wisdom_holman
 from .base import RTOL_FLOOR, Integrator, Option
 from .wisdom_holman import refuse_unkickable, split_gravity
 
@@ -27,14 +28,14 @@ SPEED = 1.0
 #: A body whose step is long against its time scale about the central one,
 #: ``PERICENTRE^2 h^2 ((v^2 + 3 rdot^2) / r^2 + G m_0 / r^3) > 1``, makes the
 #: segment be integrated whole by the inner integrator: the jump's and the
-#: kicks' error grows as that time scale falls towards the step.  1.5 flags a
-#: circular orbit turning more than 0.47 rad a step, and a body falling
-#: straight in further out: Mercury's perihelion at a twentieth of its
-#: period (the usual Wisdom-Holman step) stays outside, a sungrazing
-#: comet's energy error falls by more than two orders of magnitude against
-#: no criterion, and a radial plunge's is REBOUND's TRACE's to a factor of
-#: 2.4 (benchmarks/RESULTS.md has the sweep of this factor).
-PERICENTRE = 1.5
+#: kicks' error grows as that time scale falls towards the step.  1 flags a
+#: circular orbit turning more than 0.71 rad a step, and a body falling
+#: straight in from further out: Mercury's perihelion at a twentieth or a
+#: fifteenth of its period (the usual Wisdom-Holman steps) stays outside,
+#: and a sungrazing comet's energy error falls by three orders of magnitude
+#: against no criterion (benchmarks/RESULTS.md has the sweep of this
+#: factor).
+PERICENTRE = 1.0
 #: The inner integrator's relative tolerance per step, per body, in the
 #: group's own frame (DOP853's error estimate): the stress suite's close
 #: encounters end with energy errors of at most about 1e-10 at it
@@ -69,9 +70,9 @@ class Trace(Integrator):
         scale about the central one, ``pericentre^2 dt^2 ((v^2 + 3 rdot^2) /
         r^2 + G m_0 / r^3) > 1`` (heliocentric distance, speed and radial
         speed), makes the whole segment be integrated by the adaptive
-        integrator (default 1.5: a circular orbit turning more than 0.47 rad
+        integrator (default 1: a circular orbit turning more than 0.71 rad
         a step, a body falling straight in from further out; Mercury's
-        perihelion at a twentieth of its period is not flagged; 0 switches
+        perihelion at a fifteenth of its period is not flagged; 0 switches
         it off).
     rtol : float
         Relative tolerance of the adaptive integrator per step (default
@@ -209,7 +210,8 @@ class Trace(Integrator):
         ((3, 3), [0, 0, 0])
         """
         stages = len(_dop853.B)
-        inner = _trace.inner_arrays(n, stages)
+        # the drift's planets in vector lanes from as many bodies as wh's
+        inner = _trace.inner_arrays(n, stages, lanes=n >= wisdom_holman.LANES_FROM_BODIES)
         return {"xh": np.zeros((n, 3)), "vb": np.zeros((n, 3)),
                 "xc": np.zeros((n, 3)), "vc": np.zeros((n, 3)),
                 "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3)), "acc": np.zeros((n, 3)),

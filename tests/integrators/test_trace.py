@@ -129,7 +129,7 @@ def test_close_pericentre_is_integrated_whole():
     # Kepler drift is exact but its jump and kicks are not at a time scale
     # below the step (energy error 2e-3, measured, as trace without the
     # criterion); the default criterion integrates those segments whole:
-    # measured 5.5e-6 (1.2e-5 with pericentre=1, 2.2e-6 with 2)
+    # measured 2.2e-6 (1.2e-6 with pericentre=1.5, 7e-7 with 2)
     sim, res = _run(_comet(), "trace", 1 * u.day, 10 * u.yr, outputs=11)
     _, off = _run(_comet(), orbits.integrators.get("trace", pericentre=0.0), 1 * u.day,
                   10 * u.yr, outputs=11)
@@ -139,12 +139,12 @@ def test_close_pericentre_is_integrated_whole():
 
 
 def test_the_inner_planets_perihelia_at_the_users_step_are_not_flagged():
-    # the Sun and eight planets at a twentieth of Mercury's period: at its
-    # perihelion the step is 0.66 of its time scale about the Sun (measured
-    # 0 segments flagged in 30), below the default criterion's 1 / 1.5; a
-    # step of a fifth of the period flags it (30 of 30)
+    # the Sun and eight planets at a twentieth and a fifteenth of Mercury's
+    # period: at its perihelion the step is 0.66 and 0.88 of its time scale
+    # about the Sun, below the default criterion's 1 (measured 0 segments
+    # flagged of 30); a step of a fifth of the period flags it (30 of 30)
     bodies = orbits.scenes.solar_system(moon=False)
-    for days, flagged in ((4.398, False), (17.6, True)):
+    for days, flagged in ((4.398, False), (5.865, False), (17.6, True)):
         sim = orbits.Simulation(bodies, "trace", dt=days * u.day, monitors=())
         sim.run(until=30 * days * u.day, progress=False)
         assert (sim._ws["counts"][0] > 0) == flagged, days
