@@ -75,7 +75,6 @@ from .gravity import pair_accelerations, pull_pair, zero_rows
 from .status import Status
 from .stepping import (GO, _record, accept_fsal, dop853_error, epilogue, first_record,
                        stage_errors)
-from .wh_lanes import kepler_drift_lanes, lanes_scratch
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 # the names the templates below are written against, bound by specialize
@@ -119,15 +118,18 @@ def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, k_peri, enc):
     n = xh.shape[0]
     peri = 0
     kp2 = (k_peri * h) ** 2
+    kg2 = (kp2 * gm[0]) ** 2
     vmax2 = 0.0
     for i in range(1, n):
         ri2 = xh[i, 0] * xh[i, 0] + xh[i, 1] * xh[i, 1] + xh[i, 2] * xh[i, 2]
         r2[i] = ri2
         vi2 = vb[i, 0] * vb[i, 0] + vb[i, 1] * vb[i, 1] + vb[i, 2] * vb[i, 2]
         rv = xh[i, 0] * vb[i, 0] + xh[i, 1] * vb[i, 1] + xh[i, 2] * vb[i, 2]
-        # (v^2 + 3 rdot^2) / r^2 + G m_0 / r^3, with rdot^2 = (x . v)^2 / r^2
-        rate2 = (vi2 + 3.0 * rv * rv / ri2) / ri2 + gm[0] / (ri2 * math.sqrt(ri2))
-        if kp2 * rate2 > 1.0:
+        # kp2 ((v^2 + 3 rdot^2) / r^2 + G m_0 / r^3) > 1 with rdot = x . v / r,
+        # times r^4 and without a root: d = r^4 - kp2 (v^2 r^2 + 3 (x . v)^2)
+        # <= 0, or kp2 G m_0 r > d, that is (kp2 G m_0)^2 r^2 > d^2
+        d = ri2 * ri2 - kp2 * (vi2 * ri2 + 3.0 * rv * rv)
+        if d <= 0.0 or kg2 * ri2 > d * d:
             peri = 1
         vmax2 = max(vmax2, vi2)
     count = 0
@@ -417,7 +419,7 @@ def inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol):
     their integration with the group's pulls.  Returns False if the inner
     integrator failed (step-size underflow)."""
     A, b, c, e5, e3 = tabs
-    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts, _ = inner
+    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts = inner
     n = xh.shape[0]
     groups = _groups(enc, n, n_active, label)
     # the groups' starting rows, before the Kepler drift moves them
@@ -463,7 +465,7 @@ def exact_flow(xh, vb, gm, n_active, enc, h, x, v, inner, tabs, rtol):
     """Every body and every pull over ``h`` by the inner integrator, in inertial
     coordinates (a close pericentre passage); ``x``, ``v`` are scratch."""
     A, b, c, e5, e3 = tabs
-    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts, _ = inner
+    label, idx, ky, ku, y, u, y1, u1, ys, us, hbox, counts = inner
     n = xh.shape[0]
     from_democratic_heliocentric(xh, vb, gm, x, v)
     for i in range(n):
@@ -489,12 +491,7 @@ def _drift(xh, vb, gm, eta, n_active, enc, flagged, peri, h, w1, w2, x, v, inner
         return exact_flow(xh, vb, gm, n_active, enc, h, x, v, inner, tabs, rtol)
     if flagged:
         return inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol)
-    S = inner.lanes[0]
-    if S.shape[1] > 0:
-        # the planets in vector lanes, bit for bit kepler_drift_all
-        kepler_drift_lanes(xh, vb, eta, h, S)
-    else:
-        kepler_drift_all(xh, vb, eta, h, w1, w2)
+    kepler_drift_all(xh, vb, eta, h, w1, w2)
     return True
 
 
@@ -580,11 +577,7 @@ class Inner(NamedTuple):
     group ``label``, a group's rows ``idx``, the DOP853 stages ``ky``,
     ``ku``, the group's state ``y``, ``u`` and step result ``y1``, ``u1``,
     the rows at the segment's start ``ys``, ``us``, the step memory
-    ``hbox[0]`` and ``counts`` (segments with flags, redos, inner steps);
-    and, as a tuple of one array (scratch, not part of the state a
-    checkpoint saves), the scratch of the planets' drift in vector lanes
-    ``lanes`` (:func:`~orbits._kernels.wh_lanes.lanes_scratch`; no columns
-    where the drift is the scalar one)."""
+    ``hbox[0]`` and ``counts`` (segments with flags, redos, inner steps)."""
     label: np.ndarray
     idx: np.ndarray
     ky: np.ndarray
@@ -597,7 +590,6 @@ class Inner(NamedTuple):
     us: np.ndarray
     hbox: np.ndarray
     counts: np.ndarray
-    lanes: tuple
 
 
 def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, checks, check, ahead,
@@ -811,12 +803,10 @@ def trace_loop(record=_record, terms=None):
                       step_end=epilogue(record, key, cache=cache, runtime=not cache))
 
 
-def inner_arrays(n, stages, lanes=False):
+def inner_arrays(n, stages):
     """The inner integrator's arrays (:class:`Inner`) for ``n`` bodies and a
-    method of ``stages`` stages; ``lanes``: the drift's planets in vector
-    lanes."""
+    method of ``stages`` stages."""
     return Inner(np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
                  np.zeros((stages + 1, n, 3)), np.zeros((stages + 1, n, 3)),
                  np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)),
-                 np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(1), np.zeros(3, dtype=np.int64),
-                 (lanes_scratch(n) if lanes else np.zeros((1, 0)),))
+                 np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(1), np.zeros(3, dtype=np.int64))

@@ -10,7 +10,6 @@ from .._kernels.status import with_status
 from .._kernels.stopping import ahead_pointer, stop_record
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
-from . import wisdom_holman
 from .base import RTOL_FLOOR, Integrator, Option
 from .wisdom_holman import refuse_unkickable, split_gravity
 
@@ -210,8 +209,7 @@ class Trace(Integrator):
         ((3, 3), [0, 0, 0])
         """
         stages = len(_dop853.B)
-        # the drift's planets in vector lanes from as many bodies as wh's
-        inner = _trace.inner_arrays(n, stages, lanes=n >= wisdom_holman.LANES_FROM_BODIES)
+        inner = _trace.inner_arrays(n, stages)
         return {"xh": np.zeros((n, 3)), "vb": np.zeros((n, 3)),
                 "xc": np.zeros((n, 3)), "vc": np.zeros((n, 3)),
                 "xs": np.zeros((n, 3)), "vs": np.zeros((n, 3)), "acc": np.zeros((n, 3)),
