@@ -28,11 +28,17 @@ cannot (see "three passes" below).  The passes come in two forms:
   with Wisdom-Holman (a twentieth of the innermost period, up to a radian of
   an orbit): up to two iterations, each lane with the four- or the nine-term
   series (:func:`~orbits._kernels.stumpff.stumpff_medium_lane`), both made
-  in every lane and the scalar path's taken by a select.  They cost about
-  1.5 times the short passes, and run where the short ones declined a
-  planet, and then first for the next :data:`RETRY` drifts (row
-  :data:`MEMO`, column 1), as a scene whose step is long for some planet
-  declines it at every step.
+  in every lane and the scalar path's taken by a select.  The steps' drift
+  of the state kept in the lanes (:func:`resident_drift`) takes them
+  always: a lane whose step is short takes the four-term series and keeps
+  the first iteration's anomaly, as the short passes would, so the loop
+  compiles one drift instead of two (5 s less on a first run) for 7-16 %
+  more time a step at the benchmark's short steps and a little less at the
+  users' steps (benchmarks/RESULTS.md).  The outputs' drifts
+  (:func:`kepler_drift_lanes`, :func:`resident_drift_twice`) take the short
+  passes, and the medium ones, compiled once, where those declined a planet,
+  then first for the next :data:`RETRY` drifts (row :data:`MEMO`, column
+  1).
 
 A lane is taken where the scalar path would have done exactly what its
 passes did (converged after the iterations they make, every Stumpff
@@ -583,21 +589,13 @@ def resident_store(S, xj, vj):
 @njit(inline="always")
 def resident_drift(xj, vj, eta, h, S):
     """:func:`kepler_drift_lanes` of the lanes' state (row 0 of ``xj`` in a
-    straight line); a declined planet goes to the scalar drift, with its row
-    of ``xj``, ``vj`` as scratch.  Returns how many planets were declined."""
+    straight line), by the medium passes alone (see the module notes); a
+    declined planet goes to the scalar drift, with its row of ``xj``, ``vj``
+    as scratch.  Returns how many planets were declined."""
     straight_drift(xj, vj, 0, h)
     n = xj.shape[0]
     P = lane_columns(n)
-    if _medium_first(S):
-        rejected = _medium_resident(S, h, np.uint64(P))
-    else:
-        rejected = drift_columns(S[_RX], S[_RX + 1], S[_RX + 2], S[_RX + 3], S[_RX + 4],
-                                 S[_RX + 5], S[_RMU], S[_RY], S[_RY + 1], S[_RY + 2],
-                                 S[_RY + 3], S[_RY + 4], S[_RY + 5], S[_RTAKE], S, _T, h,
-                                 np.uint64(0), np.uint64(P))
-        if rejected:
-            S[MEMO, 1] = RETRY
-            rejected = _medium_resident(S, h, np.uint64(P))
+    rejected = _medium_resident(S, h, np.uint64(P))
     declined = 0
     if rejected:
         declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)
