@@ -39,10 +39,10 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "lo
 FIRST_COMPILE_SECONDS = {
     "euler": 4.0, "symplectic-euler": 5.0, "verlet": 4.0, "leapfrog": 2.0,
     "rk2": 3.0, "rk4": 4.0, "yoshida4": 4.0, "yoshida6": 4.0, "yoshida8": 4.0,
-    "wh": 41.0, "wh democratic-heliocentric": 44.0,
-    "saba2": 41.0, "saba2 democratic-heliocentric": 44.0,
-    "saba3": 41.0, "saba3 democratic-heliocentric": 44.0,
-    "saba4": 41.0, "saba4 democratic-heliocentric": 44.0,
+    "wh": 41.0, "wh democratic-heliocentric": 36.0,
+    "saba2": 41.0, "saba2 democratic-heliocentric": 36.0,
+    "saba3": 41.0, "saba3 democratic-heliocentric": 36.0,
+    "saba4": 41.0, "saba4 democratic-heliocentric": 36.0,
     "dopri5": 5.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 9.0, "taylor": 6.0,
     "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 28.0,
 }
