@@ -230,15 +230,18 @@ def _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, h, zmax=_STUMPFF_SHORT_Z)
 
 
 @njit(inline="always")
+def _started(T, t, k):
+    # what the first pass kept of column k for the iterations: (s, r0, eta,
+    # beta, zeta)
+    return T[t, k], T[t + 1, k], T[t + 3, k], T[t + 4, k], T[t + 5, k]
+
+
+@njit(inline="always")
 def _iterate_column(T, t, k, h):
     # the second pass of column k's drift by h: one quartic iteration from
     # the first pass's rows, the new anomaly into row t + 7 of T and 1.0 where
     # it has converged into row t + 8
-    s = T[t, k]
-    r0 = T[t + 1, k]
-    et = T[t + 3, k]
-    beta = T[t + 4, k]
-    zeta = T[t + 5, k]
+    s, r0, et, beta, zeta = _started(T, t, k)
     z = beta * s * s
     c0, c1, c2, c3, _ = stumpff_lane(z, False)
     d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
@@ -249,9 +252,12 @@ def _iterate_column(T, t, k, h):
 
 
 @njit(inline="always")
-def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k):
+def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k,
+                   medium=False):
     # the third pass of column k's drift: the f and g functions of the
-    # iterated anomaly; 1 if the column is not right, else 0
+    # iterated anomaly, with the four-term Stumpff series (the medium passes:
+    # _stumpff_short's four- or nine-term); 1 if the column is not right,
+    # else 0
     mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
     s = T[t + 7, k]
     r0 = T[t + 1, k]
@@ -260,13 +266,16 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
     beta = T[t + 4, k]
     zeta = T[t + 5, k]
     z = beta * s * s
-    c0, c1, c2, c3, _ = stumpff_lane(z, False)
+    if medium:
+        c0, c1, c2, c3, inside = stumpff_medium_lane(z)
+    else:
+        c0, c1, c2, c3, _ = stumpff_lane(z, False)
+        inside = abs(z) <= _STUMPFF_SHORT_Z
     # (_advance's sigma is this et: the same expression of the start)
     _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, et, zeta, c1, c2)
     Y0[k], Y1[k], Y2[k], U0[k], U1[k], U2[k] = advanced_state(x0, y0, z0, vx0, vy0, vz0, fm1,
                                                               g, fdot, gdm1)
-    take = ((T[t + 6, k] != 0.0) & (T[t + 8, k] != 0.0) & (abs(z) <= _STUMPFF_SHORT_Z)
-            & (r > 0.0))
+    take = (T[t + 6, k] != 0.0) & (T[t + 8, k] != 0.0) & inside & (r > 0.0)
     tk_[k] = 1.0 if take else 0.0
     return 0 if take else 1
 
@@ -279,11 +288,7 @@ def _iterate_column_medium(T, t, k, h):
     # converged after the first keeps that anomaly (the scalar path stops
     # there).  Row t + 8: 1.0 where the anomaly kept has converged with every
     # Stumpff argument it used within the series
-    s = T[t, k]
-    r0 = T[t + 1, k]
-    et = T[t + 3, k]
-    beta = T[t + 4, k]
-    zeta = T[t + 5, k]
+    s, r0, et, beta, zeta = _started(T, t, k)
     c0, c1, c2, c3, in0 = stumpff_medium_lane(beta * s * s)
     d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
     s1 = s + d
@@ -295,24 +300,6 @@ def _iterate_column_medium(T, t, k, h):
     T[t + 7, k] = s1 if done1 else s2
     ok = in0 & (done1 | (in1 & done2))
     T[t + 8, k] = 1.0 if ok else 0.0
-
-
-@njit(inline="always")
-def _finish_column_medium(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, k):
-    # _finish_column with _stumpff_short's four- or nine-term series
-    mu, x0, y0, z0, vx0, vy0, vz0 = column_start(X0, X1, X2, V0, V1, V2, MU, k)
-    s = T[t + 7, k]
-    r0 = T[t + 1, k]
-    ir0 = T[t + 2, k]
-    et = T[t + 3, k]
-    zeta = T[t + 5, k]
-    c0, c1, c2, c3, inside = stumpff_medium_lane(T[t + 4, k] * s * s)
-    _, _, r, ir, fm1, g, fdot, gdm1 = f_and_g(mu, s, r0, ir0, et, zeta, c1, c2)
-    Y0[k], Y1[k], Y2[k], U0[k], U1[k], U2[k] = advanced_state(x0, y0, z0, vx0, vy0, vz0, fm1,
-                                                              g, fdot, gdm1)
-    take = (T[t + 6, k] != 0.0) & (T[t + 8, k] != 0.0) & inside & (r > 0.0)
-    tk_[k] = 1.0 if take else 0.0
-    return 0 if take else 1
 
 
 @njit(inline="always")
@@ -343,8 +330,8 @@ def medium_columns(S, src, mu, dst, take, t, h, column_steps, P):
         _iterate_column_medium(S, t, k, hk)
     rejected = 0
     for k in range(P):
-        rejected += _finish_column_medium(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2,
-                                          tk_, S, t, k)
+        rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, S,
+                                   t, k, True)
     return rejected
 
 
