@@ -117,7 +117,7 @@ from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, advanced_state, f_and_g, kepl
 from .stumpff import _STUMPFF_MEDIUM_Z, _STUMPFF_SHORT_Z, stumpff_lane, stumpff_medium_lane
 
 # the names the templates below are written against, bound by specialize
-step_of, = slots("step_of")
+step_of, short_passes, own_steps = slots("step_of", "short_passes", "own_steps")
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
            "lanes_scratch", "kepler_drift_lanes",
@@ -315,8 +315,7 @@ def medium_columns(S, src, mu, dst, take, t, h, column_steps, P):
     ``dst .. dst + 5``, the verdict ``take``, the passes' ``t .. t + 8``;
     each column's step is row :data:`_H`'s where ``column_steps``, else
     ``h``.  Returns how many of the ``P`` columns are left to the scalar
-    drift.  Not inlined: one compilation serves every loop, and it is called
-    only where the short passes declined a planet."""
+    drift."""
     X0, X1, X2, V0, V1, V2 = S[src], S[src + 1], S[src + 2], S[src + 3], S[src + 4], S[src + 5]
     Y0, Y1, Y2, U0, U1, U2 = S[dst], S[dst + 1], S[dst + 2], S[dst + 3], S[dst + 4], S[dst + 5]
     MU = S[mu]
@@ -442,35 +441,6 @@ def _medium_first(S):
     return False
 
 
-@njit(inline="always")
-def _single_pass(S, h0, P):
-    # every column of the scratch by the step h0: the short-step passes, and
-    # the medium ones where those declined a planet (_medium_first)
-    if _medium_first(S):
-        return _medium_scratch(S, h0, False, P)
-    rejected = _pass_rows_one(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
-                              S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
-                              S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
-    if rejected:
-        S[MEMO, 1] = RETRY
-        rejected = _medium_scratch(S, h0, False, P)
-    return rejected
-
-
-@njit(inline="always")
-def _single_pass_steps(S, h0, P):
-    # every column of the scratch by its own step (row _H), as _single_pass
-    if _medium_first(S):
-        return _medium_scratch(S, h0, True, P)
-    rejected = _pass_rows_steps(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
-                                S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
-                                S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
-    if rejected:
-        S[MEMO, 1] = RETRY
-        rejected = _medium_scratch(S, h0, True, P)
-    return rejected
-
-
 @njit
 def kepler_drift_lanes(xj, vj, mu, h, S):
     """:func:`~orbits._kernels.wisdom_holman.kepler_drift_all` with the
@@ -542,6 +512,28 @@ _RF = _RY
 _T = _R + 24
 #: rows of the scratch of a loop that keeps its state in the lanes
 SCRATCH_ROWS = _R + 33
+
+
+def _scratch_pass(S, h0, P):
+    # every column of the scratch by the step h0 (by its own, row _H, where
+    # own_steps): the short-step passes (short_passes, the _pass_rows of
+    # that step), and the medium ones where those declined a planet
+    # (_medium_first); specialised here, after the rows it names (_T)
+    if _medium_first(S):
+        return _medium_scratch(S, h0, own_steps, P)
+    rejected = short_passes(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
+                            S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
+                            S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
+    if rejected:
+        S[MEMO, 1] = RETRY
+        rejected = _medium_scratch(S, h0, own_steps, P)
+    return rejected
+
+
+_single_pass = specialize(_scratch_pass, "one_step", inline=True, short_passes=_pass_rows_one,
+                          own_steps=False)
+_single_pass_steps = specialize(_scratch_pass, "column_steps", inline=True,
+                                short_passes=_pass_rows_steps, own_steps=True)
 
 
 def lanes_scratch_shape(n):
