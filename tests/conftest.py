@@ -7,3 +7,33 @@ import pytest
 @pytest.fixture(scope="session")
 def rng():
     return np.random.default_rng(20261121)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _kernels_compile_once_per_type():
+    """After the session's tests: no kernel of the package was compiled twice
+    for argument types that differ only in constants.  numba types a
+    constant argument (``0``, ``True``) as a literal and compiles the callee
+    again for each constant it meets, as long as the first compilation; the
+    kernels pass constants to compiled functions with
+    ``orbits._kernels._jit.value``.  Fails at the session's end (as an error
+    in the last test's teardown), naming the kernel and its signatures."""
+    yield
+    import gc
+
+    from numba.core import types
+    from numba.core.registry import CPUDispatcher
+
+    twice = []
+    for obj in gc.get_objects():
+        if not issubclass(type(obj), CPUDispatcher):  # (not a weak proxy)
+            continue
+        if not getattr(obj.py_func, "__module__", "").startswith("orbits"):
+            continue
+        seen = {}
+        for sig in obj.signatures:
+            key = str(tuple(types.unliteral(a) for a in sig))
+            if key in seen:
+                twice.append(f"{obj.py_func.__qualname__}: {seen[key]} and {sig}")
+            seen[key] = sig
+    assert not twice, "compiled once per constant:\n" + "\n".join(twice)

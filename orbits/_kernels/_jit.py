@@ -26,6 +26,10 @@ compilation options are the same everywhere and can be changed once.
   they cost more than a kick with nothing to do (benchmarks/RESULTS.md).
   Without the runtime the loop cannot create arrays: numba refuses to
   compile one that tries.
+* :func:`value` hands a constant to a compiled (not inlined) function as a
+  value of its type: numba types a constant argument (``0``, ``True``, a
+  bound slot's flag) as a literal, and compiles the callee once for each
+  constant it meets, each a compilation as long as the first.
 * :mod:`._inlining` makes numba's ``inline="always"`` quicker to compile
   (each inlined function's front end once, and one copy of its scope per
   copy of its IR): the same code, in half the time for the largest loops.
@@ -42,7 +46,8 @@ from numba.extending import intrinsic
 from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
-           "cfunc", "pointer", "Pointer", "fma", "data_pointer", "KERNEL_STAMP", "NUMBA_OPTIONS"]
+           "cfunc", "pointer", "Pointer", "fma", "value", "data_pointer", "KERNEL_STAMP",
+           "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -149,6 +154,18 @@ def fma(typingctx, a, b, c):
 
     def codegen(context, builder, signature, args):
         return builder.fma(*args)
+
+    return sig, codegen
+
+
+@intrinsic
+def value(typingctx, x):
+    """``x`` as a value of its type, not the constant it may be (see the module
+    notes); in compiled code only."""
+    sig = nbtypes.unliteral(x)(x)
+
+    def codegen(context, builder, signature, args):
+        return context.cast(builder, args[0], signature.args[0], signature.return_type)
 
     return sig, codegen
 

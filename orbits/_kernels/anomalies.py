@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import njit, value
 
 __all__ = [
     "KEPLER_MAX_ITER",
@@ -217,7 +217,7 @@ def _solve_elliptic_reduced(M, e):
         E = _cubic_root(2.0 * (1.0 - e) / e, 3.0 * M / e)
         lo = max(lo, E)
     E = min(max(E, lo), hi)
-    return _newton_in_bracket(E, lo, hi, M, e, 1.0 - e, False)
+    return _newton_in_bracket(E, lo, hi, M, e, 1.0 - e, value(False))
 
 
 @njit
@@ -305,7 +305,7 @@ def _solve_hyperbolic_positive(M, e):
     # large F.
     F = F_cubic if F_cubic < 1.0 else lo
     F = min(max(F, lo), hi)
-    return _newton_in_bracket(F, lo, hi, M, e, em1, True)
+    return _newton_in_bracket(F, lo, hi, M, e, em1, value(True))
 
 
 @njit

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import njit, value
 from .anomalies import _TWO_PI, _one_plus_e_cos, mean_from_true
 from .status import Status
 
@@ -119,15 +119,15 @@ def elements_to_state(mu, a, e, inc, Omega, omega, f, out_pos, out_vel):
               and math.isfinite(omega) and math.isfinite(f))
     if (not finite or not (mu > 0.0) or not (e >= 0.0) or e == 1.0
             or (e < 1.0 and not (a > 0.0)) or (e > 1.0 and not (a < 0.0))):
-        _fill_nan(out_pos, 3)
-        _fill_nan(out_vel, 3)
+        _fill_nan(out_pos, value(3))
+        _fill_nan(out_vel, value(3))
         return Status.INVALID_ELEMENTS
     cf = math.cos(f)
     sf = math.sin(f)
     denom = _one_plus_e_cos(e, f)
     if not (denom > 0.0):
-        _fill_nan(out_pos, 3)
-        _fill_nan(out_vel, 3)
+        _fill_nan(out_pos, value(3))
+        _fill_nan(out_vel, value(3))
         return Status.BEYOND_ASYMPTOTE
     # (1 - e)(1 + e) rather than 1 - e^2: exact for e near 1.
     p = a * ((1.0 - e) * (1.0 + e))
@@ -239,7 +239,7 @@ def state_to_elements(mu, pos, vel, out):
     v2 = vx * vx + vy * vy + vz * vz
     if (not (mu > 0.0) or not math.isfinite(mu) or not math.isfinite(r)
             or not math.isfinite(v2) or r == 0.0):
-        _fill_nan(out, 7)
+        _fill_nan(out, value(7))
         return Status.INVALID_STATE
     v = math.sqrt(v2)
     alpha = 2.0 / r - v2 / mu          # 1 / a (vis-viva)
@@ -249,7 +249,7 @@ def state_to_elements(mu, pos, vel, out):
     hz = x * vy - y * vx
     h = math.sqrt(hx * hx + hy * hy + hz * hz)
     if h <= RADIAL_TOL * r * v:
-        _fill_nan(out, 7)
+        _fill_nan(out, value(7))
         out[0] = 1.0 / alpha
         out[1] = 1.0
         return Status.RADIAL_ORBIT

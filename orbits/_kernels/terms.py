@@ -41,7 +41,7 @@ import numpy as np
 
 from numba.core import types as nbtypes
 
-from ._jit import njit, slots, specialize
+from ._jit import njit, slots, specialize, value
 from .coordinates import row_difference
 from .invariants import _add
 from .jacobians import central_differences
@@ -882,7 +882,7 @@ def table_reads_velocities(tab):
 @njit
 def table_accel(x, v, t, tab, acc):
     """Adds the accelerations of every term of the table ``tab`` to ``acc``."""
-    rows_accel(x, v, t, tab, 0, tab.codes.shape[0], acc)
+    rows_accel(x, v, t, tab, value(0), tab.codes.shape[0], acc)
 
 
 @njit
@@ -972,7 +972,7 @@ def table_jacobian(x, v, t, tab, jx, jv):
         elif c == GR_POTENTIAL:
             gr_potential_jacobian(x, v, t, (ints[0], gm, reals[0]), jx, jv)
         elif c == GR_FULL:
-            row_difference_jacobian(x, v, t, tab, k, True, jx, jv)
+            row_difference_jacobian(x, v, t, tab, k, value(True), jx, jv)
         elif c == ZONAL:
             zonal_jacobian(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]), jx, jv)
         elif c == MIGRATION:
@@ -984,8 +984,8 @@ def table_jacobian(x, v, t, tab, jx, jv):
         elif c == RADIATION:
             radiation_jacobian(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), jx, jv)
         elif c == USER:
-            row_difference_jacobian(x, v, t, tab, k, _user_velocity_dependent(tab.user),
-                                     jx, jv)
+            row_difference_jacobian(x, v, t, tab, k,
+                                     value(_user_velocity_dependent(tab.user)), jx, jv)
 
 
 #: the kernels of every table of terms: one key, so one loop for any combination

@@ -93,7 +93,7 @@ import numpy as np
 
 from numba import types as nbtypes
 
-from ._jit import KERNEL_STAMP, data_pointer, njit, pointer, slots, specialize
+from ._jit import KERNEL_STAMP, data_pointer, njit, pointer, slots, specialize, value
 from .coordinates import interior_gm, to_jacobi
 from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
@@ -272,7 +272,7 @@ def _scalar_drifts(X, V, MU, h, alone, nb, one_x, one_v):
             for c in range(3):
                 one_x[0, c] = X[c, k]
                 one_v[0, c] = V[c, k]
-            kepler_drift(MU[k], one_x, one_v, 0, h)
+            kepler_drift(MU[k], one_x, one_v, value(0), h)
             for c in range(3):
                 X[c, k] = one_x[0, c]
                 V[c, k] = one_v[0, c]

@@ -107,7 +107,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit, slots, specialize
+from ._jit import njit, slots, specialize, value
 # the planets' columns, padded to a multiple of the lane width (shared with the
 # gravity kernels' lanes)
 from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pull_rows,
@@ -518,15 +518,17 @@ def _scratch_pass(S, h0, P):
     # every column of the scratch by the step h0 (by its own, row _H, where
     # own_steps): the short-step passes (short_passes, the _pass_rows of
     # that step), and the medium ones where those declined a planet
-    # (_medium_first); specialised here, after the rows it names (_T)
+    # (_medium_first); specialised here, after the rows it names (_T).  The
+    # flag goes as a value (not the constant it is here), so that both
+    # copies call one compilation of _medium_scratch
     if _medium_first(S):
-        return _medium_scratch(S, h0, own_steps, P)
+        return _medium_scratch(S, h0, value(own_steps), P)
     rejected = short_passes(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
                             S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
                             S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
     if rejected:
         S[MEMO, 1] = RETRY
-        rejected = _medium_scratch(S, h0, own_steps, P)
+        rejected = _medium_scratch(S, h0, value(own_steps), P)
     return rejected
 
 

@@ -92,7 +92,7 @@ References
 
 import math
 
-from ._jit import called, njit, slots, specialize
+from ._jit import called, njit, slots, specialize, value
 from .coordinates import (from_democratic_heliocentric, from_jacobi, jacobi_step, row,
                           row_difference, set_row, to_democratic_heliocentric, to_jacobi)
 from .gravity import add_pulls, pull_with_sums, zero_rows
@@ -636,9 +636,10 @@ _to_jacobi, _from_jacobi, _to_heliocentric, _from_heliocentric = (
 
 @njit(inline="always")
 def _carrying(targs, k):
-    # targs with the tangent arguments set to carry k vectors
+    # targs with the tangent arguments set to carry k vectors (a value, so
+    # that the kernels called with these targs compile once for every k)
     tp = targs[1]
-    return (targs[0], (tp[0], tp[1], k, tp[3], tp[4], tp[5], tp[6]))
+    return (targs[0], (tp[0], tp[1], value(k), tp[3], tp[4], tp[5], tp[6]))
 
 
 def _tangent_record(xj, vj, t, mon, n_mon, mon_t, mon_out):

@@ -55,6 +55,37 @@ def _call(f, a):
     return f(a)
 
 
+def test_a_constant_handed_on_by_value_compiles_the_callee_once():
+    # numba types a constant argument as a literal: without value, the
+    # callee has one compilation per constant (the first pair of callers)
+    @numba.njit
+    def callee(a, flag, k):
+        return a + k if flag else a - k
+
+    @numba.njit
+    def literal_true(a):
+        return callee(a, True, 1)
+
+    @numba.njit
+    def literal_false(a):
+        return callee(a, False, 2)
+
+    assert literal_true(1.0) == 2.0 and literal_false(1.0) == -1.0
+    assert len(callee.signatures) == 2
+
+    @numba.njit
+    def value_true(a):
+        return callee(a, _jit.value(True), _jit.value(1))
+
+    @numba.njit
+    def value_false(a):
+        return callee(a, _jit.value(False), _jit.value(2))
+
+    assert value_true(1.0) == 2.0 and value_false(1.0) == -1.0
+    assert len(callee.signatures) == 3
+    assert callee.signatures[2] == (nbtypes.float64, nbtypes.boolean, nbtypes.int64)
+
+
 def test_a_pointer_is_an_argument_typed_by_its_signature():
     # numba types a Pointer from _numba_type_ and takes its address through
     # the wrapper address protocol; a numba that read neither would fail here
