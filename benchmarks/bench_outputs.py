@@ -29,12 +29,15 @@ taken between calls, and streamed, beside REBOUND's IAS15 advanced to each
 output time (``exact_finish_time=1``) in the same Python loop.
 
 The cost of an output is the run's time minus the same run with two
-outputs, divided by the number of outputs: the median, over ``--repeats``
-pairs timed one after the other, of the pair's difference, after a warm-up
-that excludes compilation.  The ``+-`` column is half the interquartile
-range of the pairs' figures in memory: on a shared machine a few per cent
-of drift in the steps' speed moves an output's figure by a tenth of a
-microsecond at k = 10, where the outputs are a tenth of the run.
+outputs, divided by the number of outputs, each run the quickest of
+``--repeats`` (runs with and without outputs timed in turn, after a warm-up
+that excludes compilation; REBOUND's the same way): other work on the
+machine only adds time, so the quickest run is the least disturbed, where a
+median of the pairs' differences moved by a tenth of a microsecond from run
+to run at k = 10 (the outputs are a tenth of the run there, and a few per
+cent of drift in the steps' speed passes for their cost).  The ``+-``
+column is half the interquartile range of the pairs' differences in
+memory: how far one pair's figure strays.
 Memory: the peak resident size of a process that streams 10^6 outputs to a
 file, against one that takes 10^4 (``--memory``), so that the difference is
 what the outputs keep in memory.
@@ -185,8 +188,8 @@ def _spread(costs):
     return (q3 - q1) / 2
 
 
-def _median(f, repeats):
-    return statistics.median(f() for _ in range(repeats))
+def _best(f, repeats):
+    return min(f() for _ in range(repeats))
 
 
 def _peak_rss(n_out):
@@ -205,7 +208,7 @@ def _peak_rss(n_out):
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--outputs", type=int, default=100_000)
-    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--repeats", type=int, default=7)
     p.add_argument("--quick", action="store_true")
     p.add_argument("--memory", action="store_true", help="also measure peak memory")
     p.add_argument("--clock", choices=("wall", "cpu"), default="wall",
@@ -216,7 +219,7 @@ def main(argv=None):
     n_out = 20_000 if args.quick else args.outputs
     repeats = 1 if args.quick else args.repeats
     path = os.path.join(tempfile.mkdtemp(), "bench.h5")
-    print(f"outer solar system, {n_out} outputs, median of {repeats}; "
+    print(f"outer solar system, {n_out} outputs, best of {repeats}; "
           f"us per output beyond its steps ({args.clock} clock)")
     print(f"{'integrator':10s} {'step':>7s} {'which':14s} {'k':>4s} {'steps us':>9s} "
           f"{'memory':>7s} {'+-':>6s} {'goal':>9s} {'hdf5':>7s} {'REBOUND loop':>12s} "
@@ -228,19 +231,20 @@ def main(argv=None):
                       lambda: _ours(integrator, dt, 100, k, path)):
                 f()                                   # compile, warm the caches
             # each run with outputs beside the same run without, in turn, and
-            # the median of the differences: at k = 10 an output is a tenth of
-            # the run, and medians taken apart let the machine's drift between
-            # them (a few per cent of the steps) pass for the outputs' cost
+            # the best of each: other work on the machine only ever adds time,
+            # so the quickest of several runs is the one it disturbed least
+            # (at k = 10 an output is a tenth of the run, and a few per cent
+            # of drift in the steps' speed would pass for the outputs' cost)
             pairs = [(_ours(integrator, dt, 1, k * n_out), _ours(integrator, dt, n_out, k),
                       _ours(integrator, dt, 1, k * n_out, path),
                       _ours(integrator, dt, n_out, k, path)) for _ in range(repeats)]
-            base = statistics.median(p[0] for p in pairs)
-            mem = base + statistics.median(p[1] - p[0] for p in pairs)
-            base_path = statistics.median(p[2] for p in pairs)
-            h5 = base_path + statistics.median(p[3] - p[2] for p in pairs)
+            base = min(p[0] for p in pairs)
+            mem = min(p[1] for p in pairs)
+            base_path = min(p[2] for p in pairs)
+            h5 = min(p[3] for p in pairs)
             try:
-                reb_base = _median(lambda: _rebound(integrator, dt, 1, k * n_out), repeats)
-                reb = _median(lambda: _rebound(integrator, dt, n_out, k), repeats)
+                reb_base = _best(lambda: _rebound(integrator, dt, 1, k * n_out), repeats)
+                reb = _best(lambda: _rebound(integrator, dt, n_out, k), repeats)
                 reb_cost = (reb - reb_base) / n_out * 1e6
             except Exception as exc:  # REBOUND missing: say so, measure ours
                 print(f"  REBOUND: {exc}")

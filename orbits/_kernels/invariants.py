@@ -51,7 +51,11 @@ def _add(s, c, term):
     return t, c + (big if abs(s) >= abs(term) else small)
 
 
-@njit
+# energy, angular_momentum, momentum and center_of_mass are inlined into
+# monitor_row, which every run's monitors call: one compilation instead of
+# five, each with numba's fixed cost of a function (about 0.2 s)
+
+@njit(inline="always")
 def energy(x, v, m, G, n_active, eps2):
     """Total energy, kinetic plus pairwise potential (softened if ``eps2 > 0``).
 
@@ -79,7 +83,7 @@ def energy(x, v, m, G, n_active, eps2):
     return s + c
 
 
-@njit
+@njit(inline="always")
 def angular_momentum(x, v, m, out):
     """Total angular momentum ``sum m x cross v`` into ``out`` (shape (3,))."""
     s0 = c0 = s1 = c1 = s2 = c2 = 0.0
@@ -92,7 +96,7 @@ def angular_momentum(x, v, m, out):
     out[2] = s2 + c2
 
 
-@njit
+@njit(inline="always")
 def momentum(v, m, out):
     """Total linear momentum into ``out`` (shape (3,))."""
     for k in range(3):
@@ -103,7 +107,7 @@ def momentum(v, m, out):
         out[k] = s + c
 
 
-@njit
+@njit(inline="always")
 def center_of_mass(x, m, out):
     """Centre-of-mass position into ``out`` (shape (3,))."""
     mt = 0.0

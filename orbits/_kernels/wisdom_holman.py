@@ -938,19 +938,24 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
         # the next step's first drift (see _lanes_note)
         drift = _lanes_drift
         key = f"{key}_lanes"
-        recorder = specialize(_lanes_note, key, cache=cache, nrt=nrt)
+        # the kernels that work on the lanes alone are the same for both
+        # coordinate systems (each row's Kepler G M is data): named without
+        # them, they compile once for both (the outputs' drift takes some 15 s)
+        lanes = "lanes"
+        recorder = specialize(_lanes_note, lanes, cache=cache, nrt=nrt)
         outputs = dict(
             RESIDENT=True,
-            resident_drift=specialize(_resident_drift, key, cache=cache, inline=True, nrt=nrt),
+            resident_drift=specialize(_resident_drift, lanes, cache=cache, inline=True,
+                                      nrt=nrt),
             resident_perturbation=specialize(COORDINATE_SYSTEMS[coordinates][4], key,
                                              cache=cache, inline=True, nrt=nrt),
-            lanes_in=called(specialize(_resident_in, key, cache=cache, inline=True, nrt=nrt),
+            lanes_in=called(specialize(_resident_in, lanes, cache=cache, inline=True, nrt=nrt),
                             nrt),
-            lanes_out=called(specialize(_resident_out, key, cache=cache, inline=True, nrt=nrt),
-                             nrt),
-            lanes_check=specialize(_resident_check, key, cache=cache, inline=True, nrt=nrt),
-            output_pending=specialize(_lanes_pending, key, cache=cache, inline=True, nrt=nrt),
-            output_drift=called(specialize(_resident_output_drift, key, cache=cache,
+            lanes_out=called(specialize(_resident_out, lanes, cache=cache, inline=True,
+                                        nrt=nrt), nrt),
+            lanes_check=specialize(_resident_check, lanes, cache=cache, inline=True, nrt=nrt),
+            output_pending=specialize(_lanes_pending, lanes, cache=cache, inline=True, nrt=nrt),
+            output_drift=called(specialize(_resident_output_drift, lanes, cache=cache,
                                            inline=True, nrt=nrt), nrt),
             make_output=specialize(_lanes_output, key, cache=cache, nrt=nrt,
                                    sync_kernel=sync, record=record))
