@@ -889,15 +889,15 @@ def _kernels(coordinates, terms=None, lanes=False):
                                   HELIOCENTRIC=coordinates != "jacobi")
     # the corrector and an output's synchronisation run once a call or an
     # output: they call the drift and the perturbation step, compiled once,
-    # instead of inlining a copy at each of their call sites
+    # instead of inlining a copy at each of their call sites.  Both drift
+    # every planet: in lanes, bit for bit, where the loop drifts in lanes (so
+    # that the loop compiles one drift of arrays (N, 3), not two)
+    drift = called(_lanes_drift if lanes else _plain_drift, nrt)
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
-                           drift=called(_plain_drift, nrt), perturbation=called(perturbation, nrt))
-    # an output's synchronisation drifts every planet by the owed half step:
-    # in lanes, bit for bit, where the loop drifts in lanes
+                           drift=drift, perturbation=called(perturbation, nrt))
     sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
-                      cache=cache, nrt=nrt,
-                      drift=called(_lanes_drift if lanes else _plain_drift, nrt),
-                      from_internal=from_internal, corrector_kernel=corrector)
+                      cache=cache, nrt=nrt, drift=drift, from_internal=from_internal,
+                      corrector_kernel=corrector)
     return to_internal, perturbation, corrector, sync
 
 
