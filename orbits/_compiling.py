@@ -30,21 +30,21 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "lo
 
 #: Seconds a loop's first compile takes on an empty cache: the compiling
 #: inside the first ``Simulation.run`` of the outer solar system, on the
-#: reference machine (2-core AMD EPYC, Zen 4 with AVX-512, a busy host, where the same
-#: figure scatters by up to a factor of two from run to run; measured with
+#: reference machine (2-core AMD EPYC, Zen 4 with AVX-512, a quiet host; on a
+#: busy one the same figure grows by up to a factor of two; measured with
 #: ``benchmarks/bench_first_compile.py``, which prints this table anew, and
 #: recorded in benchmarks/RESULTS.md).  Keyed by :func:`loop_label`; only the
 #: notice's estimate reads it.  The methods of a family share their loop
 #: (the SABA methods wh's), so a family's first method compiles it.
 FIRST_COMPILE_SECONDS = {
-    "euler": 4.0, "symplectic-euler": 5.0, "verlet": 4.0, "leapfrog": 2.0,
-    "rk2": 3.0, "rk4": 4.0, "yoshida4": 4.0, "yoshida6": 4.0, "yoshida8": 4.0,
-    "wh": 41.0, "wh democratic-heliocentric": 36.0,
-    "saba2": 41.0, "saba2 democratic-heliocentric": 36.0,
-    "saba3": 41.0, "saba3 democratic-heliocentric": 36.0,
-    "saba4": 41.0, "saba4 democratic-heliocentric": 36.0,
-    "dopri5": 5.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 9.0, "taylor": 6.0,
-    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 28.0,
+    "euler": 2.0, "symplectic-euler": 2.0, "verlet": 2.0, "leapfrog": 2.0,
+    "rk2": 2.0, "rk4": 2.0, "yoshida4": 2.0, "yoshida6": 2.0, "yoshida8": 2.0,
+    "wh": 26.0, "wh democratic-heliocentric": 26.0,
+    "saba2": 26.0, "saba2 democratic-heliocentric": 26.0,
+    "saba3": 26.0, "saba3 democratic-heliocentric": 26.0,
+    "saba4": 26.0, "saba4 democratic-heliocentric": 26.0,
+    "dopri5": 5.0, "dop853": 5.0, "rk4-doubling": 4.0, "ias15": 6.0, "taylor": 4.0,
+    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 23.0,
 }
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
@@ -88,7 +88,7 @@ def notice(label):
     --------
     >>> from orbits._compiling import notice
     >>> notice("wh")
-    'orbits: compiling the wh loop for this CPU, once (about 41 s; `orbits compile` does it ahead)'
+    'orbits: compiling the wh loop for this CPU, once (about 26 s; `orbits compile` does it ahead)'
     """
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
