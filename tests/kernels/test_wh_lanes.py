@@ -179,6 +179,35 @@ def test_two_drifts_in_one_pass_are_each_the_scalar_drift(f):
     assert np.sum(~took2) >= 1            # the copy had declined planets too
 
 
+@pytest.mark.parametrize("owed", [0.0, math.pi / 170])
+def test_the_outputs_drift_of_the_loop_with_and_without_a_drift_owed(owed):
+    # the lanes' loop's output drift (as wh_loop compiles it): the state
+    # drifted by h in the lanes, and the output's copy, drifted by what it
+    # owes, in xs, vs; with nothing owed the copy is the state itself.  Each
+    # bit for bit the scalar drift, with declined planets among them
+    drift = W.called(W.specialize(W._resident_output_drift, "lanes", inline=True, nrt=False),
+                     False)
+    xj, vj, mu = system(CIRCULAR[:2] + [(1.0, 0.99, 0.0)] + CIRCULAR[2:])
+    h = 2 * math.pi / 160
+    w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
+    a, b = xj.copy(), vj.copy()
+    W.kepler_drift_all(a, b, mu, h, w1, w2)
+    c, d = xj.copy(), vj.copy()
+    if owed:
+        W.kepler_drift_all(c, d, mu, owed, w1, w2)
+    S = L.lanes_scratch(len(xj))
+    L.resident_load(xj, vj, mu, mu, S)
+    S[W.PENDING, 0] = 1.0
+    xs, vs = np.full_like(xj, np.nan), np.full_like(xj, np.nan)
+    x, acc = np.zeros_like(xj), np.zeros_like(xj)
+    drift(xj, vj, mu, h, xs, vs, owed, x, acc, (S,))
+    assert S[W.PENDING, 0] == 0.0
+    L.resident_store(S, xj, vj)
+    assert np.array_equal(xj, a) and np.array_equal(vj, b)
+    assert np.array_equal(xs, c) and np.array_equal(vs, d)
+    assert np.sum(S[L._TAKE, :len(xj) - 1] == 0.0) == 1    # the e = 0.99 planet declined
+
+
 @pytest.mark.parametrize("planets", [1, 3, 4, 5, 8, 9])
 def test_two_drifts_packed_side_by_side_for_every_size(planets):
     # the state's planets and the copy's share the lanes (four planets or
