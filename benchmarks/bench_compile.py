@@ -26,10 +26,13 @@ compiles from nothing) or ``--quick`` (``wh`` alone).
 import argparse
 import json
 import os
-import subprocess
+import pathlib
 import sys
 import tempfile
 import textwrap
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from _child import run_child  # noqa: E402 - children import the package imported here
 
 SCENES = [("leapfrog", "leapfrog", 10.0), ("wh", "wh", 30.0),
           ("wh democratic-heliocentric", "wh:democratic-heliocentric", 30.0),
@@ -61,9 +64,8 @@ _CHILD = textwrap.dedent("""
 def _first_run(spec, dt, own):
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        out = subprocess.run([sys.executable, "-c", _CHILD, spec, str(dt),
-                              "own" if own else "ours"],
-                             env=env, capture_output=True, text=True, check=True)
+        out = run_child(["-c", _CHILD, spec, str(dt), "own" if own else "ours"],
+                        env=env, capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 

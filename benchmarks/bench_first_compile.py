@@ -26,10 +26,13 @@ process compiles from nothing), or name loops: ``... leapfrog wh``.
 import argparse
 import json
 import os
-import subprocess
+import pathlib
 import sys
 import tempfile
 import textwrap
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from _child import run_child  # noqa: E402 - children import the package imported here
 
 _CHILD = textwrap.dedent("""
     import json, sys
@@ -76,8 +79,8 @@ def _loops():
 def _first_run(spec):
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        out = subprocess.run([sys.executable, "-c", _CHILD, spec], env=env,
-                             capture_output=True, text=True, check=True)
+        out = run_child(["-c", _CHILD, spec], env=env, capture_output=True, text=True,
+                        check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 

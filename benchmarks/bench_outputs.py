@@ -59,7 +59,6 @@ import argparse
 import os
 import pathlib
 import statistics
-import subprocess
 import sys
 import tempfile
 import textwrap
@@ -72,6 +71,7 @@ import orbits
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import bench_wh  # noqa: E402 - the steps' names and the innermost period
+from _child import run_child  # noqa: E402 - children import the package imported here
 
 MEMORY_GOAL = 0.5
 HDF5_GOAL = 2.0
@@ -200,8 +200,7 @@ def _peak_rss(n_out):
         sim.run(until={n_out} * 10 * u.day, outputs={n_out} + 1, output=path, progress=False)
         print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
     """)
-    out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True,
-                         check=True)
+    out = run_child(["-c", child], capture_output=True, text=True, check=True)
     return int(out.stdout.split()[-1]) / 1024.0     # MB (ru_maxrss in kB on Linux)
 
 

@@ -36,10 +36,13 @@ import argparse
 import contextlib
 import json
 import os
-import subprocess
+import pathlib
 import sys
 import tempfile
 import textwrap
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from _child import run_child  # noqa: E402 - children import the package imported here
 
 _USER_MODULE = textwrap.dedent("""
     import numba
@@ -137,8 +140,8 @@ def main(argv=None):
             if integrator == "wh" and not args.rows:
                 rows = rows + BATCH_ROWS
             for row in rows:
-                out = subprocess.run([sys.executable, "-c", _CHILD, integrator, row], env=env,
-                                     capture_output=True, text=True)
+                out = run_child(["-c", _CHILD, integrator, row], env=env,
+                                capture_output=True, text=True)
                 if out.returncode:
                     print(f"{integrator:10s} {row:26s} failed:\n{out.stderr}", flush=True)
                     ok = False
