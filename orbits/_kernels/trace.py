@@ -427,7 +427,7 @@ def inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol):
         for d in range(3):
             ys[i, d] = xh[i, d]
             us[i, d] = vb[i, d]
-    kepler_drift_all(xh, vb, eta, h, w1, w2)
+    _kepler_drift_all_call(xh, vb, eta, h, w1, w2)
     ok = True
     for g in range(groups):
         ns = np.int64(0)   # not a constant: _dop853 is compiled for one type of it
@@ -491,7 +491,7 @@ def _drift(xh, vb, gm, eta, n_active, enc, flagged, peri, h, w1, w2, x, v, inner
         return exact_flow(xh, vb, gm, n_active, enc, h, x, v, inner, tabs, rtol)
     if flagged:
         return inner_drift(xh, vb, gm, eta, n_active, enc, h, w1, w2, inner, tabs, rtol)
-    kepler_drift_all(xh, vb, eta, h, w1, w2)
+    _kepler_drift_all_call(xh, vb, eta, h, w1, w2)
     return True
 
 
@@ -528,10 +528,14 @@ def trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v,
 
 
 # the loop's rare paths (a call's start, a step redone, the step an encounter
-# begins) call these, compiled once, instead of inlining a copy each
+# begins) call these, compiled once, instead of inlining a copy each; the
+# Kepler drift of every body too, from the drifts of segments with flags
+# (_drift, inner_drift) and the synchronisation's, where the loop's own
+# unflagged segment keeps its inlined copy
 _criterion_call = called(criterion)
 _pair_accelerations_call = called(pair_accelerations)
 _jump_call = called(jump)
+_kepler_drift_all_call = called(kepler_drift_all)
 
 
 class Work(NamedTuple):
