@@ -44,7 +44,7 @@ FIRST_COMPILE_SECONDS = {
     "saba3": 26.0, "saba3 democratic-heliocentric": 26.0,
     "saba4": 26.0, "saba4 democratic-heliocentric": 26.0,
     "dopri5": 5.0, "dop853": 5.0, "rk4-doubling": 4.0, "ias15": 6.0, "taylor": 4.0,
-    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 23.0,
+    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 20.0,
 }
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
