@@ -2,7 +2,9 @@
 
 What is measured
 ----------------
-For each loop (an integrator, and each Wisdom-Holman coordinate system), a
+For each loop (an integrator, each Wisdom-Holman coordinate system, and
+the Wisdom-Holman loops with the planets in vector lanes, which a run takes
+with ``lanes="on"``, or by default once it is long or that loop compiled), a
 fresh process with an empty numba cache (``NUMBA_CACHE_DIR`` a new
 directory) makes a simulation of the outer solar system and runs it for ten
 steps; the seconds numba spent compiling inside that run
@@ -20,7 +22,8 @@ running it; the import excluded) against the goals of the issue "Start in
 seconds": ``leapfrog`` <= 2 s, ``ias15`` <= 3 s, every other loop <= 6 s.
 
 Run ``python benchmarks/bench_first_compile.py`` (several minutes: each
-process compiles from nothing), or name loops: ``... leapfrog wh``.
+process compiles from nothing), or name loops: ``... leapfrog wh
+wh:democratic-heliocentric wh+lanes``.
 """
 
 import argparse
@@ -39,15 +42,19 @@ _CHILD = textwrap.dedent("""
     import astropy.units as u
     import orbits
     from orbits._compiling import loop_label
-    name, _, coords = sys.argv[1].partition(":")
-    integ = orbits.integrators.get(name, **({"coordinates": coords} if coords else {}))
+    spec, _, lanes = sys.argv[1].partition("+")
+    name, _, coords = spec.partition(":")
+    options = {"coordinates": coords} if coords else {}
+    if lanes:
+        options["lanes"] = "on"
+    integ = orbits.integrators.get(name, **options)
     import time
     dt = None if integ.adaptive else 10 * u.day
     cpu = time.process_time()
     sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integ, dt=dt)
     result = sim.run(until=100 * u.day, outputs=3, progress=False)
     cpu = time.process_time() - cpu
-    print(json.dumps({"label": loop_label(integ), "compile": result.compile_time,
+    print(json.dumps({"label": loop_label(integ, bool(lanes)), "compile": result.compile_time,
                       "wall": result.wall_time, "cpu": cpu}))
 """)
 
@@ -69,10 +76,14 @@ def _loops():
         integ = orbits.integrators.get(info.name)
         if not integ.compiled:
             continue
-        out.append(info.name)
-        default = type(integ).options.get("coordinates")
+        options = type(integ).options
+        default = options.get("coordinates")
+        specs = [info.name]
         if default is not None:
-            out.extend(f"{info.name}:{c}" for c in COORDINATES if c != default)
+            specs += [f"{info.name}:{c}" for c in COORDINATES if c != default]
+        if "lanes" in options:
+            specs += [f"{spec}+lanes" for spec in specs]
+        out.extend(specs)
     return out
 
 
@@ -86,7 +97,8 @@ def _first_run(spec):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("loops", nargs="*", help="integrator or integrator:coordinates")
+    parser.add_argument("loops", nargs="*",
+                        help="integrator, integrator:coordinates, or either +lanes")
     args = parser.parse_args(argv)
     from orbits._compiling import FIRST_COMPILE_SECONDS
     print("outer solar system, first run (10 steps) on an empty numba cache: seconds "

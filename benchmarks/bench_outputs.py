@@ -9,7 +9,9 @@ the step people use, a twentieth of Jupiter's period (``P_in / 20``,
 outputs (default 10^5) one every ``k`` steps (k = 1 and 10, and 10.4:
 outputs that do not fall a whole number of steps apart, each on the step
 nearest its time), default monitors (energy and angular momentum at each
-output):
+output); ``wh`` with ``lanes="on"``, the loop of a long run and of every run
+once it is compiled on the machine (its outputs are made beside the next
+step's drift, in the lanes):
 
 * ``memory``: ``Simulation.run(outputs=...)`` kept in memory, and every field
   of its result read (the result makes its Quantities and monitor series when
@@ -89,6 +91,9 @@ _clock = time.perf_counter
 
 
 def _ours(integrator, dt, n_out, k, path=None):
+    if integrator == "wh":
+        # the loop with the planets in vector lanes (see the module notes)
+        integrator = orbits.integrators.get("wh", lanes="on")
     sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator, dt=dt * u.day)
     until = n_out * k * dt * u.day
     t0 = _clock()

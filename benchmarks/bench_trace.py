@@ -5,7 +5,8 @@ Three parts, each timed around the public ``Simulation.run`` (warm: every
 loop compiled by a short run first) and, for REBOUND, around ``integrate``:
 
 1. **Far from encounters**: ``trace`` against ``wh`` with
-   ``coordinates="democratic-heliocentric"``, whose map it is when nothing
+   ``coordinates="democratic-heliocentric"`` (and ``lanes="on"``, the loop
+   of a long run, its planets in vector lanes), whose map it is when nothing
    is flagged, both with the default options (the default monitors, at the
    run's two outputs; ``--monitors none`` for ``monitors=()``), on the outer
    solar system and the Sun with eight planets at ``bench_wh.py``'s steps:
@@ -113,7 +114,7 @@ def far_from_encounters(repeats, steps, clock, monitors="default"):
 
 def _far_row(label, b, dt, which, repeats, steps, clock, monitors):
     kw = {} if monitors == "default" else {"monitors": ()}
-    wh = orbits.integrators.get("wh", coordinates=DH)
+    wh = orbits.integrators.get("wh", coordinates=DH, lanes="on")
     makers = {"wh": lambda: orbits.Simulation(b, wh, dt=dt, **kw),
               "trace": lambda: orbits.Simulation(b, "trace", dt=dt, **kw)}
     for make in makers.values():
@@ -154,7 +155,7 @@ def encounters(repeats, clock):
     from orbits.validation.stress import ENCOUNTER_TIME, encounter_bodies
     until = 2 * ENCOUNTER_TIME * u.day
     dt = ENCOUNTER_DT * u.day
-    wh = orbits.integrators.get("wh", coordinates=DH)
+    wh = orbits.integrators.get("wh", coordinates=DH, lanes="on")
     codes = {"wh": (wh, dt), "trace": ("trace", dt), "ias15": ("ias15", None)}
     print(f"2. close encounters (stress suite), {until}, trace and wh at dt = {dt}; "
           f"energy error at the end, wall time (median of {repeats}); below each row "

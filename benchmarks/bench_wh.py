@@ -8,7 +8,12 @@ process, ``--repeats`` times, ``n`` steps each (``n`` chosen so that one
 REBOUND run lasts about ``--target`` seconds).  Ours is timed around the
 public ``Simulation.run`` with the default options, as a user runs it (the
 default monitors, recorded at the run's two outputs; ``--monitors none``
-times ``monitors=()`` instead).  The table gives median microseconds per
+times ``monitors=()`` instead), with ``lanes="on"``: the planets in vector
+lanes, the loop that the default ``lanes="auto"`` takes for a run of 1e8
+steps or more, and for every run once that loop is compiled on the machine
+(``--lanes off`` times the scalar loop, which a shorter run takes on a
+machine that has not compiled the lanes' one; the same results bit for
+bit).  The table gives median microseconds per
 step and the median of the paired ratios.
 
 The steps.  Each scene has the benchmark's short step, tuned to where the
@@ -195,7 +200,7 @@ def our_step_time(sim, n, clock):
 def measure(label, bodies, dt, coords, rebound_names, args, clock):
     """One row: median us per step of ours and of each REBOUND integrator
     that runs, and the median paired ratios."""
-    wh = orbits.integrators.get("wh", coordinates=coords)
+    wh = orbits.integrators.get("wh", coordinates=coords, lanes=args.lanes)
     monitors = {} if args.monitors == "default" else {"monitors": ()}
     ours = orbits.Simulation(bodies, integrator=wh, dt=dt, **monitors)
     clear = orbits.Simulation(bodies, integrator="wh", dt=dt, monitors=())
@@ -256,6 +261,10 @@ def main(argv=None):
                     help="wall clock (default) or this process's CPU time")
     ap.add_argument("--monitors", choices=("default", "none"), default="default",
                     help="ours with the default monitors (default) or monitors=()")
+    ap.add_argument("--lanes", choices=("on", "off"), default="on",
+                    help="ours with lanes='on' (default: the loop of a run of 1e8 steps "
+                         "or more, and of every run once compiled) or 'off' (the scalar "
+                         "loop of a shorter run on a machine that has not compiled it)")
     args = ap.parse_args(argv)
     clock = time.perf_counter if args.clock == "wall" else time.process_time
     if args.quick:

@@ -19,13 +19,21 @@ _AHEAD_STEPS = 10
 
 
 def _variants(name):
-    """The integrators (configured) whose loops ``name`` compiles: one per
-    set of coordinates for the methods that take them."""
+    """The integrators (configured) whose loops ``name`` compiles, each with
+    whether it is the loop with the planets in vector lanes: one per set of
+    coordinates for the methods that take them, and for those with a
+    ``lanes`` option (``wh``, the SABA methods) the scalar loop and the
+    lanes' one of each."""
     integ = integrators.get(name)
-    coords = type(integ).options.get("coordinates")
+    options = type(integ).options
+    coords = options.get("coordinates")
     if coords is None:
-        return [integ]
-    return [integ] + [integrators.get(name, coordinates=c) for c in COORDINATES if c != coords]
+        return [(integ, False)]
+    order = [coords] + [c for c in COORDINATES if c != coords]
+    if "lanes" not in options:
+        return [(integrators.get(name, coordinates=c), False) for c in order]
+    return [(integrators.get(name, coordinates=c, lanes=mode), mode == "on")
+            for c in order for mode in ("off", "on")]
 
 
 def compile_ahead(names=None, progress=None, report=None):
@@ -72,10 +80,12 @@ def compile_ahead(names=None, progress=None, report=None):
     ['leapfrog']
 
     ``wh`` (and ``saba2`` to ``saba4``) compile a loop for each set of
-    coordinates: ``['wh', 'wh democratic-heliocentric']``.
+    coordinates, and each of them with the planets in vector lanes (which
+    runs take by the ``lanes`` option): ``['wh', 'wh lanes', 'wh
+    democratic-heliocentric', 'wh democratic-heliocentric lanes']``.
     """
     names = COMMON if names is None else tuple(names)
-    loops = [integ for name in names for integ in _variants(name)
+    loops = [(integ, lanes) for name in names for integ, lanes in _variants(name)
              if getattr(integ, "compiled", True)]
     if progress is None:
         progress = stderr_is_terminal()
@@ -85,8 +95,8 @@ def compile_ahead(names=None, progress=None, report=None):
     bodies = scenes.outer_solar_system()
     done = []
     try:
-        for integ in loops:
-            label = loop_label(integ)
+        for integ, lanes in loops:
+            label = loop_label(integ, lanes)
             if bar is not None:
                 bar.set_postfix_str(label)
             dt = None if integ.adaptive else _AHEAD_DT_DAYS * u.day

@@ -26,7 +26,7 @@ from numba.core.dispatcher import Dispatcher
 from ._kernels import stepping
 
 __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "loop_label",
-           "notice", "cache_dir", "stderr_is_terminal"]
+           "notice", "cache_dir", "cpu_name", "stderr_is_terminal"]
 
 #: Seconds a loop's first compile takes on an empty cache: the compiling
 #: inside the first ``Simulation.run`` of the outer solar system, on the
@@ -39,10 +39,10 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "lo
 FIRST_COMPILE_SECONDS = {
     "euler": 2.0, "symplectic-euler": 2.0, "verlet": 2.0, "leapfrog": 2.0,
     "rk2": 2.0, "rk4": 2.0, "yoshida4": 2.0, "yoshida6": 2.0, "yoshida8": 2.0,
-    "wh": 26.0, "wh democratic-heliocentric": 26.0,
-    "saba2": 26.0, "saba2 democratic-heliocentric": 26.0,
-    "saba3": 26.0, "saba3 democratic-heliocentric": 26.0,
-    "saba4": 26.0, "saba4 democratic-heliocentric": 26.0,
+    **{f"{name}{coords}{lanes}": seconds
+       for name in ("wh", "saba2", "saba3", "saba4")
+       for coords in ("", " democratic-heliocentric")
+       for lanes, seconds in (("", 15.0), (" lanes", 28.0))},
     "dopri5": 5.0, "dop853": 5.0, "rk4-doubling": 4.0, "ias15": 6.0, "taylor": 4.0,
     "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 20.0,
 }
@@ -60,24 +60,26 @@ COMMON = ("leapfrog", "ias15", "wh")
 _KIND = "numba:compile"
 
 
-def loop_label(integrator):
+def loop_label(integrator, lanes=False):
     """The name of an integrator's stepping loop, as the notice and the table
-    of :data:`FIRST_COMPILE_SECONDS` give it: its registry name, and its
+    of :data:`FIRST_COMPILE_SECONDS` give it: its registry name, its
     coordinates where they are not its default (each set of coordinates is a
-    loop of its own).
+    loop of its own), and "lanes" for the Wisdom-Holman loop with its planets
+    in vector lanes (``lanes``; see the ``lanes`` option of ``wh``).
 
     Examples
     --------
     >>> from orbits import integrators
     >>> from orbits._compiling import loop_label
     >>> loop_label(integrators.get("wh")), loop_label(integrators.get(
-    ...     "wh", coordinates="democratic-heliocentric"))
-    ('wh', 'wh democratic-heliocentric')
+    ...     "wh", coordinates="democratic-heliocentric"), lanes=True)
+    ('wh', 'wh democratic-heliocentric lanes')
     """
     coords = integrator.config.get("coordinates")
-    if coords is None or coords == type(integrator).options.get("coordinates"):
-        return integrator.name
-    return f"{integrator.name} {coords}"
+    label = integrator.name
+    if coords is not None and coords != type(integrator).options.get("coordinates"):
+        label = f"{label} {coords}"
+    return f"{label} lanes" if lanes else label
 
 
 def notice(label):
@@ -88,7 +90,7 @@ def notice(label):
     --------
     >>> from orbits._compiling import notice
     >>> notice("wh")
-    'orbits: compiling the wh loop for this CPU, once (about 26 s; `orbits compile` does it ahead)'
+    'orbits: compiling the wh loop for this CPU, once (about 15 s; `orbits compile` does it ahead)'
     """
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
@@ -226,6 +228,20 @@ def cache_dir():
         if isinstance(value, Dispatcher) and value.stats.cache_path:
             return value.stats.cache_path   # numba's choice: beside the source, or user-wide
     return os.path.join(os.path.dirname(os.path.abspath(stepping.__file__)), "__pycache__")
+
+
+def cpu_name():
+    """The processor numba compiles for (``NUMBA_CPU_NAME`` where set), as
+    its cache keys compiled code by it.
+
+    Examples
+    --------
+    >>> from orbits._compiling import cpu_name
+    >>> isinstance(cpu_name(), str) and cpu_name() != ""
+    True
+    """
+    import llvmlite.binding as llvm
+    return _config.CPU_NAME or llvm.get_host_cpu_name()
 
 
 def stderr_is_terminal():

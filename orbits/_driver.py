@@ -289,7 +289,15 @@ class Driven:
         else:
             bar = _ProgressBar(plan.total_steps, progress)
             bar.update(self.steps - plan.start_step)
-        self._compile_clock = CompileClock(loop_label(self.integrator),
+            if isinstance(self._ws, dict):
+                # the simulation's step count at the run's end, for the
+                # integrators that choose a loop by the length of the run
+                # (wh's lanes="auto")
+                self._ws["steps_by_end"] = plan.start_step + plan.total_steps
+        lanes = getattr(self.integrator, "lanes_wanted", None)
+        lanes = (lanes is not None and getattr(self._force, "inner", None) is None
+                 and lanes(self._ws, self._x.shape[0], self._force.recorder))
+        self._compile_clock = CompileClock(loop_label(self.integrator, lanes),
                                            quiet=progress is False)
         wall0 = _time.perf_counter()
         self._wall0 = wall0

@@ -39,7 +39,7 @@ def configured(integrator, options, signature_of):
     --------
     >>> from orbits._integrator_choice import configured
     >>> configured("wh", {"corrector": 17}, orbits.Simulation.__init__)
-    WisdomHolman(coordinates='jacobi', corrector=17)
+    WisdomHolman(coordinates='jacobi', corrector=17, lanes='auto')
     """
     if isinstance(integrator, _integrators.Integrator):
         if options:

@@ -121,7 +121,7 @@ def test_option_help_names_the_integrators_that_take_each_option():
     values = {"epsilon": 1e-8, "tol": 1e-12, "rtol": 1e-6, "atol": 1e-10, "corrector": 17,
               "coordinates": "democratic-heliocentric", "min_dt": 1e-6,
               "adaptive_mode": "prs24", "order": 12, "hill": 2.0, "speed": 2.0,
-              "pericentre": 1.0}
+              "pericentre": 1.0, "lanes": "off"}
     refused = {"corrector": {"saba2", "saba3", "saba4"}}
     taken_by = {option: {name for _, names in takers for name in names}
                 for option, takers in cli.integrator_options().items()}

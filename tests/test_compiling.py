@@ -186,6 +186,18 @@ def test_the_default_loops_are_those_the_help_names(capsys):
     assert "default: " + ", ".join(_compiling.COMMON) in help_text
 
 
+def test_wh_compiles_its_scalar_and_its_lanes_loops_ahead():
+    # runs take the lanes' loop by the lanes option ("auto": by the run's
+    # length, or once compiled), so both are compiled ahead, the scalar first
+    from orbits._ahead import _variants
+    got = [(loop_label(integ, lanes), integ.config["lanes"]) for integ, lanes in _variants("wh")]
+    assert got == [("wh", "off"), ("wh lanes", "on"),
+                   ("wh democratic-heliocentric", "off"),
+                   ("wh democratic-heliocentric lanes", "on")]
+    assert all(f"{label}" in _compiling.FIRST_COMPILE_SECONDS for label, _ in got)
+    assert [loop_label(i, lanes) for i, lanes in _variants("ias15")] == ["ias15"]
+
+
 def test_every_compiled_integrator_has_a_loop_label():
     labels = [loop_label(orbits.integrators.get(i.name))
               for i in orbits.integrators.available()]

@@ -21,7 +21,7 @@ def test_every_integrators_options_are_taken_beside_its_name(name):
     changed = {
         "epsilon": 1e-10, "min_dt": 1e-9, "adaptive_mode": "prs24", "rtol": 1e-10,
         "atol": 1e-13, "tol": 1e-14, "order": 12, "coordinates": "democratic-heliocentric",
-        "corrector": 17, "hill": 4.0, "speed": 2.0, "pericentre": 3.0,
+        "corrector": 17, "hill": 4.0, "speed": 2.0, "pericentre": 3.0, "lanes": "off",
     }
     options = {k: changed[k] for k in plain.options}
     if name.startswith("saba"):
@@ -38,7 +38,7 @@ def test_the_issues_examples():
     sim = orbits.Simulation(bodies(), "wh", dt=1 * u.day, corrector=17,
                             coordinates="democratic-heliocentric")
     assert sim.integrator.config == {"coordinates": "democratic-heliocentric",
-                                     "corrector": 17}
+                                     "corrector": 17, "lanes": "auto"}
     assert sim.config.integrator_options == sim.integrator.config
 
 

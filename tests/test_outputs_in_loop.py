@@ -79,8 +79,8 @@ def test_wh_outputs_made_beside_the_next_drift_with_a_corrector_or_other_coordin
     # must be those of the immediate synchronisation between calls
     from orbits.integrators import get
     make = lambda: orbits.Simulation(  # noqa: E731
-        orbits.scenes.solar_system(moon=False), get("wh", **options), dt=1 * u.day,
-        monitors=["energy", "angular_momentum"])
+        orbits.scenes.solar_system(moon=False), get("wh", lanes="on", **options),
+        dt=1 * u.day, monitors=["energy", "angular_momentum"])
     inloop = make().run(until=3000 * u.day, outputs=377, progress=False)
     sim = make()
     sim.monitor_every = 10 ** 9

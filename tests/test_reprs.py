@@ -59,7 +59,7 @@ def test_simulation_repr_says_integrator_step_time_bodies_forces():
     sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "wh", dt=100 * u.day,
                             forces=[forces.GRPotential("Sun")])
     text = repr(sim)
-    for part in ("6 bodies", "t = 0 d", "wh(coordinates='jacobi', corrector=0)",
+    for part in ("6 bodies", "t = 0 d", "wh(coordinates='jacobi', corrector=0, lanes='auto')",
                  "dt = 100 d", "GRPotential(source='Sun')"):
         assert part in text, text
     sim = orbits.Simulation(orbits.scenes.kepler(), "ias15",

@@ -151,7 +151,7 @@ def get(name, **options):
     >>> orbits.integrators.get("dopri5").config
     {'rtol': 1e-09, 'atol': 1e-12}
     >>> orbits.integrators.get("whfast", corrector=17)   # an alias (ALIASES)
-    WisdomHolman(coordinates='jacobi', corrector=17)
+    WisdomHolman(coordinates='jacobi', corrector=17, lanes='auto')
     """
     if isinstance(name, Integrator):
         if options:

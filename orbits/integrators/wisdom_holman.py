@@ -12,6 +12,7 @@ two operators with more stages, bringing the error to
 """
 
 import math
+import os
 import warnings
 
 import numpy as np
@@ -31,7 +32,8 @@ from . import tableaux
 from .base import Integrator, Option
 
 __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
-           "split_gravity", "refuse_unkickable",
+           "split_gravity", "refuse_unkickable", "lanes_pay", "lanes_ready",
+           "LANES_FROM_BODIES", "LANES_FROM_STEPS", "LANES_MODES",
            "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS", "CORRECTOR_SPACING",
            "corrector_stages"]
 
@@ -63,6 +65,61 @@ LANES_FROM_BODIES = 4
 #: days); the Sun and eight planets (N = 9) gain 23 % with two declined (40
 #: days).  The results are the same either way.
 LANES_COST_OF_DECLINED = 9
+
+#: With ``lanes="auto"`` (the default), a run takes the lanes' loop where it
+#: was compiled on this machine already (:func:`lanes_ready`), or where the
+#: simulation's step count reaches this many steps by the run's end; shorter
+#: runs take the scalar loop, with the same results bit for bit.  On an
+#: empty cache the lanes' loop takes 27-29 CPU seconds to compile against the
+#: scalar one's 15-16 (25 more where the scalar one is compiled already), and
+#: saves 0.06-0.09 us a step on the outer solar system, 0.22-0.28 on the Sun
+#: and eight planets (AVX-512; benchmarks/RESULTS.md): a run of the Sun and
+#: eight planets repays it from 6e7 to 1e8 steps (the outer solar system
+#: from 2e8 to 3e8), and a run that long steps for 20 s or more.
+LANES_FROM_STEPS = 100_000_000
+
+#: the values of the ``lanes`` option
+LANES_MODES = ("auto", "on", "off")
+
+#: The lanes' loops known to be compiled: in this process (their names), and
+#: across processes by a marker file beside numba's cache (:func:`lanes_ready`)
+_LANES_READY = set()
+
+
+def _lanes_marker(name):
+    # the marker of the lanes' loop `name` (whose name carries the kernels'
+    # digest) compiled for this CPU, beside numba's cache
+    from .._compiling import cache_dir, cpu_name
+    return os.path.join(cache_dir(), f"{name}.{cpu_name()}.ready")
+
+
+def lanes_ready(loop):
+    """Whether the lanes' loop ``loop`` (a compiled loop of
+    :func:`orbits._kernels.wisdom_holman.wh_loop`) is compiled on this
+    machine: called in this process, or compiled (or loaded) by an earlier
+    one, which left a marker beside numba's cache.  The marker carries the
+    loop's name, which changes with the kernels' sources, and the CPU's."""
+    name = loop.py_func.__qualname__
+    if name in _LANES_READY:
+        return True
+    if os.path.exists(_lanes_marker(name)):
+        _LANES_READY.add(name)
+        return True
+    return False
+
+
+def _note_lanes_ready(loop):
+    # the lanes' loop `loop` has run in this process: so noted, and marked
+    # for later processes (a folder that cannot be written leaves no marker)
+    name = loop.py_func.__qualname__
+    if name in _LANES_READY:
+        return
+    _LANES_READY.add(name)
+    try:
+        with open(_lanes_marker(name), "x"):
+            pass
+    except OSError:
+        pass
 
 
 def lanes_pay(x, v, gm, dt):
@@ -257,6 +314,14 @@ class WisdomHolman(Integrator):
     back to the workspace for an output, a non-finite state and the end of
     a call).
 
+    The lanes' loop takes some 14 CPU seconds more to compile than the
+    scalar one, which a run of fewer than some 1e8 steps does not win back.
+    So the ``lanes`` option, ``"auto"`` by default, takes it for a run that
+    reaches :data:`LANES_FROM_STEPS` steps, and for every run once it is
+    compiled on the machine (by such a run, ``lanes="on"`` or ``orbits
+    compile``; :func:`lanes_ready`); other runs take the scalar loop.
+    ``"on"`` and ``"off"`` choose.  The results do not depend on it.
+
     Stopping conditions: ``escape_distance`` (and ``escape_unbound``) of
     :class:`~orbits.Simulation`, checked after every step on the inertial
     state as an output sees it, :class:`~orbits.errors.Escape` naming the
@@ -318,6 +383,11 @@ class WisdomHolman(Integrator):
         Option("corrector", int, 0, "order of the symplectic corrector of the map K(h/2) "
                "I(h) K(h/2) (Wisdom, Holman & Touma 1996; SABA: 0 only); 0: none",
                choices=tuple(CORRECTORS)),
+        Option("lanes", str, "auto", "the planets' drifts and kicks in vector lanes, the "
+               "same results bit for bit: 'on' wherever they pay (4 bodies or more, no "
+               "added terms), 'off', or 'auto': 'on' for a run that reaches 1e8 steps or "
+               "once their loop is compiled on this machine (it takes some 14 s more "
+               "to compile)", choices=LANES_MODES),
     )
     summary = ("Wisdom-Holman map, Kepler drifts and interaction kicks in Jacobi or "
                "democratic heliocentric coordinates")
@@ -452,35 +522,64 @@ class WisdomHolman(Integrator):
             # chosen once for the workspace, at its first step: a shorter
             # last step does not switch loops
             ws["lanes_pay"] = lanes_pay(x, v, gm, dt)
-        terms, targs, lanes = self._loop_terms(ws, x.shape[0])
-        if stop is not None and lanes:
-            # the lanes' state is not in xj, vj between steps: the scalar
-            # loop, bit for bit the same steps
-            targs, lanes = (), False
+        lanes = (stop is None and self.lanes_wanted(ws, x.shape[0], force.recorder)
+                 and ws["lanes_pay"])
+        # (the lanes' state is not in xj, vj between steps: a run with
+        # stopping conditions takes the scalar loop, bit for bit the same steps)
+        terms, targs = self._loop_terms(ws, x.shape[0], lanes)
         loop = _wh.wh_loop(self.config["coordinates"], terms, force.recorder, lanes)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
-        return with_status(*loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
-                                 records.outputs(mon, step0, mon_t, mon_out),
-                                 records.checks(check_every, sargs), check, targs))
+        out = loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
+                   records.outputs(mon, step0, mon_t, mon_out),
+                   records.checks(check_every, sargs), check, targs)
+        if lanes:
+            _note_lanes_ready(loop)
+        return with_status(*out)
+
+    def lanes_wanted(self, ws, n, recorder=None):
+        """Whether a run of ``n`` bodies steps in the vector lanes (where
+        they pay, :func:`lanes_pay`), by the ``lanes`` option: ``"on"``,
+        ``"off"``, or with ``"auto"`` where the simulation reaches
+        :data:`LANES_FROM_STEPS` steps by the run's end (``ws["steps_by_end"]``,
+        set by the run) or the lanes' loop (for ``recorder``, the monitors'
+        recorder) is compiled already (:func:`lanes_ready`).  Only the time
+        differs: the results are the same bit for bit.
+
+        Examples
+        --------
+        >>> wh = orbits.integrators.get("wh")
+        >>> ws = wh.workspace(5)
+        >>> wh.lanes_wanted({**ws, "steps_by_end": 10 ** 8}, 5), wh.lanes_wanted(ws, 3)
+        (True, False)
+        >>> orbits.integrators.get("wh", lanes="on").lanes_wanted(ws, 5)
+        True
+        """
+        mode = self.config["lanes"]
+        if n < LANES_FROM_BODIES or "terms" in ws or mode == "off":
+            return False
+        if mode == "on" or ws.get("steps_by_end", 0) >= LANES_FROM_STEPS:
+            return True
+        return lanes_ready(_wh.wh_loop(self.config["coordinates"], None,
+                                       _wh._record if recorder is None else recorder, True))
 
     @staticmethod
-    def _loop_terms(ws, n):
-        # (terms, the loop's targs, whether it drifts in lanes) for n rows: the
-        # added terms' kernel and arguments, or, from LANES_FROM_BODIES bodies
-        # without terms where the lanes pay (lanes_pay), the lanes' scratch; the loop and the synchronisation
-        # take the same targs, so that what they share compiles once.  The
-        # scratch is kept in the workspace as a tuple: not an array, so neither
-        # saved nor restored (what it carries from step to step, a count of
-        # drifts left to the scalar solver, only chooses between two paths
-        # with the same results)
+    def _loop_terms(ws, n, lanes):
+        # (terms, the loop's targs) for n rows: the added terms' kernel and
+        # arguments, or, for the lanes' loop, the lanes' scratch; the loop and
+        # the synchronisation take the same targs, so that what they share
+        # compiles once.  The scratch is kept in the workspace as a tuple: not
+        # an array, so neither saved nor restored (what it carries from step
+        # to step, a count of drifts left to the scalar solver, only chooses
+        # between two paths with the same results).  The choice is kept for
+        # the synchronisation (ws["lanes_taken"])
         terms, targs = ws.get("terms", (None, ()))
-        lanes = terms is None and n >= LANES_FROM_BODIES and ws.get("lanes_pay", True)
+        ws["lanes_taken"] = lanes
         if lanes:
             targs = ws.get("lanes")
             if targs is None or targs[0].shape != _lanes.lanes_scratch_shape(n):
                 targs = ws["lanes"] = (_lanes.lanes_scratch(n),)
-        return terms, targs, lanes
+        return terms, targs
 
     def _advance_tangent(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t,
                          mon_out, check_every, stop=None):
@@ -520,7 +619,8 @@ class WisdomHolman(Integrator):
                  ws["vs"], x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0],
                  (targs, tp))
         elif ws["state"][0]:
-            terms, targs, lanes = self._loop_terms(ws, x.shape[0])
+            lanes = ws.get("lanes_taken", False)
+            terms, targs = self._loop_terms(ws, x.shape[0], lanes)
             sync = _wh.synchronizer(self.config["coordinates"], terms, lanes)
             sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],
                  x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0], targs)

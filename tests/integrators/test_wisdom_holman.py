@@ -509,7 +509,7 @@ def test_democratic_heliocentric_run_continued_from_a_file_is_bit_identical(tmp_
                               dt=10 * u.day)
     first.run(until=8_000 * u.day, outputs=5, output=path, progress=False)
     again = orbits.Simulation.from_file(path)
-    assert again.integrator.config == {"coordinates": DH, "corrector": 5}
+    assert again.integrator.config == {"coordinates": DH, "corrector": 5, "lanes": "auto"}
     again.run(until=20_000 * u.day, outputs=5, output=path, progress=False)
     assert np.array_equal(again._x, ref._x) and np.array_equal(again._v, ref._v)
 
@@ -552,8 +552,10 @@ def test_wh_stops_at_an_escape_in_the_step_leapfrog_does():
     m = wh.bodies.masses.value
     assert np.linalg.norm(x[3] - m @ x / m.sum()) > 50
     np.testing.assert_array_equal(wh_exc.result.positions[-1].value, wh.bodies.positions.value)
-    ref = orbits.Simulation(launched(), "wh", dt=10 * u.day)
+    ref = orbits.Simulation(launched(), orbits.integrators.get("wh", lanes="on"),
+                            dt=10 * u.day)
     ref.run(until=wh.time, outputs=2, progress=False)
+    assert ref._ws["lanes_taken"]
     np.testing.assert_array_equal(wh.bodies.positions.value, ref.bodies.positions.value)
     np.testing.assert_array_equal(wh.bodies.velocities.value, ref.bodies.velocities.value)
 

@@ -8,8 +8,9 @@ drift (see tests/kernels/test_wh_lanes.py), so nothing may differ by even an
 ulp; the kick's pulls are summed in the lanes in the scalar order, and the
 state stays in the lanes between outputs (tests/kernels/test_wh_lanes.py).
 Which loop a run takes is chosen by the number of bodies
-(``LANES_FROM_BODIES``) and of planets outside the lanes' domain
-(``LANES_COST_OF_DECLINED``), set here to force one or the other.
+(``LANES_FROM_BODIES``), of planets outside the lanes' domain
+(``LANES_COST_OF_DECLINED``) and, with the ``lanes`` option's "auto", the
+run's length (``LANES_FROM_STEPS``), set here to force one or the other.
 """
 
 import astropy.units as u
@@ -24,9 +25,11 @@ DH = "democratic-heliocentric"
 
 
 def take_lanes(monkeypatch, lanes):
-    """Make the runs that follow take the lanes' loop, or the scalar one."""
+    """Make the runs that follow take the lanes' loop, or the scalar one (the
+    ``lanes`` option's "auto", whatever the runs' length)."""
     monkeypatch.setattr(IW, "LANES_FROM_BODIES", 4 if lanes else 10 ** 9)
     monkeypatch.setattr(IW, "LANES_COST_OF_DECLINED", 0)
+    monkeypatch.setattr(IW, "LANES_FROM_STEPS", 0 if lanes else 10 ** 18)
 
 
 def with_odd_orbits():
@@ -176,3 +179,46 @@ def test_the_lanes_are_taken_where_few_planets_leave_their_domain(scene, step_da
     sim = orbits.Simulation(bodies, integrator="wh", dt=step_days * u.day, monitors=())
     sim.run(until=2 * step_days * u.day, progress=False)
     assert sim._ws["lanes_pay"] is lanes
+
+
+def test_auto_takes_the_lanes_for_long_runs_and_once_they_are_compiled(monkeypatch, tmp_path):
+    # lanes="auto" (the default): the scalar loop for a run that ends before
+    # LANES_FROM_STEPS steps on a machine that never compiled the lanes' loop
+    # (its compilation would cost more than the run saves), the lanes' loop
+    # for one that reaches it, and for any run once that loop is compiled:
+    # in this process, or in an earlier one, which left a marker beside the
+    # cache (here a folder of the test's own).  Bit for bit the same states.
+    from orbits import _compiling
+    monkeypatch.setattr(_compiling, "cache_dir", lambda: str(tmp_path))
+    monkeypatch.setattr(IW, "_LANES_READY", set())
+    monkeypatch.setattr(IW, "LANES_FROM_STEPS", 100)
+    bodies = orbits.scenes.outer_solar_system()
+
+    def run(steps, **options):
+        integ = orbits.integrators.get("wh", **options)
+        sim = orbits.Simulation(bodies, integ, dt=10 * u.day, monitors=())
+        r = sim.run(until=steps * 10 * u.day, outputs=3, progress=False)
+        return sim._ws["lanes_taken"], r.positions.value, r.velocities.value
+
+    short = run(60)
+    assert not short[0] and list(tmp_path.iterdir()) == []
+    assert run(120)[0]                                  # reaches 100 steps
+    markers = list(tmp_path.glob("*.ready"))
+    assert len(markers) == 1 and "lanes" in markers[0].name
+    again = run(60)                                     # compiled in this process
+    assert again[0]
+    assert np.array_equal(again[1], short[1]) and np.array_equal(again[2], short[2])
+    monkeypatch.setattr(IW, "_LANES_READY", set())      # a new process: the marker
+    assert run(60)[0]
+    markers[0].unlink()
+    monkeypatch.setattr(IW, "_LANES_READY", set())
+    assert not run(60)[0]
+    # "on" and "off" whatever the length; and too few bodies, or added terms, never
+    assert run(60, lanes="on")[0] and not run(120, lanes="off")[0]
+    monkeypatch.setattr(IW, "LANES_FROM_STEPS", 0)
+    three = orbits.Simulation(orbits.scenes.kepler(), "wh", dt=1 * u.day)
+    three.run(until=10 * u.day, progress=False)
+    assert not three._ws["lanes_taken"]
+    gr = orbits.Simulation(bodies, "wh", dt=10 * u.day, forces=[orbits.forces.GRPotential("Sun")])
+    gr.run(until=100 * u.day, progress=False)
+    assert not gr._ws["lanes_taken"]
