@@ -296,6 +296,7 @@ class Driven:
                 self._ws["steps_by_end"] = plan.start_step + plan.total_steps
         lanes = getattr(self.integrator, "lanes_wanted", None)
         lanes = (lanes is not None and getattr(self._force, "inner", None) is None
+                 and getattr(self, "_stop", None) is None
                  and lanes(self._ws, self._x.shape[0], self._force.recorder))
         self._compile_clock = CompileClock(loop_label(self.integrator, lanes),
                                            quiet=progress is False)
