@@ -11,7 +11,8 @@ outputs that do not fall a whole number of steps apart, each on the step
 nearest its time), default monitors (energy and angular momentum at each
 output); ``wh`` with ``lanes="on"``, the loop of a long run and of every run
 once it is compiled on the machine (its outputs are made beside the next
-step's drift, in the lanes):
+step's drift, in the lanes; ``--lanes off``: the scalar loop, which a
+shorter run takes on a machine that has not compiled that one):
 
 * ``memory``: ``Simulation.run(outputs=...)`` kept in memory, and every field
   of its result read (the result makes its Quantities and monitor series when
@@ -90,10 +91,15 @@ def scenes():
 _clock = time.perf_counter
 
 
+#: ``wh``'s lanes option (``--lanes``)
+_lanes = "on"
+
+
 def _ours(integrator, dt, n_out, k, path=None):
     if integrator == "wh":
-        # the loop with the planets in vector lanes (see the module notes)
-        integrator = orbits.integrators.get("wh", lanes="on")
+        # the loop with the planets in vector lanes, or the scalar one (see
+        # the module notes)
+        integrator = orbits.integrators.get("wh", lanes=_lanes)
     sim = orbits.Simulation(orbits.scenes.outer_solar_system(), integrator, dt=dt * u.day)
     until = n_out * k * dt * u.day
     t0 = _clock()
@@ -217,9 +223,14 @@ def main(argv=None):
     p.add_argument("--memory", action="store_true", help="also measure peak memory")
     p.add_argument("--clock", choices=("wall", "cpu"), default="wall",
                    help="wall clock (default) or this process's CPU time")
+    p.add_argument("--lanes", choices=("on", "off"), default="on",
+                   help="wh's loop with the planets in vector lanes (default) or the "
+                        "scalar one, which a shorter run takes on a machine that has not "
+                        "compiled the lanes' loop")
     args = p.parse_args(argv)
-    global _clock
+    global _clock, _lanes
     _clock = time.perf_counter if args.clock == "wall" else time.process_time
+    _lanes = args.lanes
     n_out = 20_000 if args.quick else args.outputs
     repeats = 1 if args.quick else args.repeats
     path = os.path.join(tempfile.mkdtemp(), "bench.h5")
