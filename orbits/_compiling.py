@@ -42,7 +42,7 @@ FIRST_COMPILE_SECONDS = {
     **{f"{name}{coords}{lanes}": seconds
        for name in ("wh", "saba2", "saba3", "saba4")
        for coords in ("", " democratic-heliocentric")
-       for lanes, seconds in (("", 15.0), (" lanes", 28.0))},
+       for lanes, seconds in (("", 13.0), (" lanes", 28.0))},
     "dopri5": 5.0, "dop853": 5.0, "rk4-doubling": 4.0, "ias15": 6.0, "taylor": 4.0,
     "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 20.0,
 }
@@ -90,7 +90,7 @@ def notice(label):
     --------
     >>> from orbits._compiling import notice
     >>> notice("wh")
-    'orbits: compiling the wh loop for this CPU, once (about 15 s; `orbits compile` does it ahead)'
+    'orbits: compiling the wh loop for this CPU, once (about 13 s; `orbits compile` does it ahead)'
     """
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:

@@ -931,7 +931,13 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
     nrt = not cache
-    drift = _plain_drift
+    # the scalar loop without terms, which a first, shorter run takes (the
+    # lanes' loop serves the long ones: orbits.integrators.wisdom_holman's
+    # lanes option), calls the drift that its synchronisation and corrector
+    # call instead of inlining a copy: 2.3 s less to compile for 2-5 % more
+    # a step; the loop with terms, whose long runs have no lanes, inlines it
+    # (benchmarks/RESULTS.md)
+    drift = called(_plain_drift, nrt) if terms is None else _plain_drift
     outputs = {}
     if lanes:
         # the state kept in the lanes between outputs, and outputs made beside

@@ -71,7 +71,7 @@ LANES_COST_OF_DECLINED = 9
 #: simulation's step count reaches this many steps by the run's end; shorter
 #: runs take the scalar loop, with the same results bit for bit.  On an
 #: empty cache the lanes' loop takes 27-29 CPU seconds to compile against the
-#: scalar one's 15-16 (25 more where the scalar one is compiled already), and
+#: scalar one's 12-13 (25 more where the scalar one is compiled already), and
 #: saves 0.06-0.09 us a step on the outer solar system, 0.22-0.28 on the Sun
 #: and eight planets (AVX-512; benchmarks/RESULTS.md): a run of the Sun and
 #: eight planets repays it from 6e7 to 1e8 steps (the outer solar system
@@ -314,7 +314,7 @@ class WisdomHolman(Integrator):
     back to the workspace for an output, a non-finite state and the end of
     a call).
 
-    The lanes' loop takes some 14 CPU seconds more to compile than the
+    The lanes' loop takes some 15 CPU seconds more to compile than the
     scalar one, which a run of fewer than some 1e8 steps does not win back.
     So the ``lanes`` option, ``"auto"`` by default, takes it for a run that
     reaches :data:`LANES_FROM_STEPS` steps, and for every run once it is
@@ -386,7 +386,7 @@ class WisdomHolman(Integrator):
         Option("lanes", str, "auto", "the planets' drifts and kicks in vector lanes, the "
                "same results bit for bit: 'on' wherever they pay (4 bodies or more, no "
                "added terms), 'off', or 'auto': 'on' for a run that reaches 1e8 steps or "
-               "once their loop is compiled on this machine (it takes some 14 s more "
+               "once their loop is compiled on this machine (it takes some 15 s more "
                "to compile)", choices=LANES_MODES),
     )
     summary = ("Wisdom-Holman map, Kepler drifts and interaction kicks in Jacobi or "
