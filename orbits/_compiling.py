@@ -24,6 +24,7 @@ from numba.core import event as _event
 from numba.core.dispatcher import Dispatcher
 
 from ._kernels import stepping
+from ._kernels._jit import cpu_name
 
 __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "loop_label",
            "notice", "cache_dir", "cpu_name", "stderr_is_terminal"]
@@ -228,20 +229,6 @@ def cache_dir():
         if isinstance(value, Dispatcher) and value.stats.cache_path:
             return value.stats.cache_path   # numba's choice: beside the source, or user-wide
     return os.path.join(os.path.dirname(os.path.abspath(stepping.__file__)), "__pycache__")
-
-
-def cpu_name():
-    """The processor numba compiles for (``NUMBA_CPU_NAME`` where set), as
-    its cache keys compiled code by it.
-
-    Examples
-    --------
-    >>> from orbits._compiling import cpu_name
-    >>> isinstance(cpu_name(), str) and cpu_name() != ""
-    True
-    """
-    import llvmlite.binding as llvm
-    return _config.CPU_NAME or llvm.get_host_cpu_name()
 
 
 def stderr_is_terminal():

@@ -46,8 +46,8 @@ from numba.extending import intrinsic
 from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
-           "cfunc", "pointer", "Pointer", "fma", "value", "data_pointer", "KERNEL_STAMP",
-           "NUMBA_OPTIONS"]
+           "cfunc", "pointer", "Pointer", "fma", "value", "data_pointer", "cpu_name",
+           "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
 
@@ -156,6 +156,21 @@ def fma(typingctx, a, b, c):
         return builder.fma(*args)
 
     return sig, codegen
+
+
+def cpu_name():
+    """The processor numba compiles for (``NUMBA_CPU_NAME`` where set), as
+    its cache keys compiled code by it.
+
+    Examples
+    --------
+    >>> from orbits._kernels._jit import cpu_name
+    >>> isinstance(cpu_name(), str) and cpu_name() != ""
+    True
+    """
+    import llvmlite.binding as llvm
+    from numba.core import config
+    return config.CPU_NAME or llvm.get_host_cpu_name()
 
 
 @intrinsic

@@ -27,7 +27,7 @@ import math
 import numpy as np
 import numba
 
-from ._jit import njit, njit_parallel
+from ._jit import cpu_name, njit, njit_parallel
 
 __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_reference",
            "pair_workspace", "gravity_args", "PAIR_BATCH", "SMALL_N", "N_BLOCKS",
@@ -193,7 +193,7 @@ def vector_doubles():
         llvm.initialize_native_target()
         llvm.initialize_native_asmprinter()
         target = llvm.Target.from_default_triple()
-        cpu = config.CPU_NAME or llvm.get_host_cpu_name()
+        cpu = cpu_name()
         features = (config.CPU_FEATURES if config.CPU_FEATURES is not None
                     else get_host_cpu_features())
         machine = target.create_target_machine(cpu=cpu, features=features, opt=3)

@@ -556,12 +556,23 @@ class WisdomHolman(Integrator):
         True
         """
         mode = self.config["lanes"]
-        if n < LANES_FROM_BODIES or "terms" in ws or mode == "off":
-            return False
-        if mode == "on" or ws.get("steps_by_end", 0) >= LANES_FROM_STEPS:
-            return True
-        return lanes_ready(_wh.wh_loop(self.config["coordinates"], None,
-                                       _wh._record if recorder is None else recorder, True))
+        # decided once a run (the run's driver asks first, for its notice,
+        # then every call of the loop): kept in the workspace under the
+        # run's length, the rows, the mode and whether terms are bound
+        key = (ws.get("steps_by_end", 0), n, mode, "terms" in ws)
+        memo = ws.get("lanes_wanted")
+        if memo is not None and memo[0] == key:
+            return memo[1]
+        if n < LANES_FROM_BODIES or key[3] or mode == "off":
+            wanted = False
+        elif mode == "on" or key[0] >= LANES_FROM_STEPS:
+            wanted = True
+        else:
+            wanted = lanes_ready(_wh.wh_loop(
+                self.config["coordinates"], None,
+                _wh._record if recorder is None else recorder, True))
+        ws["lanes_wanted"] = (key, wanted)
+        return wanted
 
     @staticmethod
     def _loop_terms(ws, n, lanes):
