@@ -371,6 +371,7 @@ def specialize(template, suffix, jit=True, cache=True, inline=False, nrt=True, *
 
 
 _CALLED = {}
+_CALLED_COPIES = {}
 
 
 def called(kernel, nrt=True):
@@ -381,6 +382,9 @@ def called(kernel, nrt=True):
     each inlined copy would cost its compilation again.  The same code, so
     the same results bit for bit; compiled once and cached under the
     kernel's name.  ``nrt`` as in :func:`specialize`."""
+    if _CALLED_COPIES.get(kernel) == nrt:
+        # already a called copy (with the same runtime): the same function
+        return kernel
     key = (kernel, nrt)
     if key in _CALLED:
         return _CALLED[key]
@@ -395,4 +399,5 @@ def called(kernel, nrt=True):
     if not nrt:
         options["_nrt"] = False
     _CALLED[key] = result = numba.njit(**options)(func)
+    _CALLED_COPIES[result] = nrt
     return result

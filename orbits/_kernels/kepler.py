@@ -31,6 +31,7 @@ from .stumpff import _SIXTH, _stumpff_short, stumpff
 __all__ = [
     "DRIFT_MAX_ITER",
     "kepler_drift",
+    "kepler_drift_bracketed",
     "short_step_anomaly",
     "short_start",
     "quartic_step",
@@ -334,11 +335,11 @@ def kepler_drift(mu, x, v, i, dt):
                                                 v[i, 0], v[i, 1], v[i, 2], dt)
     if s == s and advance_by_anomaly(mu, x, v, i, s, r0, ir0, beta, zeta):
         return Status.OK
-    return _kepler_drift_bracketed(mu, x, v, i, dt)
+    return kepler_drift_bracketed(mu, x, v, i, dt)
 
 
 @njit
-def _kepler_drift_bracketed(mu, x, v, i, dt):
+def kepler_drift_bracketed(mu, x, v, i, dt):
     """:func:`kepler_drift` by the bracketed solver, for any step: the anomaly
     from :func:`bracketed_anomaly`, then f and g from the universal functions
     there (the same values its last iteration tested)."""

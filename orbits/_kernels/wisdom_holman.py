@@ -108,7 +108,8 @@ from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi
                           jacobi_step, to_democratic_heliocentric, to_jacobi,
                           weighted_sum)
 from .gravity import pair_accelerations
-from .kepler import advance_by_anomaly, kepler_drift, short_step_anomaly, straight_drift
+from .kepler import (advance_by_anomaly, kepler_drift_bracketed, short_step_anomaly,
+                     straight_drift)
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
 from .stopping import no_stop
@@ -159,7 +160,10 @@ def kepler_drift_all(xj, vj, mu, h, w1, w2):
     anomaly) that the processor can overlap, rather than one body after
     the other (benchmarks/RESULTS.md).  Steps that are
     not short take :func:`~orbits._kernels.kepler.kepler_drift`'s bracketed
-    solver.
+    solver directly: :func:`~orbits._kernels.kepler.kepler_drift` would
+    try the same short step again on the same numbers, fail again, and
+    end there, so the result is the same bit for bit, and the loop does not
+    compile the short step a second time.
     """
     straight_drift(xj, vj, 0, h)
     n = xj.shape[0]
@@ -168,7 +172,7 @@ def kepler_drift_all(xj, vj, mu, h, w1, w2):
         s = w1[i, 0]
         if not (s == s and advance_by_anomaly(mu[i], xj, vj, i, s, w1[i, 1], w1[i, 2],
                                               w2[i, 0], w2[i, 1])):
-            kepler_drift(mu[i], xj, vj, i, h)
+            kepler_drift_bracketed(mu[i], xj, vj, i, h)
 
 
 @njit(inline="always")

@@ -115,6 +115,20 @@ def _template(x):
     return _scale * _kernel(x)
 
 
+def test_called_makes_one_copy_of_a_kernel_and_calling_a_copy_is_the_copy():
+    # a loop whose drift is already called (wh's scalar loop) hands it on as
+    # its owed drift too: a second call of called must not compile the same
+    # code again under another name (it did, 3 s of a first wh run)
+    once = _jit.called(_halve)
+    assert _jit.called(_halve) is once
+    assert _jit.called(once) is once
+    assert once.py_func.__name__ == f"_halve__called__{_jit.KERNEL_STAMP}"
+    # a copy without numba's runtime is another function
+    bare = _jit.called(once, nrt=False)
+    assert bare is not once and _jit.called(bare, nrt=False) is bare
+    assert once(3.0) == bare(3.0) == 1.5
+
+
 def test_specialize_binds_a_declared_slot_and_a_default():
     double = _jit.specialize(_template, "test_double", jit=False, _kernel=lambda x: x + 1.0)
     assert double(1.0) == 4.0              # (1 + 1) * the default scale 2
