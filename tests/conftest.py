@@ -1,7 +1,28 @@
 """Shared fixtures."""
 
+import signal
+import threading
+
 import numpy as np
 import pytest
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _ctrl_c_raises_as_at_a_terminal():
+    """Ctrl-C raises KeyboardInterrupt in the test processes, as in a Python
+    started at a terminal, however the test run was started: a shell starts
+    a background job (``cmd &`` in a script, ``nohup``) with SIGINT ignored,
+    and a run leaves an ignored signal ignored, so the tests of what Ctrl-C
+    does would see nothing happen.  Put back after the session."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGINT)
+    if previous == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    if previous == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, previous)
 
 
 @pytest.fixture(scope="session")
