@@ -218,11 +218,15 @@ def test_scipy_references_integrate_the_work():
     # radau carries W as one more component of its ODE, under its tolerance
     pytest.importorskip("scipy")
     integ = orbits.integrators.get("radau", rtol=1e-10, atol=1e-13)
-    free = _sim(integ, drag_on=False).run(until=1 * u.yr, outputs=11, progress=False)
-    dragged = _sim(integ).run(until=1 * u.yr, outputs=11, progress=False)
+    # a quarter of the orbit (scipy's Radau evaluates the force some 2500
+    # times, each a call from Python)
+    free = _sim(integ, drag_on=False).run(until=0.25 * u.yr, outputs=11, progress=False)
+    dragged = _sim(integ).run(until=0.25 * u.yr, outputs=11, progress=False)
     e = dragged.energy.value
-    # measured 4.9e-13 against 4.4e-13 without the drag, which took 2.2e-3 out
-    assert abs(e[-1] - e[0]) / abs(e[0]) > 1e-3
+    # measured: E + W off by 1.1e-13 against 1.3e-13 without the drag, which
+    # took 6.1e-4 of the energy out (over the whole orbit 4.9e-13 against
+    # 4.4e-13, with 2.2e-3 out)
+    assert abs(e[-1] - e[0]) / abs(e[0]) > 1e-4
     assert dragged.energy_error.max() < 3 * free.energy_error.max()
 
 

@@ -46,6 +46,7 @@ from numba.extending import intrinsic
 from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
+           "compiled_for",
            "cfunc", "pointer", "Pointer", "fma", "value", "data_pointer", "cpu_name",
            "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
@@ -144,6 +145,30 @@ def pointer(kernel, signature):
     func.__qualname__ = name
     func.__module__ = py.__module__
     return Pointer(cfunc(signature, func))
+
+
+def compiled_for(kernel, *args):
+    """The compiled code ``kernel`` runs for arguments of the types of
+    ``args`` (compiled now, or loaded from the cache, where need be), as a
+    function to call from Python with arguments of exactly those types; a
+    plain Python ``kernel`` is returned as it is.
+
+    A call of a compiled function from Python first types every argument:
+    arrays and numbers take numba's quick path, but an argument that holds
+    a compiled pointer (a table of force terms with a user's term) is typed
+    element by element in Python, some milliseconds a call.  A caller that
+    calls a kernel many times with the same arguments' types (scipy's
+    solvers call the force once an evaluation) types them once here.  The
+    function returned converts its arguments by those types without
+    checking them: an array of another layout or type is read wrongly, so
+    callers hand it C-contiguous float64 arrays as they did the first time.
+
+    Built on the dispatcher's ``compile(signature)``, which returns that
+    code; ``tests/kernels/test_jit.py`` fails on a numba where it does not.
+    """
+    if not isinstance(kernel, numba.core.dispatcher.Dispatcher):
+        return kernel
+    return kernel.compile(tuple(numba.typeof(a) for a in args))
 
 
 @intrinsic

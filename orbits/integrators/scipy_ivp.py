@@ -20,6 +20,7 @@ scipy's solver integrates (and controls the error of) with the rest, so that
 import numpy as np
 
 from .._kernels import stepping as _stepping
+from .._kernels._jit import compiled_for
 from .._kernels.status import Status
 from ..errors import IntegratorOptionError
 from .base import ToleranceControlled
@@ -60,12 +61,22 @@ class ScipyIntegrator(ToleranceControlled):
         work = force.dissipative
         if work:
             fargs = _stepping.work_bound(force, fargs, ws)
-            rate = _stepping.work_kernels(force)["work_rate"]
+        # the force (and the work rate) as compiled for these arguments' types,
+        # typed once here rather than at each of scipy's evaluations (a table
+        # with a user's term took milliseconds an evaluation to type); the
+        # states handed on below are C-contiguous float64 (n, 3) as these are
+        xc = np.ascontiguousarray(x, dtype=np.float64)
+        vc = np.ascontiguousarray(v, dtype=np.float64)
+        accel = compiled_for(force.kernel, xc, vc, float(t), fargs, acc)
+        if work:
+            rate = compiled_for(_stepping.work_kernels(force)["work_rate"], xc, vc, float(t),
+                                fargs)
 
         def rhs(time, y):
-            xs = np.ascontiguousarray(y[:3 * n].reshape(n, 3))
-            vs = np.ascontiguousarray(y[3 * n:6 * n].reshape(n, 3))
-            force.kernel(xs, vs, time, fargs, acc)
+            xs = np.ascontiguousarray(y[:3 * n].reshape(n, 3), dtype=np.float64)
+            vs = np.ascontiguousarray(y[3 * n:6 * n].reshape(n, 3), dtype=np.float64)
+            time = float(time)
+            accel(xs, vs, time, fargs, acc)
             parts = [y[3 * n:6 * n], acc.ravel()]
             if work:
                 parts.append([-rate(xs, vs, time, fargs)])

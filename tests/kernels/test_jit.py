@@ -129,6 +129,27 @@ def test_called_makes_one_copy_of_a_kernel_and_calling_a_copy_is_the_copy():
     assert once(3.0) == bare(3.0) == 1.5
 
 
+def test_compiled_for_is_the_code_a_call_runs_typed_once():
+    # the code numba runs for the arguments' types, called without typing them
+    # again (scipy's solvers call the force so, once an evaluation): the same
+    # result as the dispatcher's, and on a numba whose dispatcher.compile does
+    # not return that code this fails (orbits._kernels._jit.compiled_for)
+    pointer = _jit.pointer(_halve, _UNARY)
+    args = (2.0, (3.0, pointer.cfunc))    # a table holds its C callables so
+    code = _jit.compiled_for(_apply_held, *args)
+    assert code is not _apply_held and callable(code)
+    assert code(*args) == _apply_held(*args) == 1.5 + 2.0
+    assert len(_apply_held.signatures) == 1          # the same compilation
+    # a plain Python function is its own code
+    assert _jit.compiled_for(_triple, 1.0) is _triple
+
+
+@_jit.njit(cache=False)
+def _apply_held(a, held):
+    b, f = held
+    return f(b) + a
+
+
 def test_specialize_binds_a_declared_slot_and_a_default():
     double = _jit.specialize(_template, "test_double", jit=False, _kernel=lambda x: x + 1.0)
     assert double(1.0) == 4.0              # (1 + 1) * the default scale 2
