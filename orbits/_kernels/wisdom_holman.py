@@ -942,8 +942,6 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     # a step; the loop with terms, whose long runs have no lanes, inlines it
     # (benchmarks/RESULTS.md)
     drift = called(_plain_drift, nrt) if terms is None else _plain_drift
-    if terms is None and not lanes:
-        perturbation = called(perturbation, nrt)
     outputs = {}
     if lanes:
         # the state kept in the lanes between outputs, and outputs made beside
