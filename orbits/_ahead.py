@@ -22,12 +22,14 @@ def _variants(name):
     """The integrators (configured) whose loops ``name`` compiles, each with
     whether it is the loop with the planets in vector lanes: one per set of
     coordinates for the methods that take them, and for those with a
-    ``lanes`` option (``wh``, the SABA methods) the scalar loop and the
-    lanes' one of each."""
+    ``lanes`` option (``wh``, the SABA methods, ``trace``) the scalar loop
+    and the lanes' one of each."""
     integ = integrators.get(name)
     options = type(integ).options
     coords = options.get("coordinates")
     if coords is None:
+        if "lanes" in options:
+            return [(integrators.get(name, lanes=mode), mode == "on") for mode in ("off", "on")]
         return [(integ, False)]
     order = [coords] + [c for c in COORDINATES if c != coords]
     if "lanes" not in options:

@@ -45,7 +45,7 @@ FIRST_COMPILE_SECONDS = {
        for coords in ("", " democratic-heliocentric")
        for lanes, seconds in (("", 13.0), (" lanes", 28.0))},
     "dopri5": 5.0, "dop853": 5.0, "rk4-doubling": 4.0, "ias15": 6.0, "taylor": 4.0,
-    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 20.0,
+    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 20.0, "trace lanes": 30.0,
 }
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
@@ -65,8 +65,8 @@ def loop_label(integrator, lanes=False):
     """The name of an integrator's stepping loop, as the notice and the table
     of :data:`FIRST_COMPILE_SECONDS` give it: its registry name, its
     coordinates where they are not its default (each set of coordinates is a
-    loop of its own), and "lanes" for the Wisdom-Holman loop with its planets
-    in vector lanes (``lanes``; see the ``lanes`` option of ``wh``).
+    loop of its own), and "lanes" for the loop with its planets in vector
+    lanes (``lanes``; see the ``lanes`` option of ``wh`` and ``trace``).
 
     Examples
     --------

@@ -196,6 +196,8 @@ def test_wh_compiles_its_scalar_and_its_lanes_loops_ahead():
                    ("wh democratic-heliocentric lanes", "on")]
     assert all(f"{label}" in _compiling.FIRST_COMPILE_SECONDS for label, _ in got)
     assert [loop_label(i, lanes) for i, lanes in _variants("ias15")] == ["ias15"]
+    assert [(loop_label(i, lanes), i.config["lanes"]) for i, lanes in _variants("trace")] == [
+        ("trace", "off"), ("trace lanes", "on")]
 
 
 def test_every_compiled_integrator_has_a_loop_label():

@@ -75,10 +75,12 @@ from .gravity import pair_accelerations, pull_pair, zero_rows
 from .status import Status
 from .stepping import (GO, _record, accept_fsal, dop853_error, epilogue, first_record,
                        stage_errors)
+from .trace_lanes import FAR_WAIT, criterion_scales, far_steps
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 # the names the templates below are written against, bound by specialize
-HAS_TERMS, step_end, term_kick = slots("HAS_TERMS", "step_end", "term_kick")
+HAS_TERMS, step_end, term_kick, LANES, far_run = slots("HAS_TERMS", "step_end", "term_kick",
+                                                       "LANES", "far_run")
 
 __all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
            "inner_arrays",
@@ -96,7 +98,6 @@ MAX_REDO = 8
 #: constant passed (a literal type), and it is compiled once for both
 MODE_GROUP = 0.0
 MODE_ALL = 1.0
-_CBRT2 = 1.2599210498948732
 _TINY = 1e-300
 _EPS = 2.220446049250313e-16
 
@@ -117,8 +118,7 @@ def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, k_peri, enc):
     """
     n = xh.shape[0]
     peri = 0
-    kp2 = (k_peri * h) ** 2
-    kg2 = (kp2 * gm[0]) ** 2
+    kp2, kg2, kv2, kh2 = criterion_scales(h, gm[0], k_hill, k_speed, k_peri)
     vmax2 = 0.0
     for i in range(1, n):
         ri2 = xh[i, 0] * xh[i, 0] + xh[i, 1] * xh[i, 1] + xh[i, 2] * xh[i, 2]
@@ -133,12 +133,9 @@ def criterion(xh, vb, gm, hill, r2, n_active, k_hill, k_speed, h, k_peri, enc):
             peri = 1
         vmax2 = max(vmax2, vi2)
     count = 0
-    kv = k_speed * abs(h)
-    kv2 = kv * kv
     # |V_i - V_j| <= 2 max |V|: pairs farther apart than that many steps of
     # it skip the relative speed
     reach2 = 4.0 * kv2 * vmax2
-    kh2 = (k_hill * _CBRT2) ** 2
     third = 1.0 / 3.0
     g3 = 3.0 * gm[0]
     for i in range(2, n):
@@ -641,7 +638,31 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
     half = 0.5 * dt
     until_check = check_every
     until_record = first_record(every, step0, mon_t)
-    for k in range(nsteps):
+    far_wait = 0
+    k = 0
+    while k < nsteps:
+        if LANES:
+            if far_wait > 0:
+                far_wait -= 1
+            elif (not conditions and owed == half and state[2] != 0 and state[3] == 0
+                  and state[4] == 0):
+                # far from encounters: the steps before the next output and the
+                # call's last step in the lanes (orbits._kernels.trace_lanes),
+                # until a criterion point may flag; this step then as below
+                m = nsteps - k - 1
+                if 0 < until_record <= m:
+                    m = until_record - 1
+                if m > 0:
+                    done, until_check, why = far_run(xh, vb, xc, vc, gm, eta, hill, n_active,
+                                                     dt, k_hill, k_speed, k_peri, m,
+                                                     until_check, check_every, targs)
+                    k += done
+                    until_record -= done
+                    if why == 2:
+                        owed_box[0] = owed
+                        return Status.NON_FINITE, k - 1, n_mon
+                    if why == 1:
+                        far_wait = FAR_WAIT
         seg = owed + half
         flagged = state[4] != 0
         peri = state[3] != 0
@@ -777,6 +798,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
             every, mon, n_mon, mon_t, mon_out, stopping, ())
         if status != GO:
             return status, done, n_mon
+        k += 1
     return Status.OK, nsteps, n_mon
 
 
@@ -785,7 +807,24 @@ def _no_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
     pass
 
 
-def trace_loop(record=_record, terms=None):
+@njit(inline="always")
+def _no_far(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_peri, m,
+            until_check, check_every, targs):
+    return 0, until_check, 0
+
+
+_far_steps_call = called(far_steps, nrt=False)
+
+
+@njit(inline="always")
+def _far(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_peri, m,
+         until_check, check_every, targs):
+    # the lanes' loop: targs holds the lanes' scratch
+    return _far_steps_call(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed,
+                           k_peri, m, until_check, check_every, targs[0])
+
+
+def trace_loop(record=_record, terms=None, lanes=False):
     """The ``trace`` loop, ``record`` recording the monitors, and ``terms`` (a
     :class:`~orbits._kernels.terms.TermKernel` of position-only terms, or
     None) kicked with the interaction, as ``wh`` kicks them.  It takes
@@ -793,18 +832,27 @@ def trace_loop(record=_record, terms=None):
     check, ahead, targs)``: a :class:`Work`, a :class:`Criteria`, an
     :class:`Inner`, the DOP853 tables, the records of :mod:`.records`, the
     stopping conditions' pointer (:func:`~.stopping.stop_record`),
-    :func:`~.stopping.ahead_pointer`'s pointer and the terms' arguments."""
+    :func:`~.stopping.ahead_pointer`'s pointer and the terms' arguments, or
+    with ``lanes`` (no terms) a tuple of the lanes' scratch
+    (:func:`~.trace_lanes.far_scratch_shape`): the loop whose steps far from
+    encounters go through :func:`~.trace_lanes.far_steps`, the same results
+    bit for bit."""
     key = "trace"
     if terms is None:
         kick, cache = _no_term_kick, True
     else:
+        if lanes:
+            raise ValueError("the lanes' trace loop takes no added terms")
         key = f"{key}_{terms.key}"
         cache = terms.cache
         kick = specialize(_heliocentric_term_kick, f"trace_{terms.key}", cache=cache,
                           inline=True, nrt=not cache, extra=terms.accel)
+    step = epilogue(record, key, cache=cache, runtime=not cache)
+    if lanes:
+        key = f"{key}_lanes"
     return specialize(_trace_loop, key, cache=cache, nrt=not cache,
-                      HAS_TERMS=terms is not None, term_kick=kick,
-                      step_end=epilogue(record, key, cache=cache, runtime=not cache))
+                      HAS_TERMS=terms is not None, term_kick=kick, LANES=lanes,
+                      far_run=_far if lanes else _no_far, step_end=step)
 
 
 def inner_arrays(n, stages):

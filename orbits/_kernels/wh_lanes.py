@@ -123,8 +123,8 @@ __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns
            "lanes_scratch", "kepler_drift_lanes",
            "drift_columns", "column_start", "SCRATCH_ROWS", "lanes_scratch_shape", "resident_load",
            "resident_store", "resident_drift_twice", "resident_drift", "resident_finite",
-           "resident_kick",
-           "resident_jump_kick"]
+           "resident_kick", "resident_jump_kick", "resident_jump", "resident_pulls",
+           "resident_velocity_kick", "STATE", "SUMS"]
 
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
@@ -505,6 +505,9 @@ _R = DRIFT_ROWS
 #: of the Jacobi kick (3)
 _RX, _RY, _RMU, _RTAKE, _RA, _RQ, _RW, _RK = (_R, _R + 6, _R + 12, _R + 13, _R + 14, _R + 17,
                                               _R + 20, _R + 21)
+#: the first rows of the lanes' state (x, y, z, vx, vy, vz) and of the
+#: pulls' sums (3), for the kernels that work on that state
+STATE, SUMS = _RX, _RA
 #: the central body's factors 1 / r^3 in the Jacobi kick (the drift's end
 #: rows, free during the kick)
 _RF = _RY
@@ -745,17 +748,20 @@ def _resident_velocity_kick(S, h, P):
 
 
 @njit(inline="always")
-def resident_jump_kick(xj, vj, gm, n_active, h, S):
-    """:func:`~orbits._kernels.wisdom_holman.jump_interaction_kick` of the
-    lanes' state (democratic heliocentric), bit for bit: the half jump, the
-    planets' pulls summed over the sources in ascending order
-    (:func:`~orbits._kernels.gravity.pull_rows`, as
-    :func:`~orbits._kernels.gravity.pair_accelerations_lanes` does), the
-    kick, the half jump."""
-    n = xj.shape[0]
-    P = lane_columns(n)
-    Pu = np.uint64(P)
-    _resident_jump(S, gm, n_active, 0.5 * h, Pu)
+def resident_jump(S, gm, n_active, h, n):
+    """:func:`~orbits._kernels.wisdom_holman.jump` of the lanes' state of
+    ``n`` bodies by ``h``, bit for bit."""
+    _resident_jump(S, gm, n_active, h, np.uint64(lane_columns(n)))
+
+
+@njit(inline="always")
+def resident_pulls(S, gm, n_active, n):
+    """The planets' mutual pulls on the lanes' state of ``n`` bodies (the
+    central body's left out) into the sums' rows (:data:`SUMS`), summed over
+    the sources in ascending order (:func:`~orbits._kernels.gravity.pull_rows`):
+    bit for bit :func:`~orbits._kernels.gravity.pair_accelerations` from
+    body 1."""
+    Pu = np.uint64(lane_columns(n))
     _zero_sums(S, Pu)
     X = S[_RX]
     Y = S[_RX + 1]
@@ -763,8 +769,27 @@ def resident_jump_kick(xj, vj, gm, n_active, h, S):
     for j in range(1, n_active):
         pull_rows(X, Y, Z, S[_RA], S[_RA + 1], S[_RA + 2], Pu, X[j - 1], Y[j - 1], Z[j - 1],
                   gm[j], np.uint64(j - 1), 0.0, np.uint64(n - 1))
-    _resident_velocity_kick(S, h, Pu)
-    _resident_jump(S, gm, n_active, 0.5 * h, Pu)
+
+
+@njit(inline="always")
+def resident_velocity_kick(S, h, n):
+    """The lanes' velocities of ``n`` bodies kicked by ``h`` times the sums."""
+    _resident_velocity_kick(S, h, np.uint64(lane_columns(n)))
+
+
+@njit(inline="always")
+def resident_jump_kick(xj, vj, gm, n_active, h, S):
+    """:func:`~orbits._kernels.wisdom_holman.jump_interaction_kick` of the
+    lanes' state (democratic heliocentric), bit for bit: the half jump, the
+    planets' pulls summed over the sources in ascending order
+    (:func:`resident_pulls`, as
+    :func:`~orbits._kernels.gravity.pair_accelerations_lanes` does), the
+    kick, the half jump."""
+    n = xj.shape[0]
+    resident_jump(S, gm, n_active, 0.5 * h, n)
+    resident_pulls(S, gm, n_active, n)
+    resident_velocity_kick(S, h, n)
+    resident_jump(S, gm, n_active, 0.5 * h, n)
 
 
 @njit(inline="always")

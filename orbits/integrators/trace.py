@@ -5,13 +5,16 @@ import numpy as np
 
 from .._kernels import records
 from .._kernels import trace as _trace
+from .._kernels import trace_lanes as _trace_lanes
+from .._kernels.gravity import aligned_zeros
 from .._kernels.coordinates import from_democratic_heliocentric
 from .._kernels.status import with_status
 from .._kernels.stopping import ahead_pointer, stop_record
 from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
 from .base import RTOL_FLOOR, Integrator, Option
-from .wisdom_holman import refuse_unkickable, split_gravity
+from .wisdom_holman import (LANES_MODES, lanes_choice, lanes_pay, lanes_ready,
+                            note_lanes_ready, refuse_unkickable, split_gravity)
 
 __all__ = ["Trace", "HILL", "SPEED", "PERICENTRE", "RTOL"]
 
@@ -129,6 +132,13 @@ class Trace(Integrator):
     :data:`~orbits.integrators.wisdom_holman.MASS_RATIO_LIMIT` times the first
     runs with a :class:`~orbits.integrators.wisdom_holman.NoDominantBodyWarning`.
 
+    Far from encounters, from four bodies on, a run without added terms or
+    stopping conditions can take its steps with the planets in vector lanes
+    (the drift, jumps and kick of ``wh``'s lanes, and the criterion tested
+    there, :mod:`orbits._kernels.trace_lanes`), with the same results bit for
+    bit; the ``lanes`` option chooses as ``wh``'s does (``"auto"``: a run of
+    1e8 steps, or once that loop is compiled on the machine).
+
     The workspace's ``"counts"`` holds the segments with flags, the segments
     redone and the adaptive integrator's steps since it was made.
 
@@ -182,6 +192,11 @@ class Trace(Integrator):
                "be integrated whole (0: off)", sign="non-negative"),
         Option("rtol", float, RTOL, "relative tolerance of the encounter integrator's step",
                sign="positive"),
+        Option("lanes", str, "auto", "the steps far from encounters with the planets in "
+               "vector lanes, the same results bit for bit: 'on' (4 bodies or more, no "
+               "added terms, no stopping conditions), 'off', or 'auto': 'on' for a run "
+               "that reaches 1e8 steps or once their loop is compiled on this machine",
+               choices=LANES_MODES),
     )
     summary = ("TRACE: democratic heliocentric Wisdom-Holman map, adaptive DOP853 for close "
                "encounters, time-reversible switching")
@@ -275,14 +290,51 @@ class Trace(Integrator):
             self.bind(ws, force, fargs)
             terms, targs = ws["terms"]
         c = self.config
-        loop = _trace.trace_loop(record=force.recorder, terms=terms)
+        # far from encounters, the planets in vector lanes: a run without
+        # stopping conditions (checked at every criterion point) or terms
+        if "lanes_pay" not in ws:
+            # chosen once for the workspace, at its first step, as wh chooses
+            ws["lanes_pay"] = lanes_pay(x, v, ws["gm"], dt)
+        lanes = (stop is None and terms is None and ws["lanes_pay"]
+                 and self.lanes_wanted(ws, x.shape[0], force.recorder))
+        if lanes:
+            targs = ws.get("lanes")
+            if targs is None or targs[0].shape != _trace_lanes.far_scratch_shape(x.shape[0]):
+                targs = ws["lanes"] = (aligned_zeros(_trace_lanes.far_scratch_shape(
+                    x.shape[0])),)
+        loop = _trace.trace_loop(record=force.recorder, terms=terms, lanes=lanes)
         criteria = _trace.Criteria(float(c["hill"]), float(c["speed"]), float(c["pericentre"]),
                                    float(c["rtol"]))
         sargs, check = stop_record(stop)
-        return with_status(*loop(
-            x, v, float(t), float(dt), int(nsteps), records.work(_trace.Work, ws), criteria,
-            self._inner(ws), self._tabs, records.outputs(mon, step0, mon_t, mon_out),
-            records.checks(check_every, sargs), check, ahead_pointer(stop is not None), targs))
+        out = loop(x, v, float(t), float(dt), int(nsteps), records.work(_trace.Work, ws),
+                   criteria, self._inner(ws), self._tabs,
+                   records.outputs(mon, step0, mon_t, mon_out),
+                   records.checks(check_every, sargs), check, ahead_pointer(stop is not None),
+                   targs)
+        if lanes:
+            note_lanes_ready(loop)
+        return with_status(*out)
+
+    def lanes_wanted(self, ws, n, recorder=None):
+        """Whether a run of ``n`` bodies takes its steps far from encounters
+        with the planets in vector lanes, by the ``lanes`` option (see
+        :func:`~orbits.integrators.wisdom_holman.lanes_choice`; ``recorder``
+        the monitors' recorder, whose loop ``"auto"`` looks for).  Only the
+        time differs: the results are the same bit for bit.
+
+        Examples
+        --------
+        >>> tr = orbits.integrators.get("trace")
+        >>> ws = tr.workspace(5)
+        >>> tr.lanes_wanted({**ws, "steps_by_end": 10 ** 8}, 5), tr.lanes_wanted(ws, 3)
+        (True, False)
+        >>> orbits.integrators.get("trace", lanes="off").lanes_wanted(
+        ...     {**ws, "steps_by_end": 10 ** 8}, 5)
+        False
+        """
+        return lanes_choice(ws, self.config["lanes"], n, lambda: lanes_ready(
+            _trace.trace_loop(record=_trace._record if recorder is None else recorder,
+                              lanes=True)))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v`` (the owed part of the

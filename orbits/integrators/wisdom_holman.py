@@ -32,7 +32,8 @@ from . import tableaux
 from .base import Integrator, Option
 
 __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
-           "split_gravity", "refuse_unkickable", "lanes_pay", "lanes_ready",
+           "split_gravity", "refuse_unkickable", "lanes_pay", "lanes_ready", "lanes_choice",
+           "note_lanes_ready",
            "LANES_FROM_BODIES", "LANES_FROM_STEPS", "LANES_MODES",
            "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS", "CORRECTOR_SPACING",
            "corrector_stages"]
@@ -108,9 +109,10 @@ def lanes_ready(loop):
     return False
 
 
-def _note_lanes_ready(loop):
-    # the lanes' loop `loop` has run in this process: so noted, and marked
-    # for later processes (a folder that cannot be written leaves no marker)
+def note_lanes_ready(loop):
+    """Note that the lanes' loop ``loop`` has run in this process, and
+    mark it for later processes (a folder that cannot be written leaves no
+    marker; :func:`lanes_ready`)."""
     name = loop.py_func.__qualname__
     if name in _LANES_READY:
         return
@@ -120,6 +122,31 @@ def _note_lanes_ready(loop):
             pass
     except OSError:
         pass
+
+
+def lanes_choice(ws, mode, n, ready):
+    """Whether a run of ``n`` bodies steps in the vector lanes by the
+    ``lanes`` option ``mode`` of ``wh`` or ``trace``: ``"on"``, ``"off"``,
+    or with ``"auto"`` where the simulation reaches :data:`LANES_FROM_STEPS`
+    steps by the run's end (``ws["steps_by_end"]``, set by the run) or
+    ``ready()`` says the lanes' loop is compiled already
+    (:func:`lanes_ready`); never below :data:`LANES_FROM_BODIES` bodies or
+    with added terms bound (``ws["terms"]``).  Decided once a run (the
+    run's driver asks first, for its notice, then every call of the loop):
+    kept in the workspace under the run's length, the rows, the mode and
+    whether terms are bound."""
+    key = (ws.get("steps_by_end", 0), n, mode, "terms" in ws)
+    memo = ws.get("lanes_wanted")
+    if memo is not None and memo[0] == key:
+        return memo[1]
+    if n < LANES_FROM_BODIES or key[3] or mode == "off":
+        wanted = False
+    elif mode == "on" or key[0] >= LANES_FROM_STEPS:
+        wanted = True
+    else:
+        wanted = ready()
+    ws["lanes_wanted"] = (key, wanted)
+    return wanted
 
 
 def lanes_pay(x, v, gm, dt):
@@ -534,7 +561,7 @@ class WisdomHolman(Integrator):
                    records.outputs(mon, step0, mon_t, mon_out),
                    records.checks(check_every, sargs), check, targs)
         if lanes:
-            _note_lanes_ready(loop)
+            note_lanes_ready(loop)
         return with_status(*out)
 
     def lanes_wanted(self, ws, n, recorder=None):
@@ -555,24 +582,9 @@ class WisdomHolman(Integrator):
         >>> orbits.integrators.get("wh", lanes="on").lanes_wanted(ws, 5)
         True
         """
-        mode = self.config["lanes"]
-        # decided once a run (the run's driver asks first, for its notice,
-        # then every call of the loop): kept in the workspace under the
-        # run's length, the rows, the mode and whether terms are bound
-        key = (ws.get("steps_by_end", 0), n, mode, "terms" in ws)
-        memo = ws.get("lanes_wanted")
-        if memo is not None and memo[0] == key:
-            return memo[1]
-        if n < LANES_FROM_BODIES or key[3] or mode == "off":
-            wanted = False
-        elif mode == "on" or key[0] >= LANES_FROM_STEPS:
-            wanted = True
-        else:
-            wanted = lanes_ready(_wh.wh_loop(
-                self.config["coordinates"], None,
-                _wh._record if recorder is None else recorder, True))
-        ws["lanes_wanted"] = (key, wanted)
-        return wanted
+        return lanes_choice(ws, self.config["lanes"], n, lambda: lanes_ready(_wh.wh_loop(
+            self.config["coordinates"], None, _wh._record if recorder is None else recorder,
+            True)))
 
     @staticmethod
     def _loop_terms(ws, n, lanes):

@@ -1,0 +1,249 @@
+"""``trace``'s steps far from encounters, with the planets in vector lanes.
+
+A segment of ``trace`` (:mod:`orbits._kernels.trace`) that neither its
+start nor its end flags, between two such segments, is the step of ``wh``
+in democratic heliocentric coordinates bit for bit: the Kepler drift of a
+whole step, the half jump, the planets' mutual kick, the half jump.
+:func:`far_steps` makes a run of such steps on the state kept in the lanes
+of :mod:`orbits._kernels.wh_lanes` (its drift, jumps and pulls, each bit for
+bit the scalar kernel), as ``wh``'s loop does between outputs, and
+evaluates the switching criterion at each step's criterion point (after the
+first half jump, with the velocities half kicked) in the lanes too.
+
+The lanes' criterion (:func:`may_flag`) is a bound, not the criterion: it
+stops the run of steps wherever :func:`~orbits._kernels.trace.criterion`
+could flag something.  It makes the scalar criterion's own operations on the
+same numbers (squared distances and speeds, the bound on the Hill radius
+that the scalar criterion starts from) and takes, with a relative margin of
+:data:`MARGIN`, a pair within the speed radius or within that bound, or a
+body within the pericentre threshold; the Hill radius itself (a cube root
+and two square roots) is left to the scalar criterion.  The step where it
+stops is taken by the scalar loop from that step's start and the criterion
+point before it, both kept in the lanes: it evaluates the criterion and
+flags, redoes or goes on as it would have.  So the run is the scalar loop's
+bit for bit, whatever the lanes' criterion says; only the time differs.
+
+Each pair of planets is tested once per source body in the lanes (both
+orders, the same squared numbers), and only the pairs that the scalar
+criterion tests (an active source); the padding columns are left out.
+"""
+
+import numpy as np
+
+from ._jit import njit
+from .gravity import LANE_WIDTH, lane_columns
+from .wh_lanes import (SCRATCH_ROWS, STATE, SUMS, resident_drift, resident_finite,
+                       resident_jump, resident_load, resident_pulls, resident_store,
+                       resident_velocity_kick)
+
+__all__ = ["far_steps", "may_flag", "load_hill", "load_point", "criterion_scales",
+           "far_scratch_shape", "MARGIN", "FAR_WAIT", "FAR_STEPS"]
+
+#: 2^(1/3): ((m_i + m_j) / 3 m_0)^(1/3) <= 2^(1/3) max(hill_i, hill_j)
+_CBRT2 = 1.2599210498948732
+
+#: The lanes' criterion's relative margin on each threshold (see the module
+#: notes): it takes the same operations as the scalar criterion, so the
+#: margin only guards the bound against a difference of rounding.
+MARGIN = 1.0 + 1e-12
+
+#: Steps the scalar loop takes after the lanes' criterion stopped a run of
+#: steps, before it tries the lanes again: a pair near its switching radius
+#: stops the lanes at every step, and each try costs a step's drift and kick
+#: in the lanes on top of the scalar step.
+FAR_WAIT = 16
+
+# the rows of the scratch after the lanes' state's (wh_lanes.SCRATCH_ROWS):
+# each column's squared Hill factor, squared distance and half-kicked
+# velocity (3),
+# the step's start (6) and the last criterion point (6), and a count of the
+# steps made in the lanes (row FAR_STEPS, column 0)
+_HILL2 = SCRATCH_ROWS
+_R2 = _HILL2 + 1
+_VS = _R2 + 1
+_START = _VS + 3
+_POINT = _START + 6
+#: the scratch's row whose column 0 counts the steps made in the lanes
+FAR_STEPS = _POINT + 6
+
+
+def far_scratch_shape(n):
+    """The shape of the scratch of :func:`far_steps` for ``n`` bodies: the
+    lanes' state's (:func:`~orbits._kernels.wh_lanes.lanes_scratch_shape`)
+    and the rows above."""
+    return (FAR_STEPS + 1, 2 * lane_columns(n))
+
+
+@njit(inline="always")
+def criterion_scales(h, gm0, k_hill, k_speed, k_peri):
+    """The squared scales of the switching criterion at the step ``h``:
+    ``(k_peri h)^2``, ``((k_peri h)^2 G m_0)^2``, ``(k_speed |h|)^2`` and
+    ``(2^(1/3) k_hill)^2``."""
+    kp2 = (k_peri * h) ** 2
+    kg2 = (kp2 * gm0) ** 2
+    kv = k_speed * abs(h)
+    kh2 = (k_hill * _CBRT2) ** 2
+    return kp2, kg2, kv * kv, kh2
+
+
+@njit(inline="always")
+def load_hill(S, hill, n):
+    """Each column's squared Hill factor ``hill[i]^2`` into its row (the
+    padding repeats body 1's)."""
+    H2 = S[_HILL2]
+    for k in range(lane_columns(n)):
+        i = k + 1 if k + 1 < n else 1
+        H2[k] = hill[i] * hill[i]
+
+
+@njit(inline="always")
+def load_point(S, xh, vs, gm, hill):
+    """A criterion point into the lanes as :func:`far_steps` has it: the
+    positions ``xh`` and the velocities ``vs`` (half kicked) of the
+    planets, and the Hill factors; what :func:`may_flag` reads."""
+    n = xh.shape[0]
+    resident_load(xh, vs, gm, gm, S)
+    load_hill(S, hill, n)
+    for k in range(lane_columns(n)):
+        i = k + 1 if k + 1 < n else 1
+        for d in range(3):
+            S[_VS + d, k] = vs[i, d]
+
+
+@njit(inline="always")
+def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
+    """Whether :func:`~orbits._kernels.trace.criterion` could flag a pair or
+    a pericentre at the lanes' criterion point of the step ``h``: the
+    positions in the lanes' state, the velocities in the rows ``_VS`` (see
+    the module notes).  A pair is taken within the speed radius where ``d^2 < (k_speed h)^2
+    |V_i - V_j|^2`` alone: the scalar criterion asks that and a bound
+    (``d^2 < 4 (k_speed h)^2 max |V|^2``) which it implies but for
+    rounding, so leaving the bound out takes a few more pairs, never
+    fewer."""
+    kp2, kg2, kv2, kh2 = criterion_scales(h, gm[0], k_hill, k_speed, k_peri)
+    m = np.uint64(n - 1)
+    P = np.uint64(lane_columns(n))
+    X = S[STATE]
+    Y = S[STATE + 1]
+    Z = S[STATE + 2]
+    U = S[_VS]
+    V = S[_VS + 1]
+    W = S[_VS + 2]
+    R2 = S[_R2]
+    H2 = S[_HILL2]
+    lo = MARGIN - 1.0
+    kgm = MARGIN * kg2
+    hits = 0
+    # (whole rows of lanes, the padding masked: loops that LLVM vectorises)
+    for k in range(P):
+        ri2 = X[k] * X[k] + Y[k] * Y[k] + Z[k] * Z[k]
+        R2[k] = ri2
+        vi2 = U[k] * U[k] + V[k] * V[k] + W[k] * W[k]
+        rv = X[k] * U[k] + Y[k] * V[k] + Z[k] * W[k]
+        d = ri2 * ri2 - kp2 * (vi2 * ri2 + 3.0 * rv * rv)
+        hits += (k < m) & ((d <= lo * ri2 * ri2) | (kgm * ri2 > d * d))
+    if hits:
+        return True
+    kvm = MARGIN * kv2
+    khm = MARGIN * kh2
+    L = np.uint64(LANE_WIDTH)
+    for j in range(1, n_active):
+        # the pairs (i, j), i > j, as the scalar criterion takes them: the
+        # lanes after column c, from the vector register that holds it on
+        c = np.uint64(j - 1)
+        xj = X[c]
+        yj = Y[c]
+        zj = Z[c]
+        uj = U[c]
+        vj = V[c]
+        wj = W[c]
+        aj = H2[c]
+        rj2 = R2[c]
+        for k in range((c + np.uint64(1)) // L * L, P):
+            dx = X[k] - xj
+            dy = Y[k] - yj
+            dz = Z[k] - zj
+            d2 = dx * dx + dy * dy + dz * dz
+            ux = U[k] - uj
+            uy = V[k] - vj
+            uz = W[k] - wj
+            bound = khm * max(H2[k], aj) * max(R2[k], rj2)
+            hits += ((k > c) & (k < m)
+                     & ((d2 < kvm * (ux * ux + uy * uy + uz * uz)) | (d2 < bound)))
+    return hits != 0
+
+
+@njit(inline="always")
+def _copy_rows(S, src, dst, rows, P):
+    for r in range(rows):
+        A = S[src + r]
+        B = S[dst + r]
+        for k in range(P):
+            B[k] = A[k]
+
+
+@njit(inline="always")
+def far_steps(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_peri, m,
+              until_check, check_every, S):
+    """Up to ``m`` unflagged steps of ``trace`` in the lanes, from a state
+    ``xh``, ``vb`` (democratic heliocentric) that owes half a step's drift,
+    whose last segment had no flags (see the module notes); ``xc``, ``vc``
+    get the last criterion point, as the scalar loop keeps it.  The
+    epilogue's finite check every ``check_every`` steps (``until_check``
+    counting down), on the lanes.  Returns ``(steps made, until_check,
+    why)``: ``why`` 0 when ``m`` were made, 1 when the next step's criterion
+    point may flag (the state is that step's start), 2 when the state is not
+    finite after the last step made."""
+    n = xh.shape[0]
+    P = lane_columns(n)
+    half = 0.5 * dt
+    seg = half + half
+    resident_load(xh, vb, gm, eta, S)
+    load_hill(S, hill, n)
+    done = 0
+    why = 0
+    while done < m:
+        _copy_rows(S, STATE, _START, 6, P)
+        b0 = xh[0, 0]
+        b1 = xh[0, 1]
+        b2 = xh[0, 2]
+        resident_drift(xh, vb, eta, seg, S)
+        resident_jump(S, gm, n_active, half, n)
+        resident_pulls(S, gm, n_active, n)
+        for r in range(3):
+            V = S[STATE + 3 + r]
+            A = S[SUMS + r]
+            Vs = S[_VS + r]
+            for k in range(P):
+                Vs[k] = V[k] + half * A[k]
+        if may_flag(S, gm, n_active, n, dt, k_hill, k_speed, k_peri):
+            _copy_rows(S, _START, STATE, 6, P)
+            xh[0, 0] = b0
+            xh[0, 1] = b1
+            xh[0, 2] = b2
+            why = 1
+            break
+        _copy_rows(S, STATE, _POINT, 3, P)
+        _copy_rows(S, _VS, _POINT + 3, 3, P)
+        resident_velocity_kick(S, dt, n)
+        resident_jump(S, gm, n_active, half, n)
+        done += 1
+        until_check -= 1
+        if until_check == 0:
+            until_check = check_every
+            if not resident_finite(xh, vb, S):
+                why = 2
+                break
+    resident_store(S, xh, vb)
+    if done > 0:
+        # the last criterion point: the planets from the lanes, the central
+        # row as the scalar loop has it there (its drift done, no pull)
+        for i in range(1, n):
+            for d in range(3):
+                xc[i, d] = S[_POINT + d, i - 1]
+                vc[i, d] = S[_POINT + 3 + d, i - 1]
+        for d in range(3):
+            xc[0, d] = xh[0, d]
+            vc[0, d] = vb[0, d] + half * 0.0
+        S[FAR_STEPS, 0] += done
+    return done, until_check, why
