@@ -5,9 +5,10 @@ Three parts, each timed around the public ``Simulation.run`` (warm: every
 loop compiled by a short run first) and, for REBOUND, around ``integrate``:
 
 1. **Far from encounters**: ``trace`` against ``wh`` with
-   ``coordinates="democratic-heliocentric"`` (and ``lanes="on"``, the loop
-   of a long run, its planets in vector lanes), whose map it is when nothing
-   is flagged, both with the default options (the default monitors, at the
+   ``coordinates="democratic-heliocentric"``, whose map it is when nothing
+   is flagged, both with ``lanes="on"`` (the loop of a long run, and of every
+   run once it is compiled on the machine: the planets in vector lanes;
+   ``--lanes off`` for the scalar loops, which a shorter first run takes), both with the default options (the default monitors, at the
    run's two outputs; ``--monitors none`` for ``monitors=()``), on the outer
    solar system and the Sun with eight planets at ``bench_wh.py``'s steps:
    the benchmark's short step (10 d; 0.5 d), the steps between (50 and
@@ -67,6 +68,10 @@ SCATTER_DT = 20.0             # days
 YEAR = 365.25
 
 
+#: the ``lanes`` option of ``wh`` and ``trace`` in part 1 (``--lanes``)
+_lanes = "on"
+
+
 def _timed_run(make, until, outputs=2, clock=time.perf_counter, loops=None):
     sim = make()
     if loops is not None:
@@ -114,9 +119,10 @@ def far_from_encounters(repeats, steps, clock, monitors="default"):
 
 def _far_row(label, b, dt, which, repeats, steps, clock, monitors):
     kw = {} if monitors == "default" else {"monitors": ()}
-    wh = orbits.integrators.get("wh", coordinates=DH, lanes="on")
+    wh = orbits.integrators.get("wh", coordinates=DH, lanes=_lanes)
+    trace = orbits.integrators.get("trace", lanes=_lanes)
     makers = {"wh": lambda: orbits.Simulation(b, wh, dt=dt, **kw),
-              "trace": lambda: orbits.Simulation(b, "trace", dt=dt, **kw)}
+              "trace": lambda: orbits.Simulation(b, trace, dt=dt, **kw)}
     for make in makers.values():
         make().run(until=2 * dt, outputs=2, progress=False)
     rebs = {}
@@ -261,7 +267,12 @@ def main(argv=None):
                     help="wall clock (default) or this process's CPU time")
     ap.add_argument("--monitors", choices=("default", "none"), default="default",
                     help="part 1 with the default monitors (default) or monitors=()")
+    ap.add_argument("--lanes", choices=("on", "off"), default="on",
+                    help="part 1's wh and trace with their planets in vector lanes (default) "
+                         "or the scalar loops")
     args = ap.parse_args(argv)
+    global _lanes
+    _lanes = args.lanes
     clock = time.perf_counter if args.clock == "wall" else time.process_time
     if args.quick:
         args.repeats, args.steps, args.years = 3, 50_000, 200.0
