@@ -84,7 +84,9 @@ def compile_ahead(names=None, progress=None, report=None):
     ``wh`` (and ``saba2`` to ``saba4``) compile a loop for each set of
     coordinates, and each of them with the planets in vector lanes (which
     runs take by the ``lanes`` option): ``['wh', 'wh lanes', 'wh
-    democratic-heliocentric', 'wh democratic-heliocentric lanes']``.
+    democratic-heliocentric', 'wh democratic-heliocentric lanes']``;
+    ``trace`` its loop and the one with its steps far from encounters in
+    vector lanes: ``['trace', 'trace lanes']``.
     """
     names = COMMON if names is None else tuple(names)
     loops = [(integ, lanes) for name in names for integ, lanes in _variants(name)
