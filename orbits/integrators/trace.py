@@ -80,6 +80,11 @@ class Trace(Integrator):
         Relative tolerance of the adaptive integrator per step (default
         1e-12), measured per body in the frame of its group of encountering
         bodies.
+    lanes : {"auto", "on", "off"}
+        The steps far from encounters with the planets in vector lanes, the
+        same results bit for bit (see the notes); ``"auto"`` (default) takes
+        them for a run that reaches 1e8 steps, or once their loop is
+        compiled on the machine.
 
     Notes
     -----
