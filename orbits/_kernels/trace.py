@@ -52,7 +52,11 @@ checks' windows (from one check to the next) still cover the whole run.
 When neither of two successive segments has a flag, the
 two half kicks between them are the single kick ``I(h)`` of the
 Wisdom-Holman map, with its arithmetic: far from encounters ``trace`` is
-bit for bit ``wh`` with ``coordinates="democratic-heliocentric"``.
+bit for bit ``wh`` with ``coordinates="democratic-heliocentric"``.  The
+loop's copy with the lanes (:func:`trace_loop` with ``lanes``) makes such
+steps with the planets in vector lanes (:mod:`.trace_lanes`) between its
+outputs, and takes with this loop's own code every step whose criterion
+point may flag.
 
 References
 ----------
