@@ -89,3 +89,14 @@ def test_from_import_and_submodules():
         orbits.no_such_name
     with pytest.raises(ImportError):
         from orbits import no_such_name  # noqa: F401
+
+
+def test_a_run_without_tables_loads_no_table_module():
+    # astropy.table (0.24 s a process) is imported where a table is made: an
+    # encounter log, resolved collisions, a file's logs; a plain run makes none
+    proc = _python("-c", "import sys, astropy.units as u, orbits; "
+                         "sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "
+                         "'leapfrog', dt=10 * u.day); sim.run(until=100 * u.day, outputs=2, "
+                         "progress=False); print('astropy.table' in sys.modules)")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False"]

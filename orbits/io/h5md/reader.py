@@ -11,7 +11,6 @@ import json
 
 import astropy.units as u
 import numpy as np
-from astropy.table import QTable
 
 from ... import epochs as _epochs
 from ... import forces
@@ -224,6 +223,8 @@ def _collisions(g, par):
 def _encounters(g):
     """The encounter log of a file (group ``encounters``) as the QTable of
     ``Result.encounters``."""
+    # (astropy.table is imported where a table is made: 0.24 s a process)
+    from astropy.table import QTable
     k = _log_rows(g, _ENCOUNTER_COLUMNS)
     col = lambda name: g[name][:k] << u.Unit(g[name].attrs["unit"])  # noqa: E731
     text = lambda name: np.array(_decode(g[name][:k]), dtype=str)  # noqa: E731
