@@ -162,7 +162,7 @@ def declared():
     """
     modules = {path.stem: _Module(ast.parse(path.read_text(encoding="utf-8")))
                for path in sorted(INTEGRATORS.glob("*.py"))}
-    listed = [_find_class(modules, "__init__", name) for name in modules["__init__"].registered]
+    listed = [_find_class(modules, stem, cls) for stem, cls in modules["__init__"].registered]
     others = [(stem, cls) for stem, module in modules.items() for cls in module.classes]
     found = {}
     for where in [*listed, *others]:
@@ -176,8 +176,9 @@ def declared():
 
 class _Module:
     """What :func:`declared` needs of a module's syntax tree: its constants,
-    what it imports from its siblings, its classes, and the class names of a
-    ``for ... in (A, B, ...)`` loop (the registry's ``register`` loop)."""
+    what it imports from its siblings, its classes, and the ``(module,
+    class)`` pairs of a ``_BUILT_IN`` table (the registry's built-in
+    integrators, in its order)."""
 
     def __init__(self, tree):
         self.constants, self.imports, self.classes, self.registered = {}, {}, {}, []
@@ -185,13 +186,14 @@ class _Module:
             if isinstance(node, ast.Assign) and len(node.targets) == 1 \
                     and isinstance(node.targets[0], ast.Name):
                 self.constants[node.targets[0].id] = node.value
+                if node.targets[0].id == "_BUILT_IN" and isinstance(node.value, ast.Dict):
+                    self.registered = [tuple(e.value for e in v.elts)
+                                       for v in node.value.values]
             elif isinstance(node, ast.ImportFrom) and node.level == 1 and node.module:
                 for alias in node.names:
                     self.imports[alias.asname or alias.name] = (node.module, alias.name)
             elif isinstance(node, ast.ClassDef):
                 self.classes[node.name] = node
-            elif isinstance(node, ast.For) and isinstance(node.iter, ast.Tuple):
-                self.registered = [e.id for e in node.iter.elts if isinstance(e, ast.Name)]
 
 
 def _class_attribute(node, attribute):

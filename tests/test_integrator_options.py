@@ -11,7 +11,7 @@ import orbits
 from orbits import _integrator_options, cli
 from orbits._integrator_options import Option
 from orbits.errors import IntegratorOptionError
-from orbits.integrators import _REGISTRY
+from orbits.integrators import _classes
 
 
 def _run_parser():
@@ -28,27 +28,27 @@ def _flags(parser, group):
 def test_the_source_reading_finds_what_the_classes_declare():
     # the command line reads the declarations without importing the integrators;
     # what it reads is what the registered classes hold, in the registry's order
-    live = {cls.name: cls.option_specs for cls in _REGISTRY.values()}
+    live = {cls.name: cls.option_specs for cls in _classes()}
     assert _integrator_options.declared() == live
     assert list(_integrator_options.declared()) == list(live)
     assert any(live.values())
 
 
 def test_options_are_made_from_the_declarations():
-    for cls in _REGISTRY.values():
+    for cls in _classes():
         assert cls.options == {spec.name: spec.default for spec in cls.option_specs}
         assert orbits.integrators.get(cls.name).config == cls.options, cls.name
 
 
 def test_every_declared_option_has_a_flag_and_every_flag_a_declaration():
     flags = _flags(_run_parser(), "integrator options")
-    declared = {spec.flag: spec for cls in _REGISTRY.values() for spec in cls.option_specs}
+    declared = {spec.flag: spec for cls in _classes() for spec in cls.option_specs}
     assert set(flags) == set(declared)
     for flag, action in flags.items():
         spec = declared[flag]
         assert action.dest == spec.name
         assert spec.help in action.help
-        takers = [c.name for c in _REGISTRY.values() if spec in c.option_specs]
+        takers = [c.name for c in _classes() if spec in c.option_specs]
         assert ", ".join(takers) in action.help, flag
 
 

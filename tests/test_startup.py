@@ -91,12 +91,23 @@ def test_from_import_and_submodules():
         from orbits import no_such_name  # noqa: F401
 
 
-def test_a_run_without_tables_loads_no_table_module():
+def test_a_run_loads_neither_tables_nor_other_integrators():
     # astropy.table (0.24 s a process) is imported where a table is made: an
-    # encounter log, resolved collisions, a file's logs; a plain run makes none
+    # encounter log, resolved collisions, a file's logs; a plain run makes
+    # none.  An integrator's module (with its kernels) is imported when the
+    # integrator is first asked for: a leapfrog run imports no other
+    others = ["orbits.integrators." + m for m in ("wisdom_holman", "trace", "ias15", "taylor")]
     proc = _python("-c", "import sys, astropy.units as u, orbits; "
                          "sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "
                          "'leapfrog', dt=10 * u.day); sim.run(until=100 * u.day, outputs=2, "
-                         "progress=False); print('astropy.table' in sys.modules)")
+                         "progress=False); print('astropy.table' in sys.modules, "
+                         f"[m for m in {others!r} if m in sys.modules])")
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.split() == ["False"]
+    assert proc.stdout.split() == ["False", "[]"]
+
+
+def test_the_registry_table_names_each_class_by_its_name():
+    # the built-in table's names are the classes' own, in the registry's order
+    from orbits import integrators
+    assert [cls.name for cls in integrators._classes()] == list(integrators._BUILT_IN)
+    assert integrators.IAS15 is type(integrators.get("ias15"))

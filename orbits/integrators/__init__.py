@@ -9,27 +9,39 @@ RK4()
 """
 
 import difflib
+import importlib
 from typing import NamedTuple
 
 from ..errors import UnknownIntegratorError
 from .base import ExplicitRungeKutta, Integrator, Option, SplittingMethod
-from .composition import Yoshida4, Yoshida6, Yoshida8
-from .doubling import RK4Doubling
-from .embedded import DOP853, Dopri5
-from .euler import Euler, SymplecticEuler
-from .ias15 import IAS15
-from .implicit import ImplicitEuler, ImplicitMidpoint
-from .leapfrog import Leapfrog, Verlet
-from .runge_kutta import RK2, RK4
-from .scipy_ivp import LSODA, Radau
-from .taylor import Taylor
-from .trace import Trace
-from .wisdom_holman import SABA2, SABA3, SABA4, WisdomHolman
 
 __all__ = ["get", "available", "aliases", "register", "adaptive_names", "Integrator",
            "IntegratorInfo", "Option", "SplittingMethod", "ExplicitRungeKutta", "ALIASES",
            "DEFAULT"]
 
+#: The built-in integrators in the registry's order: name -> (module, class).
+#: A module (with its kernels) is imported when its integrator is first
+#: asked for: importing all of them costs 0.1 s a process, and a run needs
+#: one (benchmarks/RESULTS.md).
+_BUILT_IN = {
+    "euler": ("euler", "Euler"), "symplectic-euler": ("euler", "SymplecticEuler"),
+    "verlet": ("leapfrog", "Verlet"), "leapfrog": ("leapfrog", "Leapfrog"),
+    "rk2": ("runge_kutta", "RK2"), "rk4": ("runge_kutta", "RK4"),
+    "yoshida4": ("composition", "Yoshida4"), "yoshida6": ("composition", "Yoshida6"),
+    "yoshida8": ("composition", "Yoshida8"),
+    "wh": ("wisdom_holman", "WisdomHolman"), "saba2": ("wisdom_holman", "SABA2"),
+    "saba3": ("wisdom_holman", "SABA3"), "saba4": ("wisdom_holman", "SABA4"),
+    "dopri5": ("embedded", "Dopri5"), "dop853": ("embedded", "DOP853"),
+    "rk4-doubling": ("doubling", "RK4Doubling"),
+    "radau": ("scipy_ivp", "Radau"), "lsoda": ("scipy_ivp", "LSODA"),
+    "ias15": ("ias15", "IAS15"), "taylor": ("taylor", "Taylor"),
+    "implicit-euler": ("implicit", "ImplicitEuler"),
+    "implicit-midpoint": ("implicit", "ImplicitMidpoint"),
+    "trace": ("trace", "Trace"),
+}
+
+#: name -> class: the built-in integrators imported so far, and those
+#: registered (:func:`register`)
 _REGISTRY = {}
 
 #: The integrator of ``Simulation(bodies)`` and ``orbits run``: adaptive, so
@@ -113,10 +125,33 @@ def register(cls):
     return cls
 
 
-for _cls in (Euler, SymplecticEuler, Verlet, Leapfrog, RK2, RK4, Yoshida4, Yoshida6,
-             Yoshida8, WisdomHolman, SABA2, SABA3, SABA4, Dopri5, DOP853,
-             RK4Doubling, Radau, LSODA, IAS15, Taylor, ImplicitEuler, ImplicitMidpoint, Trace):
-    register(_cls)
+def _names():
+    # every name in the registry's order: the built-in ones, then those
+    # registered
+    return [*_BUILT_IN, *(n for n in _REGISTRY if n not in _BUILT_IN)]
+
+
+def _class(name):
+    # the class of a name of _names(), its module imported on first use
+    cls = _REGISTRY.get(name)
+    if cls is None:
+        module, attr = _BUILT_IN[name]
+        cls = _REGISTRY[name] = getattr(importlib.import_module(f"{__name__}.{module}"),
+                                        attr)
+    return cls
+
+
+def _classes():
+    # every class of the registry, in its order (every module imported)
+    return [_class(name) for name in _names()]
+
+
+def __getattr__(attr):
+    # the built-in classes as attributes of the package (orbits.integrators.IAS15)
+    for module, cls in _BUILT_IN.values():
+        if cls == attr:
+            return getattr(importlib.import_module(f"{__name__}.{module}"), attr)
+    raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
 
 
 def get(name, **options):
@@ -163,21 +198,23 @@ def get(name, **options):
 def _lookup(name):
     """The class registered under ``name`` or one of its aliases."""
     if isinstance(name, str):
-        cls = _REGISTRY.get(ALIASES.get(name.lower(), name)) or _REGISTRY.get(name.lower())
-        if cls is not None:
-            return cls
+        names = _names()
+        for key in (ALIASES.get(name.lower(), name), name.lower()):
+            if key in names:
+                return _class(key)
     raise UnknownIntegratorError(_unknown_message(name))
 
 
 def _unknown_message(name):
     text = f"unknown integrator {name!r}"
-    valid = f"valid names: {', '.join(_REGISTRY)}; aliases: " + ", ".join(
+    valid = f"valid names: {', '.join(_names())}; aliases: " + ", ".join(
         f"{a} -> {n}" for a, n in ALIASES.items())
     if not isinstance(name, str):
         return f"{text}: a name is a string; {valid}"
     note, nearest = _ELSEWHERE.get(name.lower(), (None, None))
     if note is None:
-        close = difflib.get_close_matches(name.lower(), [*_REGISTRY, *ALIASES], n=1, cutoff=0.6)
+        close = difflib.get_close_matches(name.lower(), [*_names(), *ALIASES], n=1,
+                                          cutoff=0.6)
         nearest = ALIASES.get(close[0], close[0]) if close else None
     else:
         text += f"; {note}"
@@ -213,7 +250,7 @@ def adaptive_names():
     >>> orbits.integrators.adaptive_names()[-2:]
     ['ias15', 'taylor']
     """
-    return [name for name, cls in _REGISTRY.items() if cls.adaptive]
+    return [name for name in _names() if _class(name).adaptive]
 
 
 def available():
@@ -230,4 +267,4 @@ def available():
     """
     return [IntegratorInfo(c.name, c.order, c.symplectic, c.adaptive, c.summary,
                            tuple(a for a, n in ALIASES.items() if n == c.name))
-            for c in _REGISTRY.values()]
+            for c in map(_class, _names())]

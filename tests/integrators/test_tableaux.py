@@ -6,8 +6,8 @@ import pytest
 from orbits import integrators
 from orbits.integrators.base import ExplicitRungeKutta, SplittingMethod
 
-RK = [c for c in integrators._REGISTRY.values() if issubclass(c, ExplicitRungeKutta)]
-SPLIT = [c for c in integrators._REGISTRY.values() if issubclass(c, SplittingMethod)]
+RK = [c for c in integrators._classes() if issubclass(c, ExplicitRungeKutta)]
+SPLIT = [c for c in integrators._classes() if issubclass(c, SplittingMethod)]
 
 
 @pytest.mark.parametrize("cls", RK, ids=lambda c: c.name)
