@@ -6,7 +6,6 @@ import numpy as np
 from .._kernels import records
 from .._kernels import trace as _trace
 from .._kernels import trace_lanes as _trace_lanes
-from .._kernels.gravity import aligned_zeros
 from .._kernels.coordinates import from_democratic_heliocentric
 from .._kernels.status import with_status
 from .._kernels.stopping import ahead_pointer, stop_record
@@ -14,7 +13,8 @@ from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
 from .base import RTOL_FLOOR, Integrator, Option
 from .wisdom_holman import (LANES_MODES, lanes_choice, lanes_pay, lanes_ready,
-                            note_lanes_ready, refuse_unkickable, split_gravity)
+                            lanes_scratch_in, note_lanes_ready, refuse_unkickable,
+                            split_gravity)
 
 __all__ = ["Trace", "HILL", "SPEED", "PERICENTRE", "RTOL"]
 
@@ -303,10 +303,7 @@ class Trace(Integrator):
         lanes = (stop is None and terms is None and ws["lanes_pay"]
                  and self.lanes_wanted(ws, x.shape[0], force.recorder))
         if lanes:
-            targs = ws.get("lanes")
-            if targs is None or targs[0].shape != _trace_lanes.far_scratch_shape(x.shape[0]):
-                targs = ws["lanes"] = (aligned_zeros(_trace_lanes.far_scratch_shape(
-                    x.shape[0])),)
+            targs = lanes_scratch_in(ws, _trace_lanes.far_scratch_shape(x.shape[0]))
         loop = _trace.trace_loop(record=force.recorder, terms=terms, lanes=lanes)
         criteria = _trace.Criteria(float(c["hill"]), float(c["speed"]), float(c["pericentre"]),
                                    float(c["rtol"]))

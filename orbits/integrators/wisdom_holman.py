@@ -23,6 +23,7 @@ from .._kernels import records
 from .._kernels import wisdom_holman as _wh
 from .._kernels import wh_lanes as _lanes
 from .._kernels import wh_tangent as _wht
+from .._kernels.gravity import aligned_zeros
 from .._kernels.kepler import _SHORT_STEP
 from .._kernels.stumpff import _STUMPFF_MEDIUM_Z
 from .._kernels.stepping import DRIFT, KICK, work_bound
@@ -33,7 +34,7 @@ from .base import Integrator, Option
 
 __all__ = ["WisdomHolman", "SABA2", "SABA3", "SABA4", "NoDominantBodyWarning",
            "split_gravity", "refuse_unkickable", "lanes_pay", "lanes_ready", "lanes_choice",
-           "note_lanes_ready",
+           "note_lanes_ready", "lanes_scratch_in",
            "LANES_FROM_BODIES", "LANES_FROM_STEPS", "LANES_MODES",
            "MASS_RATIO_LIMIT", "COORDINATES", "CORRECTORS", "CORRECTOR_SPACING",
            "corrector_stages"]
@@ -147,6 +148,18 @@ def lanes_choice(ws, mode, n, ready):
         wanted = ready()
     ws["lanes_wanted"] = (key, wanted)
     return wanted
+
+
+def lanes_scratch_in(ws, shape):
+    """The lanes' loop's ``targs``: a tuple of its scratch of ``shape``, kept
+    in the workspace (``ws["lanes"]``; a tuple, not an array, so neither
+    saved nor restored: what it carries from step to step only chooses
+    between paths with the same results), made anew when the shape
+    changes (a merger)."""
+    targs = ws.get("lanes")
+    if targs is None or targs[0].shape != shape:
+        targs = ws["lanes"] = (aligned_zeros(shape),)
+    return targs
 
 
 def lanes_pay(x, v, gm, dt):
@@ -599,9 +612,7 @@ class WisdomHolman(Integrator):
         terms, targs = ws.get("terms", (None, ()))
         ws["lanes_taken"] = lanes
         if lanes:
-            targs = ws.get("lanes")
-            if targs is None or targs[0].shape != _lanes.lanes_scratch_shape(n):
-                targs = ws["lanes"] = (_lanes.lanes_scratch(n),)
+            targs = lanes_scratch_in(ws, _lanes.lanes_scratch_shape(n))
         return terms, targs
 
     def _advance_tangent(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t,
