@@ -100,7 +100,7 @@ def _user_function_failed(fargs):
     """Whether a user term of a table in ``fargs`` (nested tuples) returned the
     wrong shape (see :mod:`orbits._user_functions`)."""
     if isinstance(fargs, TermTable):
-        return fargs.user is not None and bool(fargs.user.flag[0])
+        return bool(fargs.user.flag[0])
     if isinstance(fargs, tuple):
         return any(_user_function_failed(f) for f in fargs)
     return False

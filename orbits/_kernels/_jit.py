@@ -47,7 +47,8 @@ from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
            "compiled_for",
-           "cfunc", "pointer", "Pointer", "fma", "value", "data_pointer", "cpu_name",
+           "cfunc", "pointer", "Pointer", "address_caller", "fma", "value", "data_pointer",
+           "cpu_name",
            "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
 NUMBA_OPTIONS = dict(cache=True, error_model="numpy", fastmath=False, nogil=True)
@@ -221,6 +222,49 @@ def data_pointer(typingctx, address):
         return builder.inttoptr(args[0], context.get_value_type(signature.return_type))
 
     return sig, codegen
+
+
+def address_caller(signature):
+    """``call(address, args)``, in compiled code only: calls the C callable
+    (:func:`cfunc`) of ``signature`` whose address is the integer
+    ``address`` (a ``CFunc``'s ``address``) with the tuple ``args``, each
+    converted to the signature's type, and returns what it returns.
+
+    A compiled function called from Python types its arguments first, and
+    an argument holding a compiled function is typed element by element in
+    Python (half a millisecond for a simulation's force arguments), where
+    arrays and numbers take numba's quick path.  An address in an int64
+    array travels as data: the arguments' type is the same whatever
+    function it names, so one compiled loop serves every function of the
+    signature.  The address must name a live C callable of that signature:
+    the caller keeps the ``CFunc`` alive and never sends the address to
+    another process.  The call is the one numba makes for a first-class
+    function of the signature (its ``FunctionPrototype``);
+    ``tests/kernels/test_jit.py`` fails on a numba where it is not."""
+    proto = nbtypes.FunctionPrototype(signature.return_type, signature.args)
+    declared = signature.args
+
+    def codegen(context, builder, sig, args):
+        address, packed = args
+        given = sig.args[1]
+        values = [context.cast(builder, builder.extract_value(packed, i), given[i], declared[i])
+                  for i in range(len(declared))]
+        function = builder.inttoptr(address, context.get_value_type(proto))
+        out = builder.call(function, values)
+        if signature.return_type == nbtypes.void:
+            return context.get_dummy_value()
+        return out
+
+    @intrinsic
+    def call(typingctx, address, args):
+        if not isinstance(address, nbtypes.Integer) or not isinstance(args, nbtypes.BaseTuple):
+            return None
+        if len(args) != len(declared) or not all(
+                typingctx.can_convert(a, d) for a, d in zip(args, declared)):
+            return None
+        return signature.return_type(nbtypes.int64, args), codegen
+
+    return call
 
 
 def njit_parallel(func=None, **overrides):

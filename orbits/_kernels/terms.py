@@ -41,7 +41,7 @@ import numpy as np
 
 from numba.core import types as nbtypes
 
-from ._jit import njit, slots, specialize, value
+from ._jit import address_caller, njit, slots, specialize, value
 from .coordinates import row_difference
 from .invariants import _add
 from .jacobians import central_differences
@@ -49,7 +49,7 @@ from .jacobians import central_differences
 # the name the energy template below is written against, bound by specialize
 body_energy, = slots("body_energy")
 
-__all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "TABLE", "table",
+__all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "no_user_terms", "TABLE", "table",
            "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
@@ -777,22 +777,33 @@ USER_ENERGY = nbtypes.float64(_A2, _I1, _F2, _F1)
 
 
 class UserTerms(NamedTuple):
-    """A table's user terms: the compiled pointers and their work arrays.
+    """A table's user terms: the addresses of their compiled functions and
+    their work arrays.
 
-    ``pos[k]`` is the internal row of the body set's row ``k`` (the user's
-    functions see the bodies in the body set's order); ``xu``, ``vu`` are
-    scratch in that order, ``mu`` the masses in it.  A function that returns
-    the wrong shape fills ``acc`` with NaN and sets ``flag[0] = 1``: the loop
-    then stops as for a non-finite state, and the caller names the cause."""
+    ``address`` holds the addresses of the C callables of :data:`USER_ACCEL`
+    and :data:`USER_ENERGY` (0: none), called through
+    :func:`~orbits._kernels._jit.address_caller`, so that a table's type is
+    the same with and without user terms.  ``pos[k]`` is the internal row of
+    the body set's row ``k`` (the user's functions see the bodies in the body
+    set's order); ``xu``, ``vu`` are scratch in that order, ``mu`` the masses
+    in it.  A function that returns the wrong shape fills ``acc`` with NaN and
+    sets ``flag[0] = 1``: the loop then stops as for a non-finite state, and
+    the caller names the cause."""
 
-    accel: object
-    energy: object
+    address: np.ndarray   # int64 (2,): accelerations, energy
     pos: np.ndarray
     xu: np.ndarray
     vu: np.ndarray
     mu: np.ndarray
     flag: np.ndarray
     velocity_dependent: bool
+
+
+def no_user_terms():
+    """The :class:`UserTerms` of a table without user terms."""
+    return UserTerms(np.zeros(2, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                     np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
+                     np.zeros(1, dtype=np.int64), False)
 
 
 class TermTable(NamedTuple):
@@ -807,7 +818,7 @@ class TermTable(NamedTuple):
     m: np.ndarray         # masses, internal order
     an: np.ndarray        # scratch (N, 3)
     pot: np.ndarray       # scratch (N,)
-    user: UserTerms   # or None: no user terms
+    user: UserTerms
 
 
 class TermRow(NamedTuple):
@@ -823,11 +834,10 @@ def table(rows, gm, m, user=None):
     """The :class:`TermTable` of ``rows`` (:class:`TermRow`) over bodies with
     ``G m`` ``gm`` and masses ``m`` (internal order); ``user`` the
     :class:`UserTerms` of the rows coded :data:`USER`, or None without such
-    rows.  A table without user terms holds arrays and numbers alone, which
-    numba types on a call from Python in a microsecond or two; a compiled
-    pointer in it is typed element by element in Python (some 0.2 ms a call),
-    so only tables with user terms carry one (their loops are compiled apart,
-    once, for every user function)."""
+    rows.  Every table holds arrays and numbers alone (a user function by
+    its address), which numba types on a call from Python in a few
+    microseconds, and all are of one type: one loop serves tables with and
+    without user terms."""
     n = len(m)
     rows = list(rows)
     codes = np.array([r.code for r in rows], dtype=np.int64)
@@ -841,28 +851,30 @@ def table(rows, gm, m, user=None):
             per_body[k] = r.per_body
     return TermTable(codes, ints, reals, per_body, np.ascontiguousarray(gm, dtype=np.float64),
                      np.ascontiguousarray(m, dtype=np.float64), np.zeros((n, 3)), np.zeros(n),
-                     user)
+                     no_user_terms() if user is None else user)
+
+
+_call_accel = address_caller(USER_ACCEL)
+_call_energy = address_caller(USER_ENERGY)
 
 
 @njit
 def _user_accel(u, x, v, t, acc):
-    # the user terms' accelerations (none where the table has none: u is None)
-    if u is not None:
-        u.accel(x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc)
+    # the user terms' accelerations (none where the table has none: address 0)
+    if u.address[0] != 0:
+        _call_accel(u.address[0], (x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc))
 
 
 @njit
 def _user_energy(u, x):
-    if u is not None:
-        return u.energy(x, u.pos, u.xu, u.mu)
+    if u.address[1] != 0:
+        return _call_energy(u.address[1], (x, u.pos, u.xu, u.mu))
     return 0.0
 
 
 @njit
 def _user_velocity_dependent(u):
-    if u is not None:
-        return u.velocity_dependent
-    return False
+    return u.velocity_dependent
 
 
 @njit

@@ -1,6 +1,7 @@
 """The package's numba options (orbits._kernels._jit)."""
 
 import numba
+import numpy
 import pytest
 from numba.core import types as nbtypes
 
@@ -95,6 +96,50 @@ def test_a_pointer_is_an_argument_typed_by_its_signature():
         assert _call(p, 3.0) == expected
         assert p(3.0) == expected           # from Python: the function as Python
     assert len(_call.signatures) == 1       # one compilation for every such pointer
+
+
+_FILL = nbtypes.void(nbtypes.float64[:, :], nbtypes.float64, nbtypes.int64[::1])
+_call_fill = _jit.address_caller(_FILL)
+_call_unary = _jit.address_caller(_UNARY)
+
+
+def _fill(out, a, flag):
+    for i in range(out.shape[0]):
+        for d in range(out.shape[1]):
+            out[i, d] += a * (3 * i + d)
+    flag[0] = 7
+
+
+@_jit.njit(cache=False)
+def _by_address(addresses, out, flag):
+    # arrays of other layouts than the signature's are converted (C to A)
+    _call_fill(addresses[0], (out, 2.0, flag))
+    return _call_unary(addresses[1], (4.0,))
+
+
+def test_an_address_calls_its_c_callable_with_its_signature():
+    # user terms travel as addresses in an int64 array (orbits._kernels.terms);
+    # on a numba whose C callables take their arguments otherwise than its
+    # first-class functions' prototype, this fails or crashes
+    fill = _jit.cfunc(_FILL, _fill)
+    for kernel, expected in ((_halve, 2.0), (_triple, 12.0)):
+        unary = _jit.pointer(kernel, _UNARY)
+        addresses = numpy.array([fill.address, unary.cfunc.address], dtype=numpy.int64)
+        out = numpy.ones((2, 3))
+        flag = numpy.zeros(1, dtype=numpy.int64)
+        assert _by_address(addresses, out, flag) == expected
+        assert out.tolist() == [[1.0, 3.0, 5.0], [7.0, 9.0, 11.0]] and flag[0] == 7
+    assert len(_by_address.signatures) == 1   # one compilation for every address
+
+
+def test_an_address_caller_refuses_arguments_of_another_signature():
+    with pytest.raises(numba.TypingError):
+        _by_address_wrongly(numpy.zeros(2, dtype=numpy.int64))
+
+
+@_jit.njit(cache=False)
+def _by_address_wrongly(addresses):
+    return _call_unary(addresses[1], (4.0, 1.0))
 
 
 def test_a_kernel_pointer_is_its_own_code_cached_under_the_stamp():
