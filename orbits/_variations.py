@@ -81,9 +81,9 @@ def bind(sim, variations, seed):
     sim._rows_x[n:] = dx.reshape(-1, 3)
     sim._rows_v[n:] = dv.reshape(-1, 3)
     sim._chaos_box = _var.chaos_box(0.0)
-    sim._force = _var.with_variations(sim._base_force, masses=bool(n_mass), chaos=chaos)
+    sim._force = _var.with_variations(sim._base_force, chaos=chaos)
     sim._fargs = _var.variation_args(sim._base_fargs, n, dm, sim._chaos_box,
-                                      sim.units.G, sim._eps2)
+                                      sim.units.G, sim._eps2, chaos)
 
 
 def tangent_rows(sim):

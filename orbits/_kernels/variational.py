@@ -57,11 +57,10 @@ from .invariants import MONITOR_COLUMNS
 from .jacobians import jacobian_for
 
 # the names the templates below are written against, bound by specialize
-(CHAOS_ON, MASSES, MEGNO_COLUMN, inner, inner_add, inner_note, inner_rate,
- inner_record, jacobian, reads, inner_reads, table_reads, inner_on) = slots(
-    "CHAOS_ON", "MASSES", "MEGNO_COLUMN", "inner", "inner_add", "inner_note",
-    "inner_rate", "inner_record", "jacobian", "reads", "inner_reads", "table_reads",
-    "inner_on")
+(MEGNO_COLUMN, inner, inner_add, inner_note, inner_rate, inner_record, jacobian, reads,
+ inner_reads, table_reads, inner_on) = slots(
+    "MEGNO_COLUMN", "inner", "inner_add", "inner_note", "inner_rate", "inner_record",
+    "jacobian", "reads", "inner_reads", "table_reads", "inner_on")
 
 __all__ = ["with_variations", "variation_args", "chaos_update", "chaos_rescaled",
            "chaos_values", "chaos_box", "measured_rows", "CHAOS", "RENORMALISE_EXPONENT",
@@ -186,21 +185,21 @@ def _varied(x, v, t, fargs, acc):
     for j in range(k):
         o = n * (j + 1)
         tangent_product(jx, jv, x, v, o, n, acc, velocity)
-        if MASSES:
-            G, eps2 = vargs[5]
-            for l in range(n):
-                g = G * dm[j, l]
-                if g == 0.0:
+        # gravity's da/dm dm: nothing where the vector varies no mass
+        G, eps2 = vargs[5][0], vargs[5][1]
+        for l in range(n):
+            g = G * dm[j, l]
+            if g == 0.0:
+                continue
+            for i in range(n):
+                if i == l:
                     continue
-                for i in range(n):
-                    if i == l:
-                        continue
-                    d0, d1, d2 = row_difference(x, l, i)
-                    s2 = d0 * d0 + d1 * d1 + d2 * d2 + eps2
-                    f = g / (s2 * math.sqrt(s2))
-                    acc[o + i, 0] += f * d0
-                    acc[o + i, 1] += f * d1
-                    acc[o + i, 2] += f * d2
+                d0, d1, d2 = row_difference(x, l, i)
+                s2 = d0 * d0 + d1 * d1 + d2 * d2 + eps2
+                f = g / (s2 * math.sqrt(s2))
+                acc[o + i, 0] += f * d0
+                acc[o + i, 1] += f * d1
+                acc[o + i, 2] += f * d2
 
 
 def _varied_jacobian(x, v, t, fargs, jx, jv):
@@ -246,7 +245,7 @@ def _varied_work_add(fargs, dw):
 def _varied_note(fargs, mon_out, row):
     # the work, then the chaos indicators, into the monitor row just recorded
     inner_note(fargs[0], mon_out, row)
-    if CHAOS_ON:
+    if fargs[1][5][2]:
         box = fargs[1][4]
         span = box[1] - box[0]
         if span != 0.0:
@@ -256,10 +255,10 @@ def _varied_note(fargs, mon_out, row):
 
 
 def _tangent_step(x, v, t, fargs):
-    # after every step: the chaos accumulators (tangent vector 0); True asks
-    # the loop to stop for a renormalisation
-    if CHAOS_ON:
-        vargs = fargs[1]
+    # after every step: the chaos accumulators (tangent vector 0), where the
+    # chaos indicators are on; True asks the loop to stop for a renormalisation
+    vargs = fargs[1]
+    if vargs[5][2]:
         n = vargs[0]
         return chaos_update(x[n:2 * n], v[n:2 * n], t, vargs[4])
     return False
@@ -291,10 +290,10 @@ def measured_rows(force):
 def tangent_kernels(force):
     """The bindings of the step epilogue for ``force``: ``tangent_step(x, v, t,
     fargs) -> bool`` (the chaos accumulators after a step; True: renormalise)."""
-    if force.inner is None or not force.chaos:
+    if force.inner is None:
         return dict(tangent_step=_no_tangent_step)
     return dict(tangent_step=specialize(_tangent_step, force.key, cache=force.cache,
-                                        inline=True, CHAOS_ON=True))
+                                        inline=True))
 
 
 def _varied_work_on(fargs):
@@ -317,7 +316,6 @@ def variational_work_kernels(force, inner_kernels):
                            inner_on=inner_kernels["work_on"]),
         work_note=specialize(_varied_note, key, cache=cache, inline=True,
                              inner_note=inner_kernels["work_note"],
-                             CHAOS_ON=bool(force.chaos),
                              MEGNO_COLUMN=MONITOR_COLUMNS.index("megno")))
 
 
@@ -359,18 +357,18 @@ def velocity_reader(force):
     return _always_reads if (force.velocity_dependent or force.opaque) else _never_reads
 
 
-def with_variations(force, masses, chaos):
+def with_variations(force, chaos):
     """The force of the augmented system (see the module notes) for ``force``
     (a :class:`~orbits._kernels.stepping.ForceKernel`), with its arguments
-    ``(fargs, vargs)`` (:func:`variation_args`).  ``masses``: some tangent
-    vectors vary masses (gravity's ``da/dm`` is added); ``chaos``: tangent
-    vector 0 carries the chaos indicators."""
+    ``(fargs, vargs)`` (:func:`variation_args`).  ``chaos``: tangent vector 0
+    carries the chaos indicators.  Both are data of the arguments (the mass
+    variations ``dm``, the chaos flag), so one compiled loop serves every
+    kind of variations with and without the chaos indicators."""
     vd = bool(force.velocity_dependent)
     jac, jkey = jacobian_for(force, vd)
-    key = f"var{'m' if masses else ''}{'c' if chaos else ''}({force.key};{jkey})"
+    key = f"var({force.key};{jkey})"
     kernel = specialize(_varied, key, jit=force.jit, cache=force.cache, inline=True,
-                        inner=force.kernel, jacobian=jac, reads=velocity_reader(force),
-                        MASSES=bool(masses))
+                        inner=force.kernel, jacobian=jac, reads=velocity_reader(force))
     jacobian = specialize(_varied_jacobian, key, jit=force.jit, cache=force.cache,
                           jacobian=jac)
     record = specialize(_varied_record, key, jit=force.jit, cache=force.cache,
@@ -383,10 +381,11 @@ def with_variations(force, masses, chaos):
                        dissipative=force.dissipative)
 
 
-def variation_args(fargs, n, dm, box, G, eps2):
+def variation_args(fargs, n, dm, box, G, eps2, chaos):
     """The arguments of a force made by :func:`with_variations`: ``(fargs,
-    (n, dm, jx, jv, box, (G, eps2)))`` with ``dm`` of shape (k, n), the mass
-    variation of each tangent vector, and ``box`` the chaos accumulators."""
+    (n, dm, jx, jv, box, (G, eps2, chaos)))`` with ``dm`` of shape (k, n),
+    the mass variation of each tangent vector, ``box`` the chaos
+    accumulators and ``chaos`` whether tangent vector 0 carries them."""
     m = 3 * n
     return (fargs, (n, np.ascontiguousarray(dm, dtype=float), np.zeros((m, m)),
-                    np.zeros((m, m)), box, (float(G), float(eps2))))
+                    np.zeros((m, m)), box, (float(G), float(eps2), bool(chaos))))

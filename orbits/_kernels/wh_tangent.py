@@ -49,16 +49,17 @@ body is active, which at zero mass has the same values: the tangent feels
 its pull (as the variational equations of the other integrators do).
 
 The kernels take the tangent arguments as one tuple ``tp = (dgm, deta, k,
-masses, jx, jv, box)``: ``dgm`` (shape (K, n)) the variations of ``G m``,
+masses, jx, jv, box, chaos)``: ``dgm`` (shape (K, n)) the variations of ``G m``,
 ``deta`` (shape (K, n)) those of each row's Kepler ``G M``, ``k <= K`` the
 number of tangent vectors to carry (all of them in a step; 1 to synchronise
 the chaos indicators' vector; 0 for the bodies alone), ``masses`` whether
 any ``dm`` is non-zero, ``jx``, ``jv`` (shape (3n, 3n)) scratch for the
-terms' Jacobian, and ``box`` the chaos accumulators
-(:mod:`orbits._kernels.variational`).  The bound ``targs`` of the
+terms' Jacobian, ``box`` the chaos accumulators
+(:mod:`orbits._kernels.variational`) and ``chaos`` whether they are on.
+The bound ``targs`` of the
 Wisdom-Holman templates is then ``(the terms' args, tp)``.
 
-Chaos indicators.  With them on (a compile-time flag of the force), after
+Chaos indicators.  With them on (a flag of the arguments), after
 every step the loop takes tangent vector 0 at the step's internal point,
 before the deferred half drift and the corrector, to inertial coordinates
 (a linear map, :func:`jacobi_inertial_tangent`) and hands it to
@@ -639,7 +640,7 @@ def _carrying(targs, k):
     # targs with the tangent arguments set to carry k vectors (a value, so
     # that the kernels called with these targs compile once for every k)
     tp = targs[1]
-    return (targs[0], (tp[0], tp[1], value(k), tp[3], tp[4], tp[5], tp[6]))
+    return (targs[0], (tp[0], tp[1], value(k), tp[3], tp[4], tp[5], tp[6], tp[7]))
 
 
 def _tangent_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
@@ -658,13 +659,16 @@ def _tangent_bodies(xj, vj, sync):
 
 
 def _chaos_step(xj, vj, t, sync):
-    # after every step: the chaos accumulators advanced with tangent vector 0
-    # in inertial coordinates at the step's internal point (before the
-    # deferred half drift and the corrector: see the module notes), and the
-    # vector's internal rows scaled back when it has grown large
+    # after every step, where the chaos indicators are on (tp[7]): the
+    # accumulators advanced with tangent vector 0 in inertial coordinates at
+    # the step's internal point (before the deferred half drift and the
+    # corrector: see the module notes), and the vector's internal rows scaled
+    # back when it has grown large
     gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
-    n = gm.shape[0]
     tp = targs[1]
+    if not tp[7]:
+        return False
+    n = gm.shape[0]
     inertial_tangent(xj, vj, gm, eta, xs, vs, tp)
     box = tp[6]
     if chaos_update(xs[n:2 * n], vs[n:2 * n], t, box):
@@ -674,8 +678,10 @@ def _chaos_step(xj, vj, t, sync):
 
 def _chaos_note(sync, mon_out, row):
     # the chaos indicators into the monitor row just recorded, by the
-    # variational force's own note (its fargs[1][4] is the box)
-    note(((), (0, 0, 0, 0, sync.targs[1][6])), mon_out, row)
+    # variational force's own note (its fargs[1][4] is the box, fargs[1][5][2]
+    # the chaos flag)
+    tp = sync.targs[1]
+    note(((), (0, 0, 0, 0, tp[6], (0.0, 0.0, tp[7]))), mon_out, row)
 
 
 _INERTIAL_TANGENT = {"jacobi": jacobi_inertial_tangent,
@@ -742,7 +748,7 @@ def wh_tangent_loop(coordinates, terms, force):
     """The Wisdom-Holman loop of :func:`orbits._kernels.wisdom_holman.wh_loop`
     compiled with the tangent of every operator, for a force with variations
     ``force`` (its ``inner`` the gravity, with ``terms``); with the chaos
-    indicators after every step if ``force.chaos``, and with the escape check
+    indicators after every step where they are on (data of the arguments), and with the escape check
     of :func:`~orbits._kernels.wisdom_holman.escape_kernels` on the bodies.
     Called with ``targs = (terms' args, tp)`` (see the module notes), ``gm``
     and ``eta`` of the bodies alone (``n`` entries), the state arrays of
@@ -754,10 +760,8 @@ def wh_tangent_loop(coordinates, terms, force):
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, key, cache)
     recorder = specialize(_tangent_record, key, cache=cache, nrt=nrt, synchronize=sync,
                           record=force.recorder)
-    step = None   # the epilogue's default: nothing after a step
-    if force.chaos:
-        step = specialize(_chaos_step, key, cache=cache, inline=True, nrt=nrt,
-                          inertial_tangent=_INERTIAL_TANGENT[coordinates])
+    step = specialize(_chaos_step, key, cache=cache, inline=True, nrt=nrt,
+                      inertial_tangent=_INERTIAL_TANGENT[coordinates])
     note = specialize(_chaos_note, key, cache=cache, inline=True, nrt=nrt,
                       note=work_kernels(force)["work_note"])
     bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,

@@ -508,7 +508,7 @@ class WisdomHolman(Integrator):
         # force (neither is an array: rebound, not saved); the chaos box in tp
         # is the one fargs brings, replaced by the workspace's in advance
         inner, (inner_fargs, vargs) = force.inner, fargs
-        n, dm, jx, jv, box, (G, eps2) = vargs
+        n, dm, jx, jv, box, (G, eps2, chaos) = vargs
         dm = np.ascontiguousarray(dm, dtype=np.float64)
         k = dm.shape[0]
         if dm.shape != (k, n):
@@ -527,7 +527,8 @@ class WisdomHolman(Integrator):
         else:
             # every row orbits G m_0
             deta = np.repeat(dgm[:, :1], n, axis=1)
-        ws["tangent"] = (force, n, (dgm, np.ascontiguousarray(deta), k, masses, jx, jv, box))
+        ws["tangent"] = (force, n, (dgm, np.ascontiguousarray(deta), k, masses, jx, jv, box,
+                                    chaos))
 
     def _check_system(self, ws, force, fargs):
         gm, n_active = split_gravity(self.name, force, fargs, "'leapfrog' or 'yoshida4'")
@@ -630,7 +631,7 @@ class WisdomHolman(Integrator):
         if x.shape[0] != n * (1 + tp[2]):
             raise ValueError(f"{self.name}: {x.shape[0]} state rows for {n} bodies and "
                              f"{tp[2]} tangent vectors")
-        tp = tp[:6] + (fargs[1][4],)
+        tp = tp[:6] + (fargs[1][4],) + tp[7:]
         terms, targs = ws.get("terms", (None, ()))
         gravity = fargs[0] if terms is None else fargs[0][0]
         gm, n_active = gravity[0], gravity[1]

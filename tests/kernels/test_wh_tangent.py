@@ -197,8 +197,8 @@ def _varied(name, opts, x, v, m, n_active, dx, dv, dm, chaos=False, terms=None):
     if terms is not None:
         inner = stepping.with_terms(inner, terms[0], False)
         fargs = (fargs, terms[1](m))
-    force = V.with_variations(inner, bool(np.any(dm)), chaos)
-    fargs = V.variation_args(fargs, n, dm, V.chaos_box(0.0), G, 0.0)
+    force = V.with_variations(inner, chaos)
+    fargs = V.variation_args(fargs, n, dm, V.chaos_box(0.0), G, 0.0, chaos)
     X = np.concatenate([x, *dx])
     W = np.concatenate([v, *dv])
     ws = integ.workspace(len(X))
@@ -468,9 +468,9 @@ def test_tangent_agrees_with_rebound_whfast(corrector):
     sim.integrate(1000 * 100.0, exact_finish_time=0)
     ref = np.array([[p.x, p.y, p.z, p.vx, p.vy, p.vz] for p in var.particles])
     integ = integrators.get("wh", corrector=corrector)
-    force = V.with_variations(stepping.gravity_force("small"), False, False)
+    force = V.with_variations(stepping.gravity_force("small"), False)
     fargs = V.variation_args(gravity.gravity_args(sim.G, m, n, 0.0), n, np.zeros((1, n)),
-                             V.chaos_box(0.0), sim.G, 0.0)
+                             V.chaos_box(0.0), sim.G, 0.0, False)
     X = np.concatenate([x, d[:, :3]])
     W = np.concatenate([v, d[:, 3:]])
     ws = integ.workspace(2 * n)
@@ -497,9 +497,9 @@ def test_monitors_see_the_bodies_as_without_variations():
     for chaos in (True, None):
         integ = integrators.get("wh", corrector=3)
         if chaos:
-            force = V.with_variations(stepping.gravity_force("small"), False, True)
+            force = V.with_variations(stepping.gravity_force("small"), True)
             fargs = V.variation_args(gravity.gravity_args(G, M, n, 0.0), n, np.zeros((1, n)),
-                                     V.chaos_box(0.0), G, 0.0)
+                                     V.chaos_box(0.0), G, 0.0, True)
             X, W = np.concatenate([x, dx[0]]), np.concatenate([v, dv[0]])
         else:
             force = stepping.gravity_force("small")
