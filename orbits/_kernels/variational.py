@@ -182,24 +182,25 @@ def _varied(x, v, t, fargs, acc):
                 jv[p, q] = 0.0
     jacobian(x[:n], v[:n], t, inner_args, jx, jv)
     k = dm.shape[0]
+    G, eps2, masses = vargs[5][0], vargs[5][1], vargs[5][3]
     for j in range(k):
         o = n * (j + 1)
         tangent_product(jx, jv, x, v, o, n, acc, velocity)
-        # gravity's da/dm dm: nothing where the vector varies no mass
-        G, eps2 = vargs[5][0], vargs[5][1]
-        for l in range(n):
-            g = G * dm[j, l]
-            if g == 0.0:
-                continue
-            for i in range(n):
-                if i == l:
+        if masses:
+            # gravity's da/dm dm
+            for l in range(n):
+                g = G * dm[j, l]
+                if g == 0.0:
                     continue
-                d0, d1, d2 = row_difference(x, l, i)
-                s2 = d0 * d0 + d1 * d1 + d2 * d2 + eps2
-                f = g / (s2 * math.sqrt(s2))
-                acc[o + i, 0] += f * d0
-                acc[o + i, 1] += f * d1
-                acc[o + i, 2] += f * d2
+                for i in range(n):
+                    if i == l:
+                        continue
+                    d0, d1, d2 = row_difference(x, l, i)
+                    s2 = d0 * d0 + d1 * d1 + d2 * d2 + eps2
+                    f = g / (s2 * math.sqrt(s2))
+                    acc[o + i, 0] += f * d0
+                    acc[o + i, 1] += f * d1
+                    acc[o + i, 2] += f * d2
 
 
 def _varied_jacobian(x, v, t, fargs, jx, jv):
@@ -383,9 +384,11 @@ def with_variations(force, chaos):
 
 def variation_args(fargs, n, dm, box, G, eps2, chaos):
     """The arguments of a force made by :func:`with_variations`: ``(fargs,
-    (n, dm, jx, jv, box, (G, eps2, chaos)))`` with ``dm`` of shape (k, n),
-    the mass variation of each tangent vector, ``box`` the chaos
-    accumulators and ``chaos`` whether tangent vector 0 carries them."""
+    (n, dm, jx, jv, box, (G, eps2, chaos, masses)))`` with ``dm`` of shape
+    (k, n), the mass variation of each tangent vector, ``box`` the chaos
+    accumulators, ``chaos`` whether tangent vector 0 carries them and
+    ``masses`` whether any vector varies a mass."""
     m = 3 * n
-    return (fargs, (n, np.ascontiguousarray(dm, dtype=float), np.zeros((m, m)),
-                    np.zeros((m, m)), box, (float(G), float(eps2), bool(chaos))))
+    dm = np.ascontiguousarray(dm, dtype=float)
+    return (fargs, (n, dm, np.zeros((m, m)), np.zeros((m, m)), box,
+                    (float(G), float(eps2), bool(chaos), bool(np.any(dm != 0.0)))))

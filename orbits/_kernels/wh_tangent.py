@@ -681,7 +681,7 @@ def _chaos_note(sync, mon_out, row):
     # variational force's own note (its fargs[1][4] is the box, fargs[1][5][2]
     # the chaos flag)
     tp = sync.targs[1]
-    note(((), (0, 0, 0, 0, tp[6], (0.0, 0.0, tp[7]))), mon_out, row)
+    note(((), (0, 0, 0, 0, tp[6], (0.0, 0.0, tp[7], tp[3]))), mon_out, row)
 
 
 _INERTIAL_TANGENT = {"jacobi": jacobi_inertial_tangent,

@@ -508,7 +508,7 @@ class WisdomHolman(Integrator):
         # force (neither is an array: rebound, not saved); the chaos box in tp
         # is the one fargs brings, replaced by the workspace's in advance
         inner, (inner_fargs, vargs) = force.inner, fargs
-        n, dm, jx, jv, box, (G, eps2, chaos) = vargs
+        n, dm, jx, jv, box, (G, eps2, chaos, _) = vargs
         dm = np.ascontiguousarray(dm, dtype=np.float64)
         k = dm.shape[0]
         if dm.shape != (k, n):
