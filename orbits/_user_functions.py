@@ -27,13 +27,16 @@ from ._kernels._jit import KERNEL_STAMP, bound_globals, cfunc, slots, specialize
 from ._kernels import terms as _kterms
 
 # the names the templates below are written against, bound by specialize
-adder, head, tail, user, user_accel, user_potential = slots(
-    "adder", "head", "tail", "user", "user_accel", "user_potential")
+adder, head, tail, user, user_accel, user_jac, user_potential = slots(
+    "adder", "head", "tail", "user", "user_accel", "user_jac", "user_potential")
 
-__all__ = ["code_key", "cacheable", "term_pointers", "force_pointer", "force_args", "FORCE_SIZE"]
+__all__ = ["code_key", "cacheable", "term_pointers", "force_pointer", "force_args",
+           "jacobian_pointer", "FORCE_SIZE", "JACOBIAN_SIZE"]
 
 #: ``flag[0]`` after a user function returned the wrong number of values
 FORCE_SIZE = 1
+#: ``flag[0]`` after a user's Jacobian returned matrices of the wrong shape
+JACOBIAN_SIZE = 2
 
 _SIMPLE = (bool, int, float, complex, str, bytes, type(None))
 
@@ -251,6 +254,49 @@ def force_pointer(accel, ndim):
     if key not in _POINTERS:
         _POINTERS[key] = _cfunc(_force_pointer, force_signature(ndim), f"{key[0]}_{ndim}",
                                 cache=cacheable(accel), user_accel=accel)
+    return _POINTERS[key]
+
+
+_A2 = nbtypes.float64[:, :]
+
+
+def jacobian_signature(ndim):
+    """The signature of :func:`jacobian_pointer`'s pointer for a state of
+    ``ndim`` dimensions: ``(x, v, t, size, shape, flag, jx, jv)``."""
+    return nbtypes.void(_C2, _C2, nbtypes.float64, nbtypes.int64,
+                        nbtypes.UniTuple(nbtypes.int64, ndim), nbtypes.int64[::1], _A2, _A2)
+
+
+def _jacobian_pointer(x, v, t, size, shape, flag, jx, jv):
+    # the user's (size, size) matrices over the flattened state fill the
+    # leading block of jx, jv (orbits._kernels.jacobians.user_jacobian)
+    xu = x.ravel()[:size].reshape(shape)
+    vu = v.ravel()[:size].reshape(shape)
+    dadx, dadv = user_jac(xu, vu, t)
+    jxu = np.asarray(dadx)
+    jvu = np.asarray(dadv)
+    if jxu.shape[0] != size or jxu.shape[1] != size or jvu.shape[0] != size \
+            or jvu.shape[1] != size:
+        flag[0] = JACOBIAN_SIZE
+        for p in range(size):
+            for q in range(size):
+                jx[p, q] = math.nan
+                jv[p, q] = math.nan
+        return
+    for p in range(size):
+        for q in range(size):
+            jx[p, q] = jxu[p, q]
+            jv[p, q] = jvu[p, q]
+
+
+def jacobian_pointer(jac, ndim):
+    """The compiled pointer of a user's ``jac(x, v, t) -> (da/dx, da/dv)``
+    for a state of ``ndim`` dimensions (:func:`jacobian_signature`), cached
+    on disk for its code, as :func:`force_pointer`."""
+    key = ("jacobian", code_key(jac), ndim)
+    if key not in _POINTERS:
+        _POINTERS[key] = _cfunc(_jacobian_pointer, jacobian_signature(ndim),
+                                f"{key[1]}_{ndim}", cache=cacheable(jac), user_jac=jac)
     return _POINTERS[key]
 
 

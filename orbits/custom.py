@@ -173,14 +173,20 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
 
     _check_accel(accel, x0, v0, t0, shape)
     force = _stepping.user_force(accel, jit=_is_jitted(accel))
-    if jacobian is not None:
-        _check_jacobian(jacobian, x0, v0, t0, size)
-        force = force._replace(jacobian=_jacobians.user_jacobian(jacobian, _is_jitted(jacobian)),
-                               key=f"{force.key}_jac{id(jacobian)}")
-    if velocity_dependent:
-        force = force._replace(velocity_dependent=True)
     fargs = (_user_functions.force_args(accel, shape) if _is_jitted(accel)
              else (size, tuple(int(s) for s in shape)))
+    if jacobian is not None:
+        _check_jacobian(jacobian, x0, v0, t0, size)
+        if _is_jitted(accel) and _is_jitted(jacobian):
+            # through its pointer, cached for its code: one loop for every Jacobian
+            force = force._replace(jacobian=_jacobians.user_jacobian_pointer())
+            fargs = fargs + (_user_functions.jacobian_pointer(jacobian, len(shape)),)
+        else:
+            force = force._replace(
+                jacobian=_jacobians.user_jacobian(jacobian, _is_jitted(jacobian)),
+                key=f"{force.key}_jac{id(jacobian)}")
+    if velocity_dependent:
+        force = force._replace(velocity_dependent=True)
     if integ.adaptive:
         ws = integ.workspace(rows, 0.0 if dt is None else float(dt))
         t0, until = float(t0), float(until)
@@ -295,6 +301,11 @@ class _UserRun(Driven):
         t = self._now()
         if len(self._fargs) > 3 and self._fargs[3][0] == _user_functions.FORCE_SIZE:
             _resize_error(ValueError(_stepping.USER_FORCE_SIZE), self.shape, t)
+        if len(self._fargs) > 4 and self._fargs[3][0] == _user_functions.JACOBIAN_SIZE:
+            raise ForceTermError(f"jacobian(x, v, t) returned matrices of another shape "
+                                 f"during the run (after t = {t:.10g}); expected two "
+                                 f"({self.size}, {self.size}) arrays every call",
+                                 term="jacobian", field="return value")
         raise kind(text.format(name=self.integrator.name, next=self.steps + 1, t=t,
                                steps=self.steps)
                    + f"; the trajectory up to the last good step {self.steps} is kept on "

@@ -67,6 +67,10 @@ def drag(x, v, t, m):
 @numba.njit
 def spring(x, v, t):
     return -x
+
+@numba.njit
+def spring_jacobian(x, v, t):
+    return -np.eye(x.size), np.zeros((x.size, x.size))
 """
 
 _CHILD = """
@@ -95,14 +99,17 @@ with event.install_listener("numba:compile", Listener()):
     sim.run(until=10 * u.day, outputs=2, progress=False)
     tr = orbits.integrate(userforces.spring, np.ones(3), np.zeros(3), dt=0.01, steps=10,
                           method="rk4")
+    tr = orbits.integrate(userforces.spring, np.ones(3), np.zeros(3), dt=0.01, steps=10,
+                          method="implicit-midpoint", jacobian=userforces.spring_jacobian)
 print(json.dumps(compiled))
 """
 
 
 def test_user_functions_from_a_module_compile_once_and_load_in_a_new_process(tmp_path):
     # the second process compiles none of the package's code: its loops and the
-    # pointers to the users' functions come from numba's cache (the user's own
-    # functions compile as the user declared them, here without a cache)
+    # pointers to the users' functions (a force term, a force, a Jacobian) come
+    # from numba's cache (the user's own functions compile as the user declared
+    # them, here without a cache)
     (tmp_path / "userforces.py").write_text(_MODULE)
     env = dict(os.environ, PYTHONPATH=str(tmp_path) + os.pathsep
                + os.environ.get("PYTHONPATH", ""))

@@ -56,7 +56,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ._jit import njit, slots, specialize
-from .jacobians import jacobian_for
+from .jacobians import POINTER_KEY, jacobian_for
 from .status import Status
 from .stepping import GO, WORK_SLOTS, first_record, state_is_finite, step_epilogue, work_kernels
 
@@ -272,6 +272,7 @@ def implicit_loop(force, velocity_dependent):
     if jkey == "fd" and velocity_dependent:
         jkey = "fd_v"
     return specialize(_implicit_loop, f"theta_{force.key}_{jkey}",
-                      jit=force.jit, cache=force.cache and not jkey.startswith("own"),
+                      jit=force.jit,
+                      cache=force.cache and (jkey == POINTER_KEY or not jkey.startswith("own")),
                       force=force.kernel, jacobian=jac, step_end=step_epilogue(force),
                       **work_kernels(force))

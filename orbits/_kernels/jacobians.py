@@ -22,7 +22,8 @@ from ._jit import njit, slots, specialize
 force, VELOCITY, base_jacobian, extra, extra_reads, user_jac, differences = slots(
     "force", "VELOCITY", "base_jacobian", "extra", "extra_reads", "user_jac", "differences")
 
-__all__ = ["gravity_jacobian", "user_jacobian", "finite_difference_jacobian", "jacobian_for",
+__all__ = ["gravity_jacobian", "user_jacobian", "user_jacobian_pointer", "POINTER_KEY",
+           "finite_difference_jacobian", "jacobian_for",
            "central_differences", "FD_STEP"]
 
 _EPS = 2.220446049250313e-16
@@ -93,6 +94,25 @@ def _user_jacobian(x, v, t, fargs, jx, jv):
         for q in range(size):
             jx[p, q] = jxu[p, q]
             jv[p, q] = jvu[p, q]
+
+
+def _user_jacobian_pointer(x, v, t, fargs, jx, jv):
+    # a user's compiled Jacobian through its pointer
+    # (orbits._user_functions.jacobian_pointer): fargs = (size, shape, the
+    # force's pointer, flag, the Jacobian's pointer)
+    fargs[4](x, v, t, fargs[0], fargs[1], fargs[3], jx, jv)
+
+
+#: :func:`jacobian_for`'s key of :func:`user_jacobian_pointer`, the one user
+#: Jacobian whose loops are cached on disk
+POINTER_KEY = "jac_pointer"
+
+
+def user_jacobian_pointer():
+    """The Jacobian kernel of a user's compiled ``jac`` called through its
+    pointer, the last of the force's arguments: compiled once, cached, for
+    every such function (as :func:`orbits._kernels.stepping.user_force`)."""
+    return specialize(_user_jacobian_pointer, "user_pointer", inline=True)
 
 
 def user_jacobian(jac, jit):
@@ -202,6 +222,10 @@ def jacobian_for(force, velocity_dependent):
                           extra_reads=force.terms.reads_velocities), key
     own = getattr(force, "jacobian", None)
     if own is not None:
+        # a user's compiled Jacobian through its pointer is one kernel for all
+        # (its loops are cached, POINTER_KEY); another is named by its identity
+        if own is user_jacobian_pointer():
+            return own, POINTER_KEY
         return own, f"own{id(own)}"
     if force.key in _GRAVITY_KEYS:
         return gravity_jacobian, "gravity"

@@ -235,6 +235,30 @@ def test_bad_jacobian_shape_is_a_clear_error():
                          method="implicit-midpoint", jacobian=jac)
 
 
+@numba.njit
+def _jacobian_that_grows(x, v, t):
+    # right at t0 (the check before the run), one row and column too many past t = 0.25
+    n = x.size + (1 if t > 0.25 else 0)
+    return -np.eye(n), np.zeros((n, n))
+
+
+def test_a_compiled_jacobian_that_changes_shape_stops_the_run_with_a_named_error():
+    # the Jacobian runs through its compiled pointer, which checks the shape
+    # of every result: the run stops after the last step whose Jacobians were
+    # right (the step ending at 0.2 or 0.3, as Newton's method evaluates it at
+    # the step's start, middle or end) and says which function and what it expected
+    @numba.njit
+    def spring(x, v, t):
+        return -x
+
+    with pytest.raises(orbits.errors.ForceTermError,
+                       match=r"jacobian\(x, v, t\) returned matrices of another shape during "
+                             r"the run \(after t = 0\.[23]\); expected two \(3, 3\)") as exc:
+        orbits.integrate(spring, np.ones(3), np.zeros(3), dt=0.1, steps=10,
+                         method="implicit-midpoint", jacobian=_jacobian_that_grows)
+    assert exc.value.term == "jacobian" and exc.value.field == "return value"
+
+
 def test_newton_failure_is_a_convergence_failure():
     # x'' = x^2 from x = 1, v = 0 with h = 1: implicit Euler's equation for
     # W = v1 - v0 is W = (1 + W)^2, which has no real root, so Newton's
