@@ -98,7 +98,10 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
         of component ``p`` of ``accel(x, v, t).ravel()`` with respect to
         component ``q`` of ``x.ravel()`` (or ``v.ravel()``).  Return zeros for
         ``da/dv`` if ``accel`` does not depend on ``v``.  A ``numba.njit``
-        function runs compiled, like ``accel``.  Without it the implicit
+        function with a ``numba.njit`` ``accel`` runs compiled through a
+        pointer, as ``accel`` does: one compiled loop, cached on disk,
+        serves every such pair, and each function's pointer is cached for
+        its code.  Without it the implicit
         methods use central differences of ``accel`` (relative step
         ``eps**(1/3)``, see :mod:`orbits._kernels.implicit`), which cost
         ``2 x0.size`` evaluations of ``accel`` (twice that with
@@ -123,6 +126,9 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
     ConvergenceFailure
         An implicit method's Newton iteration did not converge in a step;
         ``.result`` as for ``NonFiniteState``.
+    ForceTermError
+        A compiled ``accel`` or ``jacobian`` returned an array of another
+        shape during the run.
 
     Examples
     --------
