@@ -15,7 +15,9 @@ The rows: the integrator alone (its loop compiled), then with ``GR``
 other combinations of built-in terms, then a :class:`~orbits.forces.UserForce`
 from an importable module (its pointer compiled once), then the same again in
 a new process (loaded), then each stopping condition, collision mode,
-``encounter_log`` and a chaos monitor (MEGNO) added to the integrator alone;
+``encounter_log`` and a chaos monitor (MEGNO) added to the integrator alone,
+then the variational equations of the state and the masses (``variations="all"``:
+one loop serves every kind of variations and the chaos monitors);
 for ``wh``, an ensemble in batch mode of 4 systems (the batch loop
 compiled) and then of 8 (a new size: the kick written out for it alone).
 Goals (issue "Start in seconds"): a combination of built-in terms after the
@@ -71,6 +73,7 @@ _CHILD = textwrap.dedent("""
         "encounter_log": dict(encounter_log=0.1 * u.au),
         "escape_distance": dict(escape_distance=1000 * u.au),
         "monitors megno": dict(monitors=("energy", "megno")),
+        "variations all": dict(variations="all"),
     }
     options = all_options.get(combo, {})
     if combo.startswith("batch"):
@@ -106,13 +109,13 @@ _CHILD = textwrap.dedent("""
 
 ROWS = ["none", "GR", "GRPotential + J2", "GR + migration", "UserForce",
         "UserForce (new process)", "encounter_distance", "escape_distance", "collisions merge",
-        "encounter_log", "monitors megno"]
+        "encounter_log", "monitors megno", "variations all"]
 #: the rows of wh alone: batch mode at one size of ensemble, then at another
 BATCH_ROWS = ["batch 4", "batch 8"]
 #: rows held to the goal of <= 1 s: the combinations after the first, the user force loaded
 GOAL_ROWS = {"GRPotential + J2": 1.0, "GR + migration": 1.0, "UserForce (new process)": 1.0,
              "encounter_distance": 1.0, "escape_distance": 1.0, "collisions merge": 1.0,
-             "encounter_log": 1.0, "monitors megno": 1.0}
+             "encounter_log": 1.0, "monitors megno": 1.0, "variations all": 1.0}
 
 
 def main(argv=None):
