@@ -7,7 +7,7 @@ of :mod:`orbits.errors`, which carries the result up to the last good state.
 import time as _time
 
 from ._kernels.status import Status
-from ._kernels.terms import TermTable
+from ._kernels.terms import TermTable, user_flag
 from .errors import (CloseEncounter, Collision, ConvergenceFailure, Escape, ForceTermError,
                      NonFiniteState, StepSizeUnderflow)
 
@@ -100,7 +100,7 @@ def _user_function_failed(fargs):
     """Whether a user term of a table in ``fargs`` (nested tuples) returned the
     wrong shape (see :mod:`orbits._user_functions`)."""
     if isinstance(fargs, TermTable):
-        return bool(fargs.user.flag[0])
+        return bool(user_flag(fargs.user))
     if isinstance(fargs, tuple):
         return any(_user_function_failed(f) for f in fargs)
     return False

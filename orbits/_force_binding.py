@@ -104,12 +104,9 @@ def _term_table(sim, bound, ctx):
     if users:
         accel, energy = _user_functions.term_pointers(users)
         pos = np.argsort(ctx.order).astype(np.int64)
-        n = len(pos)
         # the functions stay alive in term_pointers' cache for the process
-        user = _kterms.UserTerms(np.array([accel.address, energy.address], dtype=np.int64),
-                                 pos, np.zeros((n, 3)), np.zeros((n, 3)),
-                                 np.ascontiguousarray(ctx.m[pos]),
-                                 np.zeros(1, dtype=np.int64),
-                                 any(u.velocity_dependent for u in users))
+        user = _kterms.user_terms(accel.address, energy.address, pos,
+                                  np.ascontiguousarray(ctx.m[pos]),
+                                  any(u.velocity_dependent for u in users))
         rows.append(_kterms.TermRow(_kterms.USER))
     return _kterms.table(rows, sim._gm, sim._m, user)

@@ -49,7 +49,8 @@ from .jacobians import central_differences
 # the name the energy template below is written against, bound by specialize
 body_energy, = slots("body_energy")
 
-__all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "no_user_terms", "TABLE", "table",
+__all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "user_terms", "no_user_terms",
+           "user_flag", "TABLE", "table",
            "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
@@ -777,33 +778,48 @@ USER_ENERGY = nbtypes.float64(_A2, _I1, _F2, _F1)
 
 
 class UserTerms(NamedTuple):
-    """A table's user terms: the addresses of their compiled functions and
-    their work arrays.
+    """A table's user terms, in two arrays (a table is handed to compiled
+    kernels field by field, so fewer arrays are fewer words a call).
 
-    ``address`` holds the addresses of the C callables of :data:`USER_ACCEL`
+    ``ints`` holds the addresses of the C callables of :data:`USER_ACCEL`
     and :data:`USER_ENERGY` (0: none), called through
-    :func:`~orbits._kernels._jit.address_caller`, so that a table's type is
-    the same with and without user terms.  ``pos[k]`` is the internal row of
-    the body set's row ``k`` (the user's functions see the bodies in the body
-    set's order); ``xu``, ``vu`` are scratch in that order, ``mu`` the masses
-    in it.  A function that returns the wrong shape fills ``acc`` with NaN and
-    sets ``flag[0] = 1``: the loop then stops as for a non-finite state, and
-    the caller names the cause."""
+    :func:`~orbits._kernels._jit.address_caller` so that a table's type is
+    the same with and without user terms, then whether they read the
+    velocities (1) or not (0), the flag, and ``pos``: ``pos[k]`` the internal
+    row of the body set's row ``k`` (the user's functions see the bodies in
+    the body set's order).  ``reals`` is scratch ``xu``, ``vu`` (each (n,
+    3), in that order) and the masses ``mu`` in it.  A function that returns
+    the wrong shape fills ``acc`` with NaN and sets the flag to 1: the loop
+    then stops as for a non-finite state, and the caller names the cause
+    (:func:`user_flag`)."""
 
-    address: np.ndarray   # int64 (2,): accelerations, energy
-    pos: np.ndarray
-    xu: np.ndarray
-    vu: np.ndarray
-    mu: np.ndarray
-    flag: np.ndarray
-    velocity_dependent: bool
+    ints: np.ndarray    # int64: accelerations' address, energy's, velocities, flag, pos
+    reals: np.ndarray   # float64 (7 n,): xu, vu, mu
+
+
+#: the fixed entries of :attr:`UserTerms.ints`
+_ACCEL, _ENERGY, _READS, _FLAG, _POS = range(5)
+
+
+def user_terms(accel, energy, pos, mu, velocity_dependent):
+    """The :class:`UserTerms` of C callables at the addresses ``accel`` and
+    ``energy`` over bodies in the order ``pos`` with masses ``mu``."""
+    n = len(pos)
+    ints = np.concatenate([[accel, energy, int(bool(velocity_dependent)), 0],
+                           np.asarray(pos, dtype=np.int64)]).astype(np.int64)
+    reals = np.zeros(7 * n)
+    reals[6 * n:] = mu
+    return UserTerms(ints, reals)
 
 
 def no_user_terms():
     """The :class:`UserTerms` of a table without user terms."""
-    return UserTerms(np.zeros(2, dtype=np.int64), np.zeros(0, dtype=np.int64),
-                     np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
-                     np.zeros(1, dtype=np.int64), False)
+    return user_terms(0, 0, np.zeros(0, dtype=np.int64), np.zeros(0), False)
+
+
+def user_flag(u):
+    """The flag of the user terms ``u``: 1 after a function returned the wrong shape."""
+    return int(u.ints[_FLAG])
 
 
 class TermTable(NamedTuple):
@@ -861,20 +877,28 @@ _call_energy = address_caller(USER_ENERGY)
 @njit
 def _user_accel(u, x, v, t, acc):
     # the user terms' accelerations (none where the table has none: address 0)
-    if u.address[0] != 0:
-        _call_accel(u.address[0], (x, v, t, u.pos, u.xu, u.vu, u.mu, u.flag, acc))
+    address = u.ints[_ACCEL]
+    if address != 0:
+        n = u.ints.shape[0] - _POS
+        r = u.reals
+        _call_accel(address, (x, v, t, u.ints[_POS:], r[:3 * n].reshape((n, 3)),
+                              r[3 * n:6 * n].reshape((n, 3)), r[6 * n:],
+                              u.ints[_FLAG:_FLAG + 1], acc))
 
 
 @njit
 def _user_energy(u, x):
-    if u.address[1] != 0:
-        return _call_energy(u.address[1], (x, u.pos, u.xu, u.mu))
+    address = u.ints[_ENERGY]
+    if address != 0:
+        n = u.ints.shape[0] - _POS
+        return _call_energy(address, (x, u.ints[_POS:], u.reals[:3 * n].reshape((n, 3)),
+                                      u.reals[6 * n:]))
     return 0.0
 
 
 @njit
 def _user_velocity_dependent(u):
-    return u.velocity_dependent
+    return u.ints[_READS] != 0
 
 
 @njit
