@@ -770,6 +770,19 @@ class Simulation(Driven):
     def _fail(self, status, rec, wall0):
         _failures.fail(self, status, rec, wall0)
 
+    def __reduce__(self):
+        # a copy made field by field (pickle, copy.deepcopy) loses which arrays
+        # are views of which (the bodies' rows of the state, the workspace's
+        # bound arrays) and would run to other numbers without a word
+        raise TypeError(
+            "a Simulation does not pickle or deep-copy: make another from "
+            "Simulation.from_config(sim.bodies, sim.config) and put the state back with "
+            "set_state(sim.state), or write the run to a file (run(..., output=path)) and "
+            "restore it with Simulation.from_file")
+
+    def __deepcopy__(self, memo):
+        return self.__reduce__()
+
     def __repr__(self):
         """One line: bodies, time, integrator and its options, step, forces, stopping
         conditions."""

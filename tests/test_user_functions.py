@@ -155,3 +155,37 @@ def test_a_user_force_made_by_exec_runs_again_in_a_new_process():
                            text=True, timeout=600) for _ in range(2)]
     assert [o.returncode for o in outs] == [0, 0], outs[1].stderr[-2000:]
     assert outs[0].stdout == outs[1].stdout
+
+
+def test_a_simulation_and_a_table_with_user_terms_do_not_pickle():
+    # a simulation copied field by field ran to other numbers (its state's
+    # views became arrays of their own): it refuses, saying what to do; and a
+    # table of user terms holds the addresses of compiled code in this
+    # process, which another process would call blindly
+    import copy
+    import pickle
+
+    import astropy.units as u
+
+    sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+                            forces=[orbits.forces.UserForce(_module_level_drag,
+                                                            velocity_dependent=True)])
+    for deed in (pickle.dumps, copy.deepcopy):
+        with pytest.raises(TypeError, match="does not pickle or deep-copy: make another"):
+            deed(sim)
+    table = sim._fargs[1]
+    with pytest.raises(TypeError, match="UserForce terms .* cannot be pickled"):
+        pickle.dumps(table)
+    twin = copy.deepcopy(table)           # in this process the addresses stay good
+    assert np.array_equal(twin.user.ints, table.user.ints)
+    # the way the message gives: the same numbers as the original
+    again = orbits.Simulation.from_config(sim.bodies, sim.config, functions={
+        "_module_level_drag": _module_level_drag})
+    again.set_state(sim.state)
+    for s in (sim, again):
+        s.run(until=5 * u.day, outputs=2, progress=False)
+    assert np.array_equal(sim.state.x, again.state.x)
+    # a table without user terms pickles
+    plain = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day,
+                              forces=[orbits.forces.GR("Star")])
+    pickle.loads(pickle.dumps(plain._fargs[1]))

@@ -796,6 +796,22 @@ class UserTerms(NamedTuple):
     ints: np.ndarray    # int64: accelerations' address, energy's, velocities, flag, pos
     reals: np.ndarray   # float64 (7 n,): xu, vu, mu
 
+    def __deepcopy__(self, memo):
+        # the same process: the addresses stay good
+        return UserTerms(self.ints.copy(), self.reals.copy())
+
+    def __reduce__(self):
+        # another process has other addresses: a pickle of them would call
+        # whatever lies there, so user terms do not pickle
+        if self.ints[_ACCEL] != 0 or self.ints[_ENERGY] != 0:
+            raise TypeError(
+                "a simulation with UserForce terms holds the addresses of their compiled "
+                "code in this process and cannot be pickled; send what makes it (its "
+                "bodies, integrator and forces, as orbits.Ensemble does), or run it with "
+                "output= to a file and restore it with Simulation.from_file(path, "
+                "functions=...)")
+        return (UserTerms, (self.ints, self.reals))
+
 
 #: the fixed entries of :attr:`UserTerms.ints`
 _ACCEL, _ENERGY, _READS, _FLAG, _POS = range(5)
