@@ -30,7 +30,7 @@ from ._kernels import terms as _kterms
 adder, head, tail, user, user_accel, user_jac, user_potential = slots(
     "adder", "head", "tail", "user", "user_accel", "user_jac", "user_potential")
 
-__all__ = ["code_key", "cacheable", "term_pointers", "force_pointer", "force_args",
+__all__ = ["code_key", "cacheable", "term_pointers", "try_term", "force_pointer", "force_args",
            "jacobian_pointer", "FORCE_SIZE", "JACOBIAN_SIZE"]
 
 #: ``flag[0]`` after a user function returned the wrong number of values
@@ -217,6 +217,41 @@ def term_pointers(terms):
            _cfunc(_potential_pointer, _kterms.USER_ENERGY, suffix, cache=cache, adder=pot))
     _POINTERS[keys] = out
     return out
+
+
+def try_term(term, x, v, mu):
+    """Calls the pointers of the :class:`~orbits.forces.UserForce` ``term``
+    alone (:func:`term_pointers`) on the state ``x``, ``v`` at t = 0 with
+    masses ``mu`` (the body set's order): ``(acc, energy)``, or None where
+    the call went wrong in any way (the pointers did not compile, the
+    function returned the wrong shape or raised, which a C callable reports
+    as an unraisable error) and the caller must find out how by calling
+    the function itself.
+
+    The pointers are the run's own, loaded from the cache in a new process:
+    a check through them compiles nothing of the user's (a call from Python
+    would compile the function for Python's arguments)."""
+    try:
+        accel, energy = term_pointers([term])
+    except Exception:  # a typing error: the caller's own call names it
+        return None
+    n = x.shape[0]
+    u = _kterms.user_terms(accel.address, energy.address, np.arange(n, dtype=np.int64),
+                           np.ascontiguousarray(mu, dtype=np.float64), term.velocity_dependent)
+    x = np.ascontiguousarray(x, dtype=np.float64).copy()
+    v = np.ascontiguousarray(v, dtype=np.float64).copy()
+    acc = np.zeros((n, 3))
+    raised = []
+    hook = sys.unraisablehook
+    sys.unraisablehook = raised.append
+    try:
+        _kterms.user_accel(u, x, v, 0.0, acc)
+        e = _kterms.user_energy(u, x)
+    finally:
+        sys.unraisablehook = hook
+    if raised or _kterms.user_flag(u) != 0:
+        return None
+    return acc, e
 
 
 # -- a user's force replacing gravity (orbits.integrate) ----------------------------------

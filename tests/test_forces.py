@@ -603,6 +603,43 @@ def test_user_force_wrong_shape():
                           forces=[forces.UserForce(_wrong_shape)])
 
 
+@numba.njit
+def _one_row_too_many(x, v, t, m):
+    return np.zeros((x.shape[0] + 1, 3))
+
+
+@numba.njit
+def _raises(x, v, t, m):
+    if x[0, 0] == x[0, 0]:
+        raise ValueError("no force here")
+    return np.zeros_like(x)
+
+
+@numba.njit
+def _not_finite(x, v, t, m):
+    return np.full_like(x, np.nan)
+
+
+@numba.njit
+def _nan_potential(x, m):
+    return np.nan
+
+
+def test_user_force_errors_on_the_initial_state_name_the_function():
+    # the check calls the run's compiled pointers; where they fail (a wrong
+    # number of rows, an exception, which a compiled pointer cannot raise), the
+    # function's own call names the cause; a NaN is named as it is
+    cases = [(forces.UserForce(_one_row_too_many), r"shape \(3, 3\).*expected.*\(2, 3\)", "func"),
+             (forces.UserForce(_raises), "failed: no force here", "func"),
+             (forces.UserForce(_not_finite), "non-finite accelerations", "func"),
+             (forces.UserForce(_spring_to_origin, potential=_nan_potential),
+              "potential must return a finite float", "potential")]
+    for term, message, field in cases:
+        with pytest.raises(ForceTermError, match=message) as exc:
+            orbits.Simulation(sun_mercury(), "leapfrog", dt=1 * u.day, forces=[term])
+        assert exc.value.field == field
+
+
 def test_the_speed_of_light_is_keyword_only():
     # GRFull("Star") used to be taken, the name landing in c
     with pytest.raises(TypeError, match="positional"):

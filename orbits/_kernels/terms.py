@@ -50,7 +50,7 @@ from .jacobians import central_differences
 body_energy, = slots("body_energy")
 
 __all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "user_terms", "no_user_terms",
-           "user_flag", "TABLE", "table",
+           "user_flag", "user_accel", "user_energy", "TABLE", "table",
            "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
@@ -891,8 +891,9 @@ _call_energy = address_caller(USER_ENERGY)
 
 
 @njit
-def _user_accel(u, x, v, t, acc):
-    # the user terms' accelerations (none where the table has none: address 0)
+def user_accel(u, x, v, t, acc):
+    """Adds the accelerations of the user terms ``u`` (a :class:`UserTerms`)
+    to ``acc``; none where there are none (address 0)."""
     address = u.ints[_ACCEL]
     if address != 0:
         n = u.ints.shape[0] - _POS
@@ -903,7 +904,8 @@ def _user_accel(u, x, v, t, acc):
 
 
 @njit
-def _user_energy(u, x):
+def user_energy(u, x):
+    """The potential of the user terms ``u`` (0 where they have none)."""
     address = u.ints[_ENERGY]
     if address != 0:
         n = u.ints.shape[0] - _POS
@@ -961,7 +963,7 @@ def rows_accel(x, v, t, tab, first, end, acc):
         elif c == RADIATION:
             radiation_accel(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), acc)
         elif c == USER:
-            _user_accel(tab.user, x, v, t, acc)
+            user_accel(tab.user, x, v, t, acc)
 
 
 @njit
@@ -983,7 +985,7 @@ def table_energy(x, v, tab):
         elif c == ZONAL:
             e += zonal_energy(x, v, (ints[0], gm, reals[0], reals[1], reals[2:5], m))
         elif c == USER:
-            e += _user_energy(tab.user, x)
+            e += user_energy(tab.user, x)
     return e
 
 

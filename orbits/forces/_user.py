@@ -191,8 +191,22 @@ class UserForce(ForceTerm):
         return BoundTerm(_k.TermRow(_k.USER), user=self)
 
     def _check(self, ctx, m_user):
+        # through the run's own pointers, which a new process loads from the
+        # cache; only where they fail does the function's own call (compiled
+        # for Python's arguments) find out how, to name it
+        from .. import _user_functions
         x = ctx.x_user
         v = ctx.v_user
+        tried = _user_functions.try_term(self, x, v, m_user)
+        if tried is not None:
+            a, e = tried
+            if not np.all(np.isfinite(a)):
+                raise ForceTermError("func returned non-finite accelerations on the initial "
+                                     "state", term=repr(self), field="func")
+            if self.potential is not None and not math.isfinite(e):
+                raise ForceTermError(f"potential must return a finite float, got {e!r}",
+                                     term=repr(self), field="potential")
+            return
         try:
             a = np.asarray(self.func(x.copy(), v.copy(), 0.0, m_user))
         except Exception as exc:  # a numba typing error names the cause
@@ -210,6 +224,8 @@ class UserForce(ForceTerm):
             if not (np.ndim(e) == 0 and math.isfinite(float(e))):
                 raise ForceTermError(f"potential must return a finite float, got {e!r}",
                                      term=repr(self), field="potential")
+        raise ForceTermError("func or potential failed inside the compiled loop on the "
+                             "initial state", term=repr(self), field="func")
 
 
 def _reference(f):
