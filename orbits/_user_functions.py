@@ -15,6 +15,7 @@ accelerations with NaN and sets ``flag[0] = 1``: the loop stops as for a
 non-finite state and the caller names the cause (:func:`check_flag`).
 """
 
+import contextlib
 import hashlib
 import math
 import sys
@@ -30,7 +31,7 @@ from ._kernels import terms as _kterms
 adder, head, tail, user, user_accel, user_jac, user_potential = slots(
     "adder", "head", "tail", "user", "user_accel", "user_jac", "user_potential")
 
-__all__ = ["code_key", "cacheable", "term_pointers", "try_term", "force_pointer", "force_args",
+__all__ = ["code_key", "cacheable", "term_pointers", "try_term", "pointers_run", "force_pointer", "force_args",
            "jacobian_pointer", "FORCE_SIZE", "JACOBIAN_SIZE"]
 
 #: ``flag[0]`` after a user function returned the wrong number of values
@@ -241,17 +242,49 @@ def try_term(term, x, v, mu):
     x = np.ascontiguousarray(x, dtype=np.float64).copy()
     v = np.ascontiguousarray(v, dtype=np.float64).copy()
     acc = np.zeros((n, 3))
+    with _unraised() as raised:
+        _kterms.user_accel(u, x, v, 0.0, acc)
+        e = _kterms.user_energy(u, x)
+    if raised or _kterms.user_flag(u) != 0:
+        return None
+    return acc, e
+
+
+@contextlib.contextmanager
+def _unraised():
+    # the errors a C callable reports (it cannot raise): a list, filled on exit
     raised = []
     hook = sys.unraisablehook
     sys.unraisablehook = raised.append
     try:
-        _kterms.user_accel(u, x, v, 0.0, acc)
-        e = _kterms.user_energy(u, x)
+        yield raised
     finally:
         sys.unraisablehook = hook
-    if raised or _kterms.user_flag(u) != 0:
-        return None
-    return acc, e
+
+
+def pointers_run(accel, jac, x, v, t, shape):
+    """Whether the pointers of a user's compiled ``accel`` (and ``jac``, or
+    None) for :func:`orbits.integrate` run cleanly once on the state ``x``,
+    ``v`` (the loops' (rows, 3) arrays) at ``t``, for a state of ``shape``:
+    they compile (or load), return as many values as the state has, and
+    raise nothing.  Where not, the caller calls the functions themselves to
+    name the cause; where so, a new process has compiled nothing of the
+    user's to check them (as :func:`try_term`)."""
+    from ._kernels import jacobians as _jacobians
+    from ._kernels import stepping as _stepping
+    try:
+        fargs = force_args(accel, shape)
+        if jac is not None:
+            fargs = fargs + (jacobian_pointer(jac, len(shape)),)
+    except Exception:  # a typing error: the caller's own call names it
+        return False
+    m = x.size
+    with _unraised() as raised:
+        _stepping.user_force_call()(x.copy(), v.copy(), float(t), fargs, np.zeros_like(x))
+        if jac is not None and fargs[3][0] == 0:
+            _jacobians.user_jacobian_call()(x.copy(), v.copy(), float(t), fargs,
+                                            np.zeros((m, m)), np.zeros((m, m)))
+    return not raised and fargs[3][0] == 0
 
 
 # -- a user's force replacing gravity (orbits.integrate) ----------------------------------

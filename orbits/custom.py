@@ -177,12 +177,17 @@ def integrate(accel, x0, v0, *, dt=None, steps=None, method="verlet", t0=0.0, ev
     x.ravel()[:size] = x0.ravel()
     v.ravel()[:size] = v0.ravel()
 
-    _check_accel(accel, x0, v0, t0, shape)
+    # the compiled functions checked through the run's own pointers (loaded
+    # from the cache in a new process); the functions' own calls name a cause
+    pointed = _is_jitted(accel) and (jacobian is None or _is_jitted(jacobian))
+    if not (pointed and _user_functions.pointers_run(accel, jacobian, x, v, t0, shape)):
+        _check_accel(accel, x0, v0, t0, shape)
+        if jacobian is not None:
+            _check_jacobian(jacobian, x0, v0, t0, size)
     force = _stepping.user_force(accel, jit=_is_jitted(accel))
     fargs = (_user_functions.force_args(accel, shape) if _is_jitted(accel)
              else (size, tuple(int(s) for s in shape)))
     if jacobian is not None:
-        _check_jacobian(jacobian, x0, v0, t0, size)
         if _is_jitted(accel) and _is_jitted(jacobian):
             # through its pointer, cached for its code: one loop for every Jacobian
             force = force._replace(jacobian=_jacobians.user_jacobian_pointer())

@@ -117,3 +117,33 @@ def test_adaptive_arguments_are_checked():
         orbits.integrate(spring, 1.0, 0.0, method="dop853")
     with pytest.raises(orbits.IntegratorOptionError, match="give dt and steps"):
         orbits.integrate(spring, 1.0, 0.0, method="rk4", until=1.0)
+
+
+@numba.njit
+def _untyped(x, v, t):
+    return x + t.no_such_attribute
+
+
+@numba.njit
+def _raising(x, v, t):
+    if t == t:
+        raise ValueError("no acceleration here")
+    return -x
+
+
+@numba.njit
+def _square_jacobian(x, v, t):
+    return -np.eye(x.size + 1), np.zeros((x.size + 1, x.size + 1))
+
+
+def test_compiled_functions_that_fail_on_the_first_state_are_named_errors():
+    # the functions are first tried through the run's own compiled pointers,
+    # which cannot raise; where those fail, the functions' own calls name the cause
+    x0, v0 = np.ones(3), np.zeros(3)
+    with pytest.raises(TypeError, match="could not be compiled"):
+        orbits.integrate(_untyped, x0, v0, dt=0.01, steps=3)
+    with pytest.raises(ValueError, match="no acceleration here"):
+        orbits.integrate(_raising, x0, v0, dt=0.01, steps=3)
+    with pytest.raises(ValueError, match=r"da/dx of shape \(4, 4\); expected \(3, 3\)"):
+        orbits.integrate(spring, x0, v0, dt=0.01, steps=3, method="implicit-midpoint",
+                         jacobian=_square_jacobian)

@@ -22,7 +22,8 @@ from ._jit import njit, slots, specialize
 force, VELOCITY, base_jacobian, extra, extra_reads, user_jac, differences = slots(
     "force", "VELOCITY", "base_jacobian", "extra", "extra_reads", "user_jac", "differences")
 
-__all__ = ["gravity_jacobian", "user_jacobian", "user_jacobian_pointer", "POINTER_KEY",
+__all__ = ["gravity_jacobian", "user_jacobian", "user_jacobian_pointer", "user_jacobian_call",
+           "POINTER_KEY",
            "finite_difference_jacobian", "jacobian_for",
            "central_differences", "FD_STEP"]
 
@@ -113,6 +114,13 @@ def user_jacobian_pointer():
     pointer, the last of the force's arguments: compiled once, cached, for
     every such function (as :func:`orbits._kernels.stepping.user_force`)."""
     return specialize(_user_jacobian_pointer, "user_pointer", inline=True)
+
+
+def user_jacobian_call():
+    """:func:`user_jacobian_pointer`'s kernel as a function that Python calls
+    (``(x, v, t, fargs, jx, jv)``), compiled once, cached, for every such
+    Jacobian."""
+    return specialize(_user_jacobian_pointer, "user_pointer_call")
 
 
 def user_jacobian(jac, jit):

@@ -81,7 +81,7 @@ HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
 stages, = slots("stages")
 
 __all__ = ["DRIFT", "KICK", "Splitting", "splitting_loop", "runge_kutta_loop", "gravity_force",
-           "user_force", "state_is_finite", "ForceKernel", "with_terms",
+           "user_force", "user_force_call", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
            "clock_step", "landing_step", "add_compensated", "stop_info", "mark_recorder", "flat_rows",
@@ -670,6 +670,13 @@ def work_total(ws):
     out of the bodies since the workspace was made (0.0 without such terms)."""
     box = ws.get("work")
     return 0.0 if box is None else float(box[0] + box[1])
+
+
+def user_force_call():
+    """:func:`user_force`'s kernel for a compiled function, as a function that
+    Python calls (``(x, v, t, fargs, acc)``, the arguments of the loops):
+    compiled once, cached, for every such function."""
+    return specialize(_user_force, "user_pointer_call")
 
 
 def user_force(accel, jit):
