@@ -3,9 +3,11 @@
 Input errors say which body, which field, and what was expected.  Run-time
 failures say when and at which step they happened, and carry the result up to
 the last good state, so that nothing computed is lost.
-"""
 
-import astropy.units as u
+:class:`BodyUnitsError` is also astropy's ``UnitsError``; astropy is imported
+when that class is first asked for, so that code without units (such as
+:func:`orbits.integrate`) never imports it.
+"""
 
 __all__ = [
     "OrbitsError",
@@ -106,8 +108,7 @@ class BodyError(OrbitsError, ValueError):
         super().__init__(_located(message, _named("body", body), _named("field", field)))
 
 
-class BodyUnitsError(BodyError, u.UnitsError):
-    """A body's value has the wrong physical type, or no unit where one is needed.
+_BODY_UNITS_ERROR_DOC = """A body's value has the wrong physical type, or no unit where one is needed.
 
     Examples
     --------
@@ -118,6 +119,28 @@ class BodyUnitsError(BodyError, u.UnitsError):
     >>> issubclass(orbits.errors.BodyUnitsError, u.UnitsError)
     True
     """
+
+#: the examples of the class made on first use, which doctest finds here
+__test__ = {"BodyUnitsError": _BODY_UNITS_ERROR_DOC}
+
+
+def _body_units_error():
+    import astropy.units as u
+
+    class BodyUnitsError(BodyError, u.UnitsError):
+        __doc__ = _BODY_UNITS_ERROR_DOC
+
+    BodyUnitsError.__module__ = __name__
+    BodyUnitsError.__qualname__ = "BodyUnitsError"
+    return BodyUnitsError
+
+
+def __getattr__(name):
+    # the one class made on first use (see the module notes)
+    if name == "BodyUnitsError":
+        cls = globals()["BodyUnitsError"] = _body_units_error()
+        return cls
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class ElementsError(BodyError):

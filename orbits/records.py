@@ -8,10 +8,9 @@ modules do not import each other.  ``orbits.simulation`` re-exports them.
 
 from typing import NamedTuple
 
-import astropy.units as u
 import numpy as np
 
-from ._quantity_json import from_plain, to_plain
+from ._quantity_json import from_plain, is_quantity, to_plain
 
 __all__ = ["RunPlan", "SimulationConfig", "SimulationState", "Snapshot",
            "SimulationDescription"]
@@ -179,7 +178,7 @@ class SimulationConfig(NamedTuple):
                 "integrator_options": dict(self.integrator_options),
                 "dt": to_plain(self.dt), "forces": list(self.forces),
                 "monitors": list(self.monitors), "monitor_every": self.monitor_every,
-                "stop_conditions": {k: (to_plain(v) if isinstance(v, u.Quantity)
+                "stop_conditions": {k: (to_plain(v) if is_quantity(v)
                                         else _function_name(v) if callable(v) else v)
                                     for k, v in self.stop_conditions.items()},
                 "variations": self.variations, "seed": self.seed}

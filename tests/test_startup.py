@@ -106,6 +106,21 @@ def test_a_run_loads_neither_tables_nor_other_integrators():
     assert proc.stdout.split() == ["False", "[]"]
 
 
+def test_integrate_without_units_imports_no_astropy():
+    # orbits.integrate works on plain arrays: a user's system (here a Python
+    # function, run as Python) never imports astropy (0.4 s a process); its
+    # errors include one that is astropy's UnitsError, made when asked for
+    proc = _python("-c", "import sys, numpy as np, orbits; "
+                         "tr = orbits.integrate(lambda x, v, t: -x, np.ones(3), np.zeros(3), "
+                         "dt=0.1, steps=5); print('astropy' in sys.modules); "
+                         "from orbits.errors import BodyUnitsError; "
+                         "import astropy.units as u; "
+                         "print(issubclass(BodyUnitsError, u.UnitsError), "
+                         "BodyUnitsError is orbits.BodyUnitsError)")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False", "True", "True"]
+
+
 def test_the_registry_table_names_each_class_by_its_name():
     # the built-in table's names are the classes' own, in the registry's order
     from orbits import integrators
