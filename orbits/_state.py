@@ -19,7 +19,7 @@ from .bodies import BodySet
 from .records import SimulationDescription, SimulationState, Snapshot, _function_name
 
 __all__ = ["take_bodies", "workspace", "body_set", "record", "saved_workspace", "put_back",
-           "description", "snapshot"]
+           "description", "snapshot", "twin_parts", "rebuilt"]
 
 
 def take_bodies(sim, bodies):
@@ -112,6 +112,30 @@ def put_back(sim, state):
     sim._reference = np.zeros(max(_inv.MONITOR_WIDTH, len(ref)))
     sim._reference[:len(ref)] = ref
     sim._E_scale, sim._L_scale = (float(s) for s in state.scales)
+
+
+def twin_parts(sim):
+    """What makes a simulation equal to ``sim`` bit for bit, in this process
+    or another (:func:`rebuilt`; pickling and deep copies): its bodies now,
+    its configuration and the user's functions it names (which pickle by
+    reference), its exact state (:func:`record`, as a checkpoint keeps it),
+    the date of time 0, and the collisions it has resolved."""
+    from .forces import functions_of
+    return (body_set(sim), sim.config, record(sim), functions_of(sim._terms), sim._epoch,
+            list(sim._collisions), sim._bodies_changed)
+
+
+def rebuilt(cls, bodies, config, state, functions, epoch, collisions, changed):
+    """The simulation (a ``cls``) that :func:`twin_parts` describes: made
+    from its configuration as a restart from a file is, its state put back.
+    Its compiled code comes from numba's cache; a user's functions are made
+    into pointers again (their addresses do not travel)."""
+    sim = cls.from_config(bodies, config, _restoring=True, functions=functions)
+    sim.set_state(state)
+    sim._epoch = epoch
+    sim._collisions = collisions
+    sim._bodies_changed = changed
+    return sim
 
 
 def description(sim):

@@ -19,6 +19,7 @@ a run in memory (:mod:`orbits.recorder`), restart from a file
 (:mod:`orbits._described`).
 """
 
+import copy
 import math
 
 import numpy as np
@@ -175,7 +176,15 @@ class Simulation(Driven):
         or so.
 
     The stopping conditions are checked inside the compiled loop after every
-    step; a simulation without them compiles a loop without the check.
+    step; without them the check is one branch a step.
+
+    A simulation pickles and deep-copies (``copy.deepcopy(sim)``,
+    ``pickle``, Python's ``multiprocessing``): the copy is made again from
+    its configuration with its exact state, as a restart from a file is, and
+    runs on to the same bits as the original, its date and resolved
+    collisions with it.  A :class:`~orbits.forces.UserForce`'s functions go
+    by reference, so in another process they must come from an importable
+    module.
 
     The examples of the members start from ``sim``, a star and a planet on
     a circular orbit in days (:func:`orbits.scenes.kepler`) with
@@ -771,17 +780,16 @@ class Simulation(Driven):
         _failures.fail(self, status, rec, wall0)
 
     def __reduce__(self):
-        # a copy made field by field (pickle, copy.deepcopy) loses which arrays
-        # are views of which (the bodies' rows of the state, the workspace's
-        # bound arrays) and would run to other numbers without a word
-        raise TypeError(
-            "a Simulation does not pickle or deep-copy: make another from "
-            "Simulation.from_config(sim.bodies, sim.config) and put the state back with "
-            "set_state(sim.state), or write the run to a file (run(..., output=path)) and "
-            "restore it with Simulation.from_file")
+        # not field by field, which would lose which arrays are views of which
+        # (the bodies' rows of the state, the workspace's bound arrays) and
+        # run to other numbers: made again from its configuration, with its
+        # exact state, as a restart from a file is (_state.twin_parts)
+        return (_state.rebuilt, (type(self),) + _state.twin_parts(self))
 
     def __deepcopy__(self, memo):
-        return self.__reduce__()
+        parts = list(_state.twin_parts(self))
+        parts[5] = copy.deepcopy(parts[5], memo)     # the collisions resolved
+        return _state.rebuilt(type(self), *parts)
 
     def __repr__(self):
         """One line: bodies, time, integrator and its options, step, forces, stopping

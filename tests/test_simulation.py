@@ -203,3 +203,74 @@ def test_wall_limit_must_be_positive():
     sim = orbits.Simulation(orbits.scenes.kepler(), "leapfrog", dt=1 * u.day)
     with pytest.raises(ValueError, match="wall_limit"):
         sim.run(until=10 * u.day, outputs=2, wall_limit=0)
+
+
+def _dated_outer():
+    from astropy.time import Time
+    b = orbits.scenes.outer_solar_system()
+    b.epoch = Time(2451545.0, format="jd", scale="tdb")
+    return b
+
+
+def _crossing():
+    # two planets meeting head on after about 2.9 d (tests/test_collision_resolution.py)
+    b = orbits.BodySet()
+    b.add("Star", mass=1 * u.Msun, radius=0.005 * u.au)
+    vc = float(np.sqrt(orbits.UnitSystem().G))
+    b.add("P1", mass=2e-3 * u.Msun, position=[1, 0, 0] * u.au,
+          velocity=[0, vc, 0] * u.au / u.day, radius=0.01 * u.au)
+    c, s = np.cos(0.1), np.sin(0.1)
+    b.add("P2", mass=1e-3 * u.Msun, position=[c, s, 0] * u.au,
+          velocity=[vc * s, -vc * c, 0] * u.au / u.day, radius=0.01 * u.au)
+    b.move_to_com()
+    return b
+
+
+#: simulations whose state is more than positions and velocities: wh's owed
+#: drift, IAS15's step predictor and a term's work, the tangent vectors and
+#: MEGNO's sums, a merger that changed the bodies, and a date
+PICKLED = {
+    "wh": (lambda: orbits.Simulation(_dated_outer(), "wh", dt=100 * u.day),
+           3000 * u.day, 6000 * u.day),
+    "ias15 GR migration": (
+        lambda: orbits.Simulation(orbits.scenes.outer_solar_system(), "ias15",
+                                  forces=[orbits.forces.GR("Sun"),
+                                          orbits.forces.Migration("Saturn", tau_a=1e5 * u.yr)]),
+        3000 * u.day, 6000 * u.day),
+    "leapfrog megno": (
+        lambda: orbits.Simulation(orbits.scenes.outer_solar_system(), "leapfrog",
+                                  dt=30 * u.day, monitors=["energy", "megno"], seed=2),
+        3000 * u.day, 6000 * u.day),
+    "ias15 merge": (lambda: orbits.Simulation(_crossing(), "ias15", collisions="merge"),
+                    5 * u.day, 10 * u.day),
+}
+
+
+@pytest.mark.parametrize("case", PICKLED)
+def test_a_simulation_pickles_and_deep_copies_to_the_same_numbers(case):
+    # a pickled or deep-copied simulation is made again from its configuration
+    # with its exact state, as a restart from a file is: it runs on to the
+    # bits of the original, and of a simulation that was never copied
+    import copy
+    import pickle
+    make, first, second = PICKLED[case]
+    sims = [make(), make()]
+    for s in sims:
+        s.run(until=first, outputs=2, progress=False)
+    sims += [pickle.loads(pickle.dumps(sims[1])), copy.deepcopy(sims[1])]
+    results = [s.run(until=second, outputs=5, progress=False) for s in sims]
+    ref = results[0]
+    for s, r in zip(sims[1:], results[1:]):
+        assert s.bodies.names == sims[0].bodies.names
+        assert s.steps == sims[0].steps and s.time == sims[0].time
+        assert (s.epoch is None) == (sims[0].epoch is None)
+        if s.epoch is not None:
+            assert (s.epoch + s.time).jd == (sims[0].epoch + sims[0].time).jd
+        assert s.work == sims[0].work
+        assert len(r.collisions if r.collisions is not None else []) == \
+            len(ref.collisions if ref.collisions is not None else [])
+        for name in ("positions", "velocities", "energy"):
+            assert np.array_equal(getattr(r, name).value, getattr(ref, name).value,
+                                  equal_nan=True), name
+        if case == "leapfrog megno":
+            assert np.array_equal(r.megno, ref.megno)
