@@ -212,23 +212,27 @@ def _dated_outer():
     return b
 
 
-def _crossing():
-    # two planets meeting head on after about 2.9 d (tests/test_collision_resolution.py)
+def _crossing(r2=1.0):
+    # two planets on circles of 1 and r2 au, one prograde, one retrograde,
+    # 0.1 rad apart: they meet head on after about 2.9 d
+    # (tests/test_collision_resolution.py), or pass r2 - 1 au apart
     b = orbits.BodySet()
     b.add("Star", mass=1 * u.Msun, radius=0.005 * u.au)
     vc = float(np.sqrt(orbits.UnitSystem().G))
     b.add("P1", mass=2e-3 * u.Msun, position=[1, 0, 0] * u.au,
           velocity=[0, vc, 0] * u.au / u.day, radius=0.01 * u.au)
     c, s = np.cos(0.1), np.sin(0.1)
-    b.add("P2", mass=1e-3 * u.Msun, position=[c, s, 0] * u.au,
-          velocity=[vc * s, -vc * c, 0] * u.au / u.day, radius=0.01 * u.au)
+    v2 = vc / np.sqrt(r2)
+    b.add("P2", mass=1e-3 * u.Msun, position=[r2 * c, r2 * s, 0] * u.au,
+          velocity=[v2 * s, -v2 * c, 0] * u.au / u.day, radius=0.01 * u.au)
     b.move_to_com()
     return b
 
 
 #: simulations whose state is more than positions and velocities: wh's owed
 #: drift, IAS15's step predictor and a term's work, the tangent vectors and
-#: MEGNO's sums, a merger that changed the bodies, and a date
+#: MEGNO's sums, a merger that changed the bodies, a date, and trace's
+#: flags through a close encounter (0.03 au, inside the Hill radius, 0.087 au)
 PICKLED = {
     "wh": (lambda: orbits.Simulation(_dated_outer(), "wh", dt=100 * u.day),
            3000 * u.day, 6000 * u.day),
@@ -243,6 +247,8 @@ PICKLED = {
         3000 * u.day, 6000 * u.day),
     "ias15 merge": (lambda: orbits.Simulation(_crossing(), "ias15", collisions="merge"),
                     5 * u.day, 10 * u.day),
+    "trace encounter": (lambda: orbits.Simulation(_crossing(1.03), "trace", dt=0.05 * u.day),
+                        2 * u.day, 4 * u.day),
 }
 
 
