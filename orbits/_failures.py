@@ -1,6 +1,6 @@
 """A run's failures: a compiled loop's status other than OK (a non-finite state,
 a step-size underflow, a stopping condition met, a Newton iteration that did
-not converge, a user force of the wrong shape) turned into the named exception
+not converge, a user force of the wrong shape or that raised) turned into the named exception
 of :mod:`orbits.errors`, which carries the result up to the last good state.
 """
 
@@ -8,6 +8,7 @@ import time as _time
 
 from ._kernels.status import Status
 from ._kernels.terms import TermTable, user_flag
+from ._user_functions import RAISED
 from .errors import (CloseEncounter, Collision, ConvergenceFailure, Escape, ForceTermError,
                      NonFiniteState, StepSizeUnderflow)
 
@@ -31,10 +32,14 @@ def fail(sim, status, rec, wall0):
     result = sim._with_log(rec.result(sim, _time.perf_counter() - wall0 if wall0 else 0.0,
                                        status=reason))
     t = sim.time
-    if _user_function_failed(sim._fargs):
+    failed = _user_function_failed(sim._fargs)
+    if failed:
+        what = ("raised an exception (a compiled function's exception does not "
+                "leave the loop: call it from Python on that state to see it)"
+                if failed == RAISED else
+                "returned an array of another shape than during the check before the run")
         raise ForceTermError(
-            f"a user force returned an array of another shape than during the check "
-            f"before the run, in step {sim.steps + 1} (from t = {t:.10g}); the "
+            f"a user force {what}, in step {sim.steps + 1} (from t = {t:.10g}); the "
             f"simulation was left at the last good state, step {sim.steps}",
             term="UserForce", field="func")
     if status == Status.NON_FINITE:
@@ -97,10 +102,11 @@ def fail(sim, status, rec, wall0):
 
 
 def _user_function_failed(fargs):
-    """Whether a user term of a table in ``fargs`` (nested tuples) returned the
-    wrong shape (see :mod:`orbits._user_functions`)."""
+    """The flag of a user term of a table in ``fargs`` (nested tuples) that
+    returned the wrong shape or raised (see :mod:`orbits._user_functions`);
+    0 where none did."""
     if isinstance(fargs, TermTable):
-        return bool(user_flag(fargs.user))
+        return user_flag(fargs.user)
     if isinstance(fargs, tuple):
-        return any(_user_function_failed(f) for f in fargs)
-    return False
+        return max((_user_function_failed(f) for f in fargs), default=0)
+    return 0

@@ -10,9 +10,11 @@ that signature (numba's first-class function types), so one cached loop
 serves every user function, and a new process loads both from the cache.
 
 A wrapper cannot raise into the loop (an exception in a C callable is printed
-and dropped), so a function that returns the wrong shape fills the
-accelerations with NaN and sets ``flag[0] = 1``: the loop stops as for a
-non-finite state and the caller names the cause (:func:`check_flag`).
+and dropped), so a function that returns the wrong shape or raises fills the
+accelerations with NaN and sets ``flag[0]`` (:data:`FORCE_SIZE`,
+:data:`RAISED`, ...): the loop stops as for a non-finite state at the last
+good state, and the caller names the cause.  A potential that raises gives a
+NaN energy.
 """
 
 import contextlib
@@ -32,12 +34,16 @@ adder, head, tail, user, user_accel, user_jac, user_potential = slots(
     "adder", "head", "tail", "user", "user_accel", "user_jac", "user_potential")
 
 __all__ = ["code_key", "cacheable", "term_pointers", "try_term", "pointers_run", "force_pointer", "force_args",
-           "jacobian_pointer", "FORCE_SIZE", "JACOBIAN_SIZE"]
+           "jacobian_pointer", "FORCE_SIZE", "JACOBIAN_SIZE", "RAISED", "JACOBIAN_RAISED"]
 
 #: ``flag[0]`` after a user function returned the wrong number of values
 FORCE_SIZE = 1
 #: ``flag[0]`` after a user's Jacobian returned matrices of the wrong shape
 JACOBIAN_SIZE = 2
+#: ``flag[0]`` after a user's force raised an exception
+RAISED = 3
+#: ``flag[0]`` after a user's Jacobian raised an exception
+JACOBIAN_RAISED = 4
 
 _SIMPLE = (bool, int, float, complex, str, bytes, type(None))
 
@@ -141,9 +147,15 @@ def _term_add(x, v, t, pos, xu, vu, mu, flag, acc):
         for d in range(3):
             xu[k, d] = x[pos[k], d]
             vu[k, d] = v[pos[k], d]
-    a = user(xu, vu, t, mu)
-    if a.shape[0] != n or a.shape[1] != 3:
-        flag[0] = FORCE_SIZE
+    failed = 0
+    try:
+        a = user(xu, vu, t, mu)
+        if a.shape[0] != n or a.shape[1] != 3:
+            failed = FORCE_SIZE
+    except Exception:  # noqa: BLE001 - any exception of the user's: named by the caller
+        failed = RAISED
+    if failed:
+        flag[0] = failed
         for k in range(n):
             for d in range(3):
                 acc[pos[k], d] = math.nan
@@ -170,7 +182,10 @@ def _potential_one(x, pos, xu, mu):
     for k in range(pos.shape[0]):
         for d in range(3):
             xu[k, d] = x[pos[k], d]
-    return user_potential(xu, mu)
+    try:
+        return user_potential(xu, mu)
+    except Exception:  # noqa: BLE001 - a monitor of NaN, which the user sees
+        return math.nan
 
 
 def _potential_chain(x, pos, xu, mu):
@@ -304,10 +319,16 @@ def _force_pointer(x, v, t, size, shape, flag, acc):
     # arrays in order; the padding stays zero
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
-    a = np.asarray(user_accel(xu, vu, t)).ravel()
     flat = acc.ravel()
-    if a.size != size:
-        flag[0] = FORCE_SIZE
+    failed = 0
+    try:
+        a = np.asarray(user_accel(xu, vu, t)).ravel()
+        if a.size != size:
+            failed = FORCE_SIZE
+    except Exception:  # noqa: BLE001 - any exception of the user's: named by the caller
+        failed = RAISED
+    if failed:
+        flag[0] = failed
         for i in range(size):
             flat[i] = math.nan
         return
@@ -340,12 +361,18 @@ def _jacobian_pointer(x, v, t, size, shape, flag, jx, jv):
     # leading block of jx, jv (orbits._kernels.jacobians.user_jacobian)
     xu = x.ravel()[:size].reshape(shape)
     vu = v.ravel()[:size].reshape(shape)
-    dadx, dadv = user_jac(xu, vu, t)
-    jxu = np.asarray(dadx)
-    jvu = np.asarray(dadv)
-    if jxu.shape[0] != size or jxu.shape[1] != size or jvu.shape[0] != size \
-            or jvu.shape[1] != size:
-        flag[0] = JACOBIAN_SIZE
+    failed = 0
+    try:
+        dadx, dadv = user_jac(xu, vu, t)
+        jxu = np.asarray(dadx)
+        jvu = np.asarray(dadv)
+        if jxu.shape[0] != size or jxu.shape[1] != size or jvu.shape[0] != size \
+                or jvu.shape[1] != size:
+            failed = JACOBIAN_SIZE
+    except Exception:  # noqa: BLE001 - any exception of the user's: named by the caller
+        failed = JACOBIAN_RAISED
+    if failed:
+        flag[0] = failed
         for p in range(size):
             for q in range(size):
                 jx[p, q] = math.nan

@@ -310,13 +310,21 @@ class _UserRun(Driven):
         kind, label, text = _FAILURES.get(Status(status), _FAILURES[Status.NON_FINITE])
         rec.output(self, final=True)
         t = self._now()
-        if len(self._fargs) > 3 and self._fargs[3][0] == _user_functions.FORCE_SIZE:
+        flag = self._fargs[3][0] if len(self._fargs) > 3 else 0
+        if flag == _user_functions.FORCE_SIZE:
             _resize_error(ValueError(_stepping.USER_FORCE_SIZE), self.shape, t)
-        if len(self._fargs) > 4 and self._fargs[3][0] == _user_functions.JACOBIAN_SIZE:
+        if flag == _user_functions.JACOBIAN_SIZE:
             raise ForceTermError(f"jacobian(x, v, t) returned matrices of another shape "
                                  f"during the run (after t = {t:.10g}); expected two "
                                  f"({self.size}, {self.size}) arrays every call",
                                  term="jacobian", field="return value")
+        if flag in (_user_functions.RAISED, _user_functions.JACOBIAN_RAISED):
+            name = "accel" if flag == _user_functions.RAISED else "jacobian"
+            raise ForceTermError(f"{name}(x, v, t) raised an exception during the run, "
+                                 f"in the step after t = {t:.10g} (step {self.steps}, "
+                                 f"the last good one); a compiled function's exception "
+                                 f"does not leave the loop: call it from Python on that "
+                                 f"state to see it", term=name, field="exception")
         raise kind(text.format(name=self.integrator.name, next=self.steps + 1, t=t,
                                steps=self.steps)
                    + f"; the trajectory up to the last good step {self.steps} is kept on "

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import orbits
-from orbits.errors import NonFiniteState, UnknownIntegratorError
+from orbits.errors import ForceTermError, NonFiniteState, UnknownIntegratorError
 
 
 @numba.njit
@@ -147,3 +147,38 @@ def test_compiled_functions_that_fail_on_the_first_state_are_named_errors():
     with pytest.raises(ValueError, match=r"da/dx of shape \(4, 4\); expected \(3, 3\)"):
         orbits.integrate(spring, x0, v0, dt=0.01, steps=3, method="implicit-midpoint",
                          jacobian=_square_jacobian)
+
+
+@numba.njit
+def _spring_until(x, v, t):
+    if t > 0.1:
+        raise ValueError("no acceleration after t = 0.1")
+    return -x
+
+
+@numba.njit
+def _spring_jacobian_until(x, v, t):
+    if t > 0.1:
+        raise ValueError("no Jacobian after t = 0.1")
+    return -np.eye(x.size), np.zeros((x.size, x.size))
+
+
+@numba.njit
+def _spring_jacobian(x, v, t):
+    return -np.eye(x.size), np.zeros((x.size, x.size))
+
+
+def test_compiled_functions_that_raise_during_the_run_stop_it_with_a_named_error():
+    # an exception inside the compiled loop cannot leave it; it once went on
+    # with the accelerations of the call before
+    x0, v0 = np.ones(3), np.zeros(3)
+    with pytest.raises(ForceTermError, match=r"accel\(x, v, t\) raised an exception.*"
+                                             r"step 10, the last good one") as exc:
+        orbits.integrate(_spring_until, x0, v0, dt=0.01, steps=30)
+    assert (exc.value.term, exc.value.field) == ("accel", "exception")
+    with pytest.raises(ForceTermError, match=r"jacobian\(x, v, t\) raised an exception"):
+        orbits.integrate(spring, x0, v0, dt=0.01, steps=30, method="implicit-midpoint",
+                         jacobian=_spring_jacobian_until)
+    # the same Jacobian without the exception runs through
+    orbits.integrate(spring, x0, v0, dt=0.01, steps=30, method="implicit-midpoint",
+                     jacobian=_spring_jacobian)
