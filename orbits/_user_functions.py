@@ -17,7 +17,6 @@ good state, and the caller names the cause.  A potential that raises gives a
 NaN energy.
 """
 
-import contextlib
 import hashlib
 import math
 import sys
@@ -33,8 +32,9 @@ from ._kernels import terms as _kterms
 adder, head, tail, user, user_accel, user_jac, user_potential = slots(
     "adder", "head", "tail", "user", "user_accel", "user_jac", "user_potential")
 
-__all__ = ["code_key", "cacheable", "term_pointers", "try_term", "pointers_run", "force_pointer", "force_args",
-           "jacobian_pointer", "FORCE_SIZE", "JACOBIAN_SIZE", "RAISED", "JACOBIAN_RAISED"]
+__all__ = ["code_key", "cacheable", "term_pointers", "try_term", "pointers_run",
+           "force_pointer", "force_args", "jacobian_pointer", "FORCE_SIZE", "JACOBIAN_SIZE",
+           "RAISED", "JACOBIAN_RAISED"]
 
 #: ``flag[0]`` after a user function returned the wrong number of values
 FORCE_SIZE = 1
@@ -239,10 +239,9 @@ def try_term(term, x, v, mu):
     """Calls the pointers of the :class:`~orbits.forces.UserForce` ``term``
     alone (:func:`term_pointers`) on the state ``x``, ``v`` at t = 0 with
     masses ``mu`` (the body set's order): ``(acc, energy)``, or None where
-    the call went wrong in any way (the pointers did not compile, the
-    function returned the wrong shape or raised, which a C callable reports
-    as an unraisable error) and the caller must find out how by calling
-    the function itself.
+    the pointers did not compile or the function returned the wrong shape
+    or raised (the flag), and the caller must find out how by calling the
+    function itself.
 
     The pointers are the run's own, loaded from the cache in a new process:
     a check through them compiles nothing of the user's (a call from Python
@@ -257,24 +256,10 @@ def try_term(term, x, v, mu):
     x = np.ascontiguousarray(x, dtype=np.float64).copy()
     v = np.ascontiguousarray(v, dtype=np.float64).copy()
     acc = np.zeros((n, 3))
-    with _unraised() as raised:
-        _kterms.user_accel(u, x, v, 0.0, acc)
-        e = _kterms.user_energy(u, x)
-    if raised or _kterms.user_flag(u) != 0:
+    _kterms.user_accel(u, x, v, 0.0, acc)
+    if _kterms.user_flag(u) != 0:
         return None
-    return acc, e
-
-
-@contextlib.contextmanager
-def _unraised():
-    # the errors a C callable reports (it cannot raise): a list, filled on exit
-    raised = []
-    hook = sys.unraisablehook
-    sys.unraisablehook = raised.append
-    try:
-        yield raised
-    finally:
-        sys.unraisablehook = hook
+    return acc, _kterms.user_energy(u, x)
 
 
 def pointers_run(accel, jac, x, v, t, shape):
@@ -282,7 +267,7 @@ def pointers_run(accel, jac, x, v, t, shape):
     None) for :func:`orbits.integrate` run cleanly once on the state ``x``,
     ``v`` (the loops' (rows, 3) arrays) at ``t``, for a state of ``shape``:
     they compile (or load), return as many values as the state has, and
-    raise nothing.  Where not, the caller calls the functions themselves to
+    raise nothing (the flag stays 0).  Where not, the caller calls the functions themselves to
     name the cause; where so, a new process has compiled nothing of the
     user's to check them (as :func:`try_term`)."""
     from ._kernels import jacobians as _jacobians
@@ -294,12 +279,11 @@ def pointers_run(accel, jac, x, v, t, shape):
     except Exception:  # a typing error: the caller's own call names it
         return False
     m = x.size
-    with _unraised() as raised:
-        _stepping.user_force_call()(x.copy(), v.copy(), float(t), fargs, np.zeros_like(x))
-        if jac is not None and fargs[3][0] == 0:
-            _jacobians.user_jacobian_call()(x.copy(), v.copy(), float(t), fargs,
-                                            np.zeros((m, m)), np.zeros((m, m)))
-    return not raised and fargs[3][0] == 0
+    _stepping.user_force_call()(x.copy(), v.copy(), float(t), fargs, np.zeros_like(x))
+    if jac is not None and fargs[3][0] == 0:
+        _jacobians.user_jacobian_call()(x.copy(), v.copy(), float(t), fargs,
+                                        np.zeros((m, m)), np.zeros((m, m)))
+    return fargs[3][0] == 0
 
 
 # -- a user's force replacing gravity (orbits.integrate) ----------------------------------

@@ -192,21 +192,16 @@ class UserForce(ForceTerm):
 
     def _check(self, ctx, m_user):
         # through the run's own pointers, which a new process loads from the
-        # cache; only where they fail does the function's own call (compiled
-        # for Python's arguments) find out how, to name it
+        # cache; only where they fail, or give what is not finite, do the
+        # functions' own calls (compiled for Python's arguments) name the cause
         from .. import _user_functions
         x = ctx.x_user
         v = ctx.v_user
         tried = _user_functions.try_term(self, x, v, m_user)
         if tried is not None:
             a, e = tried
-            if not np.all(np.isfinite(a)):
-                raise ForceTermError("func returned non-finite accelerations on the initial "
-                                     "state", term=repr(self), field="func")
-            if self.potential is not None and not math.isfinite(e):
-                raise ForceTermError(f"potential must return a finite float, got {e!r}",
-                                     term=repr(self), field="potential")
-            return
+            if np.all(np.isfinite(a)) and (self.potential is None or math.isfinite(e)):
+                return
         try:
             a = np.asarray(self.func(x.copy(), v.copy(), 0.0, m_user))
         except Exception as exc:  # a numba typing error names the cause
