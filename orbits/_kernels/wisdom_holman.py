@@ -459,11 +459,16 @@ def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
                   corr, h, targs):
     # the noted output, by the usual synchronisation of the state xa, va that
     # still owes the drift owed: the loop's state when it returns, or the copy
-    # that output_drift already drifted (owed 0; xa, va are then xs, vs)
+    # that output_drift already drifted (owed 0; xa, va are then xs, vs),
+    # which without a corrector is the state at the time: the
+    # synchronisation's conversion then, without its copy and its call
     S = targs[0]
     S[PENDING, 0] = 0.0
-    sync_kernel(xa, va, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
-                targs)
+    if owed == 0.0 and corr.shape[0] == 0:
+        from_internal(xa, va, gm, eta, x, v, targs)
+    else:
+        sync_kernel(xa, va, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
+                    targs)
     record(x, v, S[PENDING, 2], mon, int(S[PENDING, 1]), mon_t, mon_out)
 
 
@@ -902,7 +907,7 @@ def _kernels(coordinates, terms=None, lanes=False):
     sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
                       cache=cache, nrt=nrt, drift=drift, from_internal=from_internal,
                       corrector_kernel=corrector)
-    return to_internal, perturbation, corrector, sync
+    return to_internal, perturbation, corrector, sync, from_internal
 
 
 def synchronizer(coordinates, terms=None, lanes=False):
@@ -931,7 +936,8 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     (:func:`escape_kernels`); the lanes' loop checks none."""
     if lanes and terms is not None:
         raise ValueError("wh_loop: the lanes' loop takes no added terms")
-    to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, lanes)
+    to_internal, perturbation, corrector, sync, from_internal = _kernels(coordinates, terms,
+                                                                         lanes)
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
     nrt = not cache
@@ -968,7 +974,8 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
             output_drift=called(specialize(_resident_output_drift, lanes, cache=cache,
                                            inline=True, nrt=nrt), nrt),
             make_output=specialize(_lanes_output, key, cache=cache, nrt=nrt,
-                                   sync_kernel=sync, record=record))
+                                   sync_kernel=sync, from_internal=from_internal,
+                                   record=record))
     else:
         recorder = specialize(_wh_record, key, cache=cache, nrt=nrt, sync_kernel=sync,
                               record=record)
