@@ -1,6 +1,8 @@
 """Compiling the stepping loops ahead of time: ``orbits compile`` and
 :func:`compile_ahead`, for clusters, containers and CI (see :mod:`._compiling`)."""
 
+import os
+
 import astropy.units as u
 from tqdm.auto import tqdm
 
@@ -19,26 +21,67 @@ _AHEAD_STEPS = 10
 
 
 def _variants(name):
-    """The integrators (configured) whose loops ``name`` compiles, each with
-    whether it is the loop with the planets in vector lanes: one per set of
-    coordinates for the methods that take them, and for those with a
-    ``lanes`` option (``wh``, the SABA methods, ``trace``) the scalar loop
-    and the lanes' one of each."""
-    integ = integrators.get(name)
-    options = type(integ).options
+    """The loops ``name`` compiles, as ``(name, options, lanes)``: the options
+    of :func:`orbits.integrators.get` that configure each, and whether it is
+    the loop with the planets in vector lanes: one per set of coordinates for
+    the methods that take them, and for those with a ``lanes`` option
+    (``wh``, the SABA methods, ``trace``) the scalar loop and the lanes' one
+    of each."""
+    options = type(integrators.get(name)).options
     coords = options.get("coordinates")
+    modes = ("off", "on") if "lanes" in options else (None,)
+
+    def loop(extra, mode):
+        opts = dict(extra) if mode is None else dict(extra, lanes=mode)
+        return (name, opts, mode == "on")
+
     if coords is None:
-        if "lanes" in options:
-            return [(integrators.get(name, lanes=mode), mode == "on") for mode in ("off", "on")]
-        return [(integ, False)]
+        return [loop({}, mode) for mode in modes]
     order = [coords] + [c for c in COORDINATES if c != coords]
-    if "lanes" not in options:
-        return [(integrators.get(name, coordinates=c), False) for c in order]
-    return [(integrators.get(name, coordinates=c, lanes=mode), mode == "on")
-            for c in order for mode in ("off", "on")]
+    return [loop({"coordinates": c}, mode) for c in order for mode in modes]
 
 
-def compile_ahead(names=None, progress=None, report=None):
+def _compile_loop(name, options, lanes):
+    """Compile one loop in this process (a few steps of the outer solar
+    system): ``(its label, the seconds spent compiling)``."""
+    integ = integrators.get(name, **options)
+    label = loop_label(integ, lanes)
+    dt = None if integ.adaptive else _AHEAD_DT_DAYS * u.day
+    until = _AHEAD_STEPS * _AHEAD_DT_DAYS * u.day
+    with CompileClock() as clock:
+        sim = Simulation(scenes.outer_solar_system(), integrator=integ, dt=dt)
+        sim.run(until=until, outputs=3, progress=False)
+    return label, clock.seconds
+
+
+def _check_jobs(jobs):
+    """``jobs`` as a number of processes (0: one a core); a named error for
+    anything else."""
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 0:
+        raise ValueError(f"jobs must be a whole number >= 0 (0: one process a core), "
+                         f"got {jobs!r}")
+    return (os.cpu_count() or 1) if jobs == 0 else jobs
+
+
+def _pool(jobs):
+    """A pool of ``jobs`` new processes (each imports the package afresh: no
+    numba state is forked), or a named error where they would import an
+    unguarded main script again."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from .ensemble.guard import _unguarded_main_call, _where
+    where = _unguarded_main_call("spawn")
+    if where is not None:
+        raise RuntimeError(
+            f"compile_ahead(jobs={jobs}) was called from {_where(*where)}, outside "
+            f'`if __name__ == "__main__":`: each of its processes imports the main script '
+            f"again and would run it; put the call under the guard, or use jobs=1")
+    return ProcessPoolExecutor(max_workers=jobs,
+                               mp_context=multiprocessing.get_context("spawn"))
+
+
+def compile_ahead(names=None, progress=None, report=None, jobs=1):
     """Compile the stepping loops of ``names`` now, so that later runs load them.
 
     ``orbits compile`` on the command line.
@@ -63,18 +106,32 @@ def compile_ahead(names=None, progress=None, report=None):
         terminal by default.
     report : callable, optional
         Called with ``(label, seconds)`` after each loop (``orbits compile``
-        prints a line with it).
+        prints a line with it), in the order the loops are done.
+    jobs : int, optional
+        Processes that compile at once (default 1, this one; 0: one a core).
+        With more, the first loop is compiled here, so that the kernels every
+        loop shares are in the cache, and the others in that many new
+        processes, which share numba's cache: the wall time falls with the
+        cores, for a little more CPU time (a kernel that two loops share may
+        be compiled in both).  From a script, call it under ``if __name__ ==
+        "__main__":`` (each new process imports the main script again).
 
     Returns
     -------
     list of (str, float)
         Each loop's name (:func:`loop_label`) and the seconds spent
-        compiling it (0 for a loop that was loaded from the cache).
+        compiling it (0 for a loop that was loaded from the cache), in the
+        order of ``names``.
 
     Raises
     ------
     UnknownIntegratorError
         A name that is not registered (checked before anything compiles).
+    ValueError
+        ``jobs`` not a whole number >= 0.
+    RuntimeError
+        ``jobs`` > 1 from the top level of a script without the
+        ``__main__`` guard.
 
     Examples
     --------
@@ -89,30 +146,39 @@ def compile_ahead(names=None, progress=None, report=None):
     vector lanes: ``['trace', 'trace lanes']``.
     """
     names = COMMON if names is None else tuple(names)
-    loops = [(integ, lanes) for name in names for integ, lanes in _variants(name)
-             if getattr(integ, "compiled", True)]
+    jobs = _check_jobs(jobs)
+    loops = [spec for name in names for spec in _variants(name)
+             if getattr(integrators.get(spec[0], **spec[1]), "compiled", True)]
     if progress is None:
         progress = stderr_is_terminal()
     bar = None
     if progress:
         bar = tqdm(total=len(loops), unit="loop", desc="compiling", leave=False)
-    bodies = scenes.outer_solar_system()
-    done = []
+    done = [None] * len(loops)
+
+    def note(i, result):
+        done[i] = result
+        if report is not None:
+            report(*result)
+        if bar is not None:
+            bar.set_postfix_str(result[0])
+            bar.update(1)
+
     try:
-        for integ, lanes in loops:
-            label = loop_label(integ, lanes)
-            if bar is not None:
-                bar.set_postfix_str(label)
-            dt = None if integ.adaptive else _AHEAD_DT_DAYS * u.day
-            until = _AHEAD_STEPS * _AHEAD_DT_DAYS * u.day
-            with CompileClock() as clock:
-                sim = Simulation(bodies.copy(), integrator=integ, dt=dt)
-                sim.run(until=until, outputs=3, progress=False)
-            done.append((label, clock.seconds))
-            if report is not None:
-                report(label, clock.seconds)
-            if bar is not None:
-                bar.update(1)
+        if jobs == 1 or len(loops) <= 1:
+            for i, spec in enumerate(loops):
+                note(i, _compile_loop(*spec))
+        else:
+            from concurrent.futures import as_completed
+            with _pool(min(jobs, len(loops) - 1)) as pool:
+                # the first loop here, so that the kernels the loops share
+                # (the monitors, the Kepler drift) are in the cache before
+                # the processes start
+                note(0, _compile_loop(*loops[0]))
+                futures = {pool.submit(_compile_loop, *spec): i
+                           for i, spec in enumerate(loops) if i > 0}
+                for future in as_completed(futures):
+                    note(futures[future], future.result())
     finally:
         if bar is not None:
             bar.close()

@@ -346,6 +346,8 @@ def _parser(with_integrator_options=True):
                            + ", ".join(COMPILE_DEFAULT))
     comp.add_argument("--all", action="store_true",
                       help="every integrator with a compiled loop")
+    comp.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
+                      help="compile in N processes at once (default 1; 0: one a core)")
     comp.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
 
@@ -360,6 +362,7 @@ examples:
   orbits compile                      # leapfrog, ias15 and wh
   orbits compile dop853 trace         # these
   orbits compile --all                # every integrator (several minutes)
+  orbits compile --all --jobs 0       # the same, in a process a core
   NUMBA_CACHE_DIR=/shared/numba orbits compile --all   # a cache the nodes share
 """
 
@@ -473,6 +476,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if args.command == "compile" and args.all and args.integrators:
         parser.error("compile: give integrator names or --all, not both")
+    if args.command == "compile" and args.jobs < 0:
+        parser.error(f"compile: --jobs must be >= 0 (0: one process a core), got {args.jobs}")
     if args.command == "elements":
         _elements_body(parser, args)
     import astropy.units as u
@@ -572,7 +577,7 @@ def _compile(args, orbits):
 
     t0 = time.perf_counter()
     loops = orbits.compile_ahead(names, progress=False if args.no_progress else None,
-                                       report=report)
+                                 report=report, jobs=args.jobs)
     wall = time.perf_counter() - t0
     if skipped and not args.all:
         print(f"{', '.join(skipped)}: run in Python, nothing to compile")

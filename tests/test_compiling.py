@@ -59,13 +59,20 @@ def test_a_first_compile_is_announced_once_and_measured(tmp_path):
 
 
 def test_orbits_compile_fills_the_cache_that_the_next_process_loads(tmp_path):
+    # two loops (euler's is the Runge-Kutta loop, leapfrog's the splitting
+    # one), the second compiled in a process of its own (--jobs 2)
     cache = tmp_path / "cache"
-    proc = _python(["-m", "orbits.cli", "compile", "euler"], cache)
+    proc = _python(["-m", "orbits.cli", "compile", "euler", "leapfrog", "--jobs", "2"], cache)
     assert proc.returncode == cli.EXIT_COMPLETED, proc.stderr
     lines = proc.stdout.splitlines()
     assert lines[0].startswith("euler") and "s compiling" in lines[0]
-    assert lines[-1].startswith("1 loop ready") and str(cache) in lines[-1]
+    assert lines[1].startswith("leapfrog") and "s compiling" in lines[1]
+    assert lines[-1].startswith("2 loops ready") and str(cache) in lines[-1]
     assert _notices(proc.stderr) == []          # orbits compile says it in its own lines
+    # the second loop was compiled in the other process: here it loads
+    proc = _python(["-c", RUN_TWICE.replace('"euler"', '"leapfrog"')], cache)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout.splitlines()[0]) == [0, 0]
     # a new process, another scene and output spacing: loaded, so nothing said
     proc = _python(["-c", RUN_TWICE], cache)
     assert proc.returncode == 0, proc.stderr
@@ -73,6 +80,19 @@ def test_orbits_compile_fills_the_cache_that_the_next_process_loads(tmp_path):
     assert _notices(proc.stderr) == []
     assert "compiling" not in proc.stdout
 
+
+
+def test_compiling_in_processes_from_an_unguarded_script_is_a_named_error(tmp_path):
+    # each new process would import the script again and run its top level:
+    # refused before anything compiles, naming the line and the guard
+    script = tmp_path / "ahead.py"
+    script.write_text("import orbits\n"
+                      "orbits.compile_ahead(['euler', 'leapfrog'], progress=False, jobs=2)\n")
+    proc = _python([str(script)], tmp_path / "cache")
+    assert proc.returncode != 0
+    assert "RuntimeError" in proc.stderr and "line 2 of" in proc.stderr, proc.stderr
+    assert '__name__ == "__main__"' in proc.stderr
+    assert not (tmp_path / "cache").exists() or not any((tmp_path / "cache").rglob("*.nbi"))
 
 # -- the clock, in this process, on functions of its own ------------------------------------
 
@@ -167,6 +187,13 @@ def test_orbits_compile_checks_its_arguments(capsys):
     with pytest.raises(SystemExit) as info:
         main(["compile", "leapfrog", "--all"])
     assert info.value.code == cli.EXIT_USAGE
+    with pytest.raises(SystemExit) as info:
+        main(["compile", "leapfrog", "--jobs", "-1"])
+    assert info.value.code == cli.EXIT_USAGE
+    assert "--jobs must be >= 0" in capsys.readouterr().err
+    for jobs in (-1, 1.5, True, "2"):
+        with pytest.raises(ValueError, match="jobs must be a whole number"):
+            orbits.compile_ahead(["leapfrog"], progress=False, jobs=jobs)
     capsys.readouterr()
     assert main(["compile", "no-such-method"]) == cli.EXIT_INPUT
     assert "valid names" in capsys.readouterr().err
@@ -190,14 +217,21 @@ def test_wh_compiles_its_scalar_and_its_lanes_loops_ahead():
     # runs take the lanes' loop by the lanes option ("auto": by the run's
     # length, or once compiled), so both are compiled ahead, the scalar first
     from orbits._ahead import _variants
-    got = [(loop_label(integ, lanes), integ.config["lanes"]) for integ, lanes in _variants("wh")]
+
+    def loops(name):
+        out = []
+        for n, options, lanes in _variants(name):
+            integ = orbits.integrators.get(n, **options)
+            out.append((loop_label(integ, lanes), integ.config.get("lanes")))
+        return out
+
+    got = loops("wh")
     assert got == [("wh", "off"), ("wh lanes", "on"),
                    ("wh democratic-heliocentric", "off"),
                    ("wh democratic-heliocentric lanes", "on")]
     assert all(f"{label}" in _compiling.FIRST_COMPILE_SECONDS for label, _ in got)
-    assert [loop_label(i, lanes) for i, lanes in _variants("ias15")] == ["ias15"]
-    assert [(loop_label(i, lanes), i.config["lanes"]) for i, lanes in _variants("trace")] == [
-        ("trace", "off"), ("trace lanes", "on")]
+    assert loops("ias15") == [("ias15", None)]
+    assert loops("trace") == [("trace", "off"), ("trace lanes", "on")]
 
 
 def test_every_compiled_integrator_has_a_loop_label():
