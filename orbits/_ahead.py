@@ -147,8 +147,8 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1):
     """
     names = COMMON if names is None else tuple(names)
     jobs = _check_jobs(jobs)
-    loops = [spec for name in names for spec in _variants(name)
-             if getattr(integrators.get(spec[0], **spec[1]), "compiled", True)]
+    loops = [spec for name in names if getattr(integrators.get(name), "compiled", True)
+             for spec in _variants(name)]
     if progress is None:
         progress = stderr_is_terminal()
     bar = None
