@@ -2,12 +2,15 @@
 :func:`compile_ahead`, for clusters, containers and CI (see :mod:`._compiling`)."""
 
 import os
+from typing import NamedTuple
 
 import astropy.units as u
 from tqdm.auto import tqdm
 
 from . import integrators, scenes
-from ._compiling import COMMON, CompileClock, loop_label, stderr_is_terminal
+from .bodies import BodySet
+from ._compiling import ADDED, COMMON, CompileClock, loop_label, stderr_is_terminal
+from .errors import IntegratorOptionError
 from .integrators.wisdom_holman import COORDINATES
 from .simulation import Simulation
 
@@ -20,38 +23,123 @@ _AHEAD_DT_DAYS = 10.0
 _AHEAD_STEPS = 10
 
 
-def _variants(name):
-    """The loops ``name`` compiles, as ``(name, options, lanes)``: the options
-    of :func:`orbits.integrators.get` that configure each, and whether it is
-    the loop with the planets in vector lanes: one per set of coordinates for
-    the methods that take them, and for those with a ``lanes`` option
-    (``wh``, the SABA methods, ``trace``) the scalar loop and the lanes' one
-    of each."""
-    options = type(integrators.get(name)).options
+class Loop(NamedTuple):
+    """A run that compiles one of an integrator's loops: the integrator's
+    registry name and options, whether it steps with the planets in vector
+    lanes, and what the run adds to plain gravity (:data:`ADDS`)."""
+
+    name: str
+    options: dict
+    lanes: bool
+    adds: str = ""
+
+
+#: What a run may add to gravity, each served by a loop (or pointer) of its
+#: own that ``orbits compile`` compiles unless told ``plain``: ``"terms"``,
+#: any combination of built-in force terms (one loop for every table of
+#: terms, its work integrated where some are dissipative); ``"variations"``,
+#: the variational equations and the chaos monitors (one loop for every kind
+#: of variations); ``"checks"``, the stopping conditions, collisions and the
+#: encounter log (one compiled check for every integrator, and what a run
+#: with them calls).
+ADDS = tuple(ADDED)
+
+
+def _variants(name, plain=False):
+    """The loops ``name`` compiles, as :class:`Loop`: one per set of
+    coordinates for the methods that take them, and for those with a
+    ``lanes`` option (``wh``, the SABA methods, ``trace``) the scalar loop
+    and the lanes' one of each; then, unless ``plain``, for each scalar loop
+    the loops of runs with force terms and with variations where the
+    integrator takes them (:data:`ADDS`), and one run with every stopping
+    condition where it checks them."""
+    integ = integrators.get(name)
+    options = type(integ).options
     coords = options.get("coordinates")
     modes = ("off", "on") if "lanes" in options else (None,)
+    order = [None] if coords is None else [coords] + [c for c in COORDINATES if c != coords]
+    loops = []
+    for c in order:
+        extra = {} if c is None else {"coordinates": c}
+        loops += [Loop(name, dict(extra) if mode is None else dict(extra, lanes=mode),
+                       mode == "on") for mode in modes]
+    if plain:
+        return loops
+    scalar = [loop for loop in loops if not loop.lanes]
+    if _terms_for(integ) is not None:
+        loops += [loop._replace(adds="terms") for loop in scalar]
+    if integ.chaos_indicators:
+        loops += [loop._replace(adds="variations") for loop in scalar]
+    if integ.stop_conditions:
+        loops.append(scalar[0]._replace(adds="checks"))
+    return loops
 
-    def loop(extra, mode):
-        opts = dict(extra) if mode is None else dict(extra, lanes=mode)
-        return (name, opts, mode == "on")
 
-    if coords is None:
-        return [loop({}, mode) for mode in modes]
-    order = [coords] + [c for c in COORDINATES if c != coords]
-    return [loop({"coordinates": c}, mode) for c in order for mode in modes]
+def _terms_for(integ):
+    """Built-in terms that ``integ`` takes and that compile its loop for
+    terms: GR and a migration (velocities read, work integrated) where it
+    takes them, else GRPotential (the Wisdom-Holman family); None where it
+    takes no added terms."""
+    from . import forces
+    for terms in ([forces.GR("Sun"), forces.Migration("Neptune", tau_a=1e7 * u.yr)],
+                  [forces.GRPotential("Sun")]):
+        try:
+            integ.check_terms(terms)
+        except IntegratorOptionError:
+            continue
+        return terms
+    return None
 
 
-def _compile_loop(name, options, lanes):
+def _checks_for(integ):
+    """The keywords of :class:`~orbits.Simulation` for every stopping
+    condition ``integ`` checks, with the outer solar system's bodies given
+    sizes (collisions need them); none is met in the few steps of the run."""
+    every = dict(encounter_distance=0.01 * u.au, escape_distance=1000 * u.au,
+                 collisions="merge", encounter_log=0.1 * u.au)
+    taken = integ.stop_conditions
+    return every if taken is True else {k: every[k] for k in taken if k in every}
+
+
+def _compile_loop(name, options, lanes, adds=""):
     """Compile one loop in this process (a few steps of the outer solar
-    system): ``(its label, the seconds spent compiling)``."""
+    system, with what ``adds`` names, :data:`ADDS`): ``(its label, the
+    seconds spent compiling)``."""
     integ = integrators.get(name, **options)
-    label = loop_label(integ, lanes)
+    label = loop_label(integ, lanes, adds)
     dt = None if integ.adaptive else _AHEAD_DT_DAYS * u.day
     until = _AHEAD_STEPS * _AHEAD_DT_DAYS * u.day
+    bodies = scenes.outer_solar_system()
+    kw = {}
+    if adds == "terms":
+        kw["forces"] = _terms_for(integ)
+    elif adds == "variations":
+        kw["monitors"] = ("energy", "megno")
+    elif adds == "checks":
+        kw = _checks_for(integ)
+        if "collisions" in kw:
+            bodies = BodySet.from_arrays(bodies.masses, bodies.positions, bodies.velocities,
+                                         names=bodies.names, units=bodies.units,
+                                         radii=[1e-3] * len(bodies) * u.au)
     with CompileClock() as clock:
-        sim = Simulation(scenes.outer_solar_system(), integrator=integ, dt=dt)
+        sim = Simulation(bodies, integrator=integ, dt=dt, **kw)
         sim.run(until=until, outputs=3, progress=False)
     return label, clock.seconds
+
+
+def _pool_order(loops):
+    """The indices of ``loops`` after the first in the order a pool takes
+    them: the first run with each addition (which compiles what every
+    integrator's runs with it share: the terms' table, the stopping
+    conditions' check), then the loops of gravity alone, then the other
+    runs with additions, which by then load what they share."""
+    rest = range(1, len(loops))
+    firsts = {}
+    for i in rest:
+        firsts.setdefault(loops[i].adds, i)
+    head = [i for adds, i in firsts.items() if adds]
+    return (head + [i for i in rest if not loops[i].adds]
+            + [i for i in rest if loops[i].adds and i not in head])
 
 
 def _check_jobs(jobs):
@@ -81,7 +169,7 @@ def _pool(jobs):
                                mp_context=multiprocessing.get_context("spawn"))
 
 
-def compile_ahead(names=None, progress=None, report=None, jobs=1):
+def compile_ahead(names=None, progress=None, report=None, jobs=1, plain=False):
     """Compile the stepping loops of ``names`` now, so that later runs load them.
 
     ``orbits compile`` on the command line.
@@ -90,6 +178,12 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1):
     (:func:`orbits.scenes.outer_solar_system`) for a few steps, in both
     Wisdom-Holman coordinate systems where it takes them, which compiles its
     loop and the kernels it calls into numba's cache (:func:`orbits._compiling.cache_dir`).
+    Unless ``plain``, it runs again with what a run may add, each served by
+    a loop of its own: built-in force terms (one loop for any combination of
+    them), the variational equations and chaos monitors (one loop for every
+    kind), and the stopping conditions, collisions and encounter log (one
+    compiled check for every integrator).  Afterwards a run that adds any of
+    these compiles nothing (a user's own force compiles its function once).
     Integrators that run in Python (scipy's ``radau`` and ``lsoda``) have
     nothing to compile and are skipped.  The cache is per CPU and numba
     version: compile on the machine (or image) that runs, before many
@@ -115,6 +209,9 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1):
         cores, for a little more CPU time (a kernel that two loops share may
         be compiled in both).  From a script, call it under ``if __name__ ==
         "__main__":`` (each new process imports the main script again).
+    plain : bool, optional
+        Only the loops of runs of gravity alone, without terms, variations
+        or stopping conditions (about a third of the time).
 
     Returns
     -------
@@ -135,20 +232,26 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1):
 
     Examples
     --------
-    >>> [label for label, _ in orbits.compile_ahead(["leapfrog"], progress=False)]
+    >>> [label for label, _ in orbits.compile_ahead(["leapfrog"], progress=False,
+    ...                                               plain=True)]
     ['leapfrog']
+
+    Without ``plain``, ``leapfrog`` compiles ``['leapfrog', 'leapfrog with
+    force terms', 'leapfrog with variations', 'leapfrog with stopping
+    conditions']``.
 
     ``wh`` (and ``saba2`` to ``saba4``) compile a loop for each set of
     coordinates, and each of them with the planets in vector lanes (which
     runs take by the ``lanes`` option): ``['wh', 'wh lanes', 'wh
-    democratic-heliocentric', 'wh democratic-heliocentric lanes']``;
-    ``trace`` its loop and the one with its steps far from encounters in
-    vector lanes: ``['trace', 'trace lanes']``.
+    democratic-heliocentric', 'wh democratic-heliocentric lanes']``, then
+    the scalar loops with terms and with variations; ``trace`` its loop and
+    the one with its steps far from encounters in vector lanes: ``['trace',
+    'trace lanes']``, then the others it takes.
     """
     names = COMMON if names is None else tuple(names)
     jobs = _check_jobs(jobs)
     loops = [spec for name in names if getattr(integrators.get(name), "compiled", True)
-             for spec in _variants(name)]
+             for spec in _variants(name, plain)]
     if progress is None:
         progress = stderr_is_terminal()
     bar = None
@@ -175,8 +278,8 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1):
                 # (the monitors, the Kepler drift) are in the cache before
                 # the processes start
                 note(0, _compile_loop(*loops[0]))
-                futures = {pool.submit(_compile_loop, *spec): i
-                           for i, spec in enumerate(loops) if i > 0}
+                futures = {pool.submit(_compile_loop, *loops[i]): i
+                           for i in _pool_order(loops)}
                 for future in as_completed(futures):
                     note(futures[future], future.result())
     finally:

@@ -40,11 +40,13 @@ def offset_rows(sim, rows):
 
 
 def table(sim):
-    """``result.collisions``: an astropy QTable of the collisions resolved (None
-    when the run does not resolve collisions)."""
+    """What makes ``result.collisions``, an astropy QTable of the collisions
+    resolved so far (None when the run does not resolve collisions): a
+    function of no arguments, called where the field is first read."""
     if not resolves(sim):
         return None
-    return _collisions.table(sim._collisions, sim.units)
+    rows, units = list(sim._collisions), sim.units
+    return lambda: _collisions.table(rows, units)
 
 
 def resolve(sim, rec, wall0):

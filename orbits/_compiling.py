@@ -26,7 +26,8 @@ from numba.core.dispatcher import Dispatcher
 from ._kernels import stepping
 from ._kernels._jit import cpu_name
 
-__all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "loop_label",
+__all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "ADDED",
+           "loop_label",
            "notice", "cache_dir", "cpu_name", "stderr_is_terminal"]
 
 #: Seconds a loop's first compile takes on an empty cache: the compiling
@@ -51,6 +52,17 @@ FIRST_COMPILE_SECONDS = {
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
 UNKNOWN_ESTIMATE = "a few seconds"
 
+#: What a run adds to gravity that makes a loop of its own (or, for the
+#: stopping conditions, one compiled check for every integrator), as the
+#: loop's label names it: ``orbits compile`` compiles each ahead.
+ADDED = {"terms": "with force terms", "variations": "with variations",
+         "checks": "with stopping conditions"}
+
+#: What the notice says of a loop for force terms or variations: such
+#: loops took 11-25 s to compile for leapfrog, ias15 and wh on the 2-core
+#: AMD EPYC with Zen 3 (``orbits compile``, 2026-11-29; benchmarks/RESULTS.md).
+ADDED_ESTIMATE = "10-30 s"
+
 #: Seconds: a loop expected to compile in less than this is not announced.
 NOTICE_FROM = 1.0
 
@@ -61,12 +73,13 @@ COMMON = ("leapfrog", "ias15", "wh")
 _KIND = "numba:compile"
 
 
-def loop_label(integrator, lanes=False):
+def loop_label(integrator, lanes=False, adds=""):
     """The name of an integrator's stepping loop, as the notice and the table
     of :data:`FIRST_COMPILE_SECONDS` give it: its registry name, its
     coordinates where they are not its default (each set of coordinates is a
-    loop of its own), and "lanes" for the loop with its planets in vector
-    lanes (``lanes``; see the ``lanes`` option of ``wh`` and ``trace``).
+    loop of its own), "lanes" for the loop with its planets in vector
+    lanes (``lanes``; see the ``lanes`` option of ``wh`` and ``trace``), and
+    what the run adds to gravity (``adds``, a key of :data:`ADDED`).
 
     Examples
     --------
@@ -75,12 +88,16 @@ def loop_label(integrator, lanes=False):
     >>> loop_label(integrators.get("wh")), loop_label(integrators.get(
     ...     "wh", coordinates="democratic-heliocentric"), lanes=True)
     ('wh', 'wh democratic-heliocentric lanes')
+    >>> loop_label(integrators.get("ias15"), adds="terms")
+    'ias15 with force terms'
     """
     coords = integrator.config.get("coordinates")
     label = integrator.name
     if coords is not None and coords != type(integrator).options.get("coordinates"):
         label = f"{label} {coords}"
-    return f"{label} lanes" if lanes else label
+    if lanes:
+        label = f"{label} lanes"
+    return f"{label} {ADDED[adds]}" if adds else label
 
 
 def notice(label):
@@ -96,7 +113,12 @@ def notice(label):
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
         return None
-    about = UNKNOWN_ESTIMATE if seconds is None else f"about {float(f'{seconds:.2g}'):g} s"
+    if seconds is not None:
+        about = f"about {float(f'{seconds:.2g}'):g} s"
+    elif any(label.endswith(" " + added) for added in ADDED.values()):
+        about = f"about {ADDED_ESTIMATE}"
+    else:
+        about = UNKNOWN_ESTIMATE
     return (f"orbits: compiling the {label} loop for this CPU, once ({about}; "
             f"`orbits compile` does it ahead)")
 

@@ -298,7 +298,10 @@ class Driven:
         lanes = (lanes is not None and getattr(self._force, "inner", None) is None
                  and getattr(self, "_stop", None) is None
                  and lanes(self._ws, self._x.shape[0], self._force.recorder))
-        self._compile_clock = CompileClock(loop_label(self.integrator, lanes),
+        force = self._force
+        adds = ("variations" if getattr(force, "inner", None) is not None else
+                "terms" if getattr(force, "terms", None) is not None else "")
+        self._compile_clock = CompileClock(loop_label(self.integrator, lanes, adds),
                                            quiet=progress is False)
         wall0 = _time.perf_counter()
         self._wall0 = wall0
@@ -330,10 +333,10 @@ class Driven:
         table = getattr(self, "_encounter_table", None)
         if table is not None and result is not None:
             self._drain_log()
-            result.encounters = table()
+            result.defer("encounters", table())
         table = getattr(self, "_collision_table", None)
         if table is not None and result is not None:
-            result.collisions = table()
+            result.defer("collisions", table())
         return result
 
     def _offset_rows(self, rows):

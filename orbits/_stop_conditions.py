@@ -188,19 +188,25 @@ def log_full(sim, rec, wall0):
 
 
 def encounter_table(sim):
-    """``result.encounters``: an astropy QTable (None without ``encounter_log``)."""
+    """What makes ``result.encounters``, an astropy QTable of the approaches
+    logged so far (None without ``encounter_log``): a function of no
+    arguments, called where the field is first read (astropy.table's import
+    takes 0.24-0.5 s a process)."""
     if sim._stop_config.get("encounter_log", (None, None)) == (None, None):
         return None
-    # (astropy.table is imported where a table is made: 0.24 s a process)
-    from astropy.table import QTable
-    rows = sim._encounters
-    q = sim.units.quantity
-    col = lambda k: [r[k] for r in rows]  # noqa: E731
-    return QTable({"time": q(np.array(col(0), dtype=float), "time"),
-                   "body_1": np.array(col(1), dtype=str),
-                   "body_2": np.array(col(2), dtype=str),
-                   "distance": q(np.array(col(3), dtype=float), "length"),
-                   "speed": q(np.array(col(4), dtype=float), "length") / sim.units.time})
+    rows = list(sim._encounters)
+    units = sim.units
+
+    def make():
+        from astropy.table import QTable
+        q = units.quantity
+        col = lambda k: [r[k] for r in rows]  # noqa: E731
+        return QTable({"time": q(np.array(col(0), dtype=float), "time"),
+                       "body_1": np.array(col(1), dtype=str),
+                       "body_2": np.array(col(2), dtype=str),
+                       "distance": q(np.array(col(3), dtype=float), "length"),
+                       "speed": q(np.array(col(4), dtype=float), "length") / units.time})
+    return make
 
 
 def _grow_log(sim):

@@ -218,6 +218,15 @@ class Result:
                 self.__dict__.pop(name, None)
                 self._deferred[name] = (names, make)
 
+    def defer(self, name, make):
+        """The field ``name`` made by ``make()`` where it is first read (None:
+        the field is None), as the fields deferred at construction."""
+        if make is None:
+            self.__dict__[name] = None
+            return
+        self.__dict__.pop(name, None)
+        self._deferred[name] = ((name,), lambda: {name: make()})
+
     def __getattr__(self, name):
         # only for names not set: a deferred field, made now
         deferred = self.__dict__.get("_deferred")

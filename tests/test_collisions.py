@@ -179,3 +179,15 @@ def test_bodies_overlapping_at_the_start_are_refused_unless_merged(how):
     with pytest.raises(BodyError, match="'a' and 'b' touch at the start") as info:
         orbits.Simulation(_line(1.5), "leapfrog", dt=10, collisions=how)
     assert info.value.field == "radius" and "merge" in str(info.value)
+
+
+def test_a_result_keeps_the_collisions_resolved_by_its_end():
+    # result.collisions is made where it is first read (astropy.table's
+    # import is not paid by a run that never reads it), from the collisions
+    # as they were at the run's end: from x = 30 the bodies touch at t = 28,
+    # in the third step, after the first run
+    sim = orbits.Simulation(_line(30.0), "leapfrog", dt=10, collisions="merge")
+    first = sim.run(until=10, outputs=2, progress=False)
+    second = sim.run(until=40, outputs=2, progress=False)
+    assert len(second.collisions) == 1 and second.collisions[0]["resolution"] == "merge"
+    assert len(first.collisions) == 0

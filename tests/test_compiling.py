@@ -60,9 +60,12 @@ def test_a_first_compile_is_announced_once_and_measured(tmp_path):
 
 def test_orbits_compile_fills_the_cache_that_the_next_process_loads(tmp_path):
     # two loops (euler's is the Runge-Kutta loop, leapfrog's the splitting
-    # one), the second compiled in a process of its own (--jobs 2)
+    # one), the second compiled in a process of its own (--jobs 2); gravity
+    # alone (--plain; the loops for terms, variations and stopping
+    # conditions are the next test's)
     cache = tmp_path / "cache"
-    proc = _python(["-m", "orbits.cli", "compile", "euler", "leapfrog", "--jobs", "2"], cache)
+    proc = _python(["-m", "orbits.cli", "compile", "euler", "leapfrog", "--jobs", "2",
+                    "--plain"], cache)
     assert proc.returncode == cli.EXIT_COMPLETED, proc.stderr
     lines = proc.stdout.splitlines()
     assert lines[0].startswith("euler") and "s compiling" in lines[0]
@@ -80,6 +83,84 @@ def test_orbits_compile_fills_the_cache_that_the_next_process_loads(tmp_path):
     assert _notices(proc.stderr) == []
     assert "compiling" not in proc.stdout
 
+
+
+#: a fresh process that runs ``euler`` on the outer solar system with each
+#: addition to gravity that orbits compile compiles ahead, and prints the
+#: seconds each run spent compiling
+RUN_ADDED = """
+import json
+import astropy.units as u
+import orbits
+from orbits import forces as F
+b = orbits.scenes.outer_solar_system()
+sized = orbits.BodySet.from_arrays(b.masses, b.positions, b.velocities, names=b.names,
+                                   units=b.units, radii=[1e-3] * len(b) * u.au)
+runs = {
+    "GRPotential + J2": dict(forces=[F.GRPotential("Sun"),
+                                     F.ZonalHarmonics("Sun", 0.00465 * u.au, J2=2e-7)]),
+    "GR + tides": dict(forces=[F.GR("Sun"), F.TidesConstantTimeLag(
+        "Jupiter", k2=0.5, time_lag=0.01 * u.day, radius=7e4 * u.km)]),
+    "megno": dict(monitors=("energy", "megno")),
+    "variations": dict(variations="all"),
+    "escape, encounters": dict(escape_distance=1000 * u.au, encounter_distance=0.01 * u.au),
+    "collisions": dict(collisions="bounce"),
+    "encounter log": dict(encounter_log=0.1 * u.au),
+}
+out = {}
+for name, kw in runs.items():
+    bodies = sized if "collisions" in kw else b
+    sim = orbits.Simulation(bodies, "euler", dt=30 * u.day, **kw)
+    out[name] = sim.run(until=300 * u.day, outputs=3, progress=False).compile_time
+print(json.dumps(out))
+"""
+
+
+def test_orbits_compile_compiles_what_runs_add_to_gravity():
+    # goal 2 of "Start in seconds": an integrator compiled ahead takes any
+    # built-in terms, chaos monitors, variations, stopping conditions,
+    # collisions or encounter log without compiling again.  In the suite's
+    # own cache (what other tests compiled loads), and a new process on it
+    labels = [label for label, _ in orbits.compile_ahead(["euler"], progress=False)]
+    assert labels == ["euler", "euler with force terms", "euler with variations",
+                      "euler with stopping conditions"]
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.run([sys.executable, "-c", RUN_ADDED], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout.splitlines()[-1]) == {
+        name: 0 for name in ("GRPotential + J2", "GR + tides", "megno", "variations",
+                             "escape, encounters", "collisions", "encounter log")}
+    assert _notices(proc.stderr) == []
+
+
+def test_the_loops_compiled_ahead_follow_what_the_integrator_takes():
+    from orbits._ahead import _variants
+
+    def adds(name, plain=False):
+        return [loop.adds for loop in _variants(name, plain)]
+
+    # Taylor's series take neither terms nor variations; wh takes the terms
+    # that depend on positions alone, checks escapes, and its lanes' loops
+    # are taken by runs of gravity alone
+    assert adds("taylor") == ["", "checks"]
+    wh = [(loop.options.get("coordinates"), loop.lanes, loop.adds) for loop in _variants("wh")]
+    assert wh == [("jacobi", False, ""), ("jacobi", True, ""),
+                  ("democratic-heliocentric", False, ""),
+                  ("democratic-heliocentric", True, ""),
+                  ("jacobi", False, "terms"), ("democratic-heliocentric", False, "terms"),
+                  ("jacobi", False, "variations"),
+                  ("democratic-heliocentric", False, "variations"),
+                  ("jacobi", False, "checks")]
+    assert adds("ias15") == ["", "terms", "variations", "checks"]
+    assert adds("ias15", plain=True) == [""]
+    # in processes, the first run with each addition goes first (it compiles
+    # what all of them share), then gravity alone, then the other additions
+    from orbits._ahead import _pool_order
+    loops = _variants("leapfrog") + _variants("ias15")
+    assert [(loops[i].name, loops[i].adds) for i in _pool_order(loops)] == [
+        ("leapfrog", "terms"), ("leapfrog", "variations"), ("leapfrog", "checks"),
+        ("ias15", ""), ("ias15", "terms"), ("ias15", "variations"), ("ias15", "checks")]
 
 
 def test_compiling_in_processes_from_an_unguarded_script_is_a_named_error(tmp_path):
@@ -151,6 +232,11 @@ def test_the_notice_names_the_loop_and_its_expected_time(monkeypatch):
     assert "the wh democratic-heliocentric loop" in notice(loop_label(wh))
     assert "about 30 s" in notice(loop_label(wh))
     assert "a few seconds" in notice("no-such-loop")
+    # the loops of runs with terms or variations are named so, with their estimate
+    label = loop_label(orbits.integrators.get("leapfrog"), adds="variations")
+    assert notice(label) == ("orbits: compiling the leapfrog with variations loop for this "
+                             f"CPU, once (about {_compiling.ADDED_ESTIMATE}; `orbits compile` "
+                             "does it ahead)")
     # a loop expected to compile in under NOTICE_FROM is not announced
     monkeypatch.setitem(_compiling.FIRST_COMPILE_SECONDS, "quick", 0.5 * _compiling.NOTICE_FROM)
     assert notice("quick") is None
@@ -220,9 +306,9 @@ def test_wh_compiles_its_scalar_and_its_lanes_loops_ahead():
 
     def loops(name):
         out = []
-        for n, options, lanes in _variants(name):
-            integ = orbits.integrators.get(n, **options)
-            out.append((loop_label(integ, lanes), integ.config.get("lanes")))
+        for loop in _variants(name, plain=True):
+            integ = orbits.integrators.get(loop.name, **loop.options)
+            out.append((loop_label(integ, loop.lanes), integ.config.get("lanes")))
         return out
 
     got = loops("wh")

@@ -199,3 +199,21 @@ def test_more_approaches_in_one_step_than_the_log_holds_are_all_logged(monkeypat
     assert np.allclose(log["time"].value, 1.5, atol=1e-6)
     assert np.allclose(log["distance"].value, 0.1, atol=1e-6)
     assert sim._log.shape[0] >= 10 // 2
+
+
+def test_a_result_keeps_its_log_when_the_simulation_runs_on():
+    # the log's table is made where result.encounters is first read: it holds
+    # the passes of its run, as they were at the run's end, whatever later
+    # runs log
+    b = orbits.BodySet()
+    b.add("Sun", mass=1 * u.Msun)
+    b.add("A", mass=1e-6 * u.Msun, primary="Sun", a=1.0 * u.au, e=0.0)
+    b.add("B", mass=1e-6 * u.Msun, primary="Sun", a=1.2 * u.au, e=0.0)
+    sim = orbits.Simulation(b, "leapfrog", dt=2 * u.day, encounter_log=0.3 * u.au,
+                            monitors=())
+    first = sim.run(until=20 * u.yr, outputs=2, progress=False)
+    second = sim.run(until=40 * u.yr, outputs=2, progress=False)
+    # a conjunction every 4.18 yr (the test above): 4 by 20 yr, 5 more by 40 yr
+    assert len(second.encounters) == 5
+    assert len(first.encounters) == 4
+    assert first.encounters["time"].max() < 20 * u.yr < second.encounters["time"].min()

@@ -106,6 +106,23 @@ def test_a_run_loads_neither_tables_nor_other_integrators():
     assert proc.stdout.split() == ["False", "[]"]
 
 
+def test_the_tables_of_collisions_and_encounters_are_made_where_read():
+    # a run with collisions and an encounter log keeps their rows; the
+    # tables (astropy.table) are made where the result's fields are read
+    proc = _python("-c", "import sys, astropy.units as u, orbits; "
+                         "b = orbits.scenes.outer_solar_system(); "
+                         "b = orbits.BodySet.from_arrays(b.masses, b.positions, b.velocities, "
+                         "names=b.names, units=b.units, radii=[1e-3] * len(b) * u.au); "
+                         "sim = orbits.Simulation(b, 'leapfrog', dt=10 * u.day, "
+                         "collisions='merge', encounter_log=0.1 * u.au); "
+                         "r = sim.run(until=100 * u.day, outputs=2, progress=False); "
+                         "print('astropy.table' in sys.modules); "
+                         "print(len(r.collisions), len(r.encounters), "
+                         "type(r.encounters).__name__, 'astropy.table' in sys.modules)")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False", "0", "0", "QTable", "True"]
+
+
 def test_integrate_without_units_imports_no_astropy():
     # orbits.integrate works on plain arrays: a user's system (here a Python
     # function, run as Python) never imports astropy (0.4 s a process); its
