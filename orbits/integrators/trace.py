@@ -257,14 +257,19 @@ class Trace(Integrator):
 
     def bind(self, ws, force, fargs):
         """Keep the added terms' kernel and arguments beside the arrays (rebound
-        from the simulation, not saved)."""
-        if force.terms is not None and force.inner is None:
+        from the simulation, not saved); refuse variational equations, so
+        that a simulation asking for them is refused where it is made."""
+        self._refuse_variations(force)
+        if force.terms is not None:
             ws["terms"] = (force.terms, fargs[1])
 
-    def _check_system(self, ws, force, fargs):
+    def _refuse_variations(self, force):
         if force.inner is not None:
             raise IntegratorOptionError(
                 f"{self.name} does not integrate variational equations; use 'wh' or 'ias15'")
+
+    def _check_system(self, ws, force, fargs):
+        self._refuse_variations(force)
         gm, n_active = split_gravity(self.name, force, fargs)
         n = len(gm)
         ws["gm"][:n] = gm

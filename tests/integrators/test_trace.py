@@ -226,6 +226,14 @@ def test_refuses_velocity_dependent_terms_as_wh_does():
         orbits.Simulation(b, "trace", dt=2 * u.day, forces=[orbits.forces.GR("Sun")])
 
 
+@pytest.mark.parametrize("variations", ["state", "all", 2])
+def test_refuses_variational_equations_where_the_simulation_is_made(variations):
+    # refused by Simulation itself, before a run could start and fail
+    with pytest.raises(IntegratorOptionError, match="variational equations"):
+        orbits.Simulation(orbits.scenes.outer_solar_system(), "trace", dt=20 * u.day,
+                          variations=variations)
+
+
 def test_warns_without_a_dominant_body():
     # two equal stars: the split's premise fails, as for wh
     b = orbits.BodySet()
