@@ -35,10 +35,10 @@ def bind(sim, variations, seed):
     chaos = any(name in CHAOS_MONITORS for name in sim.monitors)
     if chaos and not sim.integrator.chaos_indicators:
         raise IntegratorOptionError(
-            f"{sim.integrator.name!r} steps outside the package's compiled loops and "
-            f"cannot follow the chaos monitors "
-            f"{', '.join(n for n in sim.monitors if n in CHAOS_MONITORS)}; use 'ias15', "
-            "'dop853', 'leapfrog' or 'wh'")
+            f"{sim.integrator.name!r} does not integrate the variational equations that "
+            f"the chaos monitors "
+            f"{', '.join(n for n in sim.monitors if n in CHAOS_MONITORS)} follow; use "
+            "'ias15', 'dop853', 'leapfrog' or 'wh'")
     if variations is None:
         n_state, n_mass, n_random = 0, 0, 0
     elif isinstance(variations, str) and variations in ("state", "all"):

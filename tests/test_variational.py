@@ -190,6 +190,10 @@ def test_bad_variations_are_named_errors():
                           seed="one")
     with pytest.raises(IntegratorOptionError, match="chaos monitors megno"):
         orbits.Simulation(_system(), "radau", monitors=["megno"])
+    # trace's steps are compiled but carry no variational equations: said so
+    with pytest.raises(IntegratorOptionError, match="'trace' does not integrate the "
+                                                    "variational equations"):
+        orbits.Simulation(_system(), "trace", dt=1 * u.day, monitors=["megno"])
     with pytest.raises(ValueError, match="unknown monitor"):
         orbits.Simulation(_system(), "leapfrog", dt=1 * u.day, monitors=["megnos"])
 
