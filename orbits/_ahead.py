@@ -1,6 +1,7 @@
 """Compiling the stepping loops ahead of time: ``orbits compile`` and
 :func:`compile_ahead`, for clusters, containers and CI (see :mod:`._compiling`)."""
 
+import functools
 import os
 from typing import NamedTuple
 
@@ -142,6 +143,42 @@ def _pool_order(loops):
             + [i for i in rest if loops[i].adds and i not in head])
 
 
+#: Bases that say nothing of a method's loop: a method whose next base is one
+#: of these has a loop family of its own (:func:`_family`)
+_GENERIC_BASES = ("Integrator", "AdaptiveIntegrator")
+
+
+@functools.lru_cache(maxsize=None)
+def _family(name):
+    """The family of methods whose loops ``name``'s may be: its class's first
+    base (the SABA methods wh's, the splitting methods theirs, dopri5 and
+    dop853 the embedded methods'), or its class where that base is generic."""
+    mro = type(integrators.get(name)).__mro__
+    return mro[0] if mro[1].__name__ in _GENERIC_BASES else mro[1]
+
+
+def _startable(i, loops, running, waiting):
+    """Whether ``loops[i]`` may start while the indices ``running`` run and
+    ``waiting`` wait: not beside a run of the same family, coordinates,
+    lanes and addition (whose loop it may share: compiled twice at once),
+    nor before the first run with its addition has ended (which compiles
+    what they all share: the terms' table, the stopping conditions'
+    check)."""
+    loop = loops[i]
+
+    def key(k):
+        other = loops[k]
+        return (_family(other.name), other.options.get("coordinates"), other.lanes,
+                other.adds)
+
+    if any(key(k) == key(i) for k in running):
+        return False
+    if loop.adds:
+        first = min(k for k in (*running, *waiting, i) if loops[k].adds == loop.adds)
+        return first == i or first not in (*running, *waiting)
+    return True
+
+
 def _check_jobs(jobs):
     """``jobs`` as a number of processes (0: one a core); a named error for
     anything else."""
@@ -272,16 +309,29 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1, plain=False):
             for i, spec in enumerate(loops):
                 note(i, _compile_loop(*spec))
         else:
-            from concurrent.futures import as_completed
-            with _pool(min(jobs, len(loops) - 1)) as pool:
+            from concurrent.futures import FIRST_COMPLETED, wait
+            workers = min(jobs, len(loops) - 1)
+            with _pool(workers) as pool:
                 # the first loop here, so that the kernels the loops share
                 # (the monitors, the Kepler drift) are in the cache before
-                # the processes start
+                # the processes start; then as many at once as there are
+                # processes, each started when it would not compile what
+                # one running compiles (_startable)
                 note(0, _compile_loop(*loops[0]))
-                futures = {pool.submit(_compile_loop, *loops[i]): i
-                           for i in _pool_order(loops)}
-                for future in as_completed(futures):
-                    note(futures[future], future.result())
+                waiting = _pool_order(loops)
+                futures = {}
+                while waiting or futures:
+                    running = list(futures.values())
+                    for i in list(waiting):
+                        if len(futures) >= workers:
+                            break
+                        if _startable(i, loops, running, waiting) or not futures:
+                            waiting.remove(i)
+                            futures[pool.submit(_compile_loop, *loops[i])] = i
+                            running.append(i)
+                    done_now, _ = wait(futures, return_when=FIRST_COMPLETED)
+                    for future in done_now:
+                        note(futures.pop(future), future.result())
     finally:
         if bar is not None:
             bar.close()

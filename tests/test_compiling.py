@@ -163,6 +163,29 @@ def test_the_loops_compiled_ahead_follow_what_the_integrator_takes():
         ("ias15", ""), ("ias15", "terms"), ("ias15", "variations"), ("ias15", "checks")]
 
 
+def test_processes_do_not_compile_one_loop_twice_at_once():
+    # saba2 runs wh's loops, verlet leapfrog's: a process starts neither
+    # beside the other's run of the same coordinates, lanes and addition;
+    # and a run with an addition waits for the first such run (which
+    # compiles the terms' table, the stopping conditions' check) to end
+    from orbits._ahead import _startable, _variants
+
+    loops = _variants("wh") + _variants("saba2") + _variants("verlet")
+    index = {(lp.name, lp.options.get("coordinates"), lp.lanes, lp.adds): i
+             for i, lp in enumerate(loops)}
+    wh = index["wh", "jacobi", False, ""]
+    saba2 = index["saba2", "jacobi", False, ""]
+    saba2_dh = index["saba2", "democratic-heliocentric", False, ""]
+    assert not _startable(saba2, loops, [wh], [saba2, saba2_dh])
+    assert _startable(saba2_dh, loops, [wh], [saba2, saba2_dh])
+    assert _startable(saba2, loops, [], [saba2])
+    first, later = index["wh", "jacobi", False, "terms"], index["verlet", None, False, "terms"]
+    assert not _startable(later, loops, [first], [later])
+    assert not _startable(later, loops, [], [first, later])
+    assert _startable(first, loops, [], [first, later])
+    assert _startable(later, loops, [], [later])
+
+
 def test_compiling_in_processes_from_an_unguarded_script_is_a_named_error(tmp_path):
     # each new process would import the script again and run its top level:
     # refused before anything compiles, naming the line and the guard
