@@ -243,8 +243,9 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1, plain=False):
         With more, the first loop is compiled here, so that the kernels every
         loop shares are in the cache, and the others in that many new
         processes, which share numba's cache: the wall time falls with the
-        cores, for a little more CPU time (a kernel that two loops share may
-        be compiled in both).  From a script, call it under ``if __name__ ==
+        cores, for a little more CPU time (a kernel that two loops of
+        different methods share may be compiled in both; a process starts
+        no loop that a running one may share).  From a script, call it under ``if __name__ ==
         "__main__":`` (each new process imports the main script again).
     plain : bool, optional
         Only the loops of runs of gravity alone, without terms, variations
