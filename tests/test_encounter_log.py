@@ -101,17 +101,21 @@ def test_a_pass_outside_the_threshold_is_not_logged_and_hill_radii_work():
     assert len(log) == 1 and abs(log[0]["distance"].to_value(u.au) - 0.3) < 0.05
 
 
-def test_a_full_log_is_emptied_and_the_run_goes_on():
+def _two_planets():
     # two planets on circular orbits at 1 and 1.2 au, starting in conjunction,
-    # meet 0.2 au apart once a synodic period; a log of 5 rows for 3 pairs
-    # is handed back to the driver after every 3rd row, emptied, and the run
-    # goes on: every pass is there, once
+    # meet 0.2 au apart once a synodic period (4.18 yr), logged within 0.3 au
     b = orbits.BodySet()
     b.add("Sun", mass=1 * u.Msun)
     b.add("A", mass=1e-6 * u.Msun, primary="Sun", a=1.0 * u.au, e=0.0)
     b.add("B", mass=1e-6 * u.Msun, primary="Sun", a=1.2 * u.au, e=0.0)
-    sim = orbits.Simulation(b, "leapfrog", dt=2 * u.day, encounter_log=0.3 * u.au,
-                            monitors=())
+    return orbits.Simulation(b, "leapfrog", dt=2 * u.day, encounter_log=0.3 * u.au,
+                             monitors=())
+
+
+def test_a_full_log_is_emptied_and_the_run_goes_on():
+    # a log of 5 rows for 3 pairs is handed back to the driver after every
+    # 3rd row, emptied, and the run goes on: every pass is there, once
+    sim = _two_planets()
     sim._log = np.zeros((5, 5))
     sim._stop = sim._stop[:14] + (sim._log, sim._log_n)
     res = sim.run(until=200 * u.yr, outputs=2, progress=False)
@@ -205,12 +209,7 @@ def test_a_result_keeps_its_log_when_the_simulation_runs_on():
     # the log's table is made where result.encounters is first read: it holds
     # the passes of its run, as they were at the run's end, whatever later
     # runs log
-    b = orbits.BodySet()
-    b.add("Sun", mass=1 * u.Msun)
-    b.add("A", mass=1e-6 * u.Msun, primary="Sun", a=1.0 * u.au, e=0.0)
-    b.add("B", mass=1e-6 * u.Msun, primary="Sun", a=1.2 * u.au, e=0.0)
-    sim = orbits.Simulation(b, "leapfrog", dt=2 * u.day, encounter_log=0.3 * u.au,
-                            monitors=())
+    sim = _two_planets()
     first = sim.run(until=20 * u.yr, outputs=2, progress=False)
     second = sim.run(until=40 * u.yr, outputs=2, progress=False)
     # a conjunction every 4.18 yr (the test above): 4 by 20 yr, 5 more by 40 yr
