@@ -245,8 +245,9 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1, plain=False):
         processes, which share numba's cache: the wall time falls with the
         cores, for a little more CPU time (a kernel that two loops of
         different methods share may be compiled in both; a process starts
-        no loop that a running one may share).  From a script, call it under ``if __name__ ==
-        "__main__":`` (each new process imports the main script again).
+        no loop that a running one may share).  From a script, call it
+        under ``if __name__ == "__main__":`` (each new process imports the
+        main script again).
     plain : bool, optional
         Only the loops of runs of gravity alone, without terms, variations
         or stopping conditions (about a third of the time).

@@ -336,8 +336,9 @@ def _parser(with_integrator_options=True):
                                       "Wisdom-Holman coordinate systems, alone and with "
                                       "force terms, variations and stopping conditions), "
                                       "so that later runs on this machine load them from "
-                                      "numba's cache instead of compiling. The cache is per CPU and "
-                                      "numba version: run it once where the runs will run "
+                                      "numba's cache instead of compiling. The cache is "
+                                      "per CPU and numba version: run it once where the "
+                                      "runs will run "
                                       "(a cluster node, a container image, a CI job) "
                                       "before many processes start.",
                           epilog=COMPILE_EXAMPLES + "\n" + _exit_help(),
