@@ -333,10 +333,10 @@ class Driven:
         table = getattr(self, "_encounter_table", None)
         if table is not None and result is not None:
             self._drain_log()
-            result.defer("encounters", table())
+            result._defer("encounters", table())
         table = getattr(self, "_collision_table", None)
         if table is not None and result is not None:
-            result.defer("collisions", table())
+            result._defer("collisions", table())
         return result
 
     def _offset_rows(self, rows):

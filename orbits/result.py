@@ -218,7 +218,7 @@ class Result:
                 self.__dict__.pop(name, None)
                 self._deferred[name] = (names, make)
 
-    def defer(self, name, make):
+    def _defer(self, name, make):
         """The field ``name`` made by ``make()`` where it is first read (None:
         the field is None), as the fields deferred at construction."""
         if make is None:

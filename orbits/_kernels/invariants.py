@@ -47,7 +47,7 @@ def _add(s, c, term):
     # the processor would mispredict whenever the terms outgrow the sum.
     # A call, not inlined by numba: LLVM inlines it where it is called, and
     # each of the sums below would otherwise carry a copy of its statements
-    # through numba's typing and lowering (0.3-0.4 s of every first run)
+    # through numba's typing and lowering (benchmarks/RESULTS.md, bench_compile)
     t = s + term
     big = (s - t) + term
     small = (term - t) + s
