@@ -83,8 +83,8 @@ from .trace_lanes import FAR_WAIT, criterion_scales, far_steps
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
 
 # the names the templates below are written against, bound by specialize
-HAS_TERMS, step_end, term_kick, LANES, far_run = slots("HAS_TERMS", "step_end", "term_kick",
-                                                       "LANES", "far_run")
+HAS_TERMS, step_end, term_kick, rare_term_kick, LANES, far_run = slots(
+    "HAS_TERMS", "step_end", "term_kick", "rare_term_kick", "LANES", "far_run")
 
 __all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
            "inner_arrays",
@@ -687,7 +687,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                 # the added terms' half kick
                 _copy(vb, vs)
                 if HAS_TERMS:
-                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
+                    rare_term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
             else:
                 jump(xh, vb, gm, n_active, half)
                 if flagged:
@@ -716,7 +716,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                 _copy(xc, xh)
                 _copy(vc, vb)
                 if state[2] and HAS_TERMS:
-                    term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)
+                    rare_term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)
                 if state[2] and not peri:
                     _interaction_kick(xh, vb, acc, gm, n_active, enc, flagged, owed)
                     _jump_call(xh, vb, gm, n_active, owed)
@@ -759,7 +759,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
             # point, after the added terms' half kick
             _copy(vs, vb)
             if HAS_TERMS:
-                term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
+                rare_term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
         else:
             if not flagged and not peri and not new_flagged:
                 # no flags either side: the Wisdom-Holman kick I(h), its arithmetic
@@ -773,7 +773,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                 _copy(vs, vb)
                 _interaction_kick(xh, vb, acc, gm, n_active, enc, new_flagged, half)
                 if HAS_TERMS:
-                    term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
+                    rare_term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
             jump(xh, vb, gm, n_active, half)
         owed = half
         owed_box[0] = owed
@@ -854,8 +854,15 @@ def trace_loop(record=_record, terms=None, lanes=False):
     step = epilogue(record, key, cache=cache, runtime=not cache)
     if lanes:
         key = f"{key}_lanes"
+    # the terms' kick is inlined where every step far from encounters kicks
+    # (after the drift, and the whole kick), and called where a segment with
+    # flags, a pericentre or a redo kicks: each inlined copy carries the table
+    # of terms' dispatch through numba's typing and lowering again, and a
+    # call costs a step some 6 % (benchmarks/RESULTS.md)
+    rare = kick if terms is None else called(kick, nrt=not cache)
     return specialize(_trace_loop, key, cache=cache, nrt=not cache,
-                      HAS_TERMS=terms is not None, term_kick=kick, LANES=lanes,
+                      HAS_TERMS=terms is not None, term_kick=kick, rare_term_kick=rare,
+                      LANES=lanes,
                       far_run=_far if lanes else _no_far, step_end=step)
 
 

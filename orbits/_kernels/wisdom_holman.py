@@ -948,6 +948,10 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     # a step; the loop with terms, whose long runs have no lanes, inlines it
     # (benchmarks/RESULTS.md)
     drift = called(_plain_drift, nrt) if terms is None else _plain_drift
+    # the loop with terms calls its perturbation step, the copy its corrector
+    # calls, instead of inlining the terms' dispatch once more: some 3 s less
+    # to compile, and the step's time within the host's scatter
+    # (benchmarks/RESULTS.md)
     outputs = {}
     if lanes:
         # the state kept in the lanes between outputs, and outputs made beside
@@ -986,7 +990,8 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
         outputs["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{key}", nrt=nrt, cache=cache,
                       to_internal=called(to_internal, nrt),
-                      drift=drift, owed_drift=called(drift, nrt), perturbation=perturbation,
+                      drift=drift, owed_drift=called(drift, nrt),
+                      perturbation=perturbation if terms is None else called(perturbation, nrt),
                       corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
                       **outputs)
