@@ -462,7 +462,6 @@ def test_wisdom_holman_refuses_velocity_dependent_terms(integrator):
         orbits.Simulation(sun_mercury(), integrator, dt=1 * u.day, forces=[forces.GR("Sun")])
 
 
-@pytest.mark.slow   # compiles wh with the term in both coordinate systems (~2.5 min)
 def test_wisdom_holman_coordinates_agree_with_terms():
     # the J2 kick in Jacobi and democratic heliocentric coordinates: both maps
     # are second order with errors O(eps h^2); at a 10 s step over an orbit

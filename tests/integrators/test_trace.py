@@ -206,7 +206,6 @@ def test_bad_options_are_named_errors(options):
         orbits.integrators.get("trace", **options)
 
 
-@pytest.mark.slow  # compiles trace and wh with the term: ~100 s on a cold cache
 def test_takes_position_only_terms_as_wh_does():
     # GRPotential joins the interaction kicks as in wh: without encounters
     # the two maps are the same operation for operation (equal bit for bit,
