@@ -858,7 +858,7 @@ def trace_loop(record=_record, terms=None, lanes=False):
     # (after the drift, and the whole kick), and called where a segment with
     # flags, a pericentre or a redo kicks: each inlined copy carries the table
     # of terms' dispatch through numba's typing and lowering again, and a
-    # call costs a step some 6 % (benchmarks/RESULTS.md)
+    # call at the first two sites shows in the step's time (benchmarks/RESULTS.md)
     rare = kick if terms is None else called(kick, nrt=not cache)
     return specialize(_trace_loop, key, cache=cache, nrt=not cache,
                       HAS_TERMS=terms is not None, term_kick=kick, rare_term_kick=rare,

@@ -949,8 +949,7 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     # (benchmarks/RESULTS.md)
     drift = called(_plain_drift, nrt) if terms is None else _plain_drift
     # the loop with terms calls its perturbation step, the copy its corrector
-    # calls, instead of inlining the terms' dispatch once more: some 3 s less
-    # to compile, and the step's time within the host's scatter
+    # calls, instead of inlining the terms' dispatch once more
     # (benchmarks/RESULTS.md)
     outputs = {}
     if lanes:
