@@ -10,7 +10,6 @@ import pytest
 EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
 
 
-@pytest.mark.slow  # ~20 s compiling every method for a user force; the docs' build runs it too
 def test_spring_example_prints_every_method(capsys):
     runpy.run_path(str(EXAMPLES / "spring.py"), run_name="__main__")
     out = capsys.readouterr().out

@@ -324,8 +324,7 @@ def test_j2_nodal_regression_first_order_theory():
 
 # -- integrators -------------------------------------------------------------------------
 
-@pytest.mark.parametrize("integrator", ["leapfrog",
-                                        pytest.param("yoshida4", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("integrator", ["leapfrog", "yoshida4"])
 def test_velocity_dependent_kick_keeps_the_order(integrator):
     # GR with an exaggerated strength (c = 30 au/day, so the 1PN terms are
     # 1e-4 of gravity): the implicit kick is symmetric, so the leapfrog stays
@@ -841,9 +840,8 @@ def test_cli_gr_option(capsys):
     assert "GRPotential" in capsys.readouterr().err
 
 
-# -- the whole registry (slow: every integrator compiles its loop for the terms) ------------
+# -- the whole registry (each family's loop for terms, which the tests above compile) -------
 
-@pytest.mark.slow
 @pytest.mark.parametrize("name", [i.name for i in orbits.integrators.available()])
 def test_every_integrator_takes_the_terms_it_can(name):
     # every registry integrator with GRPotential on Sun + Mercury: the shift GR

@@ -85,7 +85,6 @@ def test_hut_rate_at_synchronous_spin_is_the_familiar_one():
                         expected * 27 / 10.5, rel_tol=1e-10)
 
 
-@pytest.mark.slow   # the quick section's 16 runs: 3 s warm, 17 s or more compiling them
 def test_quick_section_measures_parity_and_rates(tmp_path):
     pytest.importorskip("reboundx")
     rows = []

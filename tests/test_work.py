@@ -59,10 +59,6 @@ def test_radau_weights_integrate_polynomials_to_degree_14():
 #: tolerances that give a few hundred steps a period
 METHODS = [("leapfrog", {}, 1.0), ("rk4", {}, 1.0), ("implicit-midpoint", {}, 1.0),
            ("dopri5", {"rtol": 1e-10, "atol": 1e-13}, None), ("ias15", {}, None)]
-#: in the slow run: a user's force compiles its loops afresh in every session
-#: (12-13 s each), and these two families' quadratures are the splitting and
-#: RK ones of the default run's methods
-_SLOW = {"implicit-midpoint", "dopri5"}
 
 
 def _run(name, options, dt, drag_on):
@@ -76,9 +72,7 @@ def _run(name, options, dt, drag_on):
     return r
 
 
-@pytest.mark.parametrize("name, options, dt", [
-    pytest.param(*m, marks=pytest.mark.slow) if m[0] in _SLOW else m for m in METHODS],
-    ids=[m[0] for m in METHODS])
+@pytest.mark.parametrize("name, options, dt", METHODS, ids=[m[0] for m in METHODS])
 def test_energy_plus_work_is_conserved_at_the_conservative_level(name, options, dt):
     free = _run(name, options, dt, drag_on=False)
     dragged = _run(name, options, dt, drag_on=True)

@@ -99,7 +99,6 @@ def test_public_leapfrog_is_bit_identical():
     assert np.array_equal(sim._x, xr) and np.array_equal(sim._v, vr)
 
 
-@pytest.mark.slow
 def test_public_leapfrog_is_bit_identical_after_a_million_steps():
     # the criterion: 1,000,000 steps of the outer solar system
     b = orbits.scenes.outer_solar_system()

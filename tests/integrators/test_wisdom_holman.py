@@ -167,7 +167,6 @@ def test_energy_bounded_on_the_outer_solar_system():
     assert err[-tenth:].max() < 1.5 * err[1:tenth].max()
 
 
-@pytest.mark.slow
 def test_energy_bounded_for_a_million_years():
     b = orbits.scenes.outer_solar_system()
     r = run(b, "wh", 4332.59 / 20 * u.day, 1e6 * u.yr, outputs=2001, monitors=("energy",))
@@ -314,7 +313,6 @@ def test_correctors_reduce_the_energy_error():
     assert errs[0] > 5 * errs[3] > 25 * errs[5] > 100 * errs[7]
 
 
-@pytest.mark.slow
 def test_order_17_corrector_for_a_million_years():
     # measured over 1e6 years (2000 outputs): 4.9e-9, first and last tenth
     # 4.24e-9 and 4.21e-9; REBOUND's WHFast with corrector 17: 4.2e-9 (3.5e-9
@@ -439,7 +437,6 @@ def test_democratic_heliocentric_energy_bounded():
     assert err[-tenth:].max() < 1.5 * err[1:tenth].max()
 
 
-@pytest.mark.slow
 def test_democratic_heliocentric_energy_bounded_for_a_million_years():
     # measured 2.3e-6 at most over 1e6 years (2000 outputs), 2.1e-6 in the
     # first tenth and 1.8e-6 in the last: bounded, no secular trend
