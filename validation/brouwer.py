@@ -13,7 +13,7 @@ few 1e-17 here), from the positions and velocities each code holds.
 
 From the ensemble come, at each time, the RMS of ``dE/E0`` over the members
 and its mean (the part common to all members: a bias of the method or of its
-rounding).  The growth exponent is the slope of ``log RMS`` against
+rounding), with ``z``, the mean at the end over its standard error.  The growth exponent is the slope of ``log RMS`` against
 ``log t`` fitted over the late part of the run only (``fit_from`` of the
 span on: the first orbits are dominated by the bounded, periodic error of
 each step, not by accumulated rounding).  Its uncertainty is the standard
@@ -121,6 +121,10 @@ def measure(code, mode, ensemble, times, epsilon=1e-9, fit_from=FIT_FROM, **sim_
     ``exponent`` with its bootstrap ``spread``, the exponent of ``|mean|``
     (``bias_exponent``), ``steps`` per member, ``wall`` seconds.
     ``fit_from`` is the fraction of the log-time range left out at the start.
+    ``z`` is the mean at the last time over its standard error (the spread of
+    the members there over the square root of their number): a method whose
+    members' errors are independent random walks keeps it within a few units
+    of zero.
     """
     run = ours_energy_errors if code == "orbits" else rebound_energy_errors
     t0 = time.perf_counter()
@@ -135,9 +139,11 @@ def measure(code, mode, ensemble, times, epsilon=1e-9, fit_from=FIT_FROM, **sim_
     t_from = float(np.exp(lt[0] + fit_from * (lt[-1] - lt[0])))
     p, spread = ensemble_growth_exponent(times, errors, t_from)
     mean = errors.mean(axis=0)
+    sem = float(errors[:, -1].std() / np.sqrt(len(errors)))
     return {"code": code, "mode": mode, "errors": errors, "times": times,
             "rms": np.sqrt(np.mean(errors ** 2, axis=0)), "mean": mean,
             "exponent": p, "spread": spread, "t_from": t_from,
+            "z": float(mean[-1] / sem) if sem > 0 else float("nan"),
             "bias_exponent": fit_exponent(times, np.abs(mean), t_from),
             "steps": int(np.median(steps)), "wall": wall}
 
@@ -174,7 +180,7 @@ def main(argv=None):
         f"log-spaced from 1 orbit, fit of log RMS(dE/E) against log t from "
         f"{fit_orbits:.0f} orbits on; +- is the bootstrap spread over members",
         f"{'code':8s} {'mode':7s} {'exponent':>14s} {'|mean| exp':>10s} {'RMS end':>9s} "
-        f"{'|mean| end':>10s} {'steps':>8s} {'wall s':>7s}"]
+        f"{'|mean| end':>10s} {'z':>6s} {'steps':>8s} {'wall s':>7s}"]
     for line in lines:
         print(line)
     results = []
@@ -185,7 +191,8 @@ def main(argv=None):
             results.append(r)
             lines.append(f"{code:8s} {m:7s} {r['exponent']:7.2f} +- {r['spread']:4.2f} "
                          f"{r['bias_exponent']:10.2f} {r['rms'][-1]:9.2e} "
-                         f"{abs(r['mean'][-1]):10.2e} {r['steps']:8d} {r['wall']:7.1f}")
+                         f"{abs(r['mean'][-1]):10.2e} {r['z']:6.2f} {r['steps']:8d} "
+                         f"{r['wall']:7.1f}")
             print(lines[-1], flush=True)
     if args.write:
         import pathlib
