@@ -61,13 +61,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._jit import njit, slots, specialize
+from ._jit import fma, njit, slots, specialize
 from .status import Status
 from .stepping import (GO, WORK_SLOTS, adaptive_start, add_compensated, clock_step, flat_rows,
                        flat_stages, landing_step, must_return, step_lander, work_kernels)
 from .variational import measured_rows, velocity_reader
 
-__all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "SAFETY", "PC_TOLERANCE",
+__all__ = ["SPACINGS", "C_TABLE", "D_TABLE", "R_TABLE", "R_LOW_TABLE", "SAFETY", "PC_TOLERANCE",
            "PC_MAX_ITERATIONS", "PC_EPSILON_SQUARED", "MODE_GLOBAL", "MODE_PRS24",
            "ias15_loop", "B6_ROUNDING_GAIN",
            "radau_spacings", "RADAU_WEIGHTS", "radau_weights"]
@@ -142,8 +142,10 @@ def radau_spacings():
 
 
 def _tables(h):
-    """C (b = C g), D = C^-1 (g = D b) and R (R[n, j] = 1 / (h_n - h_j), h_0 = 0),
-    computed in exact rational arithmetic from the float spacings ``h``."""
+    """C (b = C g), D = C^-1 (g = D b), R (R[n, j] = 1 / (h_n - h_j), h_0 = 0)
+    and R's low parts (``R + R_low`` is ``1 / (h_n - h_j)`` to about 2^-106
+    of it), computed in exact rational arithmetic from the float spacings
+    ``h``."""
     hs = [Fraction(0)] + [Fraction(float(x)) for x in h]
     # N_k(h) = h (h - h_1) ... (h - h_k) = sum_m C[m, k] h^(m+1)
     C = [[Fraction(0)] * 7 for _ in range(7)]
@@ -165,14 +167,28 @@ def _tables(h):
         for m in range(k - 1, -1, -1):
             D[m][k] = -sum(C[m][j] * D[j][k] for j in range(m + 1, k + 1))
     R = np.zeros((8, 8))
+    R_low = np.zeros((8, 8))
     for n in range(1, 8):
         for j in range(n):
-            R[n, j] = float(1 / (hs[n] - hs[j]))
+            exact = 1 / (hs[n] - hs[j])
+            R[n, j] = float(exact)
+            R_low[n, j] = float(exact - Fraction(R[n, j]))
     return (np.array([[float(c) for c in row] for row in C]),
-            np.array([[float(c) for c in row] for row in D]), R)
+            np.array([[float(c) for c in row] for row in D]), R, R_low)
 
 
-C_TABLE, D_TABLE, R_TABLE = _tables(SPACINGS)
+#: The corrector multiplies by ``R_TABLE + R_LOW_TABLE`` with a fused
+#: multiply-add (``fma(d, R, d * R_low)``), so that a divided difference is
+#: its exact value rounded once.  With ``R`` alone each factor kept its own
+#: fixed rounding, the same at every step: the divided differences of a force
+#: linear in time came out with a spurious second one (4e-16 of the slope),
+#: and the step's velocity weighed the force's change by 1 + 6.5e-19.  That
+#: error kept its sign at every step and drifted the energy by
+#: ``-6.5e-19 |a|^2 dt^2`` a step: on the outer solar system, +5e-15 of |E|
+#: over 1e4 Jupiter orbits in every member of an ensemble, as large as the
+#: random walk of the rounding errors (benchmarks/RESULTS.md,
+#: validation/brouwer.py).
+C_TABLE, D_TABLE, R_TABLE, R_LOW_TABLE = _tables(SPACINGS)
 
 
 def radau_weights(h):
@@ -215,6 +231,7 @@ _H = SPACINGS
 _C = C_TABLE
 _D = D_TABLE
 _R = R_TABLE
+_RL = R_LOW_TABLE
 _WR = RADAU_WEIGHTS
 # binomial(k + 1, m + 1) for the extrapolation of b to the next step
 _BINOM = np.array([[float(math.comb(k + 1, m + 1)) for k in range(7)] for m in range(7)])
@@ -455,14 +472,20 @@ def _ias15_loop(x, v, t, control, work, fargs, outputs, landing, sargs, check):
                 # the corrector, a pass over every component at a time (each
                 # a loop LLVM vectorises; each component's operations in the
                 # order of the nested form): the new divided difference r
-                # and its change dg take vs, free until the step's end
+                # and its change dg take vs, free until the step's end; each
+                # factor 1 / (h_sub - h_j) is R + R_low, applied with one
+                # rounding (see R_LOW_TABLE)
                 R0 = _R[sub, 0]
+                R0_low = _RL[sub, 0]
                 for k in range(m3):
-                    vs1[k] = (acc1[k] - a01[k]) * R0
+                    dd = acc1[k] - a01[k]
+                    vs1[k] = fma(dd, R0, dd * R0_low)
                 for j in range(1, sub):
                     rj = _R[sub, j]
+                    rj_low = _RL[sub, j]
                     for k in range(m3):
-                        vs1[k] = (vs1[k] - g1[j - 1, k]) * rj
+                        dd = vs1[k] - g1[j - 1, k]
+                        vs1[k] = fma(dd, rj, dd * rj_low)
                 for k in range(m3):
                     r = vs1[k]
                     vs1[k] = r - g1[sub - 1, k]
