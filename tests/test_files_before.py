@@ -1,8 +1,9 @@
 """Files written before a change of the file code still load and resume bit for bit.
 
 The files in tests/data/before_split/ were written by orbits at commit e5f7d5b
-(tests/data/make_before_split.py says how): runs stopped after the fifth of
-eleven outputs.  Each is read, resumed, and compared with the same run made
+(tests/data/make_before_split.py says how, and how ias15's file follows the
+corrector's later arithmetic): runs stopped after the fifth of eleven
+outputs.  Each is read, resumed, and compared with the same run made
 now without a stop, value for value.
 """
 

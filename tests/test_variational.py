@@ -226,16 +226,23 @@ def test_megno_grows_as_half_the_lyapunov_exponent_on_a_chaotic_system():
     # Saturn moved in to 6.6 au (period ratio 1.37): chaotic.  <Y> ~ lambda t / 2
     # where ln |delta| ~ lambda t; the slope of <Y> fitted over the second half
     # against lambda from ln |delta| / t at the end.  The two differ by how
-    # the local rate of divergence wanders over the run (chaotic orbits
-    # linger in some regions): measured 0.95 here, 0.79 to 1.01 for
-    # neighbouring initial states, so 10 % on this one
-    sim = orbits.Simulation(_planets(6.6), "ias15", monitors=CHAOS, seed=1)
-    r = sim.run(until=2e3 * 11.86 * u.yr, outputs=21, progress=False)
-    t = r.times.to_value(u.yr)
-    slope = np.polyfit(t[10:], r.megno[10:], 1)[0]
-    lam = r.lyapunov[-1].to_value(1 / u.yr)
-    assert r.megno[-1] > 100
-    assert abs(2 * slope / lam - 1) < 0.1
+    # the local rate of divergence wanders over a run (chaotic orbits linger
+    # in some regions), and each run's ratio changes with the last bits of
+    # its state: over Saturn at 6.58-6.62 au and two tangent vectors each,
+    # 0.63-1.16 (median 0.84; 0.24-1.06 with the corrector's arithmetic
+    # before 2026-11-30).  So the median of three neighbouring runs, measured
+    # 0.88 (1.16, 0.63, 0.88), within 0.35 of 1: a MEGNO growing at lambda
+    # or at lambda / 4 fails by far
+    ratios = []
+    for a in (6.59, 6.6, 6.61):
+        sim = orbits.Simulation(_planets(a), "ias15", monitors=CHAOS, seed=1)
+        r = sim.run(until=2e3 * 11.86 * u.yr, outputs=21, progress=False)
+        t = r.times.to_value(u.yr)
+        slope = np.polyfit(t[10:], r.megno[10:], 1)[0]
+        lam = r.lyapunov[-1].to_value(1 / u.yr)
+        assert r.megno[-1] > 100
+        ratios.append(2 * slope / lam)
+    assert abs(np.median(ratios) - 1) < 0.35, ratios
     # ln |delta| passed 2**300 several times: the renormalisations kept it finite
     assert r.fli[-1] > 300 * np.log(2) and np.isfinite(r.fli).all()
     assert np.isfinite(r.tangent_vectors).all()

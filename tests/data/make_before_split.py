@@ -7,6 +7,14 @@ Run from the repository root (at that commit the recorder is
 ``orbits.io.hdf5.FileRecorder``)::
 
     python tests/data/make_before_split.py tests/data/before_split
+
+``ias15-interrupted.h5`` was written again on 2026-11-30 by that commit with
+the corrector's arithmetic of 182f0fc (each factor ``1 / (h_n - h_j)`` as
+``R + R_low`` with a fused multiply-add: the lines of the corrector and of
+``_tables`` in ``orbits/_kernels/ias15.py`` as they are now), so that its rows
+are those of a run made now; the file code is e5f7d5b's.
+``leapfrog-interrupted.h5`` is e5f7d5b's (written again the same way, its
+positions are equal to the bit).
 """
 
 import pathlib
