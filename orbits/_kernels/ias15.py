@@ -178,16 +178,12 @@ def _tables(h):
 
 
 #: The corrector multiplies by ``R_TABLE + R_LOW_TABLE`` with a fused
-#: multiply-add (``fma(d, R, d * R_low)``), so that a divided difference is
-#: its exact value rounded once.  With ``R`` alone each factor kept its own
-#: fixed rounding, the same at every step: the divided differences of a force
-#: linear in time came out with a spurious second one (4e-16 of the slope),
-#: and the step's velocity weighed the force's change by 1 + 6.5e-19.  That
-#: error kept its sign at every step and drifted the energy by
-#: ``-6.5e-19 |a|^2 dt^2`` a step: on the outer solar system, +5e-15 of |E|
-#: over 1e4 Jupiter orbits in every member of an ensemble, as large as the
-#: random walk of the rounding errors (benchmarks/RESULTS.md,
-#: validation/brouwer.py).
+#: multiply-add (``fma(d, R, d * R_low)``), so that each divided difference is
+#: its exact value rounded once.  With ``R`` alone each factor would keep its
+#: own fixed rounding, the same at every step: a force linear in time would
+#: get a spurious second divided difference, the velocity would weigh the
+#: force's change by a constant factor off one, and the energy would drift
+#: with one sign at every step (benchmarks/RESULTS.md, validation/brouwer.py).
 C_TABLE, D_TABLE, R_TABLE, R_LOW_TABLE = _tables(SPACINGS)
 
 
