@@ -46,16 +46,16 @@ def test_energy_error_grows_like_a_random_walk(mode):
 
     # Brouwer's law: independent rounding errors make the energy error a random
     # walk, t^0.5.  Three standard deviations of a 16-member exponent above it
-    # fail.  Measured with this ensemble 0.58 (global) and 0.56 (prs24), REBOUND
-    # 0.53 and 0.59; over 46 members (three seeds) 0.53 and 0.52 +- 0.02, REBOUND
-    # 0.52 and 0.53 +- 0.03.
+    # fail.  Measured with this ensemble 0.46 +- 0.03 (global) and 0.46 +- 0.06
+    # (prs24); over 46 members 0.47 +- 0.02 (global), REBOUND 0.52 +- 0.03.
     assert r["exponent"] < 0.5 + 3 * max(SPREAD, r["spread"]), info
     # The sharper test: an error of a sign common to all members (truncation, or
     # a rounding bias) shows in their mean, which for independent walks stays
-    # within a few standard errors of zero.  Before b was recomputed from g at
-    # the end of each step, the mean after 1e4 orbits was 5 (global) and 7
-    # (prs24) standard errors from zero, while the exponent over this span still
-    # read 0.52 and 0.61; measured now 1.4 and 0.6 standard errors.
+    # within a few standard errors of zero.  Measured +1.05 (global) and -0.11
+    # (prs24) standard errors; REBOUND's IAS15 -0.94 and +0.41 on this ensemble.
+    # With the corrector's factors 1 / (h_n - h_j) rounded once each (see
+    # orbits._kernels.ias15.R_LOW_TABLE) it read +3.0 and +4.05, with the
+    # exponent still 0.54 and 0.50.
     assert abs(r["mean"][-1]) < 3 * sem, info
-    # and the size: no larger than twice REBOUND's (measured 1.5 and 0.7 times)
+    # and the size: no larger than twice REBOUND's (measured 0.87 and 0.65 times)
     assert r["rms"][-1] < 2 * REBOUND_RMS[mode], info
