@@ -13,10 +13,11 @@ few 1e-17 here), from the positions and velocities each code holds.
 
 From the ensemble come, at each time, the RMS of ``dE/E0`` over the members
 and its mean (the part common to all members: a bias of the method or of its
-rounding), with ``z``, the mean at the end over its standard error.  The growth exponent is the slope of ``log RMS`` against
-``log t`` fitted over the late part of the run only (``fit_from`` of the
-span on: the first orbits are dominated by the bounded, periodic error of
-each step, not by accumulated rounding).  Its uncertainty is the standard
+rounding), with ``z``, the mean at the end over its standard error.  The
+growth exponent is the slope of ``log RMS`` against ``log t`` fitted over
+the late part of the run only (``fit_from`` of the span on: the first orbits
+are dominated by the bounded, periodic error of each step, not by
+accumulated rounding).  Its uncertainty is the standard
 deviation of the exponent over bootstrap resamplings of the members.
 
 Rounding errors that are independent from step to step make the energy error
