@@ -40,9 +40,11 @@ class Loop(NamedTuple):
 #: any combination of built-in force terms (one loop for every table of
 #: terms, its work integrated where some are dissipative); ``"variations"``,
 #: the variational equations and the chaos monitors (one loop for every kind
-#: of variations); ``"checks"``, the stopping conditions, collisions and the
-#: encounter log (one compiled check for every integrator, and what a run
-#: with them calls).
+#: of variations); ``"terms+variations"``, both together (the variational
+#: equations of gravity with terms: one more loop, for every table of terms
+#: and every kind of variations); ``"checks"``, the stopping conditions,
+#: collisions and the encounter log (one compiled check for every
+#: integrator, and what a run with them calls, with or without the others).
 ADDS = tuple(ADDED)
 
 
@@ -51,9 +53,9 @@ def _variants(name, plain=False):
     coordinates for the methods that take them, and for those with a
     ``lanes`` option (``wh``, the SABA methods, ``trace``) the scalar loop
     and the lanes' one of each; then, unless ``plain``, for each scalar loop
-    the loops of runs with force terms and with variations where the
-    integrator takes them (:data:`ADDS`), and one run with every stopping
-    condition where it checks them."""
+    the loops of runs with force terms, with variations and with both where
+    the integrator takes them (:data:`ADDS`), and one run with every
+    stopping condition where it checks them."""
     integ = integrators.get(name)
     options = type(integ).options
     coords = options.get("coordinates")
@@ -71,6 +73,8 @@ def _variants(name, plain=False):
         loops += [loop._replace(adds="terms") for loop in scalar]
     if integ.chaos_indicators:
         loops += [loop._replace(adds="variations") for loop in scalar]
+        if _terms_for(integ) is not None:
+            loops += [loop._replace(adds="terms+variations") for loop in scalar]
     if integ.stop_conditions:
         loops.append(scalar[0]._replace(adds="checks"))
     return loops
@@ -112,11 +116,11 @@ def _compile_loop(name, options, lanes, adds=""):
     until = _AHEAD_STEPS * _AHEAD_DT_DAYS * u.day
     bodies = scenes.outer_solar_system()
     kw = {}
-    if adds == "terms":
+    if adds in ("terms", "terms+variations"):
         kw["forces"] = _terms_for(integ)
-    elif adds == "variations":
+    if adds in ("variations", "terms+variations"):
         kw["monitors"] = ("energy", "megno")
-    elif adds == "checks":
+    if adds == "checks":
         kw = _checks_for(integ)
         if "collisions" in kw:
             bodies = BodySet.from_arrays(bodies.masses, bodies.positions, bodies.velocities,

@@ -56,6 +56,7 @@ UNKNOWN_ESTIMATE = "a few seconds"
 #: stopping conditions, one compiled check for every integrator), as the
 #: loop's label names it: ``orbits compile`` compiles each ahead.
 ADDED = {"terms": "with force terms", "variations": "with variations",
+         "terms+variations": "with force terms and variations",
          "checks": "with stopping conditions"}
 
 #: What the notice says of a loop for force terms or variations: such

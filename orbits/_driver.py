@@ -299,7 +299,9 @@ class Driven:
                  and getattr(self, "_stop", None) is None
                  and lanes(self._ws, self._x.shape[0], self._force.recorder))
         force = self._force
-        adds = ("variations" if getattr(force, "inner", None) is not None else
+        inner = getattr(force, "inner", None)
+        adds = ("terms+variations" if getattr(inner, "terms", None) is not None else
+                "variations" if inner is not None else
                 "terms" if getattr(force, "terms", None) is not None else "")
         self._compile_clock = CompileClock(loop_label(self.integrator, lanes, adds),
                                            quiet=progress is False)

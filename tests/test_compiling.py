@@ -103,6 +103,11 @@ runs = {
         "Jupiter", k2=0.5, time_lag=0.01 * u.day, radius=7e4 * u.km)]),
     "megno": dict(monitors=("energy", "megno")),
     "variations": dict(variations="all"),
+    "GR + megno": dict(forces=[F.GR("Sun")], monitors=("energy", "megno")),
+    "GRPotential + variations + escape": dict(forces=[F.GRPotential("Sun")],
+                                              variations="state",
+                                              escape_distance=1000 * u.au),
+    "GR + collisions": dict(forces=[F.GR("Sun")], collisions="bounce"),
     "escape, encounters": dict(escape_distance=1000 * u.au, encounter_distance=0.01 * u.au),
     "collisions": dict(collisions="bounce"),
     "encounter log": dict(encounter_log=0.1 * u.au),
@@ -119,10 +124,12 @@ print(json.dumps(out))
 def test_orbits_compile_compiles_what_runs_add_to_gravity():
     # goal 2 of "Start in seconds": an integrator compiled ahead takes any
     # built-in terms, chaos monitors, variations, stopping conditions,
-    # collisions or encounter log without compiling again.  In the suite's
-    # own cache (what other tests compiled loads), and a new process on it
+    # collisions or encounter log, and any combination of them, without
+    # compiling again.  In the suite's own cache (what other tests compiled
+    # loads), and a new process on it
     labels = [label for label, _ in orbits.compile_ahead(["euler"], progress=False)]
     assert labels == ["euler", "euler with force terms", "euler with variations",
+                      "euler with force terms and variations",
                       "euler with stopping conditions"]
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     proc = subprocess.run([sys.executable, "-c", RUN_ADDED], cwd=ROOT, env=env,
@@ -130,7 +137,9 @@ def test_orbits_compile_compiles_what_runs_add_to_gravity():
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout.splitlines()[-1]) == {
         name: 0 for name in ("GRPotential + J2", "GR + tides", "megno", "variations",
-                             "escape, encounters", "collisions", "encounter log")}
+                             "GR + megno", "GRPotential + variations + escape",
+                             "GR + collisions", "escape, encounters", "collisions",
+                             "encounter log")}
     assert _notices(proc.stderr) == []
 
 
@@ -151,16 +160,19 @@ def test_the_loops_compiled_ahead_follow_what_the_integrator_takes():
                   ("jacobi", False, "terms"), ("democratic-heliocentric", False, "terms"),
                   ("jacobi", False, "variations"),
                   ("democratic-heliocentric", False, "variations"),
+                  ("jacobi", False, "terms+variations"),
+                  ("democratic-heliocentric", False, "terms+variations"),
                   ("jacobi", False, "checks")]
-    assert adds("ias15") == ["", "terms", "variations", "checks"]
+    assert adds("ias15") == ["", "terms", "variations", "terms+variations", "checks"]
     assert adds("ias15", plain=True) == [""]
     # in processes, the first run with each addition goes first (it compiles
     # what all of them share), then gravity alone, then the other additions
     from orbits._ahead import _pool_order
     loops = _variants("leapfrog") + _variants("ias15")
     assert [(loops[i].name, loops[i].adds) for i in _pool_order(loops)] == [
-        ("leapfrog", "terms"), ("leapfrog", "variations"), ("leapfrog", "checks"),
-        ("ias15", ""), ("ias15", "terms"), ("ias15", "variations"), ("ias15", "checks")]
+        ("leapfrog", "terms"), ("leapfrog", "variations"), ("leapfrog", "terms+variations"),
+        ("leapfrog", "checks"), ("ias15", ""), ("ias15", "terms"), ("ias15", "variations"),
+        ("ias15", "terms+variations"), ("ias15", "checks")]
 
 
 def test_processes_do_not_compile_one_loop_twice_at_once():
