@@ -17,7 +17,9 @@ from an importable module (its pointer compiled once), then the same again in
 a new process (loaded), then each stopping condition, collision mode,
 ``encounter_log`` and a chaos monitor (MEGNO) added to the integrator alone,
 then the variational equations of the state and the masses (``variations="all"``:
-one loop serves every kind of variations and the chaos monitors);
+one loop serves every kind of variations and the chaos monitors), then
+``GRPotential`` with MEGNO (the loop of terms with variations: one more,
+for every table of terms and every kind of variations);
 for ``wh``, an ensemble in batch mode of 4 systems (the batch loop
 compiled) and then of 8 (a new size: the kick written out for it alone).
 Goals (issue "Start in seconds"): a combination of built-in terms after the
@@ -31,8 +33,8 @@ the rows of the second show what a condition costs an integrator with that
 pointer already in the cache.
 
 ``--ahead`` first fills each new cache with ``orbits compile INTEGRATOR``
-(the integrator compiled: its loops alone and with terms, variations and
-stopping conditions; the line gives its CPU seconds), so that every row
+(the integrator compiled: its loops alone and with terms, variations, both
+and stopping conditions; the line gives its CPU seconds), so that every row
 shows what the addition costs an integrator already compiled: each row but
 the first ``UserForce`` (which compiles the user's own function) and the
 batch rows is then held to the goal of <= 1 s, ``none`` and ``GR`` too.
@@ -82,6 +84,8 @@ _CHILD = textwrap.dedent("""
         "monitors megno": dict(monitors=("energy", "megno")),
         "variations all": dict(variations="all"),
     }
+    # a term with the chaos monitors: the loop of terms with variations
+    all_options["GRPotential + monitors megno"] = dict(monitors=("energy", "megno"))
     options = all_options.get(combo, {})
     if combo.startswith("batch"):
         # an ensemble of B copies in batch mode (integrator wh): its loop,
@@ -97,7 +101,8 @@ _CHILD = textwrap.dedent("""
     if combo.startswith("UserForce") or combo in all_options:
         import benchuser
         terms = ([F.UserForce(benchuser.drag, velocity_dependent=True)]
-                 if combo.startswith("UserForce") else [])
+                 if combo.startswith("UserForce") else
+                 [F.GRPotential("Sun")] if combo.startswith("GRPotential") else [])
     else:
         terms = made[combo]()
     adaptive = orbits.integrators.get(integrator).adaptive
@@ -131,7 +136,7 @@ _AHEAD = textwrap.dedent("""
 
 ROWS = ["none", "GR", "GRPotential + J2", "GR + migration", "UserForce",
         "UserForce (new process)", "encounter_distance", "escape_distance", "collisions merge",
-        "encounter_log", "monitors megno", "variations all"]
+        "encounter_log", "monitors megno", "variations all", "GRPotential + monitors megno"]
 #: the rows of wh alone: batch mode at one size of ensemble, then at another
 BATCH_ROWS = ["batch 4", "batch 8"]
 #: rows held to the goal of <= 1 s: the combinations after the first, the user force loaded
@@ -177,18 +182,18 @@ def main(argv=None):
                     ok = False
                     continue
                 cpu = json.loads(out.stdout.strip().splitlines()[-1])["cpu"]
-                print(f"{integrator:10s} {'orbits compile ' + integrator:26s} {cpu:7.2f} s",
+                print(f"{integrator:10s} {'orbits compile ' + integrator:30s} {cpu:7.2f} s",
                       flush=True)
             for row in rows:
                 out = run_child(["-c", _CHILD, integrator, row], env=env,
                                 capture_output=True, text=True)
                 if out.returncode:
-                    print(f"{integrator:10s} {row:26s} failed:\n{out.stderr}", flush=True)
+                    print(f"{integrator:10s} {row:30s} failed:\n{out.stderr}", flush=True)
                     ok = False
                     continue
                 got = json.loads(out.stdout.strip().splitlines()[-1])
                 if "refused" in got:
-                    print(f"{integrator:10s} {row:26s} not taken: {got['refused'][:60]}",
+                    print(f"{integrator:10s} {row:30s} not taken: {got['refused'][:60]}",
                           flush=True)
                     continue
                 cpu = got["cpu"]
@@ -197,7 +202,7 @@ def main(argv=None):
                 if goal is not None:
                     verdict = f"goal <= {goal:.0f} s: {'PASS' if cpu <= goal else 'MISS'}"
                     ok = ok and cpu <= goal
-                print(f"{integrator:10s} {row:26s} {cpu:7.2f} s  {verdict}", flush=True)
+                print(f"{integrator:10s} {row:30s} {cpu:7.2f} s  {verdict}", flush=True)
     if shared is not None:
         shared.cleanup()
     print("all goals met" if ok else "some goals missed")

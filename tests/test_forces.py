@@ -476,6 +476,27 @@ def test_wisdom_holman_coordinates_agree_with_terms():
     assert np.abs(out[0] - out[1]).max() < 1e-5 * 7000
 
 
+@pytest.mark.parametrize("name", ["wh", "trace"])
+def test_one_loop_with_terms_for_systems_on_both_sides_of_the_lanes_threshold(name):
+    # wh's and trace's loops with terms take the terms' kick and recorder, not
+    # gravity's pair kernel, which changes at gravity.LANES_FROM massive
+    # bodies: the outer solar system (6) and the Sun with eight planets (9)
+    # get the same compiled loop (one compilation, not one on each side)
+    from orbits._kernels import gravity, trace as ktrace, wisdom_holman as kwh
+    small, large = orbits.scenes.outer_solar_system(), orbits.scenes.solar_system(moon=False)
+    assert len(small) < gravity.LANES_FROM <= len(large)
+    forces_ = [forces.GRPotential("Sun")]
+    loops = []
+    for b in (small, large):
+        sim = orbits.Simulation(b, name, dt=2 * u.day, forces=forces_)
+        force = sim._force
+        if name == "wh":
+            loops.append(kwh.wh_loop("jacobi", force.terms, force.recorder))
+        else:
+            loops.append(ktrace.trace_loop(record=force.recorder, terms=force.terms))
+    assert loops[0] is loops[1]
+
+
 def test_implicit_midpoint_takes_terms_with_their_jacobian():
     # implicit midpoint with J2: Newton converges with the analytic gravity
     # Jacobian plus the term's.  Over an orbit at 10 s its own phase error is

@@ -533,7 +533,13 @@ def with_terms(base, terms, velocity_dependent, work=None, dissipative=False):
     cache = base.cache and terms.cache
     kernel = specialize(_forced, key, cache=cache, inline=True, base=base.kernel,
                         extra=terms.accel)
-    record = specialize(_record_terms, key, cache=cache, extra_energy=terms.energy)
+    # the recorder does not call gravity's pair kernel: named by the terms
+    # alone, it is one compilation for every gravity kernel, and so is a loop
+    # that takes the terms' kick and this recorder but not the force
+    # (Wisdom-Holman's and trace's, whose kick is their own: one loop for
+    # both sides of gravity.LANES_FROM)
+    record = specialize(_record_terms, terms.key, cache=terms.cache,
+                        extra_energy=terms.energy)
     if work is not None:
         key += f"+work_{work.key}"
         cache = cache and work.cache
