@@ -476,21 +476,29 @@ def test_wisdom_holman_coordinates_agree_with_terms():
     assert np.abs(out[0] - out[1]).max() < 1e-5 * 7000
 
 
-@pytest.mark.parametrize("name", ["wh", "trace"])
-def test_one_loop_with_terms_for_systems_on_both_sides_of_the_lanes_threshold(name):
-    # wh's and trace's loops with terms take the terms' kick and recorder, not
-    # gravity's pair kernel, which changes at gravity.LANES_FROM massive
-    # bodies: the outer solar system (6) and the Sun with eight planets (9)
-    # get the same compiled loop (one compilation, not one on each side)
-    from orbits._kernels import gravity, trace as ktrace, wisdom_holman as kwh
+@pytest.mark.parametrize("name, terms, chaos", [("wh", True, False), ("trace", True, False),
+                                                 ("wh", False, True), ("wh", True, True)])
+def test_one_loop_for_systems_on_both_sides_of_the_lanes_threshold(name, terms, chaos):
+    # wh's and trace's loops with terms, and wh's tangent loop (chaos
+    # monitors), take the terms' kick and the recorders, not gravity's pair
+    # kernel, which changes at gravity.LANES_FROM massive bodies: the outer
+    # solar system (6) and the Sun with eight planets (9) get the same
+    # compiled loop (one compilation, not one on each side)
+    from orbits._kernels import gravity, trace as ktrace, wh_tangent, wisdom_holman as kwh
     small, large = orbits.scenes.outer_solar_system(), orbits.scenes.solar_system(moon=False)
     assert len(small) < gravity.LANES_FROM <= len(large)
-    forces_ = [forces.GRPotential("Sun")]
+    kw = {}
+    if terms:
+        kw["forces"] = [forces.GRPotential("Sun")]
+    if chaos:
+        kw["monitors"] = ("energy", "megno")
     loops = []
     for b in (small, large):
-        sim = orbits.Simulation(b, name, dt=2 * u.day, forces=forces_)
-        force = sim._force
-        if name == "wh":
+        force = orbits.Simulation(b, name, dt=2 * u.day, **kw)._force
+        assert force.key.startswith("var(gravity_" if chaos else "gravity_")
+        if chaos:
+            loops.append(wh_tangent.wh_tangent_loop("jacobi", force.inner.terms, force))
+        elif name == "wh":
             loops.append(kwh.wh_loop("jacobi", force.terms, force.recorder))
         else:
             loops.append(ktrace.trace_loop(record=force.recorder, terms=force.terms))

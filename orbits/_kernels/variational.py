@@ -315,7 +315,8 @@ def variational_work_kernels(force, inner_kernels):
                             inner_add=inner_kernels["work_add"]),
         work_on=specialize(_varied_work_on, key, cache=cache, inline=True,
                            inner_on=inner_kernels["work_on"]),
-        work_note=specialize(_varied_note, key, cache=cache, inline=True,
+        # (named without the force, as with_variations' record)
+        work_note=specialize(_varied_note, "var", cache=cache, inline=True,
                              inner_note=inner_kernels["work_note"],
                              MEGNO_COLUMN=MONITOR_COLUMNS.index("megno")))
 
@@ -372,7 +373,11 @@ def with_variations(force, chaos):
                         inner=force.kernel, jacobian=jac, reads=velocity_reader(force))
     jacobian = specialize(_varied_jacobian, key, jit=force.jit, cache=force.cache,
                           jacobian=jac)
-    record = specialize(_varied_record, key, jit=force.jit, cache=force.cache,
+    # the record calls the inner force's recorder, not the force: named
+    # without the force (the copy's name carries its bindings' too), so that
+    # loops that take the record but kick with their own pairs (wh's tangent
+    # loop) are one compilation for every gravity kernel
+    record = specialize(_varied_record, "var", jit=force.jit, cache=force.cache,
                         inner_record=force.recorder)
     # the record of force's own type (stepping.ForceKernel, whose loops' module
     # imports this one for the epilogue's tangent step and the work kernels)

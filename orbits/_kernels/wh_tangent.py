@@ -732,7 +732,12 @@ def _runtime(terms, cache):
 
 
 def _key(coordinates, force):
-    return f"tangent_{coordinates}_{force.key}"
+    # named by the terms, not by the force: the tangent loop kicks with its
+    # own pairs (_pair_tangent) and never calls gravity's pair kernel, which
+    # changes at gravity.LANES_FROM massive bodies, so that one loop serves
+    # systems on both sides of it
+    terms = force.inner.terms
+    return f"tangent_{coordinates}_{'gravity' if terms is None else terms.key}"
 
 
 def tangent_synchronizer(coordinates, terms, force):
