@@ -476,6 +476,22 @@ def test_wisdom_holman_coordinates_agree_with_terms():
     assert np.abs(out[0] - out[1]).max() < 1e-5 * 7000
 
 
+def test_wh_takes_a_term_with_the_chaos_monitors():
+    # wh's tangent loop with a force term and MEGNO (it once failed to
+    # compile: its chaos note read the work box that gravity with terms
+    # carries).  GRPotential moves the outer solar system's MEGNO after 1e4 yr
+    # by 5.2e-8 (measured, both coordinate systems), where the values stand
+    # 0.02 from 2: a bound of 1e-6 holds the term's effect on the tangent to
+    # its size
+    megno = []
+    for f in ([], [forces.GRPotential("Sun")]):
+        sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "wh", dt=100 * u.day,
+                                forces=f, monitors=("energy", "megno"), seed=1)
+        megno.append(np.asarray(sim.run(until=1e4 * u.yr, outputs=3, progress=False).megno))
+    assert abs(megno[1][-1] - 2.0) < 0.1
+    assert np.abs(megno[1] - megno[0]).max() < 1e-6
+
+
 @pytest.mark.parametrize("name, terms, chaos", [("wh", True, False), ("trace", True, False),
                                                  ("wh", False, True), ("wh", True, True)])
 def test_one_loop_for_systems_on_both_sides_of_the_lanes_threshold(name, terms, chaos):

@@ -100,7 +100,8 @@ from .gravity import add_pulls, pull_with_sums, zero_rows
 from .kepler import straight_drift
 from .kepler_tangent import advance_tangent_by_anomaly, kepler_drift_tangent
 from .stepping import epilogue, work_kernels
-from .variational import chaos_update, renormalise, tangent_product
+from .variational import (chaos_update, renormalise, tangent_product,
+                          variational_work_kernels)
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels,
                             heliocentric_interaction_kick, jump,
@@ -767,8 +768,12 @@ def wh_tangent_loop(coordinates, terms, force):
                           record=force.recorder)
     step = specialize(_chaos_step, key, cache=cache, inline=True, nrt=nrt,
                       inertial_tangent=_INERTIAL_TANGENT[coordinates])
+    # the note of the chaos indicators alone: wh takes conservative terms only,
+    # which do no work, and _chaos_note hands the note no force arguments (the
+    # note of gravity with terms would read their work box)
+    gravity = force.inner if force.inner.terms is None else force.inner.base
     note = specialize(_chaos_note, key, cache=cache, inline=True, nrt=nrt,
-                      note=work_kernels(force)["work_note"])
+                      note=variational_work_kernels(force, work_kernels(gravity))["work_note"])
     bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,
                         synchronize=sync)
     stop_args, stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
