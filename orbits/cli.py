@@ -581,7 +581,7 @@ def _compile(args, orbits):
 
     def report(label, seconds):
         done = f"{seconds:6.1f} s compiling" if seconds >= 0.05 else "   loaded from the cache"
-        tqdm.write(f"{label:52s} {done}", file=sys.stdout)
+        tqdm.write(f"{label:62s} {done}", file=sys.stdout)
 
     t0 = time.perf_counter()
     loops = orbits.compile_ahead(names, progress=False if args.no_progress else None,
