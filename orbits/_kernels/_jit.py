@@ -458,7 +458,11 @@ def called(kernel, nrt=True):
     if key in _CALLED:
         return _CALLED[key]
     py = kernel.py_func
-    name = f"{py.__name__}__called__{KERNEL_STAMP}"
+    # the runtime in the name as well: numba's cache keys a compilation by the
+    # function's name, code and argument types, not by its options, so two
+    # copies under one name would share one entry on disk and a new process
+    # could load the one with reference counts where the other was asked for
+    name = f"{py.__name__}__called{'' if nrt else '_bare'}__{KERNEL_STAMP}"
     func = types.FunctionType(py.__code__, py.__globals__, name, py.__defaults__,
                               py.__closure__)
     func.__qualname__ = name

@@ -168,10 +168,13 @@ def test_called_makes_one_copy_of_a_kernel_and_calling_a_copy_is_the_copy():
     assert _jit.called(_halve) is once
     assert _jit.called(once) is once
     assert once.py_func.__name__ == f"_halve__called__{_jit.KERNEL_STAMP}"
-    # a copy without numba's runtime is another function
+    # a copy without numba's runtime is another function, under another name
+    # (numba's disk cache keys a compilation by name, code and types alone)
     bare = _jit.called(once, nrt=False)
     assert bare is not once and _jit.called(bare, nrt=False) is bare
     assert once(3.0) == bare(3.0) == 1.5
+    names = {_jit.called(_halve, nrt=r).py_func.__qualname__ for r in (True, False)}
+    assert len(names) == 2
 
 
 def test_compiled_for_is_the_code_a_call_runs_typed_once():
