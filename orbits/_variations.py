@@ -25,14 +25,18 @@ def bind(sim, variations, seed):
     (:mod:`orbits._kernels.variational`), for ``variations`` and the chaos
     monitors; the force without them is kept as ``_base_force``,
     ``_base_fargs``."""
-    if sim._resolves_collisions and variations is not None:
+    chaos = [name for name in sim.monitors if name in CHAOS_MONITORS]
+    if sim._resolves_collisions and (variations is not None or chaos):
+        # a merger takes a body out and a bounce changes velocities at once:
+        # the tangent vectors follow neither
+        asked = "variations=" if variations is not None else f"the chaos monitors {chaos}"
         raise SimulationOptionError(
             f"collisions={sim._stop_config['collisions']!r} changes the bodies during the "
             f"run, which the variational equations cannot follow; use collisions='halt' "
-            f"with variations=")
+            f"with {asked}")
     sim._base_force, sim._base_fargs = sim._force, sim._fargs
     n = len(sim._m)
-    chaos = any(name in CHAOS_MONITORS for name in sim.monitors)
+    chaos = bool(chaos)
     if chaos and not sim.integrator.chaos_indicators:
         raise IntegratorOptionError(
             f"{sim.integrator.name!r} does not integrate the variational equations that "

@@ -176,6 +176,12 @@ def test_bad_resolution_options_are_refused_by_name():
         orbits.Simulation(_crossing(), "ias15", collisions="bounce", restitution=1.5)
     with pytest.raises(SimulationOptionError, match="variations"):
         orbits.Simulation(_crossing(), "ias15", collisions="merge", variations="state")
+    # the chaos monitors integrate tangent vectors too, which neither a
+    # merger nor a bounce carries (after a merger they were drawn again from
+    # a new seed, so that two runs of one simulation differed)
+    with pytest.raises(SimulationOptionError, match="megno"):
+        orbits.Simulation(_crossing(), "ias15", collisions="bounce",
+                          monitors=("energy", "megno"))
 
 
 def test_the_pair_formulas_conserve_what_they_should():
