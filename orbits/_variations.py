@@ -29,7 +29,8 @@ def bind(sim, variations, seed):
     if sim._resolves_collisions and (variations is not None or chaos):
         # a merger takes a body out and a bounce changes velocities at once:
         # the tangent vectors follow neither
-        asked = "variations=" if variations is not None else f"the chaos monitors {chaos}"
+        asked = ("variations=" if variations is not None
+                 else f"the chaos monitors ({', '.join(chaos)})")
         raise SimulationOptionError(
             f"collisions={sim._stop_config['collisions']!r} changes the bodies during the "
             f"run, which the variational equations cannot follow; use collisions='halt' "
