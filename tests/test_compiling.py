@@ -143,6 +143,32 @@ def test_orbits_compile_compiles_what_runs_add_to_gravity():
     assert _notices(proc.stderr) == []
 
 
+#: a fresh process that runs implicit Euler with MEGNO on the suite's cache
+#: and prints the run's compile seconds
+RUN_IMPLICIT_MEGNO = """
+import json
+import astropy.units as u
+import orbits
+sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "implicit-euler", dt=10 * u.day,
+                        monitors=("energy", "megno"))
+print(json.dumps(sim.run(until=50 * u.day, outputs=3, progress=False).compile_time))
+"""
+
+
+def test_an_implicit_loop_with_variations_is_loaded_in_a_new_process():
+    # its Jacobian is the package's own (the force with variations'), named
+    # the same in every process, so the loop is cached; named by its identity
+    # it was compiled again (10-14 s) in every process
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    seconds = []
+    for _ in range(2):
+        proc = subprocess.run([sys.executable, "-c", RUN_IMPLICIT_MEGNO], cwd=ROOT, env=env,
+                              capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr
+        seconds.append(json.loads(proc.stdout.splitlines()[-1]))
+    assert seconds[1] == 0, seconds
+
+
 def test_the_loops_compiled_ahead_follow_what_the_integrator_takes():
     from orbits._ahead import _variants
 

@@ -108,6 +108,10 @@ def _user_jacobian_pointer(x, v, t, fargs, jx, jv):
 #: Jacobian whose loops are cached on disk
 POINTER_KEY = "jac_pointer"
 
+# the module of the Jacobians of forces with variations (not imported here:
+# it imports this one)
+_VARIATIONAL = __name__.rpartition(".")[0] + ".variational"
+
 
 def user_jacobian_pointer():
     """The Jacobian kernel of a user's compiled ``jac`` called through its
@@ -231,9 +235,16 @@ def jacobian_for(force, velocity_dependent):
     own = getattr(force, "jacobian", None)
     if own is not None:
         # a user's compiled Jacobian through its pointer is one kernel for all
-        # (its loops are cached, POINTER_KEY); another is named by its identity
+        # (its loops are cached, POINTER_KEY); the package's own compiled one
+        # (a force with variations': orbits._kernels.variational) is a copy
+        # named by its bindings, the same name in every process, so that the
+        # loops that call it are cached too ("varied"); another is named by
+        # its identity, and its loops are not cached
         if own is user_jacobian_pointer():
             return own, POINTER_KEY
+        func = getattr(own, "py_func", None)
+        if force.cache and func is not None and func.__module__ == _VARIATIONAL:
+            return own, "varied"
         return own, f"own{id(own)}"
     if force.key in _GRAVITY_KEYS:
         return gravity_jacobian, "gravity"
