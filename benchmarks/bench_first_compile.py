@@ -21,6 +21,17 @@ whole first run (making the simulation, its monitors' kernels included, and
 running it; the import excluded) against the goals of the issue "Start in
 seconds": ``leapfrog`` <= 2 s, ``ias15`` <= 3 s, every other loop <= 6 s.
 
+Beside them, on the same host and the same scene (``--no-peers`` leaves
+them out), what a first run costs elsewhere, each in a fresh process:
+
+- numba alone: a bare kick-drift-kick leapfrog (pair gravity, no outputs,
+  monitors or checks; twenty lines) compiled from nothing, numba's own
+  start-up in it.  No loop compiled by numba starts quicker on this host.
+- heyoka.py: building ``taylor_adaptive`` for the N-body equations of the
+  outer solar system (its LLVM code made and compiled, its caches off), in
+  its default mode and in ``compact_mode``; the work of our ``taylor`` loop.
+  Skipped, saying so, where heyoka.py cannot be imported.
+
 Run ``python benchmarks/bench_first_compile.py`` (several minutes: each
 process compiles from nothing), or name loops: ``... leapfrog wh
 wh:democratic-heliocentric wh+lanes``.
@@ -56,6 +67,76 @@ _CHILD = textwrap.dedent("""
     cpu = time.process_time() - cpu
     print(json.dumps({"label": loop_label(integ, bool(lanes)), "compile": result.compile_time,
                       "wall": result.wall_time, "cpu": cpu}))
+""")
+
+_BARE_NUMBA = textwrap.dedent("""
+    import json, time
+    cpu = time.process_time()
+    import numpy as np
+    from numba import njit
+    imported = time.process_time() - cpu
+
+    @njit
+    def pulls(x, m, a):
+        n = x.shape[0]
+        a[:] = 0.0
+        for i in range(n):
+            for j in range(i + 1, n):
+                dx = x[j, 0] - x[i, 0]
+                dy = x[j, 1] - x[i, 1]
+                dz = x[j, 2] - x[i, 2]
+                r2 = dx * dx + dy * dy + dz * dz
+                f = 1.0 / (r2 * np.sqrt(r2))
+                a[i, 0] += m[j] * f * dx
+                a[i, 1] += m[j] * f * dy
+                a[i, 2] += m[j] * f * dz
+                a[j, 0] -= m[i] * f * dx
+                a[j, 1] -= m[i] * f * dy
+                a[j, 2] -= m[i] * f * dz
+
+    @njit
+    def leapfrog(x, v, m, dt, steps, a):
+        # written component by component: numba compiles loops of scalars
+        # quicker than array expressions
+        pulls(x, m, a)
+        for _ in range(steps):
+            for i in range(x.shape[0]):
+                for k in range(3):
+                    v[i, k] += 0.5 * dt * a[i, k]
+                    x[i, k] += dt * v[i, k]
+            pulls(x, m, a)
+            for i in range(x.shape[0]):
+                for k in range(3):
+                    v[i, k] += 0.5 * dt * a[i, k]
+
+    x = np.arange(18.0).reshape(6, 3)
+    v = np.ones((6, 3))
+    cpu = time.process_time()
+    leapfrog(x, v, np.ones(6), 0.01, 10, np.zeros((6, 3)))
+    print(json.dumps({"import": imported, "compile": time.process_time() - cpu}))
+""")
+
+_HEYOKA = textwrap.dedent("""
+    import json, sys, time
+    import numpy as np
+    import orbits
+    from bench_ias15 import _cold_jit, _heyoka, _nbody_integrator
+    hy, why = _heyoka()
+    if hy is None:
+        print(json.dumps({"missing": why}))
+        sys.exit()
+    bodies = orbits.scenes.outer_solar_system()
+    rows = {}
+    for compact in (False, True):
+        with _cold_jit(hy):
+            cpu = time.process_time()
+            system = hy.model.nbody(len(bodies), masses=list(bodies._m),
+                                    Gconst=bodies.units.G)
+            state = np.hstack([bodies._x, bodies._v]).ravel()
+            ta = hy.taylor_adaptive(system, state, compact_mode=compact)
+            ta.propagate_until(ta.time + 100.0)
+            rows["compact_mode" if compact else "default"] = time.process_time() - cpu
+    print(json.dumps(rows))
 """)
 
 #: an estimate is "about" the measurement within this factor
@@ -95,10 +176,35 @@ def _first_run(spec):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def _peers():
+    """Print the first runs of numba alone and of heyoka.py (see the module's
+    docstring)."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        out = run_child(["-c", _BARE_NUMBA], env=env, capture_output=True, text=True,
+                        check=True)
+    bare = json.loads(out.stdout.strip().splitlines()[-1])
+    print("\nthe same host, other first runs (CPU s, a fresh process each)")
+    print(f"{'numba alone: import':52s} {bare['import']:6.1f}")
+    print(f"{'numba alone: a bare leapfrog loop compiled':52s} {bare['compile']:6.1f}")
+    env = dict(os.environ)
+    here = str(pathlib.Path(__file__).resolve().parent)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH")) if p)
+    out = run_child(["-c", _HEYOKA], env=env, capture_output=True, text=True, check=True)
+    rows = json.loads(out.stdout.strip().splitlines()[-1])
+    if "missing" in rows:
+        print(f"heyoka.py: not measured ({rows['missing']})")
+        return
+    for mode, seconds in rows.items():
+        print(f"{'heyoka.py: taylor_adaptive built, ' + mode:52s} {seconds:6.1f}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("loops", nargs="*",
                         help="integrator, integrator:coordinates, or either +lanes")
+    parser.add_argument("--no-peers", action="store_true",
+                        help="leave out numba's bare loop and heyoka.py")
     args = parser.parse_args(argv)
     from orbits._compiling import FIRST_COMPILE_SECONDS
     print("outer solar system, first run (10 steps) on an empty numba cache: seconds "
@@ -129,6 +235,8 @@ def main(argv=None):
           f"{'PASS' if worst <= FACTOR else 'MISS'}")
     print(f"first runs within their goals: {'PASS' if not missed else 'MISS: ' + ', '.join(missed)}")
     print("measured, as a table: " + json.dumps(table))
+    if not args.no_peers:
+        _peers()
 
 
 if __name__ == "__main__":

@@ -31,22 +31,23 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "AD
            "notice", "cache_dir", "cpu_name", "stderr_is_terminal"]
 
 #: Seconds a loop's first compile takes on an empty cache: the compiling
-#: inside the first ``Simulation.run`` of the outer solar system, on the
-#: reference machine (2-core AMD EPYC, Zen 4 with AVX-512, a quiet host; on a
-#: busy one the same figure grows by up to a factor of two; measured with
-#: ``benchmarks/bench_first_compile.py``, which prints this table anew, and
-#: recorded in benchmarks/RESULTS.md).  Keyed by :func:`loop_label`; only the
-#: notice's estimate reads it.  The methods of a family share their loop
-#: (the SABA methods wh's), so a family's first method compiles it.
+#: inside the first ``Simulation.run`` of the outer solar system.  Each is the
+#: geometric middle of two 2-core AMD EPYC hosts' figures, a quiet Zen 4 with
+#: AVX-512 and a busy Zen 3 with AVX2 that compiles 1.3-2.4 times slower, so
+#: that the notice's "about" is within a factor of 1.6 of either
+#: (``benchmarks/bench_first_compile.py`` measures each loop; the figures are
+#: in benchmarks/RESULTS.md).  Keyed by :func:`loop_label`; only the notice's
+#: estimate reads it.  The methods of a family share their loop (the SABA
+#: methods wh's), so a family's first method compiles it.
 FIRST_COMPILE_SECONDS = {
-    "euler": 2.0, "symplectic-euler": 2.0, "verlet": 2.0, "leapfrog": 2.0,
-    "rk2": 2.0, "rk4": 2.0, "yoshida4": 2.0, "yoshida6": 2.0, "yoshida8": 2.0,
+    "euler": 3.0, "symplectic-euler": 3.0, "verlet": 3.0, "leapfrog": 3.0,
+    "rk2": 3.0, "rk4": 3.0, "yoshida4": 3.0, "yoshida6": 3.0, "yoshida8": 3.0,
     **{f"{name}{coords}{lanes}": seconds
        for name in ("wh", "saba2", "saba3", "saba4")
        for coords in ("", " democratic-heliocentric")
-       for lanes, seconds in (("", 13.0), (" lanes", 28.0))},
-    "dopri5": 5.0, "dop853": 5.0, "rk4-doubling": 4.0, "ias15": 6.0, "taylor": 4.0,
-    "implicit-euler": 4.0, "implicit-midpoint": 4.0, "trace": 20.0, "trace lanes": 30.0,
+       for lanes, seconds in (("", 16.0), (" lanes", 37.0))},
+    "dopri5": 7.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 9.0, "taylor": 6.0,
+    "implicit-euler": 5.0, "implicit-midpoint": 5.0, "trace": 27.0, "trace lanes": 41.0,
 }
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
@@ -109,7 +110,7 @@ def notice(label):
     --------
     >>> from orbits._compiling import notice
     >>> notice("wh")
-    'orbits: compiling the wh loop for this CPU, once (about 13 s; `orbits compile` does it ahead)'
+    'orbits: compiling the wh loop for this CPU, once (about 16 s; `orbits compile` does it ahead)'
     """
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
