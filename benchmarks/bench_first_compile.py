@@ -24,9 +24,13 @@ seconds": ``leapfrog`` <= 2 s, ``ias15`` <= 3 s, every other loop <= 6 s.
 Beside them, on the same host and the same scene (``--no-peers`` leaves
 them out), what a first run costs elsewhere, each in a fresh process:
 
-- numba alone: a bare kick-drift-kick leapfrog (pair gravity, no outputs,
-  monitors or checks; twenty lines) compiled from nothing, numba's own
-  start-up in it.  No loop compiled by numba starts quicker on this host.
+- numba alone (``benchmarks/_bare_numba.py``): a leapfrog and an IAS15 loop
+  with nothing but the method, compiled from nothing, numba's own first-use
+  set-up in it.  No loop of either kind compiled by numba starts quicker on
+  this host.
+- the package's set-up: the first run of ``leapfrog`` in a new process with
+  its loop already in the cache (the imports of astropy and numba, the
+  scene, the simulation): what a first run costs besides compiling.
 - heyoka.py: building ``taylor_adaptive`` for the N-body equations of the
   outer solar system (its LLVM code made and compiled, its caches off), in
   its default mode and in ``compact_mode``; the work of our ``taylor`` loop.
@@ -67,53 +71,6 @@ _CHILD = textwrap.dedent("""
     cpu = time.process_time() - cpu
     print(json.dumps({"label": loop_label(integ, bool(lanes)), "compile": result.compile_time,
                       "wall": result.wall_time, "cpu": cpu}))
-""")
-
-_BARE_NUMBA = textwrap.dedent("""
-    import json, time
-    cpu = time.process_time()
-    import numpy as np
-    from numba import njit
-    imported = time.process_time() - cpu
-
-    @njit
-    def pulls(x, m, a):
-        n = x.shape[0]
-        a[:] = 0.0
-        for i in range(n):
-            for j in range(i + 1, n):
-                dx = x[j, 0] - x[i, 0]
-                dy = x[j, 1] - x[i, 1]
-                dz = x[j, 2] - x[i, 2]
-                r2 = dx * dx + dy * dy + dz * dz
-                f = 1.0 / (r2 * np.sqrt(r2))
-                a[i, 0] += m[j] * f * dx
-                a[i, 1] += m[j] * f * dy
-                a[i, 2] += m[j] * f * dz
-                a[j, 0] -= m[i] * f * dx
-                a[j, 1] -= m[i] * f * dy
-                a[j, 2] -= m[i] * f * dz
-
-    @njit
-    def leapfrog(x, v, m, dt, steps, a):
-        # written component by component: numba compiles loops of scalars
-        # quicker than array expressions
-        pulls(x, m, a)
-        for _ in range(steps):
-            for i in range(x.shape[0]):
-                for k in range(3):
-                    v[i, k] += 0.5 * dt * a[i, k]
-                    x[i, k] += dt * v[i, k]
-            pulls(x, m, a)
-            for i in range(x.shape[0]):
-                for k in range(3):
-                    v[i, k] += 0.5 * dt * a[i, k]
-
-    x = np.arange(18.0).reshape(6, 3)
-    v = np.ones((6, 3))
-    cpu = time.process_time()
-    leapfrog(x, v, np.ones(6), 0.01, 10, np.zeros((6, 3)))
-    print(json.dumps({"import": imported, "compile": time.process_time() - cpu}))
 """)
 
 _HEYOKA = textwrap.dedent("""
@@ -179,14 +136,23 @@ def _first_run(spec):
 def _peers():
     """Print the first runs of numba alone and of heyoka.py (see the module's
     docstring)."""
+    print("\nthe same host, other first runs (CPU s, a fresh process each)")
+    bare = pathlib.Path(__file__).resolve().parent / "_bare_numba.py"
+    for loop in ("leapfrog", "ias15"):
+        with tempfile.TemporaryDirectory() as cache:
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+            out = run_child([str(bare), loop], env=env, capture_output=True, text=True,
+                            check=True)
+        row = json.loads(out.stdout.strip().splitlines()[-1])
+        print(f"{'numba alone: a bare ' + loop + ' loop compiled':52s} {row['compile']:6.1f}"
+              f"   (importing numba {row['import']:.1f})")
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        out = run_child(["-c", _BARE_NUMBA], env=env, capture_output=True, text=True,
+        run_child(["-c", _CHILD, "leapfrog"], env=env, capture_output=True, check=True)
+        out = run_child(["-c", _CHILD, "leapfrog"], env=env, capture_output=True, text=True,
                         check=True)
-    bare = json.loads(out.stdout.strip().splitlines()[-1])
-    print("\nthe same host, other first runs (CPU s, a fresh process each)")
-    print(f"{'numba alone: import':52s} {bare['import']:6.1f}")
-    print(f"{'numba alone: a bare leapfrog loop compiled':52s} {bare['compile']:6.1f}")
+    row = json.loads(out.stdout.strip().splitlines()[-1])
+    print(f"{'the package: leapfrog first run, its loop cached':52s} {row['cpu']:6.1f}")
     env = dict(os.environ)
     here = str(pathlib.Path(__file__).resolve().parent)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH")) if p)

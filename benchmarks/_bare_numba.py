@@ -1,0 +1,160 @@
+"""Two stepping loops with nothing but the method, compiled by numba alone:
+what numba takes on this host to compile the least loop of each kind.
+
+``python benchmarks/_bare_numba.py leapfrog|ias15`` compiles one of them in
+this process (an empty cache: nothing here is cached) and prints, as JSON,
+the CPU seconds of importing numba and of the loop's first call (its
+compiling, numba's own first-use set-up included, no steps taken).
+``... ias15 --check`` instead integrates a circular orbit for ten periods
+and prints the radius's largest departure from 1.
+
+- ``leapfrog``: kick-drift-kick with the pairwise pull, written component by
+  component (numba compiles loops of scalars quicker than array
+  expressions).
+- ``ias15``: the Gauss-Radau predictor-corrector of IAS15 (Rein & Spiegel
+  2015) over seven substeps with the package's tables, iterated to
+  convergence, and the global step control.  No compensated sums, outputs,
+  landing on times, monitors, stopping conditions or checks of the state:
+  what every run of the package's loops has besides.
+
+Run by ``benchmarks/bench_first_compile.py`` beside the package's first runs.
+"""
+
+import json
+import math
+import sys
+import time
+
+_cpu = time.process_time()
+import numpy as np  # noqa: E402 - the import is what is timed
+from numba import njit  # noqa: E402
+_IMPORTED = time.process_time() - _cpu
+
+
+@njit
+def pulls(x, m, a):
+    n = x.shape[0]
+    for i in range(n):
+        for d in range(3):
+            a[i, d] = 0.0
+    for i in range(n):
+        for j in range(i + 1, n):
+            dx = x[j, 0] - x[i, 0]
+            dy = x[j, 1] - x[i, 1]
+            dz = x[j, 2] - x[i, 2]
+            r2 = dx * dx + dy * dy + dz * dz
+            f = 1.0 / (r2 * math.sqrt(r2))
+            a[i, 0] += m[j] * f * dx
+            a[i, 1] += m[j] * f * dy
+            a[i, 2] += m[j] * f * dz
+            a[j, 0] -= m[i] * f * dx
+            a[j, 1] -= m[i] * f * dy
+            a[j, 2] -= m[i] * f * dz
+
+
+@njit
+def leapfrog(x, v, m, dt, steps, a):
+    pulls(x, m, a)
+    for _ in range(steps):
+        for i in range(x.shape[0]):
+            for d in range(3):
+                v[i, d] += 0.5 * dt * a[i, d]
+                x[i, d] += dt * v[i, d]
+        pulls(x, m, a)
+        for i in range(x.shape[0]):
+            for d in range(3):
+                v[i, d] += 0.5 * dt * a[i, d]
+
+
+@njit
+def ias15(x, v, m, t, t_end, dt, eps, H, R, C):
+    n = x.shape[0]
+    a0 = np.zeros((n, 3))
+    a = np.zeros((n, 3))
+    xs = np.zeros((n, 3))
+    b = np.zeros((7, n, 3))
+    g = np.zeros((7, n, 3))
+    while t < t_end:
+        dt = min(dt, t_end - t)
+        pulls(x, m, a0)
+        b[...] = 0.0
+        g[...] = 0.0
+        for _ in range(12):
+            db6 = 0.0
+            for s in range(1, 8):
+                h = H[s - 1]
+                for i in range(n):
+                    for d in range(3):
+                        p = 0.0
+                        for k in range(6, -1, -1):
+                            p = (p + b[k, i, d] / ((k + 2) * (k + 3))) * h
+                        xs[i, d] = x[i, d] + h * dt * (v[i, d] + h * dt * (
+                            0.5 * a0[i, d] + p))
+                pulls(xs, m, a)
+                for i in range(n):
+                    for d in range(3):
+                        r = (a[i, d] - a0[i, d]) * R[s, 0]
+                        for j in range(1, s):
+                            r = (r - g[j - 1, i, d]) * R[s, j]
+                        dg = r - g[s - 1, i, d]
+                        g[s - 1, i, d] = r
+                        for k in range(s):
+                            b[k, i, d] += C[k, s - 1] * dg
+                        if s == 7:
+                            db6 = max(db6, abs(dg))
+            amax = 0.0
+            for i in range(n):
+                for d in range(3):
+                    amax = max(amax, abs(a[i, d]))
+            if db6 <= 1e-16 * amax:
+                break
+        b6 = 0.0
+        for i in range(n):
+            for d in range(3):
+                b6 = max(b6, abs(b[6, i, d]))
+                sx = 0.5 * a0[i, d]
+                sv = a0[i, d]
+                for k in range(7):
+                    sx += b[k, i, d] / ((k + 2) * (k + 3))
+                    sv += b[k, i, d] / (k + 2)
+                x[i, d] += dt * (v[i, d] + dt * sx)
+                v[i, d] += dt * sv
+        t += dt
+        if b6 > 0.0 and amax > 0.0:
+            dt = min(dt * (eps / (b6 / amax)) ** (1.0 / 7.0), dt / 0.25)
+    return t
+
+
+def _tables():
+    from orbits._kernels.ias15 import _C, _H, _R
+    return _H, _R, _C
+
+
+def main(argv):
+    which = argv[0]
+    x = np.arange(18.0).reshape(6, 3)
+    v = np.ones((6, 3))
+    m = np.ones(6)
+    if which == "leapfrog":
+        cpu = time.process_time()
+        leapfrog(x, v, m, 0.01, 0, np.zeros((6, 3)))
+    elif which == "ias15" and "--check" in argv:
+        x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+        v = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+        m = np.array([1.0, 0.0])
+        worst = 0.0
+        t = 0.0
+        for _ in range(10):
+            t = ias15(x, v, m, t, t + 2 * math.pi, 0.1, 1e-9, *_tables())
+            worst = max(worst, abs(math.hypot(*(x[1] - x[0])) - 1.0))
+        print(json.dumps({"radius_error": worst}))
+        return
+    else:
+        tables = _tables()
+        cpu = time.process_time()
+        ias15(x, v, m, 0.0, 0.0, 0.01, 1e-9, *tables)
+    print(json.dumps({"import": _IMPORTED, "compile": time.process_time() - cpu}))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
