@@ -218,7 +218,10 @@ def test_sim_bodies_by_name_is_the_current_state_and_a_kept_view_a_snapshot():
 # -- result["name"] -----------------------------------------------------------------------
 
 def test_a_track_is_the_bodys_column_of_the_outputs():
-    sim = orbits.Simulation(_system(), "ias15")
+    # the outer solar system (six massive bodies): ias15's loop for small
+    # systems, which other tests compile too; _system's seven massive bodies
+    # would take the loop with gravity in vector lanes (18 s to compile)
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(com=True), "ias15")
     result = sim.run(until=20 * u.yr, outputs=5, progress=False)
     track = result["Saturn"]
     assert isinstance(track, Track) and track.name == "Saturn" and track.index == 2
