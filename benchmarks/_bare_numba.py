@@ -1,16 +1,20 @@
 """Two stepping loops with nothing but the method, compiled by numba alone:
 what numba takes on this host to compile the least loop of each kind.
 
-``python benchmarks/_bare_numba.py leapfrog|ias15`` compiles one of them in
+``python benchmarks/_bare_numba.py leapfrog|wh|ias15`` compiles one of them in
 this process (an empty cache: nothing here is cached) and prints, as JSON,
 the CPU seconds of importing numba and of the loop's first call (its
 compiling, numba's own first-use set-up included, no steps taken).
-``... ias15 --check`` instead integrates a circular orbit for ten periods
-and prints the radius's largest departure from 1.
+``... ias15 --check`` (or ``wh``) instead integrates a circular orbit for
+ten periods and prints the radius's largest departure from 1.
 
 - ``leapfrog``: kick-drift-kick with the pairwise pull, written component by
   component (numba compiles loops of scalars quicker than array
   expressions).
+- ``wh``: a Wisdom-Holman step in democratic heliocentric coordinates
+  (Duncan, Levison & Lee 1998): each planet's Kepler drift by the universal
+  variable with Stumpff's functions and Newton's iteration, the planets'
+  mutual pulls, the star's jump.
 - ``ias15``: the Gauss-Radau predictor-corrector of IAS15 (Rein & Spiegel
   2015) over seven substeps with the package's tables, iterated to
   convergence, and the global step control.  No compensated sums, outputs,
@@ -125,6 +129,94 @@ def ias15(x, v, m, t, t_end, dt, eps, H, R, C):
     return t
 
 
+@njit
+def _stumpff(z):
+    # c0..c3 of Stumpff by their series (|z| small) or closed forms
+    if abs(z) < 1e-2:
+        c3 = (1.0 - z / 20.0 * (1.0 - z / 42.0 * (1.0 - z / 72.0))) / 6.0
+        c2 = (1.0 - z / 12.0 * (1.0 - z / 30.0 * (1.0 - z / 56.0))) / 2.0
+    elif z > 0.0:
+        q = math.sqrt(z)
+        c2 = (1.0 - math.cos(q)) / z
+        c3 = (q - math.sin(q)) / (z * q)
+    else:
+        q = math.sqrt(-z)
+        c2 = (math.cosh(q) - 1.0) / -z
+        c3 = (math.sinh(q) - q) / (-z * q)
+    return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+
+
+@njit
+def kepler_drift(x, v, mu, dt):
+    # one body's two-body drift by dt about a centre of G mass mu, in place
+    r0 = math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2])
+    eta = x[0] * v[0] + x[1] * v[1] + x[2] * v[2]
+    beta = 2.0 * mu / r0 - (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    s = dt / r0
+    for _ in range(50):
+        c0, c1, c2, c3 = _stumpff(beta * s * s)
+        g1 = s * c1
+        g2 = s * s * c2
+        g3 = s * s * s * c3
+        r = r0 * c0 + eta * g1 + mu * g2
+        ds = (r0 * g1 + eta * g2 + mu * g3 - dt) / r
+        s -= ds
+        if abs(ds) <= 1e-15 * abs(s):
+            break
+    c0, c1, c2, c3 = _stumpff(beta * s * s)
+    g1 = s * c1
+    g2 = s * s * c2
+    g3 = s * s * s * c3
+    r = r0 * c0 + eta * g1 + mu * g2
+    f = 1.0 - mu * g2 / r0
+    g = dt - mu * g3
+    fd = -mu * g1 / (r0 * r)
+    gd = 1.0 - mu * g2 / r
+    for d in range(3):
+        xd = x[d]
+        x[d] = f * xd + g * v[d]
+        v[d] = fd * xd + gd * v[d]
+
+
+@njit
+def _jump(x, v, m, h):
+    # the star's part: every planet moved by h times the planets' momentum
+    # over the star's mass
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    for i in range(1, x.shape[0]):
+        p0 += m[i] * v[i, 0]
+        p1 += m[i] * v[i, 1]
+        p2 += m[i] * v[i, 2]
+    for i in range(1, x.shape[0]):
+        x[i, 0] += h * p0 / m[0]
+        x[i, 1] += h * p1 / m[0]
+        x[i, 2] += h * p2 / m[0]
+
+
+@njit
+def _kick(x, v, m, h, a):
+    # the planets' mutual pulls
+    pulls(x[1:], m[1:], a[1:])
+    for i in range(1, x.shape[0]):
+        for d in range(3):
+            v[i, d] += h * a[i, d]
+
+
+@njit
+def wh(x, v, m, dt, steps, a):
+    # democratic heliocentric: x the planets' heliocentric positions, v their
+    # barycentric velocities (rows 1..), m G times the masses, the star's
+    # first; a step is kick, jump, drift, jump, kick
+    for _ in range(steps):
+        _kick(x, v, m, 0.5 * dt, a)
+        _jump(x, v, m, 0.5 * dt)
+        for i in range(1, x.shape[0]):
+            kepler_drift(x[i], v[i], m[0], dt)
+        _jump(x, v, m, 0.5 * dt)
+        _kick(x, v, m, 0.5 * dt, a)
+
 def _tables():
     from orbits._kernels.ias15 import _C, _H, _R
     return _H, _R, _C
@@ -138,6 +230,19 @@ def main(argv):
     if which == "leapfrog":
         cpu = time.process_time()
         leapfrog(x, v, m, 0.01, 0, np.zeros((6, 3)))
+    elif which == "wh" and "--check" in argv:
+        x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+        v = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+        m = np.array([1.0, 0.0])
+        worst = 0.0
+        for _ in range(10):
+            wh(x, v, m, 2 * math.pi / 20, 20, np.zeros((2, 3)))
+            worst = max(worst, abs(math.hypot(*x[1]) - 1.0))
+        print(json.dumps({"radius_error": worst}))
+        return
+    elif which == "wh":
+        cpu = time.process_time()
+        wh(x, v, m, 0.01, 0, np.zeros((6, 3)))
     elif which == "ias15" and "--check" in argv:
         x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
         v = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])

@@ -24,10 +24,10 @@ seconds": ``leapfrog`` <= 2 s, ``ias15`` <= 3 s, every other loop <= 6 s.
 Beside them, on the same host and the same scene (``--no-peers`` leaves
 them out), what a first run costs elsewhere, each in a fresh process:
 
-- numba alone (``benchmarks/_bare_numba.py``): a leapfrog and an IAS15 loop
-  with nothing but the method, compiled from nothing, numba's own first-use
-  set-up in it.  No loop of either kind compiled by numba starts quicker on
-  this host.
+- numba alone (``benchmarks/_bare_numba.py``): a leapfrog, a Wisdom-Holman
+  (democratic heliocentric) and an IAS15 loop with nothing but the method,
+  compiled from nothing, numba's own first-use set-up in it.  No loop of
+  these kinds compiled by numba starts quicker on this host.
 - the package's set-up: the first run of ``leapfrog`` in a new process with
   its loop already in the cache (the imports of astropy and numba, the
   scene, the simulation): what a first run costs besides compiling.
@@ -138,7 +138,7 @@ def _peers():
     docstring)."""
     print("\nthe same host, other first runs (CPU s, a fresh process each)")
     bare = pathlib.Path(__file__).resolve().parent / "_bare_numba.py"
-    for loop in ("leapfrog", "ias15"):
+    for loop in ("leapfrog", "wh", "ias15"):
         with tempfile.TemporaryDirectory() as cache:
             env = dict(os.environ, NUMBA_CACHE_DIR=cache)
             out = run_child([str(bare), loop], env=env, capture_output=True, text=True,
