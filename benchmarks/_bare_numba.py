@@ -1,4 +1,4 @@
-"""Two stepping loops with nothing but the method, compiled by numba alone:
+"""Three stepping loops with nothing but the method, compiled by numba alone:
 what numba takes on this host to compile the least loop of each kind.
 
 ``python benchmarks/_bare_numba.py leapfrog|wh|ias15`` compiles one of them in
