@@ -87,10 +87,8 @@ _HEYOKA = textwrap.dedent("""
     for compact in (False, True):
         with _cold_jit(hy):
             cpu = time.process_time()
-            system = hy.model.nbody(len(bodies), masses=list(bodies._m),
-                                    Gconst=bodies.units.G)
-            state = np.hstack([bodies._x, bodies._v]).ravel()
-            ta = hy.taylor_adaptive(system, state, compact_mode=compact)
+            # heyoka.py's default tolerance, the machine epsilon
+            ta = _nbody_integrator(hy, bodies, np.finfo(float).eps, compact_mode=compact)
             ta.propagate_until(ta.time + 100.0)
             rows["compact_mode" if compact else "default"] = time.process_time() - cpu
     print(json.dumps(rows))
@@ -125,39 +123,38 @@ def _loops():
     return out
 
 
-def _first_run(spec):
+def _child_rows(*runs, pythonpath=None):
+    """Run child processes (each a list of arguments after ``python``) one
+    after the other on one new, empty numba cache; the JSON of the last
+    line each printed.  ``pythonpath``: a directory put first on the
+    children's module path."""
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        out = run_child(["-c", _CHILD, spec], env=env, capture_output=True, text=True,
-                        check=True)
-    return json.loads(out.stdout.strip().splitlines()[-1])
+        if pythonpath:
+            env["PYTHONPATH"] = os.pathsep.join(
+                p for p in (pythonpath, env.get("PYTHONPATH")) if p)
+        outs = [run_child(args, env=env, capture_output=True, text=True, check=True)
+                for args in runs]
+    return [json.loads(out.stdout.strip().splitlines()[-1]) for out in outs]
+
+
+def _first_run(spec):
+    return _child_rows(["-c", _CHILD, spec])[0]
 
 
 def _peers():
     """Print the first runs of numba alone and of heyoka.py (see the module's
     docstring)."""
     print("\nthe same host, other first runs (CPU s, a fresh process each)")
-    bare = pathlib.Path(__file__).resolve().parent / "_bare_numba.py"
+    here = pathlib.Path(__file__).resolve().parent
     for loop in ("leapfrog", "wh", "ias15"):
-        with tempfile.TemporaryDirectory() as cache:
-            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-            out = run_child([str(bare), loop], env=env, capture_output=True, text=True,
-                            check=True)
-        row = json.loads(out.stdout.strip().splitlines()[-1])
+        row, = _child_rows([str(here / "_bare_numba.py"), loop])
         print(f"{'numba alone: a bare ' + loop + ' loop compiled':52s} {row['compile']:6.1f}"
               f"   (importing numba {row['import']:.1f})")
-    with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        run_child(["-c", _CHILD, "leapfrog"], env=env, capture_output=True, check=True)
-        out = run_child(["-c", _CHILD, "leapfrog"], env=env, capture_output=True, text=True,
-                        check=True)
-    row = json.loads(out.stdout.strip().splitlines()[-1])
+    # the second run loads the loop the first compiled
+    _, row = _child_rows(["-c", _CHILD, "leapfrog"], ["-c", _CHILD, "leapfrog"])
     print(f"{'the package: leapfrog first run, its loop cached':52s} {row['cpu']:6.1f}")
-    env = dict(os.environ)
-    here = str(pathlib.Path(__file__).resolve().parent)
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH")) if p)
-    out = run_child(["-c", _HEYOKA], env=env, capture_output=True, text=True, check=True)
-    rows = json.loads(out.stdout.strip().splitlines()[-1])
+    rows, = _child_rows(["-c", _HEYOKA], pythonpath=str(here))
     if "missing" in rows:
         print(f"heyoka.py: not measured ({rows['missing']})")
         return

@@ -219,12 +219,13 @@ def _final_positions(ta, n):
     return np.array(ta.state.reshape(n, 6)[:, :3], dtype=float)
 
 
-def _nbody_integrator(hy, bodies, tol, fp_type=float, high_accuracy=False):
-    """heyoka.py's Taylor integrator on the N-body equations of ``bodies``."""
+def _nbody_integrator(hy, bodies, tol, fp_type=float, high_accuracy=False, **options):
+    """heyoka.py's Taylor integrator on the N-body equations of ``bodies``
+    (``options``: more of ``taylor_adaptive``'s, e.g. ``compact_mode``)."""
     system = hy.model.nbody(len(bodies), masses=[fp_type(m) for m in bodies._m],
                             Gconst=fp_type(bodies.units.G))
     return hy.taylor_adaptive(system, _state(bodies).astype(fp_type), tol=fp_type(tol),
-                              fp_type=fp_type, high_accuracy=high_accuracy)
+                              fp_type=fp_type, high_accuracy=high_accuracy, **options)
 
 
 class _cold_jit:
