@@ -13,8 +13,18 @@ start stay quick; ``orbits.Simulation`` or ``from orbits import Simulation``
 imports what it needs.
 """
 
+import os as _os
 from importlib import import_module as _import_module
 from importlib.util import find_spec as _find_spec
+
+# numba formats a message for every overload it tries and rejects while it
+# types a kernel, thousands in a loop's first compilation; where colorama is
+# installed each one re-wraps the standard streams to highlight the message.
+# numba's switch for that (read once, when numba is first imported) takes a
+# tenth off a first compilation: benchmarks/RESULTS.md, "bench_first_compile".
+# A user's own setting stands; a numba imported before this package keeps the
+# highlighting it chose.
+_os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
 
 #: public name -> the module that defines it, relative to this package; a name
 #: whose module is itself (``scenes``) is a submodule

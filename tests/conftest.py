@@ -6,6 +6,10 @@ import threading
 import numpy as np
 import pytest
 
+# the package first, before any test module imports numba: its numba settings
+# (orbits/__init__.py) apply only to a numba imported after it
+import orbits  # noqa: F401, I001
+
 
 @pytest.fixture(scope="session", autouse=True)
 def _ctrl_c_raises_as_at_a_terminal():

@@ -301,3 +301,26 @@ def test_no_slot_shadows_a_name_its_module_imports_or_defines():
             other |= names
         clashes += [f"{path.name}: {n}" for n in sorted(slotted & other)]
     assert not clashes, clashes
+
+
+def test_importing_the_package_first_turns_off_numbas_message_highlighting():
+    # numba re-wraps the standard streams for every rejected overload it
+    # formats while typing, where colorama is installed (the tests' and docs'
+    # extras install it); the package sets numba's documented switch before
+    # numba is imported.  A message formatted with highlighting carries ANSI
+    # escapes; here it must not (a fresh process: this one imported numba
+    # before the package)
+    import subprocess
+    import sys
+    code = ("import orbits, numba\n"
+            "@numba.njit\n"
+            "def f(x):\n"
+            "    return x.no_such_attribute\n"
+            "try:\n"
+            "    f(1.0)\n"
+            "except numba.core.errors.TypingError as e:\n"
+            "    print(repr(str(e)))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert "no_such_attribute" in out
+    assert "\\x1b[" not in out
