@@ -35,6 +35,7 @@ compilation options are the same everywhere and can be changed once.
   copy of its IR): the same code, in half the time for the largest loops.
 """
 
+import ctypes
 import hashlib
 import pathlib
 import types
@@ -47,7 +48,8 @@ from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
            "compiled_for",
-           "cfunc", "pointer", "Pointer", "address_caller", "fma", "value", "data_pointer",
+           "cfunc", "pointer", "idle_pointer", "Pointer", "address_caller", "fma", "value",
+           "data_pointer",
            "cpu_name",
            "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
@@ -130,22 +132,45 @@ class Pointer:
         return self.cfunc(*args)
 
 
-def pointer(kernel, signature):
+def pointer(kernel, signature, cache=True):
     """``kernel`` (a compiled function, or a plain one) compiled as a C
     callable of ``signature`` (:func:`cfunc`), as a :class:`Pointer`.  A
     compiled kernel's own code is compiled, cached under its name, not a
     function that calls it, so that a call through the pointer hands the
     arguments over once (a wrapper would hand them on again, which shows
-    beside the stopping conditions' 16 arguments, nine of them arrays)."""
+    beside the stopping conditions' 16 arguments, nine of them arrays).
+    ``cache``: False where the kernel cannot be cached (it binds a user's
+    function)."""
     py = getattr(kernel, "py_func", None)
     if py is None:
-        return Pointer(cfunc(signature, kernel))
+        return Pointer(cfunc(signature, kernel, cache))
     name = f"{py.__name__}__pointer"
     func = types.FunctionType(py.__code__, py.__globals__, name, py.__defaults__,
                               py.__closure__)
     func.__qualname__ = name
     func.__module__ = py.__module__
-    return Pointer(cfunc(signature, func))
+    return Pointer(cfunc(signature, func, cache))
+
+
+#: a C callable that takes nothing and returns 0, for :func:`idle_pointer`
+_IDLE = ctypes.CFUNCTYPE(ctypes.c_int64)(lambda: 0)
+_IDLE_POINTERS = {}
+
+
+def idle_pointer(signature):
+    """A :class:`Pointer` of ``signature`` that is never to be called: for a
+    loop argument the loop calls only where its data say so, in a run whose
+    data say not (wh's escape check without stopping conditions).  The loop
+    is typed, compiled and cached as for the real pointer of the signature,
+    and nothing else is compiled.  numba takes no address of 0: the address
+    is that of a C callable that takes nothing and returns the integer 0."""
+    found = _IDLE_POINTERS.get(signature)
+    if found is None:
+        found = _IDLE_POINTERS[signature] = Pointer.__new__(Pointer)
+        found.cfunc = None
+        found._numba_type_ = nbtypes.FunctionType(signature)
+        found._address = ctypes.cast(_IDLE, ctypes.c_void_p).value
+    return found
 
 
 def compiled_for(kernel, *args):

@@ -103,7 +103,7 @@ from .stepping import epilogue, work_kernels
 from .variational import (chaos_update, renormalise, tangent_product,
                           variational_work_kernels)
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
-                            _synchronize, _wh_loop, escape_kernels,
+                            _synchronize, _wh_loop, escape_kernels, escape_pointer,
                             heliocentric_interaction_kick, jump,
                             short_step_anomalies)
 
@@ -117,7 +117,8 @@ __all__ = ["drift_tangent", "interaction_kick_and_tangent",
            "jump_tangent",
            "heliocentric_kick_tangent", "to_jacobi_tangent", "from_jacobi_tangent",
            "to_heliocentric_tangent", "from_heliocentric_tangent", "jacobi_inertial_tangent",
-           "heliocentric_inertial_tangent", "wh_tangent_loop", "tangent_synchronizer"]
+           "heliocentric_inertial_tangent", "wh_tangent_loop", "tangent_loop_escape",
+           "tangent_synchronizer"]
 
 
 # -- coordinates -------------------------------------------------------------------------
@@ -741,6 +742,23 @@ def _key(coordinates, force):
     return f"tangent_{coordinates}_{'gravity' if terms is None else terms.key}"
 
 
+def tangent_loop_escape(coordinates, terms, force, stopping, sync, conditions):
+    """The ``escape`` argument of :func:`wh_tangent_loop`'s loop: the escape
+    check on the bodies (:func:`~orbits._kernels.wisdom_holman.escape_pointer`)
+    for a run with stopping ``conditions``, or without; ``stopping`` the
+    stopping record and ``sync`` a
+    :class:`~orbits._kernels.wisdom_holman.Sync` of the values the loop
+    hands its synchronisation."""
+    key = _key(coordinates, force)
+    cache = force.cache
+    bodies = None
+    if conditions:
+        bodies = specialize(_tangent_bodies, key, cache=cache, inline=True,
+                            nrt=_runtime(terms, cache),
+                            synchronize=_kernels(coordinates, terms, key, cache)[3])
+    return escape_pointer(key, bodies, stopping, sync, conditions, cache)
+
+
 def tangent_synchronizer(coordinates, terms, force):
     """The compiled synchronisation (bodies and the tangent vectors that
     ``targs[1][2]`` counts) for a force with variations, ``force``, whose
@@ -755,7 +773,8 @@ def wh_tangent_loop(coordinates, terms, force):
     compiled with the tangent of every operator, for a force with variations
     ``force`` (its ``inner`` the gravity, with ``terms``); with the chaos
     indicators after every step where they are on (data of the arguments), and with the escape check
-    of :func:`~orbits._kernels.wisdom_holman.escape_kernels` on the bodies.
+    of :func:`~orbits._kernels.wisdom_holman.escape_kernels` on the bodies
+    (its ``escape`` argument :func:`tangent_loop_escape`'s).
     Called with ``targs = (terms' args, tp)`` (see the module notes), ``gm``
     and ``eta`` of the bodies alone (``n`` entries), the state arrays of
     ``n (1 + K)`` rows and a stopping record
@@ -774,9 +793,7 @@ def wh_tangent_loop(coordinates, terms, force):
     gravity = force.inner if force.inner.terms is None else force.inner.base
     note = specialize(_chaos_note, key, cache=cache, inline=True, nrt=nrt,
                       note=variational_work_kernels(force, work_kernels(gravity))["work_note"])
-    bodies = specialize(_tangent_bodies, key, cache=cache, inline=True, nrt=nrt,
-                        synchronize=sync)
-    stop_args, stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
+    stop_args, stop = escape_kernels(key, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{key}", nrt=nrt, cache=cache,
                       to_internal=called(to_internal, nrt),
                       drift=_drift, owed_drift=called(_drift, nrt), perturbation=perturbation,

@@ -101,9 +101,11 @@ References
 import math
 from typing import NamedTuple
 
+import numba
 import numpy as np
+from numba.core import types as nbtypes
 
-from ._jit import called, njit, slots, specialize
+from ._jit import called, idle_pointer, njit, pointer, slots, specialize
 from .coordinates import (from_democratic_heliocentric, from_jacobi, from_jacobi_one,
                           jacobi_step, to_democratic_heliocentric, to_jacobi,
                           weighted_sum)
@@ -119,16 +121,17 @@ from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, resident_drift_
 from .wh_lanes import resident_drift as resident_drift_rows
 
 # the names the templates below are written against, bound by specialize
-(HELIOCENTRIC, convert, drift, escape_check, extra, from_internal, owed_drift,
+(HELIOCENTRIC, convert, drift, extra, from_internal, owed_drift,
  perturbation, step, step_end, synchronize_bodies, term_kick, to_internal, sync_kernel,
  corrector_kernel, record) = slots(
-    "HELIOCENTRIC", "convert", "drift", "escape_check", "extra",
+    "HELIOCENTRIC", "convert", "drift", "extra",
     "from_internal", "owed_drift", "perturbation", "step", "step_end", "synchronize_bodies",
     "term_kick", "to_internal", "sync_kernel", "corrector_kernel", "record")
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
-           "synchronize", "apply_corrector", "may_escape", "escape_kernels",
+           "synchronize", "apply_corrector", "may_escape", "escape_kernels", "escape_pointer",
+           "loop_escape",
            "COORDINATE_SYSTEMS", "ESCAPE_MARGIN"]
 
 
@@ -537,11 +540,12 @@ class Recording(NamedTuple):
     sync: Sync
 
 
-def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, targs):
+def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, targs):
     # system: a System record, work: a Work record; checks, check: the Checks
     # record (orbits._kernels.records) and the stopping conditions' pointer,
-    # whose escape conditions the loops without lanes check (see
-    # escape_kernels)
+    # whose escape conditions the loops without lanes check through the
+    # escape pointer (see escape_kernels; the lanes' loop takes any pointer
+    # and calls none)
     gm, eta, n_active, corr, kinds, coefs = system
     xj, vj, acc, xs, vs, state, owed_box, cdt = work
     mon, step0, mon_t, mon_out = outputs
@@ -608,7 +612,7 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, targs):
             status, done, until_check, until_record, n_mon = step_end(
                 xj, vj, t + (k + 1) * dt, k, nsteps, not RESIDENT, until_check, check_every,
                 until_record, every, Recording(mon, sync), n_mon, mon_t, mon_out,
-                stop_args(stopping, sync), sync)
+                stop_args(stopping, sync, escape), sync)
         else:
             status, done = Status.NON_FINITE, k
         if status != GO:
@@ -628,7 +632,7 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, targs):
 
 
 @njit(inline="always")
-def _no_stop_args(stopping, sync):
+def _no_stop_args(stopping, sync, escape):
     # what the epilogue's stopping check takes: nothing in the lanes' loop,
     # which checks no conditions
     return ()
@@ -689,22 +693,25 @@ def may_escape(xj, vj, gm, eta, owed, corr, esc2):
     return not reach * reach <= esc2
 
 
-def _escape_args(stopping, sync):
-    return (stopping, sync)
+def _escape_args(stopping, sync, escape):
+    return (stopping, sync, escape)
 
 
+@njit(inline="always")
 def _escape_gate(xj, vj, t, args):
-    # without conditions, a branch
-    if args[0][0][0] == 0:
+    # without conditions, a branch; with them, the escape check through the
+    # loop's escape pointer (escape_pointer)
+    stopping, sync, escape = args
+    if stopping[0][0] == 0:
         return 0
-    return escape_check(xj, vj, t, args)
+    return escape(xj, vj, t, stopping, sync)
 
 
-def _escape_check(xj, vj, t, args):
+def _escape_check(xj, vj, t, stopping, sync):
     # the escape conditions of orbits._kernels.stopping (ESCAPE, UNBOUND) on
     # the inertial state at the end of the step, which is synchronised into
-    # x, v (as for an output) only where a body may be beyond the distance
-    stopping, sync = args
+    # x, v (as for an output) only where a body may be beyond the distance;
+    # stopping: the stopping record (sargs, check)
     sargs = stopping[0]
     gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
     if not may_escape(xj, vj, gm, eta, owed, corr, sargs[3]):
@@ -719,20 +726,43 @@ def _synchronize_bodies(xj, vj, sync):
                 targs)
 
 
-def escape_kernels(key, synchronize_bodies, cache=True, nrt=False):
+def escape_kernels(key, cache=True, nrt=False):
     """The bindings of :func:`_wh_loop` and of its step epilogue's stopping
     check for a loop that checks escapes (``escape_distance``, and
     ``escape_unbound``, of :class:`orbits.Simulation`) where its stopping
     record has conditions, compiled under ``key``: ``(stop_args, check)``.
-    ``synchronize_bodies(xj, vj, sync)`` writes the bodies' inertial state
-    into ``x``, ``v`` of ``sync`` (the synchronisation's arguments, as the
-    loop hands them to its epilogue)."""
-    check = specialize(_escape_check, key, cache=cache, nrt=nrt,
-                       synchronize_bodies=synchronize_bodies)
-    gate = specialize(_escape_gate, key, cache=cache, inline=True, nrt=nrt,
-                      escape_check=check)
+    The check calls the loop's ``escape`` argument, :func:`escape_pointer`'s,
+    with the internal state, the stopping record and the synchronisation's
+    arguments (a :class:`Sync`)."""
     args = specialize(_escape_args, key, cache=cache, inline=True, nrt=nrt)
-    return args, gate
+    return args, _escape_gate
+
+
+_ESCAPE_POINTERS = {}
+
+
+def escape_pointer(key, synchronize_bodies, stopping, sync, conditions, cache=True):
+    """The ``escape`` argument of a loop compiled with :func:`escape_kernels`
+    under ``key``: the escape check as a C callable, which
+    ``synchronize_bodies(xj, vj, sync)`` (writing the bodies' inertial state
+    into ``x``, ``v`` of ``sync``) serves, compiled on first use and cached
+    on disk; or, where the run has no stopping ``conditions``, a pointer of
+    the same type that is never called (:func:`~._jit.idle_pointer`), so
+    that a run without conditions compiles no escape check and one with
+    them the check alone (which calls the stopping record's own pointer, the
+    conditions' check every loop shares).  ``stopping``, ``sync``: the
+    stopping record (:func:`~.stopping.stop_record`) and a :class:`Sync` of
+    the values the loop hands the check (their types are the pointer's)."""
+    signature = nbtypes.int64(nbtypes.float64[:, ::1], nbtypes.float64[:, ::1],
+                              nbtypes.float64, numba.typeof(stopping), numba.typeof(sync))
+    if not conditions:
+        return idle_pointer(signature)
+    found = _ESCAPE_POINTERS.get((key, signature, cache))
+    if found is None:
+        check = specialize(_escape_check, key, cache=cache, nrt=not cache,
+                           synchronize_bodies=synchronize_bodies)
+        found = _ESCAPE_POINTERS[key, signature, cache] = pointer(check, signature, cache)
+    return found
 
 
 def _wh_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
@@ -927,13 +957,14 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     the loop's ``targs`` are then ``(wh_lanes.lanes_scratch(N),)``.  The
     corrector and the synchronisation stay scalar (they run once a call or
     an output).  The loop takes ``(x, v, t, dt, nsteps, system, work,
-    outputs, checks, check, targs)``: a :class:`System`, a :class:`Work`, the
-    records of :mod:`orbits._kernels.records`, the stopping conditions'
-    pointer (:func:`~orbits._kernels.stopping.stop_record`) and the terms'
-    arguments or the lanes' scratch; without ``lanes`` it
-    checks the escape conditions of :mod:`orbits._kernels.stopping` after
-    every step on the synchronised state where the record has conditions
-    (:func:`escape_kernels`); the lanes' loop checks none."""
+    outputs, checks, check, escape, targs)``: a :class:`System`, a
+    :class:`Work`, the records of :mod:`orbits._kernels.records`, the
+    stopping conditions' pointer (:func:`~orbits._kernels.stopping.stop_record`),
+    the escape check's (:func:`loop_escape`) and the terms' arguments or the
+    lanes' scratch; without ``lanes`` it checks the escape conditions of
+    :mod:`orbits._kernels.stopping` after every step on the synchronised
+    state where the record has conditions (:func:`escape_kernels`); the
+    lanes' loop checks none and calls neither pointer."""
     if lanes and terms is not None:
         raise ValueError("wh_loop: the lanes' loop takes no added terms")
     to_internal, perturbation, corrector, sync, from_internal = _kernels(coordinates, terms,
@@ -984,9 +1015,7 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
                               record=record)
     stop = no_stop
     if not lanes:
-        bodies = specialize(_synchronize_bodies, key, cache=cache, inline=True, nrt=nrt,
-                            sync_kernel=sync)
-        outputs["stop_args"], stop = escape_kernels(key, bodies, cache=cache, nrt=nrt)
+        outputs["stop_args"], stop = escape_kernels(key, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{key}", nrt=nrt, cache=cache,
                       to_internal=called(to_internal, nrt),
                       drift=drift, owed_drift=called(drift, nrt),
@@ -994,6 +1023,21 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
                       corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
                       **outputs)
+
+
+def loop_escape(coordinates, terms, stopping, sync, conditions):
+    """The ``escape`` argument of :func:`wh_loop`'s loop without lanes for
+    ``coordinates`` and ``terms``: :func:`escape_pointer`'s, for a run with
+    stopping ``conditions`` or without; ``stopping`` the stopping record and
+    ``sync`` a :class:`Sync` of the values the loop hands its
+    synchronisation."""
+    key = coordinates if terms is None else f"{coordinates}_{terms.key}"
+    cache = terms is None or terms.cache
+    bodies = None
+    if conditions:
+        bodies = specialize(_synchronize_bodies, key, cache=cache, inline=True, nrt=not cache,
+                            sync_kernel=_kernels(coordinates, terms)[3])
+    return escape_pointer(key, bodies, stopping, sync, conditions, cache)
 
 
 #: the Jacobi versions, compiled on first use

@@ -208,6 +208,30 @@ CORRECTORS = {
 }
 
 
+_CHECKS = {}
+
+
+def _loop_escape(loop, conditions, make):
+    """The ``escape`` argument of the Wisdom-Holman ``loop`` without lanes:
+    the escape check where the run has stopping ``conditions``, else a
+    pointer of its type that is never called
+    (``orbits._kernels.wisdom_holman.escape_pointer``), ``make(conditions)``
+    made once a loop and process: the types it is made for (those of the
+    stopping record and of the loop's synchronisation's arguments) are the
+    loop's."""
+    found = _CHECKS.get((loop, conditions))
+    if found is None:
+        found = _CHECKS[loop, conditions] = make(conditions)
+    return found
+
+
+def _sync_of(system, ws, x, v, targs):
+    # the synchronisation's arguments as the loop hands them on (their
+    # types; the drift owed and the corrector's step are the loop's own)
+    return _wh.Sync(system.gm, system.eta, 0.0, ws["xs"], ws["vs"], x, v, ws["acc"],
+                    system.n_active, system.corrector, 0.0, targs)
+
+
 def refuse_unkickable(integ, terms):
     """Refuse, with :class:`~orbits.errors.IntegratorOptionError`, a force term
     that the interaction kick of ``integ`` (a map of the Wisdom-Holman family)
@@ -571,9 +595,14 @@ class WisdomHolman(Integrator):
         loop = _wh.wh_loop(self.config["coordinates"], terms, force.recorder, lanes)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
+        # the lanes' loop calls no escape check: any pointer will do
+        escape = check if lanes else _loop_escape(
+            loop, stop is not None, lambda conditions: _wh.loop_escape(
+                self.config["coordinates"], terms, (sargs, check),
+                _sync_of(system, ws, x, v, targs), conditions))
         out = loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
                    records.outputs(mon, step0, mon_t, mon_out),
-                   records.checks(check_every, sargs), check, targs)
+                   records.checks(check_every, sargs), check, escape, targs)
         if lanes:
             note_lanes_ready(loop)
         return with_status(*out)
@@ -639,9 +668,13 @@ class WisdomHolman(Integrator):
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"][:n], int(n_active), self._corr, self._kinds,
                             self._coefs)
+        escape = _loop_escape(loop, stop is not None, lambda conditions: _wht.tangent_loop_escape(
+            self.config["coordinates"], terms, force, (sargs, check),
+            _sync_of(system, ws, x, v, (targs, tp)), conditions))
         return with_status(*loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
                                  records.outputs(mon, step0, mon_t, mon_out),
-                                 records.checks(check_every, sargs), check, (targs, tp)))
+                                 records.checks(check_every, sargs), check, escape,
+                                 (targs, tp)))
 
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and

@@ -557,6 +557,26 @@ def test_wh_stops_at_an_escape_in_the_step_leapfrog_does():
     np.testing.assert_array_equal(wh.bodies.velocities.value, ref.bodies.velocities.value)
 
 
+@pytest.mark.parametrize("coordinates", ["jacobi", "democratic-heliocentric"])
+def test_one_loop_serves_runs_with_and_without_escape_conditions(coordinates):
+    # the loop without lanes takes its escape check as a pointer argument: a
+    # run without stopping conditions passes one of the check's type that is
+    # never called (and compiles no check), so the run with conditions after
+    # it finds the same compiled loop, and stops at the escape (step 837, as
+    # in the test above); one loop signature, not two
+    from orbits._kernels import wisdom_holman as kwh
+    integ = orbits.integrators.get("wh", coordinates=coordinates, lanes="off")
+    plain = orbits.Simulation(launched(), integ, dt=10 * u.day)
+    plain.run(until=100 * u.day, outputs=2, progress=False)
+    loop = kwh.wh_loop(coordinates, None, plain._force.recorder)
+    assert len(loop.signatures) == 1
+    sim = orbits.Simulation(launched(), integ, dt=10 * u.day, escape_distance=50 * u.au)
+    with pytest.raises(Escape) as info:
+        sim.run(until=1000 * u.yr, outputs=2, progress=False)
+    assert info.value.step == 837 and info.value.bodies == ("comet",)
+    assert len(loop.signatures) == 1
+
+
 def test_wh_escape_unbound_passes_over_a_bound_body():
     bound = launched(0.9)
     with pytest.raises(Escape, match="comet"):

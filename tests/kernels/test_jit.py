@@ -151,6 +151,28 @@ def test_a_kernel_pointer_is_its_own_code_cached_under_the_stamp():
     assert index.startswith(f"test_jit._halve__pointer__{_jit.KERNEL_STAMP}")
 
 
+@_jit.njit(cache=False)
+def _maybe_call(f, call, x):
+    if call:
+        return f(x)
+    return -1.0
+
+
+def test_an_idle_pointer_is_typed_as_the_pointer_of_its_signature():
+    # a loop takes an idle pointer where its data say it calls none (wh's
+    # escape check without conditions): the loop compiled for it serves the
+    # real pointer of the signature, without a compilation more, and no C
+    # callable is compiled for the idle one
+    idle = _jit.idle_pointer(_UNARY)
+    assert idle.cfunc is None and idle.__wrapper_address__() > 0
+    assert _jit.idle_pointer(_UNARY) is idle
+    real = _jit.pointer(_halve, _UNARY)
+    assert numba.typeof(real) == idle._numba_type_
+    assert _maybe_call(idle, False, 4.0) == -1.0
+    assert _maybe_call(real, True, 4.0) == 2.0
+    assert len(_maybe_call.signatures) == 1
+
+
 # -- templates and their slots (specialize) ---------------------------------------
 
 _kernel, _scale = _jit.slots("_kernel", _scale=2.0)
