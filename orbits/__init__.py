@@ -21,7 +21,8 @@ from importlib.util import find_spec as _find_spec
 # types a kernel, thousands in a loop's first compilation; where colorama is
 # installed each one re-wraps the standard streams to highlight the message.
 # numba's switch for that (read once, when numba is first imported) takes a
-# tenth off a first compilation: benchmarks/RESULTS.md, "bench_first_compile".
+# few per cent off a first compilation: benchmarks/RESULTS.md,
+# "bench_first_compile".
 # A user's own setting stands; a numba imported before this package keeps the
 # highlighting it chose.
 _os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
