@@ -544,8 +544,8 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, 
     # system: a System record, work: a Work record; checks, check: the Checks
     # record (orbits._kernels.records) and the stopping conditions' pointer,
     # whose escape conditions the loops without lanes check through the
-    # escape pointer (see escape_kernels; the lanes' loop takes any pointer
-    # and calls none)
+    # escape pointer (see escape_kernels; the lanes' loop takes 0 and reads
+    # neither)
     gm, eta, n_active, corr, kinds, coefs = system
     xj, vj, acc, xs, vs, state, owed_box, cdt = work
     mon, step0, mon_t, mon_out = outputs
@@ -964,7 +964,8 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     lanes' scratch; without ``lanes`` it checks the escape conditions of
     :mod:`orbits._kernels.stopping` after every step on the synchronised
     state where the record has conditions (:func:`escape_kernels`); the
-    lanes' loop checks none and calls neither pointer."""
+    lanes' loop checks none, calls neither pointer and takes 0 for the
+    escape check's."""
     if lanes and terms is not None:
         raise ValueError("wh_loop: the lanes' loop takes no added terms")
     to_internal, perturbation, corrector, sync, from_internal = _kernels(coordinates, terms,

@@ -595,8 +595,8 @@ class WisdomHolman(Integrator):
         loop = _wh.wh_loop(self.config["coordinates"], terms, force.recorder, lanes)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
-        # the lanes' loop calls no escape check: any pointer will do
-        escape = check if lanes else _loop_escape(
+        # the lanes' loop checks no escapes: it takes a number it never reads
+        escape = 0 if lanes else _loop_escape(
             loop, stop is not None, lambda conditions: _wh.loop_escape(
                 self.config["coordinates"], terms, (sargs, check),
                 _sync_of(system, ws, x, v, targs), conditions))
