@@ -208,7 +208,7 @@ CORRECTORS = {
 }
 
 
-_CHECKS = {}
+_ESCAPES = {}
 
 
 def _loop_escape(loop, conditions, make):
@@ -219,9 +219,9 @@ def _loop_escape(loop, conditions, make):
     made once a loop and process: the types it is made for (those of the
     stopping record and of the loop's synchronisation's arguments) are the
     loop's."""
-    found = _CHECKS.get((loop, conditions))
+    found = _ESCAPES.get((loop, conditions))
     if found is None:
-        found = _CHECKS[loop, conditions] = make(conditions)
+        found = _ESCAPES[loop, conditions] = make(conditions)
     return found
 
 
