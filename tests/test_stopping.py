@@ -89,6 +89,21 @@ def test_escape_distance_and_unbound():
     assert r.status == "completed"
 
 
+def test_escapes_alone_take_the_escapes_check():
+    # a record of escape conditions alone is checked by check_escapes, whose
+    # C callable compiles in about 1.6 s where check_stop's takes 19-25 s on a
+    # 2-core AMD EPYC (benchmarks/RESULTS.md); the stops it finds are those
+    # of the tests above (the same code, inlined in both checks)
+    from orbits._kernels import stopping as ks
+    sim = orbits.Simulation(comet(1.5), integrator="leapfrog", dt=1 * u.day,
+                            escape_distance=50 * u.au, escape_unbound=True)
+    sargs, check = ks.stop_record(sim._stop)
+    assert ks.check_kind(int(sargs[0])) == "escapes"
+    assert check.cfunc._pyfunc.__code__ is ks.check_escapes.py_func.__code__
+    assert ks.check_kind(ks.ESCAPE | ks.ENCOUNTER_HILL) == "all"
+    assert ks.check_kind(0) == "none" and ks.check_kind(True) == "all"
+
+
 @pytest.mark.parametrize("integrator", ["dop853", "rk4-doubling", "ias15"])
 def test_adaptive_methods_name_the_body(integrator):
     # the last of three bodies leaves: the error names the body the

@@ -69,8 +69,9 @@ from .coordinates import centre_of_mass, row_difference
 from .encounters import closest_approach, kepler_contact
 from .status import Status
 
-__all__ = ["no_stop", "check_stop", "SARGS", "CHECK", "AHEAD", "no_conditions",
-           "stop_record", "call_check", "check_pointer", "ahead_pointer", "collision_check",
+__all__ = ["no_stop", "check_stop", "check_escapes", "SARGS", "CHECK", "AHEAD", "no_conditions",
+           "stop_record", "call_check", "check_pointer", "check_kind", "ahead_pointer",
+           "collision_check",
            "collision_pairs", "keep_state", "encounter_log", "encounter_check",
            "collision_ahead", "ENCOUNTER_DISTANCE", "ENCOUNTER_HILL", "ESCAPE", "UNBOUND",
            "COLLISION", "ENCOUNTER_LOG", "LOOKS_INSIDE"]
@@ -497,6 +498,16 @@ def check_stop(x, v, t, sargs):
         _keep(x, v, t, prev, clock, n)
         if close:
             return Status.CLOSE_ENCOUNTER
+    status = _escaped(x, v, mask, esc2, gm, info, n)
+    if status != 0:
+        return status
+    return Status.LOG_FULL if full else 0
+
+
+@njit(inline="always")
+def _escaped(x, v, mask, esc2, gm, info, n):
+    # the escape conditions (ESCAPE, UNBOUND) of the first n bodies: the
+    # first body beyond the distance (and unbound, where UNBOUND) into info
     if mask & ESCAPE:
         mt, cx, cy, cz, ux, uy, uz = centre_of_mass(x, v, gm, n)
         for i in range(n):
@@ -509,7 +520,17 @@ def check_stop(x, v, t, sargs):
                 info[0] = i
                 info[1] = -1
                 return Status.ESCAPE
-    return Status.LOG_FULL if full else 0
+    return 0
+
+
+@njit
+def check_escapes(x, v, t, sargs):
+    """:func:`check_stop` for a record whose conditions are escapes alone
+    (``ESCAPE``, ``UNBOUND``): the same answer, without the encounters',
+    collisions' and log's code, which takes most of :func:`check_stop`'s
+    compilation (the estimate of the closest approach)."""
+    mask, esc2, gm, info = sargs[0], sargs[3], sargs[4], sargs[6]
+    return _escaped(x, v, mask, esc2, gm, info, min(x.shape[0], gm.shape[0]))
 
 
 # -- the conditions as data: the stopping record of the loops ----------------------
@@ -543,13 +564,36 @@ def _no_ahead(x, v, t, h, sargs):
 _POINTERS = {}
 
 
+_CHECKS = {"none": _no_check, "escapes": check_escapes, "all": check_stop}
+
+
+def check_kind(conditions):
+    """Which check (a key of ``_CHECKS``) a stopping record's mask
+    ``conditions`` takes (True: any conditions).
+
+    Examples
+    --------
+    >>> from orbits._kernels.stopping import COLLISION, ESCAPE, UNBOUND, check_kind
+    >>> check_kind(0), check_kind(ESCAPE | UNBOUND), check_kind(ESCAPE | COLLISION)
+    ('none', 'escapes', 'all')
+    """
+    if not conditions:
+        return "none"
+    if conditions is not True and not conditions & ~(ESCAPE | UNBOUND):
+        return "escapes"
+    return "all"
+
+
 def check_pointer(conditions=True):
-    """The pointer of :func:`check_stop` (``conditions``), or of a check that
-    carries on, as a C callable of :data:`CHECK`: compiled on first use and
-    cached on disk."""
-    key = bool(conditions)
+    """The pointer of the check of a stopping record whose mask is
+    ``conditions`` (an int; True: any), as a C callable of :data:`CHECK`:
+    of :func:`check_stop`, of :func:`check_escapes` where the conditions
+    are escapes alone, or of a check that carries on where there are none.
+    Each is compiled on first use and cached on disk; all have one type, so
+    the loops serve them all."""
+    key = check_kind(conditions)
     if key not in _POINTERS:
-        _POINTERS[key] = pointer(check_stop if key else _no_check, CHECK)
+        _POINTERS[key] = pointer(_CHECKS[key], CHECK)
     return _POINTERS[key]
 
 
@@ -586,7 +630,7 @@ def stop_record(sargs=None):
         if _NONE is None:
             _NONE = (no_conditions(), check_pointer(False))
         return _NONE
-    return (sargs, check_pointer(sargs[0] != 0))
+    return (sargs, check_pointer(int(sargs[0])))
 
 
 @njit(inline="always")
