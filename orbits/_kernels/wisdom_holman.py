@@ -699,25 +699,27 @@ def _escape_args(stopping, sync, escape):
 
 @njit(inline="always")
 def _escape_gate(xj, vj, t, args):
-    # without conditions, a branch; with them, the escape check through the
-    # loop's escape pointer (escape_pointer)
+    # without conditions, a branch; with them, the bound of may_escape on the
+    # internal state, and only where a body may be beyond the distance the
+    # escape check through the loop's escape pointer (escape_pointer), which
+    # synchronises: a call through a pointer hands over the records by value,
+    # which would cost a step as much again
     stopping, sync, escape = args
-    if stopping[0][0] == 0:
+    sargs = stopping[0]
+    if sargs[0] == 0:
+        return 0
+    if not may_escape(xj, vj, sync.gm, sync.eta, sync.owed, sync.corr, sargs[3]):
         return 0
     return escape(xj, vj, t, stopping, sync)
 
 
 def _escape_check(xj, vj, t, stopping, sync):
     # the escape conditions of orbits._kernels.stopping (ESCAPE, UNBOUND) on
-    # the inertial state at the end of the step, which is synchronised into
-    # x, v (as for an output) only where a body may be beyond the distance;
-    # stopping: the stopping record (sargs, check)
-    sargs = stopping[0]
-    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
-    if not may_escape(xj, vj, gm, eta, owed, corr, sargs[3]):
-        return 0
+    # the inertial state at the end of the step, synchronised into x, v (as
+    # for an output), where _escape_gate found that a body may be beyond the
+    # distance; stopping: the stopping record (sargs, check)
     synchronize_bodies(xj, vj, sync)
-    return stopping[1](x, v, t, sargs)
+    return stopping[1](sync.x, sync.v, t, stopping[0])
 
 
 def _synchronize_bodies(xj, vj, sync):
