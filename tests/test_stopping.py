@@ -94,6 +94,7 @@ def test_escapes_alone_take_the_escapes_check():
     # C callable compiles in about 1.6 s where check_stop's takes 19-25 s on a
     # 2-core AMD EPYC (benchmarks/RESULTS.md); the stops it finds are those
     # of the tests above (the same code, inlined in both checks)
+    import numba
     from orbits._kernels import stopping as ks
     sim = orbits.Simulation(comet(1.5), integrator="leapfrog", dt=1 * u.day,
                             escape_distance=50 * u.au, escape_unbound=True)
@@ -102,6 +103,10 @@ def test_escapes_alone_take_the_escapes_check():
     assert check.cfunc._pyfunc.__code__ is ks.check_escapes.py_func.__code__
     assert ks.check_kind(ks.ESCAPE | ks.ENCOUNTER_HILL) == "all"
     assert ks.check_kind(0) == "none" and ks.check_kind(True) == "all"
+    # no conditions: a pointer of the check's type that compiles nothing (the
+    # loops call the check only where the mask is not 0)
+    none = ks.stop_record(None)[1]
+    assert none.cfunc is None and none._numba_type_ == numba.typeof(check)
 
 
 @pytest.mark.parametrize("integrator", ["dop853", "rk4-doubling", "ias15"])

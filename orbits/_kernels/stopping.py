@@ -12,7 +12,9 @@ a C callable of the signature :data:`CHECK` (numba's first-class functions,
 (the mask) is not 0 (:func:`call_check`, on the pair ``(sargs, check)``): one
 loop serves every combination of conditions, and a run without any pays a
 branch a step.  The pointer is compiled once, on
-first use, and cached; every simulation's ``sargs`` has the type
+first use, and cached (:func:`check_escapes`' where the conditions are
+escapes alone; an idle pointer, compiled from nothing, where there are
+none); every simulation's ``sargs`` has the type
 :data:`SARGS`, a run without conditions :func:`no_conditions`.  A C callable
 cannot raise into its caller; :func:`check_stop` raises nothing (numpy's
 error model, no allocation).
@@ -64,7 +66,7 @@ import math
 import numpy as np
 from numba.core import types as nbtypes
 
-from ._jit import njit, pointer
+from ._jit import idle_pointer, njit, pointer
 from .coordinates import centre_of_mass, row_difference
 from .encounters import closest_approach, kepler_contact
 from .status import Status
@@ -548,28 +550,20 @@ CHECK = nbtypes.int64(_F2, _F2, nbtypes.float64, SARGS)
 AHEAD = nbtypes.boolean(_F2, _F2, nbtypes.float64, nbtypes.float64, SARGS)
 
 
-def _no_check(x, v, t, sargs):
-    return 0
-
-
 def _ahead(x, v, t, h, sargs):
     keep_state(x, v, t, sargs)
     return collision_ahead(x, v, t, h, sargs)
 
 
-def _no_ahead(x, v, t, h, sargs):
-    return False
-
-
 _POINTERS = {}
 
 
-_CHECKS = {"none": _no_check, "escapes": check_escapes, "all": check_stop}
+_CHECKS = {"escapes": check_escapes, "all": check_stop}
 
 
 def check_kind(conditions):
-    """Which check (a key of ``_CHECKS``) a stopping record's mask
-    ``conditions`` takes (True: any conditions).
+    """Which check a stopping record's mask ``conditions`` takes (True: any
+    conditions): a key of ``_CHECKS``, or "none".
 
     Examples
     --------
@@ -587,11 +581,14 @@ def check_kind(conditions):
 def check_pointer(conditions=True):
     """The pointer of the check of a stopping record whose mask is
     ``conditions`` (an int; True: any), as a C callable of :data:`CHECK`:
-    of :func:`check_stop`, of :func:`check_escapes` where the conditions
-    are escapes alone, or of a check that carries on where there are none.
-    Each is compiled on first use and cached on disk; all have one type, so
-    the loops serve them all."""
+    of :func:`check_stop`, or of :func:`check_escapes` where the conditions
+    are escapes alone, each compiled on first use and cached on disk; where
+    there are none, an idle pointer (:func:`~._jit.idle_pointer`): the loops
+    call the check only where the mask is not 0 (:func:`call_check`), so it
+    compiles nothing.  All have one type, so the loops serve them all."""
     key = check_kind(conditions)
+    if key == "none":
+        return idle_pointer(CHECK)
     if key not in _POINTERS:
         _POINTERS[key] = pointer(_CHECKS[key], CHECK)
     return _POINTERS[key]
@@ -601,12 +598,14 @@ def ahead_pointer(conditions=True):
     """For a loop whose step may not finish (``trace``'s inner integration):
     the pointer of :data:`AHEAD` that keeps ``x``, ``v`` at ``t`` as the
     state of the last check (:func:`keep_state`) and answers
-    :func:`collision_ahead` within ``h`` (``conditions``), or that does
-    nothing; compiled on first use and cached on disk."""
-    key = ("ahead", bool(conditions))
-    if key not in _POINTERS:
-        _POINTERS[key] = pointer(_ahead if conditions else _no_ahead, AHEAD)
-    return _POINTERS[key]
+    :func:`collision_ahead` within ``h`` (``conditions``), compiled on first
+    use and cached on disk; without conditions an idle pointer, which the
+    loop does not call."""
+    if not conditions:
+        return idle_pointer(AHEAD)
+    if "ahead" not in _POINTERS:
+        _POINTERS["ahead"] = pointer(_ahead, AHEAD)
+    return _POINTERS["ahead"]
 
 
 def no_conditions():
