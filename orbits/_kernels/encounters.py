@@ -18,8 +18,9 @@ collision detector and an encounter log:
   interacts.
 
 Every function takes plain float64 scalars and length-3 arrays in the
-caller's units, with ``G`` folded into ``mu = G (m_i + m_j)``; none
-allocates, and each returns a tuple.  Invalid input (non-finite values,
+caller's units, with ``G`` folded into ``mu = G (m_i + m_j)``, and
+returns a tuple; none allocates but the tidal fit of ``closest_approach``
+during an encounter (six arrays of at most 30 numbers a fit).  Invalid input (non-finite values,
 ``mu < 0``, an empty window) gives NaNs, never an exception.
 
 References
@@ -699,84 +700,81 @@ def _dot6(a, b):
 
 
 @njit(inline="always")
-def _diff6(a, b, scale):
-    return ((a[0] - b[0]) * scale, (a[1] - b[1]) * scale, (a[2] - b[2]) * scale,
-            (a[3] - b[3]) * scale, (a[4] - b[4]) * scale, (a[5] - b[5]) * scale)
-
-
-@njit(inline="always")
-def _axpy5(a, x, y):
-    return (y[0] + a * x[0], y[1] + a * x[1], y[2] + a * x[2], y[3] + a * x[3],
-            y[4] + a * x[4])
-
-
-@njit
-def _solve5(A, b):
-    """Solve the symmetric positive semi-definite 5x5 system ``A c = b``
-    (a 5-tuple of rows) by elimination without pivoting; an unknown whose
-    pivot is below ``_PIVOT_TOL`` of the largest diagonal entry carries no
-    information and is set to 0 (the least-squares solution that leaves it
-    alone)."""
-    big = max(A[0][0], A[1][1], A[2][2], A[3][3], A[4][4])
-    keep = (True, True, True, True, True)
-    for k in range(5):
-        piv = A[k][k]
-        if not (piv > _PIVOT_TOL * big):
-            keep = _put(keep, k, False)
-            continue
-        for i in range(k + 1, 5):
-            f = A[i][k] / piv
-            A = _put(A, i, _axpy5(-f, A[k], A[i]))
-            b = _put(b, i, b[i] - f * b[k])
-    c = (0.0, 0.0, 0.0, 0.0, 0.0)
-    for k in range(4, -1, -1):
-        if keep[k]:
-            t = b[k]
-            for j in range(k + 1, 5):
-                t -= A[k][j] * c[j]
-            c = _put(c, k, t / A[k][k])
-    return c
-
-
-@njit(inline="always")
-def _gram(J):
-    """``J^T J`` of the 6x5 matrix whose columns are ``J``."""
-    return ((_dot6(J[0], J[0]), _dot6(J[0], J[1]), _dot6(J[0], J[2]), _dot6(J[0], J[3]),
-             _dot6(J[0], J[4])),
-            (_dot6(J[1], J[0]), _dot6(J[1], J[1]), _dot6(J[1], J[2]), _dot6(J[1], J[3]),
-             _dot6(J[1], J[4])),
-            (_dot6(J[2], J[0]), _dot6(J[2], J[1]), _dot6(J[2], J[2]), _dot6(J[2], J[3]),
-             _dot6(J[2], J[4])),
-            (_dot6(J[3], J[0]), _dot6(J[3], J[1]), _dot6(J[3], J[2]), _dot6(J[3], J[3]),
-             _dot6(J[3], J[4])),
-            (_dot6(J[4], J[0]), _dot6(J[4], J[1]), _dot6(J[4], J[2]), _dot6(J[4], J[3]),
-             _dot6(J[4], J[4])))
-
-
-@njit(inline="always")
-def _broyden(Jk, u, dck):
-    return (Jk[0] + u[0] * dck, Jk[1] + u[1] * dck, Jk[2] + u[2] * dck,
-            Jk[3] + u[3] * dck, Jk[4] + u[4] * dck, Jk[5] + u[5] * dck)
-
-
-@njit(inline="always")
 def _shift5(c, k, step):
     return (c[0] + (step if k == 0 else 0.0), c[1] + (step if k == 1 else 0.0),
             c[2] + (step if k == 2 else 0.0), c[3] + (step if k == 3 else 0.0),
             c[4] + (step if k == 4 else 0.0))
 
 
+@njit(inline="always")
+def _store6(out, k, a, b, scale):
+    """Row ``k`` of ``out`` := ``(a - b) * scale`` for the 6-tuple ``a`` and
+    the 6-array ``b``."""
+    out[k, 0] = (a[0] - b[0]) * scale
+    out[k, 1] = (a[1] - b[1]) * scale
+    out[k, 2] = (a[2] - b[2]) * scale
+    out[k, 3] = (a[3] - b[3]) * scale
+    out[k, 4] = (a[4] - b[4]) * scale
+    out[k, 5] = (a[5] - b[5]) * scale
+
+
+@njit(inline="always")
+def _copy6(out, a):
+    """``out[:] = a`` for the 6-tuple ``a``."""
+    out[0] = a[0]
+    out[1] = a[1]
+    out[2] = a[2]
+    out[3] = a[3]
+    out[4] = a[4]
+    out[5] = a[5]
+
+
+@njit(inline="always")
+def _row_dot(J, i, r):
+    """Row ``i`` of ``J`` times the 6-vector ``r``, summed in index order."""
+    s = J[i, 0] * r[0]
+    for m in range(1, 6):
+        s += J[i, m] * r[m]
+    return s
+
+
 @njit
-def _jacobian(mu, S0, S1, c, R, h, wv, n, tm):
-    """Columns of the mismatch's Jacobian in the field coefficients at ``c``
-    (where the mismatch is ``R``), by forward differences."""
+def _solve5(A, b, c):
+    """Solve the symmetric positive semi-definite 5x5 system ``A c = b`` by
+    elimination without pivoting, into ``c`` (``A`` and ``b`` are
+    overwritten); an unknown whose pivot is below ``_PIVOT_TOL`` of the
+    largest diagonal entry carries no information and is set to 0 (the
+    least-squares solution that leaves it alone)."""
+    big = max(A[0, 0], A[1, 1], A[2, 2], A[3, 3], A[4, 4])
+    dropped = 0     # a bit for each unknown left at 0
+    for k in range(5):
+        piv = A[k, k]
+        if not (piv > _PIVOT_TOL * big):
+            dropped |= 1 << k
+            continue
+        for i in range(k + 1, 5):
+            f = A[i, k] / piv
+            for j in range(5):
+                A[i, j] = A[i, j] + -f * A[k, j]
+            b[i] = b[i] - f * b[k]
+    for k in range(5):
+        c[k] = 0.0
+    for k in range(4, -1, -1):
+        if not (dropped >> k) & 1:
+            t = b[k]
+            for j in range(k + 1, 5):
+                t -= A[k, j] * c[j]
+            c[k] = t / A[k, k]
+
+
+@njit
+def _jacobian(mu, S0, S1, c, r, h, wv, n, tm, J):
+    """Rows ``J[k]``: the mismatch's derivative in field coefficient ``k`` at
+    ``c`` (where the mismatch is ``r``), by forward differences."""
     step = _FD_STEP / (h * h)
     inv = 1.0 / step
-    return (_diff6(_mismatch(mu, S0, S1, _shift5(c, 0, step), h, wv, n, tm), R, inv),
-            _diff6(_mismatch(mu, S0, S1, _shift5(c, 1, step), h, wv, n, tm), R, inv),
-            _diff6(_mismatch(mu, S0, S1, _shift5(c, 2, step), h, wv, n, tm), R, inv),
-            _diff6(_mismatch(mu, S0, S1, _shift5(c, 3, step), h, wv, n, tm), R, inv),
-            _diff6(_mismatch(mu, S0, S1, _shift5(c, 4, step), h, wv, n, tm), R, inv))
+    for k in range(5):
+        _store6(J, k, _mismatch(mu, S0, S1, _shift5(c, k, step), h, wv, n, tm), r, inv)
 
 
 @njit
@@ -790,7 +788,10 @@ def _fit_tidal_field(mu, S0, S1, h, n, tm):
     orbit that crosses it; so the Jacobian (forward differences, 5
     evaluations of the mismatch) is computed again only where the last
     correction missed its prediction by more than _REFRESH of the mismatch,
-    and otherwise brought up to date by Broyden's rank-one update.
+    and otherwise brought up to date by Broyden's rank-one update.  The
+    Jacobian, the normal equations and the residuals are small arrays made
+    once a fit (loops over them compile to a fraction of the code that
+    tuples unrolled into).
     """
     wv = _VELOCITY_WEIGHT * abs(h)
     # a mismatch at the rounding level of the states needs no field
@@ -800,12 +801,20 @@ def _fit_tidal_field(mu, S0, S1, h, n, tm):
     R = _mismatch(mu, S0, S1, c, h, wv, n, tm)
     if _dot6(R, R) <= noise * noise:
         return c, True, 0
-    J = _jacobian(mu, S0, S1, c, R, h, wv, n, tm)
+    J = np.empty((5, 6))    # row k: the mismatch's derivative in coefficient k
+    A = np.empty((5, 5))
+    b = np.empty(5)
+    dc = np.empty(5)
+    r = np.empty(6)         # the mismatch at c
+    u = np.empty(6)
+    _copy6(r, R)
+    _jacobian(mu, S0, S1, c, r, h, wv, n, tm, J)
     for it in range(_FIT_MAX_ITER):
-        A = _gram(J)
-        b = (-_dot6(J[0], R), -_dot6(J[1], R), -_dot6(J[2], R), -_dot6(J[3], R),
-             -_dot6(J[4], R))
-        dc = _solve5(A, b)
+        for i in range(5):
+            for k in range(5):
+                A[i, k] = _row_dot(J, i, J[k])
+            b[i] = -_row_dot(J, i, r)
+        _solve5(A, b, dc)
         c = (c[0] + dc[0], c[1] + dc[1], c[2] + dc[2], c[3] + dc[3], c[4] + dc[4])
         size = abs(c[0]) + abs(c[1]) + abs(c[2]) + abs(c[3]) + abs(c[4])
         change = abs(dc[0]) + abs(dc[1]) + abs(dc[2]) + abs(dc[3]) + abs(dc[4])
@@ -817,20 +826,23 @@ def _fit_tidal_field(mu, S0, S1, h, n, tm):
         if _dot6(R_new, R_new) <= noise * noise:
             return c, True, it + 1
         # u = R_new - (R + J dc): what the linear model did not predict
-        u = _diff6(R_new, R, 1.0)
+        _copy6(u, R_new)
+        for m in range(6):
+            u[m] = u[m] - r[m]
         for k in range(5):
-            u = _diff6(u, (J[k][0] * dc[k], J[k][1] * dc[k], J[k][2] * dc[k],
-                           J[k][3] * dc[k], J[k][4] * dc[k], J[k][5] * dc[k]), 1.0)
+            for m in range(6):
+                u[m] = u[m] - J[k, m] * dc[k]
+        _copy6(r, R_new)
         if _dot6(u, u) > (_REFRESH * _REFRESH) * _dot6(R_new, R_new):
-            J = _jacobian(mu, S0, S1, c, R_new, h, wv, n, tm)
+            _jacobian(mu, S0, S1, c, r, h, wv, n, tm, J)
         elif change > _BROYDEN_MIN * size:
             # below _BROYDEN_MIN of the field the secant is rounding noise
             norm2 = (dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2] + dc[3] * dc[3]
                      + dc[4] * dc[4])
-            J = (_broyden(J[0], u, dc[0] / norm2), _broyden(J[1], u, dc[1] / norm2),
-                 _broyden(J[2], u, dc[2] / norm2), _broyden(J[3], u, dc[3] / norm2),
-                 _broyden(J[4], u, dc[4] / norm2))
-        R = R_new
+            for k in range(5):
+                dck = dc[k] / norm2
+                for m in range(6):
+                    J[k, m] = J[k, m] + u[m] * dck
     return c, False, _FIT_MAX_ITER
 
 
