@@ -591,7 +591,8 @@ def _compile(args, orbits):
         print(f"{', '.join(skipped)}: run in Python, nothing to compile")
     compiling = sum(seconds for _, seconds in loops)
     print(f"{len(loops)} loop{'' if len(loops) == 1 else 's'} ready in {wall:.1f} s "
-          f"({compiling:.1f} s compiling); numba's cache: {_compiling.cache_dir()}")
+          f"({compiling:.1f} s compiling) for {_compiling.cpu_name()}; "
+          f"numba's cache: {_compiling.cache_dir()}")
 
 
 def _elements_body(parser, args):

@@ -5,6 +5,7 @@ import io
 import json
 import os
 import pathlib
+import platform
 import subprocess
 import sys
 import threading
@@ -37,8 +38,8 @@ print(results[0].summary())
 """
 
 
-def _python(args, cache):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT))
+def _python(args, cache, settings=None):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT), **(settings or {}))
     return subprocess.run([sys.executable, *args], cwd=ROOT, env=env, capture_output=True,
                           text=True, timeout=600)
 
@@ -83,6 +84,33 @@ def test_orbits_compile_fills_the_cache_that_the_next_process_loads(tmp_path):
     assert _notices(proc.stderr) == []
     assert "compiling" not in proc.stdout
 
+
+
+
+def _has_x86_64_v3():
+    # AVX2 and FMA, the level's vector instructions, on an x86-64 host
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        return False
+    from numba.core.codegen import get_host_cpu_features
+    features = get_host_cpu_features()
+    return "+avx2" in features and "+fma" in features
+
+
+@pytest.mark.skipif(not _has_x86_64_v3(), reason="needs an x86-64 processor with AVX2 and FMA")
+def test_a_cache_compiled_for_an_instruction_set_level_loads_in_a_new_process(tmp_path):
+    # the installation page's cache for machines with different CPUs: compiled
+    # ahead for x86-64-v3 with the level's own features (numba's
+    # NUMBA_CPU_NAME and NUMBA_CPU_FEATURES), so that numba keys it by the
+    # level and not by this processor; a new process with the same settings
+    # loads it
+    level = {"NUMBA_CPU_NAME": "x86-64-v3", "NUMBA_CPU_FEATURES": ""}
+    cache = tmp_path / "cache"
+    proc = _python(["-m", "orbits.cli", "compile", "euler", "--plain"], cache, level)
+    assert proc.returncode == cli.EXIT_COMPLETED, proc.stderr
+    assert " for x86-64-v3; " in proc.stdout.splitlines()[-1], proc.stdout
+    proc = _python(["-c", RUN_TWICE], cache, level)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout.splitlines()[0]) == [0, 0]
 
 
 #: a fresh process that runs ``euler`` on the outer solar system with each
