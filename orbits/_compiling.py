@@ -26,7 +26,7 @@ from numba.core.dispatcher import Dispatcher
 from ._kernels import stepping
 from ._kernels._jit import cpu_name
 
-__all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "ADDED",
+__all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "ADDED", "CHECKS",
            "loop_label",
            "notice", "cache_dir", "cpu_name", "stderr_is_terminal"]
 
@@ -48,7 +48,19 @@ FIRST_COMPILE_SECONDS = {
        for lanes, seconds in (("", 16.0), (" lanes", 37.0))},
     "dopri5": 7.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 9.0, "taylor": 6.0,
     "implicit-euler": 5.0, "implicit-midpoint": 5.0, "trace": 27.0, "trace lanes": 41.0,
+    # the stopping conditions' checks, one for every integrator (:data:`CHECKS`):
+    # 20-25 s, 1.1-1.6 s and 7.6 s on the Zen 3 (2026-11-30)
+    "check of the stopping conditions": 22.0, "check of the escape conditions": 1.4,
+    "look-ahead of the stopping conditions": 7.0,
 }
+
+#: The check a run's stopping conditions take (a kind of
+#: :func:`orbits._kernels.stopping.check_kind`), and ``trace``'s look-ahead
+#: (:func:`orbits._kernels.stopping.ahead_pointer`), as the notice names them
+#: and :data:`FIRST_COMPILE_SECONDS` keys them: each compiled once for every
+#: integrator, and announced by itself (:meth:`CompileClock.part`).
+CHECKS = {"escapes": "check of the escape conditions", "all": "check of the stopping conditions",
+          "ahead": "look-ahead of the stopping conditions"}
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
 UNKNOWN_ESTIMATE = "a few seconds"
@@ -111,6 +123,8 @@ def notice(label):
     >>> from orbits._compiling import notice
     >>> notice("wh")
     'orbits: compiling the wh loop for this CPU, once (about 16 s; `orbits compile` does it ahead)'
+    >>> notice("check of the stopping conditions")[:65]
+    'orbits: compiling the check of the stopping conditions for this C'
     """
     seconds = FIRST_COMPILE_SECONDS.get(label)
     if seconds is not None and seconds < NOTICE_FROM:
@@ -121,7 +135,8 @@ def notice(label):
         about = f"about {ADDED_ESTIMATE}"
     else:
         about = UNKNOWN_ESTIMATE
-    return (f"orbits: compiling the {label} loop for this CPU, once ({about}; "
+    what = label if label in CHECKS.values() else f"{label} loop"
+    return (f"orbits: compiling the {what} for this CPU, once ({about}; "
             f"`orbits compile` does it ahead)")
 
 
@@ -174,6 +189,7 @@ class CompileClock(_event.Listener):
         self._start = 0.0
         self._thread = None
         self._armed = False
+        self._armed_label = label
         self._window = _LoopWindow(self)
 
     def __enter__(self):
@@ -190,6 +206,12 @@ class CompileClock(_event.Listener):
         compilation starting inside it is the loop's, and is announced."""
         return self._window
 
+    def part(self, label):
+        """A context manager around the compiling of a part of the run that
+        is not its loop (the stopping conditions' check, :data:`CHECKS`): a
+        compilation starting inside it is announced as ``label``'s."""
+        return _LoopWindow(self, label)
+
     def on_start(self, event):
         if threading.get_ident() != self._thread:
             return
@@ -199,7 +221,7 @@ class CompileClock(_event.Listener):
         self._start = time.perf_counter()
         if self._armed:
             self._armed = False     # one line for a loop and the kernels it compiles
-            line = notice(self.label)
+            line = notice(self._armed_label)
             if line is not None:
                 stream = self.stream or sys.stderr
                 try:
@@ -217,16 +239,20 @@ class CompileClock(_event.Listener):
 
 
 class _LoopWindow:
-    """:meth:`CompileClock.loop`: arms the notice for one call (made once per
-    clock: a call of the loop allocates nothing for it)."""
+    """:meth:`CompileClock.loop` (made once per clock: a call of the loop
+    allocates nothing for it) and :meth:`CompileClock.part`: arms the notice
+    of ``label`` (the clock's own: its loop) for one call."""
 
-    __slots__ = ("clock",)
+    __slots__ = ("clock", "label")
 
-    def __init__(self, clock):
+    def __init__(self, clock, label=None):
         self.clock = clock
+        self.label = label
 
     def __enter__(self):
-        self.clock._armed = not self.clock.quiet
+        clock = self.clock
+        clock._armed = not clock.quiet
+        clock._armed_label = clock.label if self.label is None else self.label
 
     def __exit__(self, *exc):
         self.clock._armed = False

@@ -10,7 +10,7 @@ import _signal as _csignal
 import numpy as np
 from tqdm.auto import tqdm
 
-from ._compiling import CompileClock, loop_label
+from ._compiling import CHECKS, CompileClock, loop_label
 from ._kernels.invariants import MONITOR_WIDTH
 from ._kernels.status import Status
 from ._kernels.stepping import USER_FORCE_SIZE
@@ -310,6 +310,7 @@ class Driven:
         self._encounters = []
         with self._compile_clock, Signals() as self._signals:
             try:
+                self._compile_check()
                 if adaptive:
                     self._outputs_adaptive(plan, rec, bar, first_mark)
                 else:
@@ -423,6 +424,26 @@ class Driven:
         if plan.outputs == 1:
             self._advance_adaptive(plan.until, rec, wall0)
             rec.output(self, final=True)
+
+    def _compile_check(self):
+        # the stopping conditions' check, one compiled C callable for every
+        # integrator (orbits._kernels.stopping.check_pointer), compiled, or
+        # loaded from the cache, before the loop: so that its first compile
+        # is announced as the check's and not as the loop's (the check of
+        # collisions and encounters takes 20-25 s, a loop a few); and the
+        # look-ahead of an integrator whose step may not finish (trace's)
+        stop = getattr(self, "_stop", None)
+        if stop is None:
+            return
+        from ._kernels.stopping import ahead_pointer, check_kind, check_pointer
+        conditions = int(stop[0])
+        kind = check_kind(conditions)
+        if kind in CHECKS:
+            with self._compile_clock.part(CHECKS[kind]):
+                check_pointer(conditions)
+        if getattr(self.integrator, "looks_ahead", False):
+            with self._compile_clock.part(CHECKS["ahead"]):
+                ahead_pointer(True)
 
     def _marks_in_loop(self, plan, rec):
         # whether an adaptive run's outputs can be recorded in its loop: a

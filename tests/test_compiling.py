@@ -296,6 +296,53 @@ def test_the_notice_is_said_in_a_loop_window_only_and_once():
     assert clock.compiled == 3
 
 
+def test_a_part_of_the_run_is_announced_by_its_own_name():
+    out = io.StringIO()
+    check = _compiling.CHECKS["all"]
+    with CompileClock("leapfrog", stream=out) as clock:
+        with clock.part(check):
+            _fresh()(1.0)
+        with clock.loop():
+            _fresh()(1.0)
+    assert out.getvalue() == notice(check) + "\n" + notice("leapfrog") + "\n"
+    assert notice(check).startswith("orbits: compiling the check of the stopping "
+                                    "conditions for this CPU, once (about 22 s")
+
+
+@pytest.mark.parametrize("name, kw, kinds", [
+    ("leapfrog", dict(escape_distance=100 * u.au), ["escapes"]),
+    ("trace", dict(escape_distance=100 * u.au), ["escapes", "ahead"]),
+    ("leapfrog", {}, []),
+])
+def test_the_stopping_conditions_check_is_compiled_and_announced_before_the_loop(
+        monkeypatch, capsys, name, kw, kinds):
+    # the check (and trace's look-ahead) compiled inside a window of its own,
+    # before the loop: a first compile is announced as the check's, not as
+    # the loop's (a collision run's check takes 20-25 s, its loop a few).
+    # Each is made to compile something new here, as on an empty cache.
+    from orbits._kernels import stopping
+    real_check, real_ahead = stopping.check_pointer, stopping.ahead_pointer
+
+    def check_pointer(conditions=True):
+        _fresh()(1.0)
+        return real_check(conditions)
+
+    def ahead_pointer(conditions=True):
+        _fresh()(1.0)
+        return real_ahead(conditions)
+
+    monkeypatch.setattr(stopping, "check_pointer", check_pointer)
+    monkeypatch.setattr(stopping, "ahead_pointer", ahead_pointer)
+    sim = orbits.Simulation(orbits.scenes.outer_solar_system(), name, dt=30 * u.day, **kw)
+    result = sim.run(until=300 * u.day, outputs=2)
+    said = _notices(capsys.readouterr().err)
+    expected = [notice(_compiling.CHECKS[k]) for k in kinds]
+    assert said[:len(kinds)] == expected            # first, before any loop's line
+    assert [line for line in said if line in map(notice, _compiling.CHECKS.values())] == expected
+    if kinds:
+        assert result.compile_time > 0              # and counted as compiling
+
+
 def test_the_notice_is_silenced_with_the_progress_bar():
     out = io.StringIO()
     with CompileClock("wh", quiet=True, stream=out) as clock:

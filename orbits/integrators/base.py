@@ -166,6 +166,10 @@ class Integrator:
     #: loop: True for all of them, or a tuple of the :class:`~orbits.Simulation`
     #: keywords of those it checks
     stop_conditions = False
+    #: whether its loop, with stopping conditions, takes the look-ahead of a
+    #: step that may not finish (:func:`orbits._kernels.stopping.ahead_pointer`),
+    #: which the run compiles before the loop, as it does the check
+    looks_ahead = False
     #: whether its loop updates the chaos indicators after every step (the
     #: shared step epilogue, :mod:`orbits._kernels.variational`)
     chaos_indicators = True

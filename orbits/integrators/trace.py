@@ -186,6 +186,7 @@ class Trace(Integrator):
     time_symmetric = True
     needs_central_body = True
     stop_conditions = True
+    looks_ahead = True
     chaos_indicators = False
     option_specs = (
         Option("hill", float, HILL, "switching radius in mutual Hill radii",
