@@ -729,15 +729,6 @@ def _copy6(out, a):
     out[5] = a[5]
 
 
-@njit(inline="always")
-def _row_dot(J, i, r):
-    """Row ``i`` of ``J`` times the 6-vector ``r``, summed in index order."""
-    s = J[i, 0] * r[0]
-    for m in range(1, 6):
-        s += J[i, m] * r[m]
-    return s
-
-
 @njit
 def _solve5(A, b, c):
     """Solve the symmetric positive semi-definite 5x5 system ``A c = b`` by
@@ -812,8 +803,8 @@ def _fit_tidal_field(mu, S0, S1, h, n, tm):
     for it in range(_FIT_MAX_ITER):
         for i in range(5):
             for k in range(5):
-                A[i, k] = _row_dot(J, i, J[k])
-            b[i] = -_row_dot(J, i, r)
+                A[i, k] = _dot6(J[i], J[k])
+            b[i] = -_dot6(J[i], r)
         _solve5(A, b, dc)
         c = (c[0] + dc[0], c[1] + dc[1], c[2] + dc[2], c[3] + dc[3], c[4] + dc[4])
         size = abs(c[0]) + abs(c[1]) + abs(c[2]) + abs(c[3]) + abs(c[4])
