@@ -663,3 +663,31 @@ def test_a_chaos_map_of_wh_runs_has_escapes_as_outcomes():
 def _megno_member(e):
     return orbits.Simulation(launched(e), "wh", dt=10 * u.day, escape_distance=50 * u.au,
                              monitors=("energy", "megno"), seed=1)
+
+
+def test_the_loops_with_and_without_terms_call_one_compiled_drift():
+    # the Kepler drift and the conversion to the loop's coordinates that the
+    # loops call (at a call's start, for an owed drift, in the corrector) are
+    # compiled functions without the loop's targs, so the loop with added
+    # terms calls the compilations of the plain loop: a called copy taking
+    # the targs compiled again for the terms' table (4-5 CPU s)
+    from orbits._kernels import wisdom_holman as kwh
+    integ = orbits.integrators.get("wh", lanes="off")
+    loops = []
+    for forces in ([], [orbits.forces.GRPotential("Sun")]):
+        sim = orbits.Simulation(launched(), integ, dt=10 * u.day, forces=forces)
+        sim.run(until=100 * u.day, outputs=2, progress=False)
+        loops.append(kwh.wh_loop("jacobi", sim._ws.get("terms", (None,))[0],
+                                 sim._force.recorder))
+    plain, terms = (loop.py_func.__globals__ for loop in loops)
+    assert plain["corrector_kernel"] is not terms["corrector_kernel"]
+
+    def called(op):
+        # the compiled function an operator of a loop calls
+        return op.py_func.__globals__["convert"]
+
+    for name in ("owed_drift", "to_internal"):
+        assert called(plain[name]) is called(terms[name])
+        assert called(plain[name]).py_func.__code__.co_argcount == 6   # no targs
+    corrector = terms["corrector_kernel"].py_func.__globals__
+    assert called(corrector["drift"]) is called(plain["owed_drift"])
