@@ -532,11 +532,13 @@ def trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v,
 # begins) call these, compiled once, instead of inlining a copy each; the
 # Kepler drift of every body too, from the drifts of segments with flags
 # (_drift, inner_drift) and the synchronisation's, where the loop's own
-# unflagged segment keeps its inlined copy
+# unflagged segment keeps its inlined copy.  The Kepler drift's copy is the
+# one without numba's runtime that Wisdom-Holman's loops call (it allocates
+# nothing): one compilation for both integrators
 _criterion_call = called(criterion)
 _pair_accelerations_call = called(pair_accelerations)
 _jump_call = called(jump)
-_kepler_drift_all_call = called(kepler_drift_all)
+_kepler_drift_all_call = called(kepler_drift_all, nrt=False)
 
 
 class Work(NamedTuple):

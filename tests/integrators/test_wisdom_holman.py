@@ -691,3 +691,6 @@ def test_the_loops_with_and_without_terms_call_one_compiled_drift():
         assert called(plain[name]).py_func.__code__.co_argcount == 6   # no targs
     corrector = terms["corrector_kernel"].py_func.__globals__
     assert called(corrector["drift"]) is called(plain["owed_drift"])
+    # and trace's segments with flags call the same compiled drift
+    from orbits._kernels import trace
+    assert trace._kepler_drift_all_call is called(plain["owed_drift"])
