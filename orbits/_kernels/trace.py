@@ -80,7 +80,7 @@ from .status import Status
 from .stepping import (GO, _record, accept_fsal, dop853_error, epilogue, first_record,
                        stage_errors)
 from .trace_lanes import FAR_WAIT, criterion_scales, far_steps
-from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all
+from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all, plain_drift_call
 
 # the names the templates below are written against, bound by specialize
 HAS_TERMS, step_end, term_kick, rare_term_kick, LANES, far_run = slots(
@@ -532,13 +532,17 @@ def trace_synchronize(xh, vb, gm, eta, n_active, enc, state, owed, xs, vs, x, v,
 # begins) call these, compiled once, instead of inlining a copy each; the
 # Kepler drift of every body too, from the drifts of segments with flags
 # (_drift, inner_drift) and the synchronisation's, where the loop's own
-# unflagged segment keeps its inlined copy.  The Kepler drift's copy is the
-# one without numba's runtime that Wisdom-Holman's loops call (it allocates
-# nothing): one compilation for both integrators
+# unflagged segment keeps its inlined copy.  The Kepler drift is the copy
+# that Wisdom-Holman's plain loop calls (without numba's runtime: it
+# allocates nothing), with its empty targs: one compilation for both
 _criterion_call = called(criterion)
 _pair_accelerations_call = called(pair_accelerations)
 _jump_call = called(jump)
-_kepler_drift_all_call = called(kepler_drift_all, nrt=False)
+
+
+@njit(inline="always")
+def _kepler_drift_all_call(xh, vb, eta, h, w1, w2):
+    plain_drift_call(xh, vb, eta, h, w1, w2, ())
 
 
 class Work(NamedTuple):

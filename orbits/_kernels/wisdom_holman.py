@@ -874,25 +874,31 @@ def _plain_perturbation(xj, vj, x, acc, gm, eta, n_active, h, targs):
     step(xj, vj, x, acc, gm, eta, n_active, h)
 
 
-def _targs_dropped6(a, b, c, d, e, f, targs):
-    convert(a, b, c, d, e, f)
+def _targs_emptied7(a, b, c, d, e, f, targs):
+    convert(a, b, c, d, e, f, ())
 
 
-def _targs_dropped8(a, b, c, d, e, f, g, h, targs):
-    convert(a, b, c, d, e, f, g, h)
+def _targs_emptied9(a, b, c, d, e, f, g, h, targs):
+    convert(a, b, c, d, e, f, g, h, ())
 
 
-def _without_targs(kernel, name, nrt):
-    """A loop's operator (the arguments of ``kernel``, then ``targs``) that
-    calls ``kernel``, a called copy where it is inlined elsewhere, without
-    the ``targs``: its compiled call is then one for every loop, whatever
-    its ``targs`` hold (none, a table of terms, the lanes' scratch), where a
-    called copy taking them compiles again for each (4-5 s for the drift).
-    The same code, so the same results bit for bit."""
-    if kernel.targetoptions.get("inline") == "always":
-        kernel = called(kernel, nrt)
-    template = _targs_dropped6 if kernel.py_func.__code__.co_argcount == 6 else _targs_dropped8
-    return specialize(template, name, inline=True, nrt=nrt, convert=kernel)
+def _with_plain_targs(op, name, nrt):
+    """``op``, the called copy of an operator of the plain loop that reads no
+    ``targs`` (the drift, a conversion, gravity's perturbation step), as an
+    operator of a loop whose ``targs`` hold something (a table of terms, the
+    lanes' scratch): it calls ``op`` with the plain loop's empty ``targs``,
+    so that every loop calls the plain loop's compilation, where a call
+    with the loop's own ``targs`` compiles ``op`` again for their type
+    (4-5 CPU s for the drift).  The same code, so the same results bit for
+    bit."""
+    template = _targs_emptied7 if op.py_func.__code__.co_argcount == 7 else _targs_emptied9
+    return specialize(template, name, inline=True, nrt=nrt, convert=op)
+
+
+#: the Kepler drift of every planet that the plain loop calls (and its
+#: corrector, synchronisation and owed drift), compiled without numba's
+#: runtime; trace's segments with flags call it too
+plain_drift_call = called(_plain_drift, nrt=False)
 
 
 def _perturbation_with_terms(xj, vj, x, acc, gm, eta, n_active, h, targs):
@@ -954,12 +960,19 @@ def _kernels(coordinates, terms=None, lanes=False):
     # instead of inlining a copy at each of their call sites.  Both drift
     # every planet: in lanes, bit for bit, where the loop drifts in lanes (so
     # that the loop compiles one drift of arrays (N, 3), not two)
+    # (the loops with terms or lanes call the plain loop's compilations of
+    # what reads no targs: _with_plain_targs)
     if lanes:
         drift = called(_lanes_drift, nrt)
+    elif terms is None:
+        drift = called(_plain_drift, nrt)
     else:
-        drift = _without_targs(kepler_drift_all, "kepler_drift_all", nrt)
-    if terms is None:
-        called_perturbation = _without_targs(step, f"perturbation_{coordinates}", nrt)
+        drift = _with_plain_targs(called(_plain_drift, nrt), "drift", nrt)
+    if terms is not None:
+        called_perturbation = called(perturbation, nrt)
+    elif lanes:
+        called_perturbation = _with_plain_targs(called(perturbation, nrt),
+                                                f"perturbation_{coordinates}", nrt)
     else:
         called_perturbation = called(perturbation, nrt)
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
@@ -1009,8 +1022,8 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     # call instead of inlining a copy: 2.3 s less to compile for 2-5 % more
     # a step; the loop with terms, whose long runs have no lanes, inlines it
     # (benchmarks/RESULTS.md)
-    called_drift = _without_targs(kepler_drift_all, "kepler_drift_all", nrt)
-    drift = called_drift if terms is None else _plain_drift
+    drift = called(_plain_drift, nrt) if terms is None else _plain_drift
+    plain = terms is None and not lanes
     # the loop with terms calls its perturbation step, the copy its corrector
     # calls, instead of inlining the terms' dispatch once more
     # (benchmarks/RESULTS.md)
@@ -1049,10 +1062,11 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     if not lanes:
         outputs["stop_args"], stop = escape_kernels(key, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{key}", nrt=nrt, cache=cache,
-                      to_internal=_without_targs(COORDINATE_SYSTEMS[coordinates][0],
-                                                 f"to_{coordinates}", nrt),
+                      to_internal=called(to_internal, nrt) if plain else _with_plain_targs(
+                          called(to_internal, nrt), f"to_{coordinates}", nrt),
                       drift=drift,
-                      owed_drift=called(drift, nrt) if lanes else called_drift,
+                      owed_drift=called(drift, nrt) if plain or lanes else _with_plain_targs(
+                          called(_plain_drift, nrt), "drift", nrt),
                       perturbation=perturbation if terms is None else called(perturbation, nrt),
                       corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),

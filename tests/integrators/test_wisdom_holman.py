@@ -667,10 +667,11 @@ def _megno_member(e):
 
 def test_the_loops_with_and_without_terms_call_one_compiled_drift():
     # the Kepler drift and the conversion to the loop's coordinates that the
-    # loops call (at a call's start, for an owed drift, in the corrector) are
-    # compiled functions without the loop's targs, so the loop with added
-    # terms calls the compilations of the plain loop: a called copy taking
-    # the targs compiled again for the terms' table (4-5 CPU s)
+    # loops call (at a call's start, for an owed drift, in the corrector)
+    # read no targs: the loop with added terms calls the plain loop's
+    # compilations with the plain loop's empty targs, where a call with the
+    # terms' table compiled both again (4-5 CPU s)
+    from orbits._kernels import trace
     from orbits._kernels import wisdom_holman as kwh
     integ = orbits.integrators.get("wh", lanes="off")
     loops = []
@@ -682,15 +683,15 @@ def test_the_loops_with_and_without_terms_call_one_compiled_drift():
     plain, terms = (loop.py_func.__globals__ for loop in loops)
     assert plain["corrector_kernel"] is not terms["corrector_kernel"]
 
-    def called(op):
-        # the compiled function an operator of a loop calls
+    def calls(op):
+        # the compiled function an operator of the loop with terms calls
         return op.py_func.__globals__["convert"]
 
+    assert plain["owed_drift"] is kwh.plain_drift_call
     for name in ("owed_drift", "to_internal"):
-        assert called(plain[name]) is called(terms[name])
-        assert called(plain[name]).py_func.__code__.co_argcount == 6   # no targs
+        assert calls(terms[name]) is plain[name]
     corrector = terms["corrector_kernel"].py_func.__globals__
-    assert called(corrector["drift"]) is called(plain["owed_drift"])
+    assert calls(corrector["drift"]) is kwh.plain_drift_call
     # and trace's segments with flags call the same compiled drift
-    from orbits._kernels import trace
-    assert trace._kepler_drift_all_call is called(plain["owed_drift"])
+    assert trace._kepler_drift_all_call.py_func.__globals__["plain_drift_call"] \
+        is kwh.plain_drift_call
