@@ -964,17 +964,14 @@ def _kernels(coordinates, terms=None, lanes=False):
     # what reads no targs: _with_plain_targs)
     if lanes:
         drift = called(_lanes_drift, nrt)
-    elif terms is None:
+    else:
         drift = called(_plain_drift, nrt)
-    else:
-        drift = _with_plain_targs(called(_plain_drift, nrt), "drift", nrt)
-    if terms is not None:
-        called_perturbation = called(perturbation, nrt)
-    elif lanes:
-        called_perturbation = _with_plain_targs(called(perturbation, nrt),
+        if terms is not None:
+            drift = _with_plain_targs(drift, "drift", nrt)
+    called_perturbation = called(perturbation, nrt)
+    if lanes and terms is None:
+        called_perturbation = _with_plain_targs(called_perturbation,
                                                 f"perturbation_{coordinates}", nrt)
-    else:
-        called_perturbation = called(perturbation, nrt)
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
                            drift=drift, perturbation=called_perturbation)
     sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
