@@ -882,15 +882,18 @@ def _targs_emptied9(a, b, c, d, e, f, g, h, targs):
     convert(a, b, c, d, e, f, g, h, ())
 
 
-def _with_plain_targs(op, name, nrt):
-    """``op``, the called copy of an operator of the plain loop that reads no
-    ``targs`` (the drift, a conversion, gravity's perturbation step), as an
-    operator of a loop whose ``targs`` hold something (a table of terms, the
-    lanes' scratch): it calls ``op`` with the plain loop's empty ``targs``,
-    so that every loop calls the plain loop's compilation, where a call
-    with the loop's own ``targs`` compiles ``op`` again for their type
-    (4-5 CPU s for the drift).  The same code, so the same results bit for
-    bit."""
+def _plain_call(kernel, name, nrt, plain):
+    """The called copy of ``kernel``, an operator of the plain loop that
+    reads no ``targs`` (the drift, a conversion, gravity's perturbation
+    step), as the plain loop calls it (``plain``); for a loop whose
+    ``targs`` hold something (a table of terms, the lanes' scratch), an
+    operator that calls that copy with the plain loop's empty ``targs``, so
+    that every loop calls the plain loop's compilation, where a call with
+    the loop's own ``targs`` compiles it again for their type (4-5 CPU s
+    for the drift).  The same code, so the same results bit for bit."""
+    op = called(kernel, nrt)
+    if plain:
+        return op
     template = _targs_emptied7 if op.py_func.__code__.co_argcount == 7 else _targs_emptied9
     return specialize(template, name, inline=True, nrt=nrt, convert=op)
 
@@ -961,19 +964,18 @@ def _kernels(coordinates, terms=None, lanes=False):
     # every planet: in lanes, bit for bit, where the loop drifts in lanes (so
     # that the loop compiles one drift of arrays (N, 3), not two)
     # (the loops with terms or lanes call the plain loop's compilations of
-    # what reads no targs: _with_plain_targs)
+    # what reads no targs: _plain_call)
     if lanes:
         drift = called(_lanes_drift, nrt)
     else:
-        drift = called(_plain_drift, nrt)
-        if terms is not None:
-            drift = _with_plain_targs(drift, "drift", nrt)
-    called_perturbation = called(perturbation, nrt)
-    if lanes and terms is None:
-        called_perturbation = _with_plain_targs(called_perturbation,
-                                                f"perturbation_{coordinates}", nrt)
+        drift = _plain_call(_plain_drift, "drift", nrt, terms is None)
+    if terms is None:
+        perturbation_call = _plain_call(perturbation, f"perturbation_{coordinates}", nrt,
+                                        not lanes)
+    else:
+        perturbation_call = called(perturbation, nrt)
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
-                           drift=drift, perturbation=called_perturbation)
+                           drift=drift, perturbation=perturbation_call)
     sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
                       cache=cache, nrt=nrt, drift=drift, from_internal=from_internal,
                       corrector_kernel=corrector)
@@ -1020,7 +1022,6 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     # a step; the loop with terms, whose long runs have no lanes, inlines it
     # (benchmarks/RESULTS.md)
     drift = called(_plain_drift, nrt) if terms is None else _plain_drift
-    plain = terms is None and not lanes
     # the loop with terms calls its perturbation step, the copy its corrector
     # calls, instead of inlining the terms' dispatch once more
     # (benchmarks/RESULTS.md)
@@ -1059,11 +1060,11 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     if not lanes:
         outputs["stop_args"], stop = escape_kernels(key, cache=cache, nrt=nrt)
     return specialize(_wh_loop, f"wh_{key}", nrt=nrt, cache=cache,
-                      to_internal=called(to_internal, nrt) if plain else _with_plain_targs(
-                          called(to_internal, nrt), f"to_{coordinates}", nrt),
+                      to_internal=_plain_call(to_internal, f"to_{coordinates}", nrt,
+                                              terms is None and not lanes),
                       drift=drift,
-                      owed_drift=called(drift, nrt) if plain or lanes else _with_plain_targs(
-                          called(_plain_drift, nrt), "drift", nrt),
+                      owed_drift=called(drift, nrt) if lanes else _plain_call(
+                          _plain_drift, "drift", nrt, terms is None),
                       perturbation=perturbation if terms is None else called(perturbation, nrt),
                       corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
