@@ -27,6 +27,7 @@ from ._kernels import stepping
 from ._kernels._jit import cpu_name
 
 __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "ADDED", "CHECKS",
+           "TERMS",
            "loop_label",
            "notice", "cache_dir", "cpu_name", "stderr_is_terminal"]
 
@@ -40,18 +41,20 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "AD
 #: estimate reads it.  The methods of a family share their loop (the SABA
 #: methods wh's), so a family's first method compiles it.
 FIRST_COMPILE_SECONDS = {
-    "euler": 3.0, "symplectic-euler": 3.0, "verlet": 3.0, "leapfrog": 3.0,
+    "euler": 3.0, "symplectic-euler": 4.0, "verlet": 4.0, "leapfrog": 4.0,
     "rk2": 3.0, "rk4": 3.0, "yoshida4": 3.0, "yoshida6": 3.0, "yoshida8": 3.0,
     **{f"{name}{coords}{lanes}": seconds
        for name in ("wh", "saba2", "saba3", "saba4")
        for coords in ("", " democratic-heliocentric")
        for lanes, seconds in (("", 16.0), (" lanes", 37.0))},
-    "dopri5": 7.0, "dop853": 8.0, "rk4-doubling": 6.0, "ias15": 9.0, "taylor": 6.0,
+    "dopri5": 8.0, "dop853": 9.0, "rk4-doubling": 8.0, "ias15": 9.0, "taylor": 6.0,
     "implicit-euler": 5.0, "implicit-midpoint": 5.0, "trace": 27.0, "trace lanes": 41.0,
     # the stopping conditions' checks, one for every integrator (:data:`CHECKS`):
     # 20-25 s, 1.1-1.6 s and 7.6 s on the Zen 3 (2026-11-30)
     "check of the stopping conditions": 22.0, "check of the escape conditions": 1.4,
     "look-ahead of the stopping conditions": 7.0,
+    # the force terms' table (:data:`TERMS`): 9.3-11.2 s and 16 s on the Zen 3 (2026-11-30)
+    "kernels of the force terms": 10.0, "Jacobians of the force terms": 16.0,
 }
 
 #: The check a run's stopping conditions take (a kind of
@@ -61,6 +64,12 @@ FIRST_COMPILE_SECONDS = {
 #: integrator, and announced by itself (:meth:`CompileClock.part`).
 CHECKS = {"escapes": "check of the escape conditions", "all": "check of the stopping conditions",
           "ahead": "look-ahead of the stopping conditions"}
+
+#: The C callables of the force terms' table
+#: (:func:`orbits._kernels.terms.table_pointer`), as the notice names them:
+#: compiled once for every integrator, when a first simulation has terms, and
+#: the Jacobians' when a first one reads them (implicit methods, variations).
+TERMS = {"kernels": "kernels of the force terms", "jacobians": "Jacobians of the force terms"}
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
 UNKNOWN_ESTIMATE = "a few seconds"
@@ -135,7 +144,7 @@ def notice(label):
         about = f"about {ADDED_ESTIMATE}"
     else:
         about = UNKNOWN_ESTIMATE
-    what = label if label in CHECKS.values() else f"{label} loop"
+    what = label if label in CHECKS.values() or label in TERMS.values() else f"{label} loop"
     return (f"orbits: compiling the {what} for this CPU, once ({about}; "
             f"`orbits compile` does it ahead)")
 

@@ -300,9 +300,11 @@ class Driven:
                  and lanes(self._ws, self._x.shape[0], self._force.recorder))
         force = self._force
         inner = getattr(force, "inner", None)
-        adds = ("terms+variations" if getattr(inner, "terms", None) is not None else
-                "variations" if inner is not None else
-                "terms" if getattr(force, "terms", None) is not None else "")
+        # an integrator that takes terms as data runs one loop with and without them
+        separate = not getattr(self.integrator, "terms_as_data", False)
+        adds = ("terms+variations" if separate and getattr(inner, "terms", None) is not None
+                else "variations" if inner is not None else
+                "terms" if separate and getattr(force, "terms", None) is not None else "")
         self._compile_clock = CompileClock(loop_label(self.integrator, lanes, adds),
                                            quiet=progress is False)
         wall0 = _time.perf_counter()

@@ -13,6 +13,7 @@ import numpy as np
 
 from . import _user_functions
 from . import forces as _forces
+from ._compiling import TERMS, CompileClock
 from ._kernels import gravity as _gravity
 from ._kernels import stepping as _stepping
 from ._kernels import terms as _kterms
@@ -89,15 +90,16 @@ def bind_terms(sim, bodies):
     sim._force = _stepping.with_terms(sim._force, terms,
                                        any(t.velocity_dependent for t in sim._terms),
                                        work=terms, dissipative=bool(dissipative))
-    table = _term_table(sim, bound, ctx)
+    table = _term_table(sim, bound, ctx, sim.integrator.reads_jacobians)
     sim._fargs = (sim._fargs, table,
                   _stepping.work_args(_term_table(sim, dissipative, ctx), sim._m))
     sim._eargs = table
 
 
-def _term_table(sim, bound, ctx):
+def _term_table(sim, bound, ctx, jacobian=False):
     """The :class:`~orbits._kernels.terms.TermTable` of bound terms, with
-    the pointers of their user functions, if any."""
+    the pointers of their user functions, if any (and their Jacobians' with
+    ``jacobian``)."""
     users = [b.user for b in bound if b.user is not None]
     rows = [b.row for b in bound if b.user is None]
     user = None
@@ -109,4 +111,5 @@ def _term_table(sim, bound, ctx):
                                   np.ascontiguousarray(ctx.m[pos]),
                                   any(u.velocity_dependent for u in users))
         rows.append(_kterms.TermRow(_kterms.USER))
-    return _kterms.table(rows, sim._gm, sim._m, user)
+    with CompileClock(TERMS["jacobians" if jacobian else "kernels"]) as clock, clock.loop():
+        return _kterms.table(rows, sim._gm, sim._m, user, jacobian)

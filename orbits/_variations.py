@@ -13,6 +13,8 @@ import numbers
 
 import numpy as np
 
+from ._compiling import TERMS, CompileClock
+from ._kernels import terms as _kterms
 from ._kernels import variational as _var
 from .errors import IntegratorOptionError, SimulationOptionError
 from .monitors import CHAOS_MONITORS
@@ -82,6 +84,10 @@ def bind(sim, variations, seed):
             "dependence on the masses only, and the force terms "
             f"{', '.join(map(repr, sim._terms))} depend on them too; use "
             "variations='state', or drop the terms")
+    if sim._terms:
+        # the variational equations read the terms' Jacobians
+        with CompileClock(TERMS["jacobians"]) as clock, clock.loop():
+            _kterms.with_jacobian(sim._base_fargs[1])
     dx, dv, dm = _initial_tangents(sim, n, seed)
     sim._rows_x[n:] = dx.reshape(-1, 3)
     sim._rows_v[n:] = dv.reshape(-1, 3)

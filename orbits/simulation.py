@@ -237,6 +237,7 @@ class Simulation(Driven):
         self._eargs = None
         if terms:
             self.integrator.check_terms(terms)
+        if terms or self.integrator.terms_as_data:
             _binding.bind_terms(self, bodies)
 
         _monitoring.set_up(self, monitors, monitor_every)

@@ -47,6 +47,7 @@ from numba.extending import intrinsic
 from . import _inlining  # noqa: F401 - installs itself
 
 __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_globals", "called",
+           "contiguous_data",
            "compiled_for",
            "cfunc", "pointer", "idle_pointer", "Pointer", "address_caller", "fma", "value",
            "data_pointer",
@@ -245,6 +246,24 @@ def data_pointer(typingctx, address):
 
     def codegen(context, builder, signature, args):
         return builder.inttoptr(args[0], context.get_value_type(signature.return_type))
+
+    return sig, codegen
+
+
+@intrinsic
+def contiguous_data(typingctx, a):
+    """The data pointer of a C-contiguous array ``a`` (typed ``CPointer`` of
+    its dtype), for a C callable that views the array again with
+    ``numba.carray``: a pointer is one word, where an array hands over its
+    whole structure, and the view it makes counts no references; in
+    compiled code only, while the array lives.  Any other layout is a
+    typing error."""
+    if not isinstance(a, nbtypes.Array) or a.layout != "C":
+        return None
+    sig = nbtypes.CPointer(a.dtype)(a)
+
+    def codegen(context, builder, signature, args):
+        return context.make_array(signature.args[0])(context, builder, args[0]).data
 
     return sig, codegen
 

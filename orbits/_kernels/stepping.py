@@ -67,6 +67,7 @@ from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
 from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, monitor_row
 from .status import Status
 from .stopping import call_check
+from .terms import table_rows
 from .variational import tangent_kernels, variational_work_kernels
 
 # the names the templates below are written against, bound by specialize
@@ -599,7 +600,7 @@ def _no_work_rate(x, v, t, fargs):
 @njit(inline="always")
 def _table_work_on(fargs):
     # whether the terms' work arguments hold non-conservative terms
-    return fargs[2][0].codes.shape[0] > 0
+    return table_rows(fargs[2][0]) > 0
 
 
 @njit(inline="always")

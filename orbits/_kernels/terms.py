@@ -12,7 +12,11 @@ bodies first), with its parameters in one tuple ``args``:
 
 Any combination of terms is one :class:`TermTable` (a row of codes and
 parameters a term), read by one kernel of each kind (:data:`TABLE`), so a loop
-compiled for gravity with terms serves every combination of them.
+compiled for gravity with terms serves every combination of them, none
+included.  The loops call those kernels through C callables whose addresses
+the table holds (:func:`table_pointer`), handing over the data of the state
+and of the table's arrays: a loop's compilation leaves the kernels out, and
+they compile once for every loop, when a first table has terms.
 
 ``gm`` is ``G`` times the masses and ``m`` the masses, both in the internal
 order; ``inv_c2`` is ``1 / c^2`` in the simulation's units.
@@ -39,9 +43,10 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
+from numba import carray
 from numba.core import types as nbtypes
 
-from ._jit import address_caller, njit, slots, specialize, value
+from ._jit import address_caller, contiguous_data, njit, pointer, slots, specialize, value
 from .coordinates import row_difference
 from .invariants import _add
 from .jacobians import central_differences
@@ -49,8 +54,9 @@ from .jacobians import central_differences
 # the name the energy template below is written against, bound by specialize
 body_energy, = slots("body_energy")
 
-__all__ = ["TermKernel", "TermTable", "TermRow", "UserTerms", "user_terms", "no_user_terms",
-           "user_flag", "user_accel", "user_energy", "TABLE", "table",
+__all__ = ["TermKernel", "TermTable", "TermRows", "TermRow", "UserTerms", "user_terms", "no_user_terms",
+           "user_flag", "user_accel", "user_energy", "TABLE", "table", "row", "table_rows", "table_pointer",
+           "with_jacobian",
            "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",
@@ -778,8 +784,7 @@ USER_ENERGY = nbtypes.float64(_A2, _I1, _F2, _F1)
 
 
 class UserTerms(NamedTuple):
-    """A table's user terms, in two arrays (a table is handed to compiled
-    kernels field by field, so fewer arrays are fewer words a call).
+    """A table's user terms, in two arrays (views of the table's buffers).
 
     ``ints`` holds the addresses of the C callables of :data:`USER_ACCEL`
     and :data:`USER_ENERGY` (0: none), called through
@@ -795,22 +800,6 @@ class UserTerms(NamedTuple):
 
     ints: np.ndarray    # int64: accelerations' address, energy's, velocities, flag, pos
     reals: np.ndarray   # float64 (7 n,): xu, vu, mu
-
-    def __deepcopy__(self, memo):
-        # the same process: the addresses stay good
-        return UserTerms(self.ints.copy(), self.reals.copy())
-
-    def __reduce__(self):
-        # another process has other addresses: a pickle of them would call
-        # whatever lies there, so user terms do not pickle
-        if self.ints[_ACCEL] != 0 or self.ints[_ENERGY] != 0:
-            raise TypeError(
-                "a simulation with UserForce terms holds the addresses of their compiled "
-                "code in this process and cannot be pickled; send what makes it (its "
-                "bodies, integrator and forces, as orbits.Ensemble does), or run it with "
-                "output= to a file and restore it with Simulation.from_file(path, "
-                "functions=...)")
-        return (UserTerms, (self.ints, self.reals))
 
 
 #: the fixed entries of :attr:`UserTerms.ints`
@@ -838,19 +827,114 @@ def user_flag(u):
     return int(u.ints[_FLAG])
 
 
-class TermTable(NamedTuple):
-    """Force terms as data: row ``k`` is term ``codes[k]`` with its integers
-    ``ints[k]``, reals ``reals[k]`` and per-body values ``per_body[k]``."""
+#: the header of a table's integer buffer: its rows, bodies and the user
+#: terms' bodies, the addresses of its kernels' C callables (accelerations,
+#: energy, Jacobians; 0: none), and whether a term reads the velocities
+_ROWS, _BODIES, _USERS, _ACCEL_AT, _ENERGY_AT, _JACOBIAN_AT, _READS_V = range(7)
+_HEAD = 7
+
+
+class TermRows(NamedTuple):
+    """A table's rows as the kernels read them: row ``k`` is term
+    ``codes[k]`` with its integers, reals and per-body values (:func:`row`);
+    every array a view of the table's buffers (:class:`TermTable`), all
+    one-dimensional but the scratch ``an``, so that the views cost a few
+    nanoseconds (numba's reshape costs some twenty a call)."""
 
     codes: np.ndarray     # int64 (n,)
-    ints: np.ndarray      # int64 (n, INTS)
-    reals: np.ndarray     # float64 (n, REALS)
-    per_body: np.ndarray  # float64 (n, N)
+    ints: np.ndarray      # int64 (n INTS,): row k's at [k INTS, (k + 1) INTS)
+    reals: np.ndarray     # float64 (n REALS,): row k's at [k REALS, (k + 1) REALS)
+    per_body: np.ndarray  # float64 (n N,): row k's at [k N, (k + 1) N)
     gm: np.ndarray        # G m, internal order
     m: np.ndarray         # masses, internal order
     an: np.ndarray        # scratch (N, 3)
     pot: np.ndarray       # scratch (N,)
     user: UserTerms
+
+
+class TermTable(NamedTuple):
+    """Force terms as data, in two buffers and a scratch array: ``ibuf``
+    (int64: a header, then the rows' codes and integers and the user terms'
+    integers), ``rbuf`` (float64: the rows' reals and per-body values, ``G
+    m``, the masses, scratch and the user terms' reals) and ``an`` (N, 3).
+    The loops hand them to the table's C callables (:func:`table_pointer`),
+    whose addresses the header holds, and the kernels read them as
+    :class:`TermRows` (:attr:`rows`).  A table travels to another process
+    without the addresses and takes that process's on arrival."""
+
+    ibuf: np.ndarray
+    rbuf: np.ndarray
+    an: np.ndarray
+
+    @property
+    def rows(self):
+        """The :class:`TermRows` of the table (views of its buffers)."""
+        return _views.py_func(self.ibuf, self.rbuf, self.an)
+
+    @property
+    def user(self):
+        """The :class:`UserTerms` of the table."""
+        return self.rows.user
+
+    def __deepcopy__(self, memo):
+        # the same process: the addresses stay good
+        return TermTable(self.ibuf.copy(), self.rbuf.copy(), self.an.copy())
+
+    def __reduce__(self):
+        # another process has other addresses: the buffers travel with the
+        # kernels' addresses cleared, and the table takes that process's on
+        # arrival; a user's functions' addresses cannot
+        user = self.user
+        if user.ints[_ACCEL] != 0 or user.ints[_ENERGY] != 0:
+            raise TypeError(
+                "a simulation with UserForce terms holds the addresses of their compiled "
+                "code in this process and cannot be pickled; send what makes it (its "
+                "bodies, integrator and forces, as orbits.Ensemble does), or run it with "
+                "output= to a file and restore it with Simulation.from_file(path, "
+                "functions=...)")
+        ibuf = self.ibuf.copy()
+        jacobian = bool(ibuf[_JACOBIAN_AT])
+        ibuf[_ACCEL_AT:_JACOBIAN_AT + 1] = 0
+        return (_arrived, (ibuf, self.rbuf, self.an, jacobian))
+
+
+@njit(inline="always")
+def _buffer_sizes(nrows, n, nu):
+    # the lengths of a table's two buffers
+    return (_HEAD + nrows * (1 + INTS) + _POS + nu,
+            nrows * (REALS + n) + 3 * n + 7 * nu)
+
+
+@njit(inline="always")
+def _views(ibuf, rbuf, an):
+    # the TermRows of a table's buffers (in the C callables, and as Python
+    # for TermTable.rows)
+    nrows = ibuf[_ROWS]
+    n = ibuf[_BODIES]
+    nu = ibuf[_USERS]
+    i = _HEAD
+    codes = ibuf[i:i + nrows]
+    i += nrows
+    ints = ibuf[i:i + nrows * INTS]
+    i += nrows * INTS
+    uints = ibuf[i:i + _POS + nu]
+    r = nrows * REALS
+    reals = rbuf[:r]
+    per_body = rbuf[r:r + nrows * n]
+    r += nrows * n
+    gm = rbuf[r:r + n]
+    m = rbuf[r + n:r + 2 * n]
+    pot = rbuf[r + 2 * n:r + 3 * n]
+    r += 3 * n
+    ureals = rbuf[r:r + 7 * nu]
+    return TermRows(codes, ints, reals, per_body, gm, m, an, pot, UserTerms(uints, ureals))
+
+
+def _arrived(ibuf, rbuf, an, jacobian):
+    # a table unpickled: this process's addresses of its kernels
+    tab = TermTable(ibuf, rbuf, an)
+    _address(tab, jacobian)
+    return tab
 
 
 class TermRow(NamedTuple):
@@ -862,28 +946,41 @@ class TermRow(NamedTuple):
     per_body: object = None
 
 
-def table(rows, gm, m, user=None):
+def table(rows, gm, m, user=None, jacobian=False):
     """The :class:`TermTable` of ``rows`` (:class:`TermRow`) over bodies with
     ``G m`` ``gm`` and masses ``m`` (internal order); ``user`` the
     :class:`UserTerms` of the rows coded :data:`USER`, or None without such
     rows.  Every table holds arrays and numbers alone (a user function by
     its address), which numba types on a call from Python in a few
-    microseconds, and all are of one type: one loop serves tables with and
-    without user terms."""
+    microseconds, and all are of one type: one loop serves every table, an
+    empty one included.  A table with rows holds the addresses of the C
+    callables of its accelerations and energy (compiled on first use,
+    :func:`table_pointer`), and with ``jacobian`` its Jacobians'
+    (:func:`with_jacobian`)."""
     n = len(m)
     rows = list(rows)
-    codes = np.array([r.code for r in rows], dtype=np.int64)
-    ints = np.zeros((len(rows), INTS), dtype=np.int64)
-    reals = np.zeros((len(rows), REALS))
-    per_body = np.zeros((len(rows), n))
+    user = no_user_terms() if user is None else user
+    nrows, nu = len(rows), len(user.ints) - _POS
+    isize, rsize = _buffer_sizes.py_func(nrows, n, nu)
+    ibuf = np.zeros(isize, dtype=np.int64)
+    rbuf = np.zeros(rsize)
+    ibuf[_ROWS], ibuf[_BODIES], ibuf[_USERS] = nrows, n, nu
+    tab = TermTable(ibuf, rbuf, np.zeros((n, 3)))
+    t = tab.rows
     for k, r in enumerate(rows):
-        ints[k, :len(r.ints)] = r.ints
-        reals[k, :len(r.reals)] = r.reals
+        t.codes[k] = r.code
+        t.ints[k * INTS:k * INTS + len(r.ints)] = r.ints
+        t.reals[k * REALS:k * REALS + len(r.reals)] = r.reals
         if r.per_body is not None:
-            per_body[k] = r.per_body
-    return TermTable(codes, ints, reals, per_body, np.ascontiguousarray(gm, dtype=np.float64),
-                     np.ascontiguousarray(m, dtype=np.float64), np.zeros((n, 3)), np.zeros(n),
-                     no_user_terms() if user is None else user)
+            t.per_body[k * n:(k + 1) * n] = r.per_body
+    t.gm[:] = gm
+    t.m[:] = m
+    t.user.ints[:] = user.ints
+    t.user.reals[:] = user.reals
+    ibuf[_READS_V] = any(r.code in (GR, GR_FULL, MIGRATION, TIDES, RADIATION) for r in rows) or (
+        any(r.code == USER for r in rows) and bool(user.ints[_READS]))
+    _address(tab, jacobian)
+    return tab
 
 
 _call_accel = address_caller(USER_ACCEL)
@@ -919,24 +1016,44 @@ def _user_velocity_dependent(u):
     return u.ints[_READS] != 0
 
 
-@njit
+@njit(inline="always")
+def row(tab, k):
+    """Row ``k`` of the :class:`TermRows` ``tab``: its integers, its reals
+    and its per-body values (views)."""
+    n = tab.m.shape[0]
+    return (tab.ints[k * INTS:(k + 1) * INTS], tab.reals[k * REALS:(k + 1) * REALS],
+            tab.per_body[k * n:(k + 1) * n])
+
+
+@njit(inline="always")
+def table_rows(tab):
+    """The number of rows (terms) of the table ``tab``."""
+    return tab.ibuf[_ROWS]
+
+
+@njit(inline="always")
 def table_reads_velocities(tab):
     """Whether a term of the table ``tab`` reads the velocities: GR, GRFull
     and the dissipative terms do, a user's term says (each term class's
     ``velocity_dependent``, which tests/test_forces.py holds this to)."""
-    for k in range(tab.codes.shape[0]):
-        c = tab.codes[k]
-        if c == GR or c == GR_FULL or c == MIGRATION or c == TIDES or c == RADIATION:
-            return True
-        if c == USER and _user_velocity_dependent(tab.user):
-            return True
-    return False
+    return tab.ibuf[_READS_V] != 0
 
 
-@njit
-def table_accel(x, v, t, tab, acc):
-    """Adds the accelerations of every term of the table ``tab`` to ``acc``."""
-    rows_accel(x, v, t, tab, value(0), tab.codes.shape[0], acc)
+def _table_accel(xp, vp, t, nx, ip, rp, anp, accp):
+    # every row's accelerations: the C callable of table_accel
+    tab = _pointed(ip, rp, anp)
+    rows_accel(carray(xp, (nx, 3)), carray(vp, (nx, 3)), t, tab, value(0), tab.codes.shape[0],
+               carray(accp, (nx, 3)))
+
+
+@njit(inline="always")
+def _pointed(ip, rp, anp):
+    # the TermRows of the table whose arrays are at ip, rp and anp: arrays
+    # that own nothing, so that their views count no references
+    head = carray(ip, (_HEAD,))
+    n = head[_BODIES]
+    isize, rsize = _buffer_sizes(head[_ROWS], n, head[_USERS])
+    return _views(carray(ip, (isize,)), carray(rp, (rsize,)), carray(anp, (n, 3)))
 
 
 @njit
@@ -945,8 +1062,7 @@ def rows_accel(x, v, t, tab, first, end, acc):
     gm = tab.gm
     for k in range(first, end):
         c = tab.codes[k]
-        ints = tab.ints[k]
-        reals = tab.reals[k]
+        ints, reals, per_body = row(tab, k)
         if c == GR:
             gr_accel(x, v, t, (ints[0], gm, reals[0]), acc)
         elif c == GR_POTENTIAL:
@@ -961,21 +1077,22 @@ def rows_accel(x, v, t, tab, first, end, acc):
         elif c == TIDES:
             tides_accel(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]), acc)
         elif c == RADIATION:
-            radiation_accel(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), acc)
+            radiation_accel(x, v, t, (ints[0], reals[0], per_body, reals[1]), acc)
         elif c == USER:
             user_accel(tab.user, x, v, t, acc)
 
 
-@njit
-def table_energy(x, v, tab):
-    """The terms' contribution to the conserved energy (see the module notes)."""
+def _table_energy(xp, vp, nx, ip, rp, anp):
+    # the rows' energy: the C callable of table_energy
+    x = carray(xp, (nx, 3))
+    v = carray(vp, (nx, 3))
+    tab = _pointed(ip, rp, anp)
     gm = tab.gm
     m = tab.m
     e = 0.0
     for k in range(tab.codes.shape[0]):
         c = tab.codes[k]
-        ints = tab.ints[k]
-        reals = tab.reals[k]
+        ints, reals, _ = row(tab, k)
         if c == GR:
             e += gr_energy(x, v, (ints[0], gm, reals[0], m))
         elif c == GR_POTENTIAL:
@@ -1002,7 +1119,7 @@ _row_differences = specialize(central_differences, "term_row", inline=True, forc
 @njit
 def row_difference_jacobian(x, v, t, tab, k, velocity, jx, jv):
     """Adds the central-difference ``da/dx`` (and with ``velocity`` ``da/dv``)
-    of row ``k`` of ``tab`` to ``jx`` (``jv``), column by column
+    of row ``k`` of the :class:`TermRows` ``tab`` to ``jx`` (``jv``), column by column
     (:func:`~.jacobians.central_differences`): the accelerations at ``x +-
     delta e_q`` with ``delta`` :data:`FD_STEP` of the component (at least
     1e-3 of the largest), for terms without an analytic Jacobian (6N or 12N
@@ -1011,16 +1128,19 @@ def row_difference_jacobian(x, v, t, tab, k, velocity, jx, jv):
                      1e-3 * _scale(v), True)
 
 
-@njit
-def table_jacobian(x, v, t, tab, jx, jv):
-    """Adds the terms' ``da/dx`` and ``da/dv`` to ``jx`` and ``jv``: analytic
-    where a term has one, central differences for the full 1PN term and the
-    user's terms."""
+def _table_jacobian(xp, vp, t, nx, ip, rp, anp, jxp, jvp):
+    # the rows' da/dx and da/dv, analytic where a term has one, central
+    # differences for the full 1PN term and the user's terms: the C callable
+    # of table_jacobian
+    x = carray(xp, (nx, 3))
+    v = carray(vp, (nx, 3))
+    jx = carray(jxp, (3 * nx, 3 * nx))
+    jv = carray(jvp, (3 * nx, 3 * nx))
+    tab = _pointed(ip, rp, anp)
     gm = tab.gm
     for k in range(tab.codes.shape[0]):
         c = tab.codes[k]
-        ints = tab.ints[k]
-        reals = tab.reals[k]
+        ints, reals, per_body = row(tab, k)
         if c == GR:
             gr_jacobian(x, v, t, (ints[0], gm, reals[0]), jx, jv)
         elif c == GR_POTENTIAL:
@@ -1036,10 +1156,100 @@ def table_jacobian(x, v, t, tab, jx, jv):
             tides_jacobian(x, v, t, (ints[0], gm, reals[0], reals[1], reals[2:5]),
                            jx, jv)
         elif c == RADIATION:
-            radiation_jacobian(x, v, t, (ints[0], reals[0], tab.per_body[k], reals[1]), jx, jv)
+            radiation_jacobian(x, v, t, (ints[0], reals[0], per_body, reals[1]), jx, jv)
         elif c == USER:
             row_difference_jacobian(x, v, t, tab, k,
                                      value(_user_velocity_dependent(tab.user)), jx, jv)
+
+
+_P = nbtypes.CPointer(nbtypes.float64)
+_IP = nbtypes.CPointer(nbtypes.int64)
+#: the signatures of the table's C callables, which take the data of the
+#: state, of the table's arrays and of the result, and the bodies' number
+#: ``nx``: ``accel(x, v, t, nx, ibuf, rbuf, an, acc)``, ``energy(x, v, nx,
+#: ibuf, rbuf, an) -> e`` and ``jacobian(x, v, t, nx, ibuf, rbuf, an, jx, jv)``
+TABLE_ACCEL = nbtypes.void(_P, _P, nbtypes.float64, nbtypes.int64, _IP, _P, _P, _P)
+TABLE_ENERGY = nbtypes.float64(_P, _P, nbtypes.int64, _IP, _P, _P)
+TABLE_JACOBIAN = nbtypes.void(_P, _P, nbtypes.float64, nbtypes.int64, _IP, _P, _P, _P, _P)
+
+_KERNELS = {_ACCEL_AT: (_table_accel, TABLE_ACCEL), _ENERGY_AT: (_table_energy, TABLE_ENERGY),
+            _JACOBIAN_AT: (_table_jacobian, TABLE_JACOBIAN)}
+_POINTERS = {}
+
+
+def table_pointer(kind):
+    """The address of a C callable of a table's rows: ``kind`` ``"accel"``
+    (:data:`TABLE_ACCEL`), ``"energy"`` (:data:`TABLE_ENERGY`) or
+    ``"jacobian"`` (:data:`TABLE_JACOBIAN`).  Compiled on the first call in
+    a process or loaded from numba's cache on disk, and kept for the
+    process: one compilation serves every loop and every table."""
+    at = {"accel": _ACCEL_AT, "energy": _ENERGY_AT, "jacobian": _JACOBIAN_AT}[kind]
+    if at not in _POINTERS:
+        _POINTERS[at] = pointer(*_KERNELS[at])
+    return _POINTERS[at].cfunc.address
+
+
+def _address(tab, jacobian):
+    # a table's addresses of its kernels: none without rows, which the loops
+    # then do not call (so a run without terms compiles none of them), and
+    # the Jacobians' only where asked (with_jacobian)
+    if tab.ibuf[_ROWS] == 0:
+        return
+    tab.ibuf[_ACCEL_AT] = table_pointer("accel")
+    tab.ibuf[_ENERGY_AT] = table_pointer("energy")
+    if jacobian:
+        tab.ibuf[_JACOBIAN_AT] = table_pointer("jacobian")
+
+
+def with_jacobian(tab):
+    """The table ``tab`` with its Jacobians' C callable (set in place), what
+    loops that read the terms' Jacobians (implicit methods, variational
+    equations) take; compiled on first use.  A table without it adds NaN to
+    a Jacobian, so that a loop that was not given it stops."""
+    if tab.ibuf[_ROWS] > 0:
+        tab.ibuf[_JACOBIAN_AT] = table_pointer("jacobian")
+    return tab
+
+
+_call_table_accel = address_caller(TABLE_ACCEL)
+_call_table_energy = address_caller(TABLE_ENERGY)
+_call_table_jacobian = address_caller(TABLE_JACOBIAN)
+
+
+@njit(inline="always")
+def table_accel(x, v, t, tab, acc):
+    """Adds the accelerations of every term of the table ``tab`` to ``acc``."""
+    at = tab.ibuf[_ACCEL_AT]
+    if at != 0:
+        _call_table_accel(at, (contiguous_data(x), contiguous_data(v), t, x.shape[0],
+                               contiguous_data(tab.ibuf), contiguous_data(tab.rbuf),
+                               contiguous_data(tab.an), contiguous_data(acc)))
+
+
+@njit(inline="always")
+def table_energy(x, v, tab):
+    """The terms' contribution to the conserved energy (see the module notes)."""
+    at = tab.ibuf[_ENERGY_AT]
+    if at != 0:
+        return _call_table_energy(at, (contiguous_data(x), contiguous_data(v), x.shape[0],
+                                       contiguous_data(tab.ibuf), contiguous_data(tab.rbuf),
+                                       contiguous_data(tab.an)))
+    return 0.0
+
+
+@njit(inline="always")
+def table_jacobian(x, v, t, tab, jx, jv):
+    """Adds the terms' ``da/dx`` and ``da/dv`` to ``jx`` and ``jv``: analytic
+    where a term has one, central differences for the full 1PN term and the
+    user's terms."""
+    at = tab.ibuf[_JACOBIAN_AT]
+    if at != 0:
+        _call_table_jacobian(at, (contiguous_data(x), contiguous_data(v), t, x.shape[0],
+                                  contiguous_data(tab.ibuf), contiguous_data(tab.rbuf),
+                                  contiguous_data(tab.an), contiguous_data(jx),
+                                  contiguous_data(jv)))
+    elif tab.ibuf[_ROWS] > 0:
+        jx[0, 0] += math.nan
 
 
 #: the kernels of every table of terms: one key, so one loop for any combination

@@ -63,6 +63,7 @@ from .._kernels.invariants import MONITOR_WIDTH
 from .._kernels.status import with_status
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError, OrbitsWarning
+from ._loops import loop_for
 
 __all__ = ["Integrator", "SplittingMethod", "ExplicitRungeKutta", "AdaptiveIntegrator",
            "ToleranceControlled", "CompiledToleranceControlled", "Option", "MIN_DT", "RTOL_FLOOR", "NO_MARKS",
@@ -173,6 +174,13 @@ class Integrator:
     #: whether its loop updates the chaos indicators after every step (the
     #: shared step epilogue, :mod:`orbits._kernels.variational`)
     chaos_indicators = True
+    #: whether its runs without force terms take its loop with terms, an empty
+    #: table of them (:func:`orbits._kernels.terms.table`): one loop for runs
+    #: with and without terms, so that adding a term compiles nothing new
+    terms_as_data = False
+    #: whether its loop reads the force's Jacobian (the force terms' table
+    #: then carries theirs, :func:`orbits._kernels.terms.with_jacobian`)
+    reads_jacobians = False
     #: whether ``advance`` records at the steps ``mon_t`` holds on entry when
     #: ``mon[0]`` is -1 (:func:`orbits._kernels.stepping.first_record`), so that
     #: outputs that do not fall a whole number of steps apart are recorded in
@@ -390,6 +398,7 @@ class SplittingMethod(Integrator):
     operators = ()
     symplectic = True
     stop_conditions = True
+    terms_as_data = True
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -421,7 +430,7 @@ class SplittingMethod(Integrator):
         """Apply the operator table ``nsteps`` times in the compiled loop (see
         :meth:`Integrator.advance`)."""
         sargs, check = stop_record(stop)
-        return with_status(*stepping.splitting_loop(force)(
+        return with_status(*loop_for(stepping.splitting_loop, force)(
             x, v, t, dt, nsteps, self._table,
             stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"]),
             stepping.work_bound(force, fargs, ws), velocity_dependent or force.velocity_dependent,
@@ -466,6 +475,7 @@ class ExplicitRungeKutta(Integrator):
     B = None
     C = None
     stop_conditions = True
+    terms_as_data = True
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -492,7 +502,7 @@ class ExplicitRungeKutta(Integrator):
                 velocity_dependent=False, check_every=1, stop=None):
         """Take ``nsteps`` steps of the Butcher table in the compiled loop (see
         :meth:`Integrator.advance`)."""
-        loop = stepping.runge_kutta_loop(force)
+        loop = loop_for(stepping.runge_kutta_loop, force)
         fargs = stepping.work_bound(force, fargs, ws)
         sargs, check = stop_record(stop)
         work = stepping.RungeKuttaWork(ws["kx"], ws["kv"], ws["xs"], ws["vs"])
@@ -593,6 +603,7 @@ class CompiledToleranceControlled(ToleranceControlled):
 
     #: outputs can be recorded inside the loop (``advance_to``'s ``marks``)
     records_marks = True
+    terms_as_data = True
 
     def _loop_call(self, ws, force):
         """``(loop, lead, work)``: the compiled loop for ``force``, its

@@ -92,6 +92,8 @@ class IAS15(AdaptiveIntegrator):
     (0, True, True)
     """
 
+    terms_as_data = True
+
     name = "ias15"
     order = 15
     option_specs = (

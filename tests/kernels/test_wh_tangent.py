@@ -312,7 +312,8 @@ def _gr_terms():
     # the GR potential about the Sun with c = 3 au/day (c^2 58000 times too
     # small) so that the term's kick is about a planet's and its Jacobian shows
     def table(m):
-        return T.table([T.TermRow(T.GR_POTENTIAL, (0,), (1.0 / 9.0,))], G * m, m)
+        return T.table([T.TermRow(T.GR_POTENTIAL, (0,), (1.0 / 9.0,))], G * m, m,
+                       jacobian=True)
 
     return T.TABLE, table, table
 
