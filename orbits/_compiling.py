@@ -41,13 +41,13 @@ __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "AD
 #: estimate reads it.  The methods of a family share their loop (the SABA
 #: methods wh's), so a family's first method compiles it.
 FIRST_COMPILE_SECONDS = {
-    "euler": 3.0, "symplectic-euler": 4.0, "verlet": 4.0, "leapfrog": 4.0,
-    "rk2": 3.0, "rk4": 3.0, "yoshida4": 3.0, "yoshida6": 3.0, "yoshida8": 3.0,
+    "euler": 4.0, "symplectic-euler": 5.0, "verlet": 5.0, "leapfrog": 5.0,
+    "rk2": 4.0, "rk4": 4.0, "yoshida4": 5.0, "yoshida6": 5.0, "yoshida8": 5.0,
     **{f"{name}{coords}{lanes}": seconds
        for name in ("wh", "saba2", "saba3", "saba4")
        for coords in ("", " democratic-heliocentric")
        for lanes, seconds in (("", 16.0), (" lanes", 37.0))},
-    "dopri5": 8.0, "dop853": 9.0, "rk4-doubling": 8.0, "ias15": 9.0, "taylor": 6.0,
+    "dopri5": 10.0, "dop853": 11.0, "rk4-doubling": 10.0, "ias15": 12.0, "taylor": 6.0,
     "implicit-euler": 5.0, "implicit-midpoint": 5.0, "trace": 27.0, "trace lanes": 41.0,
     # the stopping conditions' checks, one for every integrator (:data:`CHECKS`):
     # 20-25 s, 1.1-1.6 s and 7.6 s on the Zen 3 (2026-11-30)
