@@ -181,7 +181,7 @@ def _invariants(sim):
     row = np.zeros(_inv.MONITOR_WIDTH)
     _inv.monitor_row(sim._x, sim._v, sim._m, sim.units.G, sim._n_active, sim._eps2,
                      _inv.ENERGY | _inv.ANGULAR_MOMENTUM, row)
-    if sim._eargs is not None:
+    if sim._terms:
         row[0] += sim._base_force.terms.energy(sim._x, sim._v, sim._eargs)
     return row[0], row[1:4].copy()
 

@@ -47,7 +47,8 @@ def row(sim, out):
     """``out`` (shape (MONITOR_WIDTH,)) filled with the monitors' values now."""
     _inv.monitor_row(sim._x, sim._v, sim._m, sim.units.G, sim._n_active, sim._eps2,
                      sim._mask, out)
-    if sim._eargs is not None and sim._mask & _inv.ENERGY:
+    # (an integrator that takes terms as data holds an empty table without them)
+    if sim._terms and sim._mask & _inv.ENERGY:
         out[0] += sim._base_force.terms.energy(sim._x, sim._v, sim._eargs)
         out[_inv.WORK_COLUMN] = _stepping.work_total(sim._ws)
     if sim._chaos_box is not None:
