@@ -50,7 +50,6 @@ __all__ = ["njit", "njit_parallel", "specialize", "slots", "Slot", "bound_global
            "contiguous_data",
            "compiled_for",
            "cfunc", "pointer", "idle_pointer", "Pointer", "address_caller", "fma", "value",
-           "data_pointer",
            "cpu_name",
            "KERNEL_STAMP", "NUMBA_OPTIONS"]
 
@@ -233,19 +232,6 @@ def value(typingctx, x):
 
     def codegen(context, builder, signature, args):
         return context.cast(builder, args[0], signature.args[0], signature.return_type)
-
-    return sig, codegen
-
-
-@intrinsic
-def data_pointer(typingctx, address):
-    """The address of a float64 array's data (``a.ctypes.data``) as a
-    pointer to float64, to hand a C callable (:class:`Pointer`) that takes
-    one; in compiled code only, while the array lives."""
-    sig = nbtypes.CPointer(nbtypes.float64)(address)
-
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(signature.return_type))
 
     return sig, codegen
 

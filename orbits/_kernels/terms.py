@@ -54,9 +54,9 @@ from .jacobians import central_differences
 # the name the energy template below is written against, bound by specialize
 body_energy, = slots("body_energy")
 
-__all__ = ["TermKernel", "TermTable", "TermRows", "TermRow", "UserTerms", "user_terms", "no_user_terms",
-           "user_flag", "user_accel", "user_energy", "TABLE", "table", "row", "table_rows", "table_pointer",
-           "with_jacobian",
+__all__ = ["TermKernel", "TermTable", "TermRows", "TermRow", "UserTerms", "user_terms",
+           "no_user_terms", "user_flag", "user_accel", "user_energy", "TABLE", "table", "row",
+           "table_rows", "table_pointer", "with_jacobian",
            "table_accel", "table_energy", "table_jacobian", "gr_accel", "gr_energy", "gr_jacobian",
            "gr_potential_accel", "gr_potential_energy", "gr_potential_jacobian",
            "gr_full_accel", "gr_full_energy", "zonal_accel", "zonal_energy", "zonal_jacobian",

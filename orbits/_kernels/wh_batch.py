@@ -93,7 +93,7 @@ import numpy as np
 
 from numba import types as nbtypes
 
-from ._jit import KERNEL_STAMP, data_pointer, njit, pointer, slots, specialize, value
+from ._jit import KERNEL_STAMP, contiguous_data, njit, pointer, slots, specialize, value
 from .coordinates import interior_gm, to_jacobi
 from .gravity import aligned_zeros
 from .kepler import (_SHORT_STEP, _SHORT_STEP_ITER, _SHORT_STEP_TOL, _SHORT_STEP_Z,
@@ -904,7 +904,7 @@ def _pointer_kick(X, V, XI, ACC, GM, MU, n_active, h, LF, nb, d, s3, a3, t4, unr
     # the number of systems as a value known only when the kick runs: a loop
     # of a trip count below 16 known when it compiles is never vectorised
     # (at 4 and 8 systems the kick would stay scalar)
-    unrolled(data_pointer(d.ctypes.data), data_pointer(V.ctypes.data), h, nb)
+    unrolled(contiguous_data(d), contiguous_data(V), h, nb)
 
 
 #: the batch loop that calls an unrolled kick through its pointer, for
