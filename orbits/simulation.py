@@ -237,7 +237,7 @@ class Simulation(Driven):
         self._eargs = None
         if terms:
             self.integrator.check_terms(terms)
-        if terms or self.integrator.terms_as_data:
+        if terms or (self.integrator.terms_as_data and self.integrator.table_in_force):
             _binding.bind_terms(self, bodies)
 
         _monitoring.set_up(self, monitors, monitor_every)

@@ -492,15 +492,17 @@ def test_wh_takes_a_term_with_the_chaos_monitors():
     assert np.abs(megno[1] - megno[0]).max() < 1e-6
 
 
-@pytest.mark.parametrize("name, terms, chaos", [("wh", True, False), ("trace", True, False),
+@pytest.mark.parametrize("name, terms, chaos", [("wh", True, False), ("wh", False, False),
+                                                 ("trace", True, False),
                                                  ("wh", False, True), ("wh", True, True)])
 def test_one_loop_for_systems_on_both_sides_of_the_lanes_threshold(name, terms, chaos):
-    # wh's and trace's loops with terms, and wh's tangent loop (chaos
-    # monitors), take the terms' kick and the recorders, not gravity's pair
+    # wh's scalar loop (with or without terms), trace's loop with terms and
+    # wh's tangent loop (chaos monitors) take the terms' kick and the
+    # recorders, not gravity's pair
     # kernel, which changes at gravity.LANES_FROM massive bodies: the outer
     # solar system (6) and the Sun with eight planets (9) get the same
     # compiled loop (one compilation, not one on each side)
-    from orbits._kernels import gravity, trace as ktrace, wh_tangent, wisdom_holman as kwh
+    from orbits._kernels import gravity, trace as ktrace, wh_tangent
     small, large = orbits.scenes.outer_solar_system(), orbits.scenes.solar_system(moon=False)
     assert len(small) < gravity.LANES_FROM <= len(large)
     kw = {}
@@ -510,12 +512,13 @@ def test_one_loop_for_systems_on_both_sides_of_the_lanes_threshold(name, terms, 
         kw["monitors"] = ("energy", "megno")
     loops = []
     for b in (small, large):
-        force = orbits.Simulation(b, name, dt=2 * u.day, **kw)._force
+        sim = orbits.Simulation(b, name, dt=2 * u.day, **kw)
+        force = sim._force
         assert force.key.startswith("var(gravity_" if chaos else "gravity_")
         if chaos:
             loops.append(wh_tangent.wh_tangent_loop("jacobi", force.inner.terms, force))
         elif name == "wh":
-            loops.append(kwh.wh_loop("jacobi", force.terms, force.recorder))
+            loops.append(sim.integrator.loop(sim))
         else:
             loops.append(ktrace.trace_loop(record=force.recorder, terms=force.terms))
     assert loops[0] is loops[1]

@@ -85,8 +85,8 @@ __all__ = ["DRIFT", "KICK", "Splitting", "splitting_loop", "runge_kutta_loop", "
            "user_force", "user_force_call", "state_is_finite", "ForceKernel", "with_terms",
            "step_epilogue", "epilogue", "GO", "first_record", "work_kernels", "work_args",
            "work_bound", "work_total", "rk_stage", "rk_sums", "adaptive_start", "must_return",
-           "clock_step", "landing_step", "add_compensated", "stop_info", "mark_recorder", "flat_rows",
-           "flat_stages", "stage_views", "stage_errors", "dop853_error", "accept_fsal",
+           "clock_step", "landing_step", "add_compensated", "stop_info", "mark_recorder",
+           "terms_recorder", "flat_rows", "flat_stages", "stage_views", "stage_errors", "dop853_error", "accept_fsal",
            "step_lander", "rk_stages"]
 
 #: operator codes of a splitting table
@@ -519,6 +519,14 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
     record_state(x, v, m, row)
 
 
+def terms_recorder(terms):
+    """The monitor recorder of gravity with the terms of the
+    :class:`~orbits._kernels.terms.TermKernel` ``terms``, whose monitors
+    ``mon`` carry the terms' energy arguments as a seventh item (with an
+    empty table, :func:`_record`'s rows)."""
+    return specialize(_record_terms, terms.key, cache=terms.cache, extra_energy=terms.energy)
+
+
 def with_terms(base, terms, velocity_dependent, work=None, dissipative=False):
     """Gravity ``base`` (a :class:`ForceKernel`) plus the terms of a
     :class:`~orbits._kernels.terms.TermKernel`: ``fargs = (base fargs, terms' args)``,
@@ -539,8 +547,7 @@ def with_terms(base, terms, velocity_dependent, work=None, dissipative=False):
     # that takes the terms' kick and this recorder but not the force
     # (Wisdom-Holman's and trace's, whose kick is their own: one loop for
     # both sides of gravity.LANES_FROM)
-    record = specialize(_record_terms, terms.key, cache=terms.cache,
-                        extra_energy=terms.energy)
+    record = terms_recorder(terms)
     if work is not None:
         key += f"+work_{work.key}"
         cache = cache and work.cache

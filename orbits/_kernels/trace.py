@@ -80,11 +80,12 @@ from .status import Status
 from .stepping import (GO, _record, accept_fsal, dop853_error, epilogue, first_record,
                        stage_errors)
 from .trace_lanes import FAR_WAIT, criterion_scales, far_steps
+from .terms import table_rows
 from .wisdom_holman import _heliocentric_term_kick, jump, kepler_drift_all, plain_drift_call
 
 # the names the templates below are written against, bound by specialize
-HAS_TERMS, step_end, term_kick, rare_term_kick, LANES, far_run = slots(
-    "HAS_TERMS", "step_end", "term_kick", "rare_term_kick", "LANES", "far_run")
+has_terms, step_end, term_kick, LANES, far_run = slots(
+    "has_terms", "step_end", "term_kick", "LANES", "far_run")
 
 __all__ = ["trace_loop", "trace_synchronize", "criterion", "inner_drift", "exact_flow",
            "inner_arrays",
@@ -616,8 +617,9 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
     # when at the end of the step.
     # criteria: a Criteria record; inner: the inner integrator's arrays
     # (Inner), whose counts (segments with flags, redos, inner steps) add up.
-    # targs: the added terms' arguments (kicked with gravity's interaction,
-    # HAS_TERMS and term_kick bound by specialize).  checks, check: the
+    # targs: the table of added terms (kicked with gravity's interaction where
+    # it has rows: has_terms and term_kick bound by specialize), or the
+    # lanes' scratch.  checks, check: the
     # Checks record (orbits._kernels.records) and the stopping conditions'
     # pointer (orbits._kernels.stopping.stop_record); ahead: the pointer of
     # orbits._kernels.stopping.ahead_pointer.
@@ -631,6 +633,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
     conditions = sargs[0] != 0
     counts = inner.counts
     n = xh.shape[0]
+    kick_terms = has_terms(targs)
     every = mon[0]
     n_mon = 0
     if state[0] == 0:
@@ -692,8 +695,8 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                 # the exact flow of gravity ends on the criterion point, less
                 # the added terms' half kick
                 _copy(vb, vs)
-                if HAS_TERMS:
-                    rare_term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
+                if kick_terms:
+                    term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
             else:
                 jump(xh, vb, gm, n_active, half)
                 if flagged:
@@ -705,7 +708,7 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                         vs[i, 0] = vb[i, 0] + half * acc[i, 0]
                         vs[i, 1] = vb[i, 1] + half * acc[i, 1]
                         vs[i, 2] = vb[i, 2] + half * acc[i, 2]
-                if HAS_TERMS:
+                if kick_terms:
                     term_kick(xh, vs, w1, w2, gm, eta, n_active, half, targs)
             npairs, peri_end = criterion(xh, vs, gm, hill, r2, n_active, k_hill,
                                          k_speed, dt, k_peri, enc_new)
@@ -721,8 +724,8 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                     peri = True
                 _copy(xc, xh)
                 _copy(vc, vb)
-                if state[2] and HAS_TERMS:
-                    rare_term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)
+                if state[2] and kick_terms:
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, owed, targs)
                 if state[2] and not peri:
                     _interaction_kick(xh, vb, acc, gm, n_active, enc, flagged, owed)
                     _jump_call(xh, vb, gm, n_active, owed)
@@ -764,8 +767,8 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
             # the next segment integrates gravity whole from the criterion
             # point, after the added terms' half kick
             _copy(vs, vb)
-            if HAS_TERMS:
-                rare_term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
+            if kick_terms:
+                term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
         else:
             if not flagged and not peri and not new_flagged:
                 # no flags either side: the Wisdom-Holman kick I(h), its arithmetic
@@ -773,13 +776,13 @@ def _trace_loop(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, check
                     vb[i, 0] += dt * acc[i, 0]
                     vb[i, 1] += dt * acc[i, 1]
                     vb[i, 2] += dt * acc[i, 2]
-                if HAS_TERMS:
+                if kick_terms:
                     term_kick(xh, vb, w1, w2, gm, eta, n_active, dt, targs)
             else:
                 _copy(vs, vb)
                 _interaction_kick(xh, vb, acc, gm, n_active, enc, new_flagged, half)
-                if HAS_TERMS:
-                    rare_term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
+                if kick_terms:
+                    term_kick(xh, vb, w1, w2, gm, eta, n_active, half, targs)
             jump(xh, vb, gm, n_active, half)
         owed = half
         owed_box[0] = owed
@@ -818,6 +821,16 @@ def _no_term_kick(xh, vb, x, acc, gm, eta, n_active, h, targs):
 
 
 @njit(inline="always")
+def _no_terms(targs):
+    return False
+
+
+@njit(inline="always")
+def _table_has_rows(targs):
+    return table_rows(targs) > 0
+
+
+@njit(inline="always")
 def _no_far(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_peri, m,
             until_check, check_every, targs):
     return 0, until_check, 0
@@ -835,9 +848,10 @@ def _far(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_peri, m
 
 
 def trace_loop(record=_record, terms=None, lanes=False):
-    """The ``trace`` loop, ``record`` recording the monitors, and ``terms`` (a
-    :class:`~orbits._kernels.terms.TermKernel` of position-only terms, or
-    None) kicked with the interaction, as ``wh`` kicks them.  It takes
+    """The ``trace`` loop, ``record`` recording the monitors, and ``terms`` (the
+    :class:`~orbits._kernels.terms.TermKernel` of a table of position-only
+    terms, or None) kicked with the interaction, as ``wh`` kicks them; the
+    loop with terms serves runs without them too, given an empty table.  It takes
     ``(x, v, t, dt, nsteps, work, criteria, inner, tabs, outputs, checks,
     check, ahead, targs)``: a :class:`Work`, a :class:`Criteria`, an
     :class:`Inner`, the DOP853 tables, the records of :mod:`.records`, the
@@ -860,14 +874,15 @@ def trace_loop(record=_record, terms=None, lanes=False):
     step = epilogue(record, key, cache=cache, runtime=not cache)
     if lanes:
         key = f"{key}_lanes"
-    # the terms' kick is inlined where every step far from encounters kicks
-    # (after the drift, and the whole kick), and called where a segment with
-    # flags, a pericentre or a redo kicks: each inlined copy carries the table
-    # of terms' dispatch through numba's typing and lowering again, and a
-    # call at the first two sites shows in the step's time (benchmarks/RESULTS.md)
-    rare = kick if terms is None else called(kick, nrt=not cache)
+    # the terms' kick is called, where it runs (a table with rows): inlined
+    # at the two sites where every step far from encounters kicks, it made
+    # the loop's first compile some 10 s longer for no time a step that
+    # shows (benchmarks/RESULTS.md)
+    if terms is not None:
+        kick = called(kick, nrt=not cache)
     return specialize(_trace_loop, key, cache=cache, nrt=not cache,
-                      HAS_TERMS=terms is not None, term_kick=kick, rare_term_kick=rare,
+                      has_terms=_no_terms if terms is None else _table_has_rows,
+                      term_kick=kick,
                       LANES=lanes,
                       far_run=_far if lanes else _no_far, step_end=step)
 

@@ -115,6 +115,7 @@ from .kepler import (advance_by_anomaly, kepler_drift_bracketed, short_step_anom
 from .status import Status
 from .stepping import DRIFT, GO, _record, epilogue, first_record
 from .stopping import no_stop
+from .terms import table_rows
 from .wh_lanes import (MEMO, PENDING, RETRY, kepler_drift_lanes, resident_drift_twice,
                        resident_finite, resident_jump_kick, resident_kick, resident_load,
                        resident_store)
@@ -905,17 +906,20 @@ plain_drift_call = called(_plain_drift, nrt=False)
 
 
 def _perturbation_with_terms(xj, vj, x, acc, gm, eta, n_active, h, targs):
-    # gravity's perturbation step, then the terms' kick: both depend on
-    # positions only, so the kicks commute (in democratic heliocentric
-    # coordinates the terms kick between the two half jumps)
+    # gravity's perturbation step, then the terms' kick where the table
+    # ``targs`` has rows: both depend on positions only, so the kicks commute
+    # (in democratic heliocentric coordinates the terms kick between the two
+    # half jumps).  With an empty table, the plain loop's step, bit for bit
     if HELIOCENTRIC:
         jump(xj, vj, gm, n_active, 0.5 * h)
         heliocentric_interaction_kick(xj, vj, acc, gm, n_active, h)
-        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)
+        if table_rows(targs) > 0:
+            term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)
         jump(xj, vj, gm, n_active, 0.5 * h)
     else:
         interaction_kick(xj, vj, x, acc, gm, eta, n_active, h)
-        term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)
+        if table_rows(targs) > 0:
+            term_kick(xj, vj, x, acc, gm, eta, n_active, h, targs)
 
 
 #: coordinate system -> (to internal, from internal, perturbation step, the
@@ -953,8 +957,10 @@ def _kernels(coordinates, terms=None, lanes=False):
         perturbation = specialize(_plain_perturbation, key, inline=True, nrt=nrt,
                                   step=step)
     else:
-        kick = specialize(term_kick, key, cache=cache, inline=True, nrt=nrt,
-                          extra=terms.accel)
+        # the terms' kick is called: it runs only where the table has rows,
+        # and the loop's step inlines gravity's perturbation alone
+        kick = called(specialize(term_kick, key, cache=cache, inline=True, nrt=nrt,
+                                 extra=terms.accel), nrt)
         perturbation = specialize(_perturbation_with_terms, key, cache=cache, inline=True,
                                   nrt=nrt, term_kick=kick,
                                   HELIOCENTRIC=coordinates != "jacobi")
@@ -1015,16 +1021,12 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
     nrt = not cache
-    # the scalar loop without terms, which a first, shorter run takes (the
-    # lanes' loop serves the long ones: orbits.integrators.wisdom_holman's
-    # lanes option), calls the drift that its synchronisation and corrector
-    # call instead of inlining a copy: 2.3 s less to compile for 2-5 % more
-    # a step; the loop with terms, whose long runs have no lanes, inlines it
-    # (benchmarks/RESULTS.md)
-    drift = called(_plain_drift, nrt) if terms is None else _plain_drift
-    # the loop with terms calls its perturbation step, the copy its corrector
-    # calls, instead of inlining the terms' dispatch once more
-    # (benchmarks/RESULTS.md)
+    # the scalar loop, which a first, shorter run takes (the lanes' loop
+    # serves the long ones: orbits.integrators.wisdom_holman's lanes option),
+    # calls the drift that its synchronisation and corrector call instead of
+    # inlining a copy: 2.3 s less to compile for 2-5 % more a step
+    # (benchmarks/RESULTS.md); with terms, the plain loop's compilation
+    drift = _plain_call(_plain_drift, "drift", nrt, terms is None)
     outputs = {}
     if lanes:
         # the state kept in the lanes between outputs, and outputs made beside
@@ -1065,7 +1067,7 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
                       drift=drift,
                       owed_drift=called(drift, nrt) if lanes else _plain_call(
                           _plain_drift, "drift", nrt, terms is None),
-                      perturbation=perturbation if terms is None else called(perturbation, nrt),
+                      perturbation=perturbation,
                       corrector_kernel=corrector,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
                       **outputs)

@@ -178,6 +178,11 @@ class Integrator:
     #: table of them (:func:`orbits._kernels.terms.table`): one loop for runs
     #: with and without terms, so that adding a term compiles nothing new
     terms_as_data = False
+    #: with ``terms_as_data``, whether that empty table is bound into the
+    #: force the loop calls (gravity then always carries a table), or the
+    #: integrator hands it to its loop itself (Wisdom-Holman's kick of the
+    #: terms is its own, so its force is gravity alone without terms)
+    table_in_force = True
     #: whether its loop reads the force's Jacobian (the force terms' table
     #: then carries theirs, :func:`orbits._kernels.terms.with_jacobian`)
     reads_jacobians = False

@@ -19,6 +19,7 @@ import numpy as np
 
 from .._kernels.status import with_status
 from .._kernels import coordinates as _coordinates
+from .._kernels import terms as _kterms
 from .._kernels import records
 from .._kernels import wisdom_holman as _wh
 from .._kernels import wh_lanes as _lanes
@@ -26,6 +27,7 @@ from .._kernels import wh_tangent as _wht
 from .._kernels.gravity import aligned_zeros
 from .._kernels.kepler import _SHORT_STEP
 from .._kernels.stumpff import _STUMPFF_MEDIUM_Z
+from .._kernels import stepping as _stepping
 from .._kernels.stepping import DRIFT, KICK, work_bound
 from .._kernels.stopping import stop_record
 from ..errors import IntegratorOptionError
@@ -160,6 +162,16 @@ def lanes_scratch_in(ws, shape):
     if targs is None or targs[0].shape != shape:
         targs = ws["lanes"] = (aligned_zeros(shape),)
     return targs
+
+
+def no_terms_in(ws, n):
+    """The empty table of force terms (:func:`orbits._kernels.terms.table`)
+    that the scalar loop takes for a run of ``n`` rows without terms, made
+    once and kept in ``ws``."""
+    tab = ws.get("no_terms")
+    if tab is None or tab.an.shape[0] != n:
+        tab = ws["no_terms"] = _kterms.table((), np.zeros(n), np.zeros(n))
+    return tab
 
 
 def lanes_pay(x, v, gm, dt):
@@ -435,6 +447,11 @@ class WisdomHolman(Integrator):
     #: outputs that do not fall a whole number of steps apart are recorded in the
     #: loop too (``every = -1``: the steps in ``mon_t``)
     records_step_marks = True
+    #: its scalar loop takes the table of terms, an empty one (its own:
+    #: :func:`no_terms_in`) for a run without terms; the lanes' loop takes
+    #: none, and the tangent loop of the variations one for runs with terms
+    terms_as_data = True
+    table_in_force = False
 
     name = "wh"
     order = 2
@@ -591,8 +608,10 @@ class WisdomHolman(Integrator):
                  and ws["lanes_pay"])
         # (the lanes' state is not in xj, vj between steps: a run with
         # stopping conditions takes the scalar loop, bit for bit the same steps)
-        terms, targs = self._loop_terms(ws, x.shape[0], lanes)
-        loop = _wh.wh_loop(self.config["coordinates"], terms, force.recorder, lanes)
+        loop, terms, targs = self._loop(ws, force, x.shape[0], lanes)
+        if "terms" not in ws and not lanes:
+            # the empty table's monitors carry it, as a run's with terms do
+            mon = mon + (targs,)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
         # the lanes' loop checks no escapes: it takes a number it never reads
@@ -606,6 +625,33 @@ class WisdomHolman(Integrator):
         if lanes:
             note_lanes_ready(loop)
         return with_status(*out)
+
+    def _loop(self, ws, force, n, lanes):
+        # (the compiled loop, the terms' kernel, the loop's targs) of a run of
+        # n rows with force: without terms, the scalar loop takes an empty
+        # table and records as a run with terms does
+        terms, targs = self._loop_terms(ws, n, lanes)
+        recorder = force.recorder
+        if not lanes and "terms" not in ws:
+            recorder = _stepping.terms_recorder(terms)
+        return _wh.wh_loop(self.config["coordinates"], terms, recorder, lanes), terms, targs
+
+    def loop(self, sim, lanes=False):
+        """The compiled loop that the simulation ``sim`` (without variations)
+        steps in, the scalar one or, with ``lanes``, the lanes' one: the
+        same scalar loop for runs with and without force terms.
+
+        Examples
+        --------
+        >>> wh = orbits.integrators.get("wh")
+        >>> bodies = orbits.scenes.outer_solar_system()
+        >>> plain = orbits.Simulation(bodies, wh, dt=30 * u.day)
+        >>> gr = orbits.Simulation(bodies, wh, dt=30 * u.day,
+        ...                        forces=[orbits.forces.GRPotential("Sun")])
+        >>> wh.loop(plain) is wh.loop(gr)
+        True
+        """
+        return self._loop(sim._ws, sim._force, len(sim._m), lanes)[0]
 
     def lanes_wanted(self, ws, n, recorder=None):
         """Whether a run of ``n`` bodies steps in the vector lanes (where
@@ -643,6 +689,12 @@ class WisdomHolman(Integrator):
         ws["lanes_taken"] = lanes
         if lanes:
             targs = lanes_scratch_in(ws, _lanes.lanes_scratch_shape(n))
+        elif terms is None:
+            # the scalar loop without terms is its loop with terms, given an
+            # empty table: one loop for both, so that adding a term compiles
+            # no loop (the table is a tuple, kept but not saved, as the
+            # scratch)
+            terms, targs = _kterms.TABLE, no_terms_in(ws, n)
         return terms, targs
 
     def _advance_tangent(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t,

@@ -219,6 +219,23 @@ def test_takes_position_only_terms_as_wh_does():
     assert sim._ws["counts"][0] == 0
 
 
+def test_one_loop_serves_runs_with_and_without_terms():
+    # the scalar loop takes the table of terms as data, an empty one without
+    # terms: the runs without terms, with GRPotential and with J2 (through
+    # an encounter: the kicks of flagged segments) step in one compiled loop
+    # of one signature
+    b = _encounter_bodies(1e-3)
+    integ = orbits.integrators.get("trace", lanes="off")
+    loops = []
+    for forces in ([], [orbits.forces.GRPotential("Star")],
+                   [orbits.forces.ZonalHarmonics("Star", radius=0.05 * u.au, J2=0.1)]):
+        sim, _ = _run(b, integ, 0.5 * u.day, 10 * u.day, forces=forces)
+        assert sim._ws["counts"][0] == 20
+        loops.append(integ.loop(sim))
+    assert loops[0] is loops[1] is loops[2]
+    assert len(loops[0].signatures) == 1
+
+
 def test_terms_kick_through_a_close_encounter():
     # a strong J2 on the star (0.1 at 0.05 au) through the 1e-3 au pass, every
     # segment flagged: the terms' kick of the flagged segments (a call of its

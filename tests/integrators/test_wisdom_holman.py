@@ -564,17 +564,16 @@ def test_one_loop_serves_runs_with_and_without_escape_conditions(coordinates):
     # never called (and compiles no check), so the run with conditions after
     # it finds the same compiled loop, and stops at the escape (step 837, as
     # in the test above); one loop signature, not two
-    from orbits._kernels import wisdom_holman as kwh
     integ = orbits.integrators.get("wh", coordinates=coordinates, lanes="off")
     plain = orbits.Simulation(launched(), integ, dt=10 * u.day)
     plain.run(until=100 * u.day, outputs=2, progress=False)
-    loop = kwh.wh_loop(coordinates, None, plain._force.recorder)
+    loop = integ.loop(plain)
     assert len(loop.signatures) == 1
     sim = orbits.Simulation(launched(), integ, dt=10 * u.day, escape_distance=50 * u.au)
     with pytest.raises(Escape) as info:
         sim.run(until=1000 * u.yr, outputs=2, progress=False)
     assert info.value.step == 837 and info.value.bodies == ("comet",)
-    assert len(loop.signatures) == 1
+    assert integ.loop(sim) is loop and len(loop.signatures) == 1
 
 
 def test_wh_escape_unbound_passes_over_a_bound_body():
@@ -665,32 +664,36 @@ def _megno_member(e):
                              monitors=("energy", "megno"), seed=1)
 
 
-def test_the_loops_with_and_without_terms_call_one_compiled_drift():
-    # the Kepler drift and the conversion to the loop's coordinates that the
-    # loops call (at a call's start, for an owed drift, in the corrector)
-    # read no targs: the loop with added terms calls the plain loop's
-    # compilations with the plain loop's empty targs, where a call with the
-    # terms' table compiled both again (4-5 CPU s)
+def test_one_loop_serves_runs_with_and_without_terms():
+    # the scalar loop takes the table of terms as data, an empty one for a
+    # run without terms: one compiled loop, of one signature, for a run
+    # without terms, with GRPotential and with J2 (the bits of runs with and
+    # without terms are held by the tests of the kick above).  The Kepler
+    # drift and the conversion it calls (at a call's start, for an owed
+    # drift, in the corrector) read no targs: they are the compilations the
+    # lanes' loop calls, with empty targs, where a call with the table
+    # compiled them again (4-5 CPU s)
     from orbits._kernels import trace
     from orbits._kernels import wisdom_holman as kwh
-    integ = orbits.integrators.get("wh", lanes="off")
-    loops = []
-    for forces in ([], [orbits.forces.GRPotential("Sun")]):
-        sim = orbits.Simulation(launched(), integ, dt=10 * u.day, forces=forces)
-        sim.run(until=100 * u.day, outputs=2, progress=False)
-        loops.append(kwh.wh_loop("jacobi", sim._ws.get("terms", (None,))[0],
-                                 sim._force.recorder))
-    plain, terms = (loop.py_func.__globals__ for loop in loops)
-    assert plain["corrector_kernel"] is not terms["corrector_kernel"]
+    for coordinates in ("jacobi", DH):
+        integ = orbits.integrators.get("wh", coordinates=coordinates, lanes="off")
+        loops = []
+        for forces in ([], [orbits.forces.GRPotential("Sun")],
+                       [orbits.forces.ZonalHarmonics("Jupiter", 71492 * u.km, J2=0.0147)]):
+            sim = orbits.Simulation(launched(), integ, dt=10 * u.day, forces=forces)
+            sim.run(until=100 * u.day, outputs=2, progress=False)
+            loops.append(integ.loop(sim))
+        assert loops[0] is loops[1] is loops[2]
+        assert len(loops[0].signatures) == 1
+    glob = loops[0].py_func.__globals__
 
     def calls(op):
-        # the compiled function an operator of the loop with terms calls
+        # the compiled function an operator of the loop calls
         return op.py_func.__globals__["convert"]
 
-    assert plain["owed_drift"] is kwh.plain_drift_call
-    for name in ("owed_drift", "to_internal"):
-        assert calls(terms[name]) is plain[name]
-    corrector = terms["corrector_kernel"].py_func.__globals__
+    assert calls(glob["owed_drift"]) is kwh.plain_drift_call
+    assert calls(glob["drift"]) is kwh.plain_drift_call
+    corrector = glob["corrector_kernel"].py_func.__globals__
     assert calls(corrector["drift"]) is kwh.plain_drift_call
     # and trace's segments with flags call the same compiled drift
     assert trace._kepler_drift_all_call.py_func.__globals__["plain_drift_call"] \

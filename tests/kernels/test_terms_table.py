@@ -109,11 +109,15 @@ def test_runs_with_and_without_terms_take_one_loop(name, dt):
     assert orbits.integrators.get(name).terms_as_data
 
 
-def test_wisdom_holman_keeps_a_loop_for_terms():
-    # wh's loop with terms inlines their kick's conversions: a loop of its own
+def test_wisdom_holman_takes_terms_as_data_in_its_scalar_loop():
+    # wh's force keeps gravity apart from the terms (its kick is its own),
+    # and the Simulation binds no table for a run without terms; its scalar
+    # loop takes an empty table of its own instead: one loop for both
     bodies = orbits.scenes.outer_solar_system()
-    plain = orbits.Simulation(bodies, "wh", dt=30 * u.day)
-    terms = orbits.Simulation(bodies, "wh", dt=30 * u.day,
+    wh = orbits.integrators.get("wh", lanes="off")
+    plain = orbits.Simulation(bodies, wh, dt=30 * u.day)
+    terms = orbits.Simulation(bodies, wh, dt=30 * u.day,
                               forces=[orbits.forces.GRPotential("Sun")])
-    assert plain._force.key != terms._force.key
-    assert not orbits.integrators.get("wh").terms_as_data
+    assert plain._force.key != terms._force.key and plain._eargs is None
+    assert wh.terms_as_data and not wh.table_in_force
+    assert wh.loop(plain) is wh.loop(terms)
