@@ -40,6 +40,7 @@ class ImplicitOneLeg(Integrator):
     theta = None
     stop_conditions = True
     reads_jacobians = True
+    terms_as_data = True
     # counted as in the loop's usual case: two Newton iterations of one force each
     forces_per_step = 2
 

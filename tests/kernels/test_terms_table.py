@@ -95,7 +95,7 @@ def test_the_jacobians_callable_is_there_only_where_asked():
 
 @pytest.mark.parametrize("name, dt", [("leapfrog", 10.0), ("yoshida4", 10.0), ("rk4", 10.0),
                                       ("dopri5", None), ("rk4-doubling", None),
-                                      ("ias15", None)])
+                                      ("ias15", None), ("implicit-midpoint", 10.0)])
 def test_runs_with_and_without_terms_take_one_loop(name, dt):
     # the integrators that take terms as data compile one loop for gravity
     # with and without terms: the force the loop is compiled for is the
