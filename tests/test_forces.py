@@ -482,14 +482,17 @@ def test_wh_takes_a_term_with_the_chaos_monitors():
     # carries).  GRPotential moves the outer solar system's MEGNO after 1e4 yr
     # by 5.2e-8 (measured, both coordinate systems), where the values stand
     # 0.02 from 2: a bound of 1e-6 holds the term's effect on the tangent to
-    # its size
-    megno = []
+    # its size.  Both runs step in one tangent loop (the one with terms, an
+    # empty table for the run without them)
+    megno, loops = [], []
     for f in ([], [forces.GRPotential("Sun")]):
         sim = orbits.Simulation(orbits.scenes.outer_solar_system(), "wh", dt=100 * u.day,
                                 forces=f, monitors=("energy", "megno"), seed=1)
         megno.append(np.asarray(sim.run(until=1e4 * u.yr, outputs=3, progress=False).megno))
+        loops.append(sim.integrator.loop(sim))
     assert abs(megno[1][-1] - 2.0) < 0.1
     assert np.abs(megno[1] - megno[0]).max() < 1e-6
+    assert loops[0] is loops[1] and len(loops[0].signatures) == 1
 
 
 @pytest.mark.parametrize("name, terms, chaos", [("wh", True, False), ("wh", False, False),
@@ -502,7 +505,7 @@ def test_one_loop_for_systems_on_both_sides_of_the_lanes_threshold(name, terms, 
     # kernel, which changes at gravity.LANES_FROM massive bodies: the outer
     # solar system (6) and the Sun with eight planets (9) get the same
     # compiled loop (one compilation, not one on each side)
-    from orbits._kernels import gravity, trace as ktrace, wh_tangent
+    from orbits._kernels import gravity, trace as ktrace
     small, large = orbits.scenes.outer_solar_system(), orbits.scenes.solar_system(moon=False)
     assert len(small) < gravity.LANES_FROM <= len(large)
     kw = {}
@@ -515,9 +518,7 @@ def test_one_loop_for_systems_on_both_sides_of_the_lanes_threshold(name, terms, 
         sim = orbits.Simulation(b, name, dt=2 * u.day, **kw)
         force = sim._force
         assert force.key.startswith("var(gravity_" if chaos else "gravity_")
-        if chaos:
-            loops.append(wh_tangent.wh_tangent_loop("jacobi", force.inner.terms, force))
-        elif name == "wh":
+        if name == "wh":
             loops.append(sim.integrator.loop(sim))
         else:
             loops.append(ktrace.trace_loop(record=force.recorder, terms=force.terms))

@@ -359,6 +359,12 @@ def velocity_reader(force):
     return _always_reads if (force.velocity_dependent or force.opaque) else _never_reads
 
 
+def varied_recorder(inner_record, jit=True, cache=True):
+    """The monitor recorder of a force with variations whose inner force
+    records with ``inner_record``: the bodies' rows alone."""
+    return specialize(_varied_record, "var", jit=jit, cache=cache, inner_record=inner_record)
+
+
 def with_variations(force, chaos):
     """The force of the augmented system (see the module notes) for ``force``
     (a :class:`~orbits._kernels.stepping.ForceKernel`), with its arguments
@@ -377,8 +383,7 @@ def with_variations(force, chaos):
     # without the force (the copy's name carries its bindings' too), so that
     # loops that take the record but kick with their own pairs (wh's tangent
     # loop) are one compilation for every gravity kernel
-    record = specialize(_varied_record, "var", jit=force.jit, cache=force.cache,
-                        inner_record=force.recorder)
+    record = varied_recorder(force.recorder, force.jit, force.cache)
     # the record of force's own type (stepping.ForceKernel, whose loops' module
     # imports this one for the epilogue's tangent step and the work kernels)
     return type(force)(kernel, key, force.jit, force.cache, jacobian=jacobian,

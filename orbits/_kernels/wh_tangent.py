@@ -99,8 +99,9 @@ from .coordinates import (from_democratic_heliocentric, from_jacobi, jacobi_step
 from .gravity import add_pulls, pull_with_sums, zero_rows
 from .kepler import straight_drift
 from .kepler_tangent import advance_tangent_by_anomaly, kepler_drift_tangent
-from .stepping import epilogue, work_kernels
-from .variational import (chaos_update, renormalise, tangent_product,
+from .stepping import epilogue, terms_recorder, work_kernels
+from .terms import table_rows
+from .variational import (chaos_update, renormalise, tangent_product, varied_recorder,
                           variational_work_kernels)
 from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
                             _synchronize, _wh_loop, escape_kernels, escape_pointer,
@@ -596,9 +597,10 @@ def _jacobi_perturbation(xj, vj, x, acc, gm, eta, n_active, h, targs):
     tp = targs[1]
     interaction_kick_and_tangent(xj, vj, x, acc, gm, eta, n_active, h, tp)
     if TERMS:
-        term_kick(xj[:n], vj[:n], x[:n], acc[:n], gm, eta, n_active, h,
-                  targs[0])
-        term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs)
+        if table_rows(targs[0]) > 0:
+            term_kick(xj[:n], vj[:n], x[:n], acc[:n], gm, eta, n_active, h,
+                      targs[0])
+            term_tangent(xj, vj, x, acc, gm, eta, n_active, h, targs)
 
 
 def _heliocentric_perturbation(xh, vb, x, acc, gm, eta, n_active, h, targs):
@@ -610,9 +612,10 @@ def _heliocentric_perturbation(xh, vb, x, acc, gm, eta, n_active, h, targs):
     heliocentric_interaction_kick(xh[:n], vb[:n], acc[:n], gm, n_active, h)
     heliocentric_kick_tangent(xh, vb, acc, gm, n_active, h, tp)
     if TERMS:
-        term_kick(xh[:n], vb[:n], x[:n], acc[:n], gm, eta, n_active, h,
-                  targs[0])
-        term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs)
+        if table_rows(targs[0]) > 0:
+            term_kick(xh[:n], vb[:n], x[:n], acc[:n], gm, eta, n_active, h,
+                      targs[0])
+            term_tangent(xh, vb, x, acc, gm, eta, n_active, h, targs)
     jump_tangent(xh, vb, gm, n_active, 0.5 * h, tp)
     jump(xh[:n], vb[:n], gm, n_active, 0.5 * h)
 
@@ -727,18 +730,16 @@ def _kernels(coordinates, terms, key, cache):
 
 def _runtime(terms, cache):
     # numba's runtime (reference counts, allocation) for a loop that a user's
-    # function joins (not cached), or whose force terms' Jacobians build their
-    # small work arrays (orbits._kernels.terms); without it numba refuses to
-    # compile them
-    return not cache or terms is not None
+    # function joins (not cached); the terms' kernels that allocate their
+    # small work arrays (the Jacobians) run behind the table's C callables
+    return not cache
 
 
-def _key(coordinates, force):
+def _key(coordinates, terms):
     # named by the terms, not by the force: the tangent loop kicks with its
     # own pairs (_pair_tangent) and never calls gravity's pair kernel, which
     # changes at gravity.LANES_FROM massive bodies, so that one loop serves
     # systems on both sides of it
-    terms = force.inner.terms
     return f"tangent_{coordinates}_{'gravity' if terms is None else terms.key}"
 
 
@@ -749,7 +750,7 @@ def tangent_loop_escape(coordinates, terms, force, stopping, sync, conditions):
     stopping record and ``sync`` a
     :class:`~orbits._kernels.wisdom_holman.Sync` of the values the loop
     hands its synchronisation."""
-    key = _key(coordinates, force)
+    key = _key(coordinates, terms)
     cache = force.cache
     bodies = None
     if conditions:
@@ -765,7 +766,7 @@ def tangent_synchronizer(coordinates, terms, force):
     position-only ``terms`` (or None) join the perturbation step;
     arguments as :func:`orbits._kernels.wisdom_holman.synchronizer`'s, with
     ``targs = (terms' args, tp)``."""
-    return _kernels(coordinates, terms, _key(coordinates, force), force.cache)[3]
+    return _kernels(coordinates, terms, _key(coordinates, terms), force.cache)[3]
 
 
 def wh_tangent_loop(coordinates, terms, force):
@@ -779,12 +780,17 @@ def wh_tangent_loop(coordinates, terms, force):
     and ``eta`` of the bodies alone (``n`` entries), the state arrays of
     ``n (1 + K)`` rows and a stopping record
     (:func:`~orbits._kernels.stopping.stop_record`)."""
-    key = _key(coordinates, force)
+    key = _key(coordinates, terms)
     cache = force.cache
     nrt = _runtime(terms, cache)
     to_internal, perturbation, corrector, sync = _kernels(coordinates, terms, key, cache)
+    # a run without terms takes the loop with terms, given an empty table
+    # (its monitors carry it, as a run's with terms do)
+    record = force.recorder
+    if terms is not None and force.inner.terms is None:
+        record = varied_recorder(terms_recorder(terms), cache=cache)
     recorder = specialize(_tangent_record, key, cache=cache, nrt=nrt, synchronize=sync,
-                          record=force.recorder)
+                          record=record)
     step = specialize(_chaos_step, key, cache=cache, inline=True, nrt=nrt,
                       inertial_tangent=_INERTIAL_TANGENT[coordinates])
     # the note of the chaos indicators alone: wh takes conservative terms only,

@@ -637,9 +637,10 @@ class WisdomHolman(Integrator):
         return _wh.wh_loop(self.config["coordinates"], terms, recorder, lanes), terms, targs
 
     def loop(self, sim, lanes=False):
-        """The compiled loop that the simulation ``sim`` (without variations)
-        steps in, the scalar one or, with ``lanes``, the lanes' one: the
-        same scalar loop for runs with and without force terms.
+        """The compiled loop that the simulation ``sim`` steps in: with
+        variations (or chaos monitors) the tangent loop, else the scalar one
+        or, with ``lanes``, the lanes' one.  The scalar and the tangent loop
+        are the same for runs with and without force terms.
 
         Examples
         --------
@@ -651,6 +652,10 @@ class WisdomHolman(Integrator):
         >>> wh.loop(plain) is wh.loop(gr)
         True
         """
+        if sim._force.inner is not None:
+            return _wht.wh_tangent_loop(self.config["coordinates"],
+                                        self._tangent_terms(sim._ws, len(sim._m))[0],
+                                        sim._force)
         return self._loop(sim._ws, sim._force, len(sim._m), lanes)[0]
 
     def lanes_wanted(self, ws, n, recorder=None):
@@ -713,9 +718,12 @@ class WisdomHolman(Integrator):
             raise ValueError(f"{self.name}: {x.shape[0]} state rows for {n} bodies and "
                              f"{tp[2]} tangent vectors")
         tp = tp[:6] + (fargs[1][4],) + tp[7:]
-        terms, targs = ws.get("terms", (None, ()))
-        gravity = fargs[0] if terms is None else fargs[0][0]
+        gravity = fargs[0] if "terms" not in ws else fargs[0][0]
         gm, n_active = gravity[0], gravity[1]
+        terms, targs = self._tangent_terms(ws, n)
+        if "terms" not in ws:
+            # the empty table's monitors carry it, as a run's with terms do
+            mon = mon + (targs,)
         loop = _wht.wh_tangent_loop(self.config["coordinates"], terms, force)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"][:n], int(n_active), self._corr, self._kinds,
@@ -728,12 +736,20 @@ class WisdomHolman(Integrator):
                                  records.checks(check_every, sargs), check, escape,
                                  (targs, tp)))
 
+    @staticmethod
+    def _tangent_terms(ws, n):
+        # (terms, their table) of the tangent loop for n bodies: a run without
+        # terms takes the loop with terms, given an empty table
+        if "terms" in ws:
+            return ws["terms"]
+        return _kterms.TABLE, no_terms_in(ws, n)
+
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
         its owed drift are kept, so that the following steps go on unchanged."""
         if ws["state"][0] and "tangent" in ws:
             force, n, tp = ws["tangent"]
-            terms, targs = ws.get("terms", (None, ()))
+            terms, targs = self._tangent_terms(ws, n)
             sync = _wht.tangent_synchronizer(self.config["coordinates"], terms, force)
             sync(ws["xj"], ws["vj"], ws["gm"][:n], ws["eta"][:n], ws["owed"][0], ws["xs"],
                  ws["vs"], x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0],
