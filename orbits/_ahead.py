@@ -35,15 +35,14 @@ class Loop(NamedTuple):
     adds: str = ""
 
 
-#: What a run may add to gravity, each served by a loop (or pointer) of its
-#: own that ``orbits compile`` compiles unless told ``plain``: ``"terms"``,
-#: any combination of built-in force terms (one loop for every table of
-#: terms, its work integrated where some are dissipative); ``"variations"``,
-#: the variational equations and the chaos monitors (one loop for every kind
-#: of variations); ``"terms+variations"``, both together (the variational
-#: equations of gravity with terms: one more loop, for every table of terms
-#: and every kind of variations); ``"checks"``, the stopping conditions,
-#: collisions and the encounter log (one compiled check for every
+#: What a run may add to gravity, which ``orbits compile`` compiles unless
+#: told ``plain``: ``"terms"``, any combination of built-in force terms (the
+#: terms' kernels, once for every integrator: each integrator's loop serves
+#: runs with and without terms); ``"variations"``, the variational equations
+#: and the chaos monitors (one loop for every kind of variations, with or
+#: without terms); ``"terms+variations"``, both together (the terms'
+#: Jacobians, once for every integrator); ``"checks"``, the stopping
+#: conditions, collisions and the encounter log (one compiled check for every
 #: integrator, and what a run with them calls, with or without the others).
 ADDS = tuple(ADDED)
 
@@ -223,11 +222,12 @@ def compile_ahead(names=None, progress=None, report=None, jobs=1, plain=False):
     (:func:`orbits.scenes.outer_solar_system`) for a few steps, in both
     Wisdom-Holman coordinate systems where it takes them, which compiles its
     loop and the kernels it calls into numba's cache (:func:`orbits._compiling.cache_dir`).
-    Unless ``plain``, it runs again with what a run may add, each served by
-    a loop of its own: built-in force terms (one loop for any combination of
-    them), the variational equations and chaos monitors (one loop for every
-    kind), and the stopping conditions, collisions and encounter log (one
-    compiled check for every integrator).  Afterwards a run that adds any of
+    Unless ``plain``, it runs again with what a run may add: built-in force
+    terms (their kernels, once for every integrator; every loop serves runs
+    with and without terms), the variational equations and chaos monitors
+    (one loop for every kind) with and without terms, and the stopping
+    conditions, collisions and encounter log (one compiled check for every
+    integrator).  Afterwards a run that adds any of
     these compiles nothing (a user's own force compiles its function once).
     Integrators that run in Python (scipy's ``radau`` and ``lsoda``) have
     nothing to compile and are skipped.  The cache is per CPU and numba

@@ -74,9 +74,10 @@ TERMS = {"kernels": "kernels of the force terms", "jacobians": "Jacobians of the
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
 UNKNOWN_ESTIMATE = "a few seconds"
 
-#: What a run adds to gravity that makes a loop of its own (or, for the
-#: stopping conditions, one compiled check for every integrator), as the
-#: loop's label names it: ``orbits compile`` compiles each ahead.
+#: What a run adds to gravity, as the loop's label names it: a loop of its
+#: own (variations) or kernels compiled once for every integrator (the
+#: terms', the stopping conditions' check) for a run that adds it first;
+#: ``orbits compile`` compiles each ahead.
 ADDED = {"terms": "with force terms", "variations": "with variations",
          "terms+variations": "with force terms and variations",
          "checks": "with stopping conditions"}
