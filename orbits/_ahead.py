@@ -164,19 +164,29 @@ def _family(name):
     return mro[0] if mro[1].__name__ in _GENERIC_BASES else mro[1]
 
 
+@functools.lru_cache(maxsize=None)
+def _loop_adds(name, adds):
+    """The addition whose loop a run of ``name`` with ``adds`` takes: an
+    integrator that takes force terms as data runs the same loop with and
+    without them (its runs with terms compile only the terms' kernels)."""
+    if integrators.get(name).terms_as_data:
+        return {"terms": "", "terms+variations": "variations"}.get(adds, adds)
+    return adds
+
+
 def _startable(i, loops, running, waiting):
     """Whether ``loops[i]`` may start while the indices ``running`` run and
     ``waiting`` wait: not beside a run of the same family, coordinates,
-    lanes and addition (whose loop it may share: compiled twice at once),
-    nor before the first run with its addition has ended (which compiles
-    what they all share: the terms' table, the stopping conditions'
-    check)."""
+    lanes and loop (:func:`_loop_adds`; a loop they share would be compiled
+    twice at once), nor before the first run with its addition has ended
+    (which compiles what they all share: the terms' table, the stopping
+    conditions' check)."""
     loop = loops[i]
 
     def key(k):
         other = loops[k]
         return (_family(other.name), other.options.get("coordinates"), other.lanes,
-                other.adds)
+                _loop_adds(other.name, other.adds))
 
     if any(key(k) == key(i) for k in running):
         return False

@@ -250,6 +250,13 @@ def test_processes_do_not_compile_one_loop_twice_at_once():
     assert not _startable(later, loops, [], [first, later])
     assert _startable(first, loops, [], [first, later])
     assert _startable(later, loops, [], [later])
+    # with terms and without, with variations and with both, wh runs one loop
+    # (terms as data): not beside each other either
+    assert not _startable(first, loops, [wh], [first])
+    both = index["wh", "jacobi", False, "terms+variations"]
+    varied = index["wh", "jacobi", False, "variations"]
+    assert not _startable(both, loops, [varied], [both])
+    assert _startable(both, loops, [wh], [both])
 
 
 def test_compiling_in_processes_from_an_unguarded_script_is_a_named_error(tmp_path):
