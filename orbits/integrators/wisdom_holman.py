@@ -166,8 +166,8 @@ def lanes_scratch_in(ws, shape):
 
 def no_terms_in(ws, n):
     """The empty table of force terms (:func:`orbits._kernels.terms.table`)
-    that the scalar loop takes for a run of ``n`` rows without terms, made
-    once and kept in ``ws``."""
+    that the scalar and tangent loops take for a run of ``n`` bodies without
+    terms, made once and kept in ``ws``."""
     tab = ws.get("no_terms")
     if tab is None or tab.an.shape[0] != n:
         tab = ws["no_terms"] = _kterms.table((), np.zeros(n), np.zeros(n))
@@ -447,9 +447,9 @@ class WisdomHolman(Integrator):
     #: outputs that do not fall a whole number of steps apart are recorded in the
     #: loop too (``every = -1``: the steps in ``mon_t``)
     records_step_marks = True
-    #: its scalar loop takes the table of terms, an empty one (its own:
-    #: :func:`no_terms_in`) for a run without terms; the lanes' loop takes
-    #: none, and the tangent loop of the variations one for runs with terms
+    #: its scalar loop and the tangent loop of the variations take the table
+    #: of terms, an empty one (its own: :func:`no_terms_in`) for a run
+    #: without terms; the lanes' loop takes none
     terms_as_data = True
     table_in_force = False
 
