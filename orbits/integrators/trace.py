@@ -4,8 +4,6 @@ integrator for close encounters (after Lu, Hernandez & Rein 2024)."""
 import numpy as np
 
 from .._kernels import records
-from .._kernels import stepping as _stepping
-from .._kernels import terms as _kterms
 from .._kernels import trace as _trace
 from .._kernels import trace_lanes as _trace_lanes
 from .._kernels.coordinates import from_democratic_heliocentric
@@ -15,8 +13,8 @@ from ..errors import IntegratorOptionError
 from . import dop853_coefficients as _dop853
 from .base import RTOL_FLOOR, Integrator, Option
 from .wisdom_holman import (LANES_MODES, lanes_choice, lanes_pay, lanes_ready,
-                            lanes_scratch_in, no_terms_in, note_lanes_ready,
-                            refuse_unkickable, split_gravity)
+                            lanes_scratch_in, note_lanes_ready, refuse_unkickable,
+                            split_gravity, table_bound)
 
 __all__ = ["Trace", "HILL", "SPEED", "PERICENTRE", "RTOL"]
 
@@ -316,11 +314,11 @@ class Trace(Integrator):
                  and self.lanes_wanted(ws, x.shape[0], force.recorder))
         if lanes:
             targs = lanes_scratch_in(ws, _trace_lanes.far_scratch_shape(x.shape[0]))
-        elif terms is None:
-            # the empty table's monitors carry it, as a run's with terms do
-            targs = no_terms_in(ws, x.shape[0])
-            mon = mon + (targs,)
-        loop = self._loop(force, terms is not None, lanes)
+            loop = _trace.trace_loop(record=force.recorder, lanes=True)
+        else:
+            # one scalar loop with and without terms (table_bound)
+            terms, targs, recorder, mon = table_bound(ws, x.shape[0], force.recorder, mon)
+            loop = _trace.trace_loop(record=recorder, terms=terms)
         criteria = _trace.Criteria(float(c["hill"]), float(c["speed"]), float(c["pericentre"]),
                                    float(c["rtol"]))
         sargs, check = stop_record(stop)
@@ -332,16 +330,6 @@ class Trace(Integrator):
         if lanes:
             note_lanes_ready(loop)
         return with_status(*out)
-
-    @staticmethod
-    def _loop(force, terms, lanes):
-        # the compiled loop of a run with force (with added terms or not):
-        # without terms, the scalar loop is the loop with terms, given an
-        # empty table (as wh's), and records as a run with terms does
-        if lanes:
-            return _trace.trace_loop(record=force.recorder, lanes=True)
-        recorder = force.recorder if terms else _stepping.terms_recorder(_kterms.TABLE)
-        return _trace.trace_loop(record=recorder, terms=_kterms.TABLE)
 
     def loop(self, sim, lanes=False):
         """The compiled loop that the simulation ``sim`` steps in, the scalar
@@ -359,7 +347,12 @@ class Trace(Integrator):
         >>> tr.loop(plain) is tr.loop(gr)
         True
         """
-        return self._loop(sim._force, bool(sim._terms), lanes)
+        if lanes:
+            return _trace.trace_loop(record=sim._force.recorder, lanes=True)
+        # (before a first run binds the terms, the empty table's kernel and
+        # recorder: a run with terms records with the same, stepping.with_terms)
+        terms, _, recorder, _ = table_bound(sim._ws, len(sim._m), sim._force.recorder)
+        return _trace.trace_loop(record=recorder, terms=terms)
 
     def lanes_wanted(self, ws, n, recorder=None):
         """Whether a run of ``n`` bodies takes its steps far from encounters

@@ -164,14 +164,23 @@ def lanes_scratch_in(ws, shape):
     return targs
 
 
-def no_terms_in(ws, n):
-    """The empty table of force terms (:func:`orbits._kernels.terms.table`)
-    that the scalar and tangent loops take for a run of ``n`` bodies without
-    terms, made once and kept in ``ws``."""
+def table_bound(ws, n, recorder=None, mon=None):
+    """What a scalar or tangent loop of ``n`` bodies (``wh``'s, ``trace``'s,
+    one loop with and without force terms) takes for the terms:
+    ``(terms' kernel, table, recorder, mon)``.  The terms bound in ``ws``
+    with the monitors' ``recorder`` and ``mon`` as they are; for a run
+    without terms an empty table (made once and kept in ``ws``: a tuple,
+    kept but not saved), with ``mon`` carrying it and the recorder of a run
+    with terms (:func:`orbits._kernels.stepping.terms_recorder`), whose
+    terms' energy is then 0."""
+    if "terms" in ws:
+        terms, tab = ws["terms"]
+        return terms, tab, recorder, mon
     tab = ws.get("no_terms")
     if tab is None or tab.an.shape[0] != n:
         tab = ws["no_terms"] = _kterms.table((), np.zeros(n), np.zeros(n))
-    return tab
+    return (_kterms.TABLE, tab, _stepping.terms_recorder(_kterms.TABLE),
+            None if mon is None else mon + (tab,))
 
 
 def lanes_pay(x, v, gm, dt):
@@ -448,7 +457,7 @@ class WisdomHolman(Integrator):
     #: loop too (``every = -1``: the steps in ``mon_t``)
     records_step_marks = True
     #: its scalar loop and the tangent loop of the variations take the table
-    #: of terms, an empty one (its own: :func:`no_terms_in`) for a run
+    #: of terms, an empty one (its own: :func:`table_bound`) for a run
     #: without terms; the lanes' loop takes none
     terms_as_data = True
     table_in_force = False
@@ -608,10 +617,7 @@ class WisdomHolman(Integrator):
                  and ws["lanes_pay"])
         # (the lanes' state is not in xj, vj between steps: a run with
         # stopping conditions takes the scalar loop, bit for bit the same steps)
-        loop, terms, targs = self._loop(ws, force, x.shape[0], lanes)
-        if "terms" not in ws and not lanes:
-            # the empty table's monitors carry it, as a run's with terms do
-            mon = mon + (targs,)
+        loop, terms, targs, mon = self._loop(ws, force, x.shape[0], lanes, mon)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
         # the lanes' loop checks no escapes: it takes a number it never reads
@@ -626,15 +632,15 @@ class WisdomHolman(Integrator):
             note_lanes_ready(loop)
         return with_status(*out)
 
-    def _loop(self, ws, force, n, lanes):
-        # (the compiled loop, the terms' kernel, the loop's targs) of a run of
-        # n rows with force: without terms, the scalar loop takes an empty
-        # table and records as a run with terms does
+    def _loop(self, ws, force, n, lanes, mon=None):
+        # (the compiled loop, the terms' kernel, the loop's targs, the
+        # monitors) of a run of n rows with force (table_bound)
         terms, targs = self._loop_terms(ws, n, lanes)
         recorder = force.recorder
-        if not lanes and "terms" not in ws:
-            recorder = _stepping.terms_recorder(terms)
-        return _wh.wh_loop(self.config["coordinates"], terms, recorder, lanes), terms, targs
+        if not lanes:
+            _, _, recorder, mon = table_bound(ws, n, recorder, mon)
+        loop = _wh.wh_loop(self.config["coordinates"], terms, recorder, lanes)
+        return loop, terms, targs, mon
 
     def loop(self, sim, lanes=False):
         """The compiled loop that the simulation ``sim`` steps in: with
@@ -654,8 +660,7 @@ class WisdomHolman(Integrator):
         """
         if sim._force.inner is not None:
             return _wht.wh_tangent_loop(self.config["coordinates"],
-                                        self._tangent_terms(sim._ws, len(sim._m))[0],
-                                        sim._force)
+                                        table_bound(sim._ws, len(sim._m))[0], sim._force)
         return self._loop(sim._ws, sim._force, len(sim._m), lanes)[0]
 
     def lanes_wanted(self, ws, n, recorder=None):
@@ -690,17 +695,11 @@ class WisdomHolman(Integrator):
         # to step, a count of drifts left to the scalar solver, only chooses
         # between two paths with the same results).  The choice is kept for
         # the synchronisation (ws["lanes_taken"])
-        terms, targs = ws.get("terms", (None, ()))
         ws["lanes_taken"] = lanes
         if lanes:
-            targs = lanes_scratch_in(ws, _lanes.lanes_scratch_shape(n))
-        elif terms is None:
-            # the scalar loop without terms is its loop with terms, given an
-            # empty table: one loop for both, so that adding a term compiles
-            # no loop (the table is a tuple, kept but not saved, as the
-            # scratch)
-            terms, targs = _kterms.TABLE, no_terms_in(ws, n)
-        return terms, targs
+            return None, lanes_scratch_in(ws, _lanes.lanes_scratch_shape(n))
+        # the scalar loop serves runs with and without terms (table_bound)
+        return table_bound(ws, n)[:2]
 
     def _advance_tangent(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t,
                          mon_out, check_every, stop=None):
@@ -720,10 +719,7 @@ class WisdomHolman(Integrator):
         tp = tp[:6] + (fargs[1][4],) + tp[7:]
         gravity = fargs[0] if "terms" not in ws else fargs[0][0]
         gm, n_active = gravity[0], gravity[1]
-        terms, targs = self._tangent_terms(ws, n)
-        if "terms" not in ws:
-            # the empty table's monitors carry it, as a run's with terms do
-            mon = mon + (targs,)
+        terms, targs, _, mon = table_bound(ws, n, None, mon)
         loop = _wht.wh_tangent_loop(self.config["coordinates"], terms, force)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"][:n], int(n_active), self._corr, self._kinds,
@@ -736,20 +732,12 @@ class WisdomHolman(Integrator):
                                  records.checks(check_every, sargs), check, escape,
                                  (targs, tp)))
 
-    @staticmethod
-    def _tangent_terms(ws, n):
-        # (terms, their table) of the tangent loop for n bodies: a run without
-        # terms takes the loop with terms, given an empty table
-        if "terms" in ws:
-            return ws["terms"]
-        return _kterms.TABLE, no_terms_in(ws, n)
-
     def synchronize(self, ws, x, v):
         """Write the current inertial state into ``x``, ``v``; the Jacobi state and
         its owed drift are kept, so that the following steps go on unchanged."""
         if ws["state"][0] and "tangent" in ws:
             force, n, tp = ws["tangent"]
-            terms, targs = self._tangent_terms(ws, n)
+            terms, targs = table_bound(ws, n)[:2]
             sync = _wht.tangent_synchronizer(self.config["coordinates"], terms, force)
             sync(ws["xj"], ws["vj"], ws["gm"][:n], ws["eta"][:n], ws["owed"][0], ws["xs"],
                  ws["vs"], x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0],
