@@ -55,6 +55,9 @@ FIRST_COMPILE_SECONDS = {
     "look-ahead of the stopping conditions": 7.0,
     # the force terms' table (:data:`TERMS`): 9.3-11.2 s and 16 s on the Zen 3 (2026-11-30)
     "kernels of the force terms": 10.0, "Jacobians of the force terms": 16.0,
+    # the splitting methods' kick of velocity-dependent terms (:data:`TERMS`):
+    # 1.4-2.1 s on the Zen 3 (2026-11-30)
+    "implicit kick of the force terms": 2.0,
 }
 
 #: The check a run's stopping conditions take (a kind of
@@ -68,8 +71,12 @@ CHECKS = {"escapes": "check of the escape conditions", "all": "check of the stop
 #: The C callables of the force terms' table
 #: (:func:`orbits._kernels.terms.table_pointer`), as the notice names them:
 #: compiled once for every integrator, when a first simulation has terms, and
-#: the Jacobians' when a first one reads them (implicit methods, variations).
-TERMS = {"kernels": "kernels of the force terms", "jacobians": "Jacobians of the force terms"}
+#: the Jacobians' when a first one reads them (implicit methods, variations);
+#: and the splitting methods' implicit kick
+#: (:func:`orbits._kernels.stepping.implicit_kick`), once for all of them,
+#: when a first run has terms that read velocities.
+TERMS = {"kernels": "kernels of the force terms", "jacobians": "Jacobians of the force terms",
+         "kick": "implicit kick of the force terms"}
 
 #: What the notice says of a loop missing from :data:`FIRST_COMPILE_SECONDS`.
 UNKNOWN_ESTIMATE = "a few seconds"

@@ -434,6 +434,11 @@ class Driven:
         # is announced as the check's and not as the loop's (the check of
         # collisions and encounters takes 20-25 s, a loop a few); and the
         # look-ahead of an integrator whose step may not finish (trace's)
+        # and the parts the integrator compiles besides its loop (the
+        # splitting methods' implicit kick), each announced as itself
+        for label, make in self.integrator.parts_ahead(self._force, self._rows_x, self._fargs):
+            with self._compile_clock.part(label):
+                make()
         stop = getattr(self, "_stop", None)
         if stop is None:
             return

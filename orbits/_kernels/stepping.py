@@ -58,9 +58,11 @@ what they were without it.
 import math
 from typing import Callable, NamedTuple
 
+import numba
 import numpy as np
+from numba.core import types as nbtypes
 
-from ._jit import called, njit, slots, specialize
+from ._jit import idle_pointer, njit, pointer, slots, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
                       accelerate_pairwise_parallel, accelerate_pairwise_rebound,
                       accelerate_pairwise_small)
@@ -75,9 +77,9 @@ from .variational import tangent_kernels, variational_work_kernels
 #: the work of non-conservative terms declares (:func:`~._jit.slots`)
 WORK_SLOTS = ("HAS_WORK", "work_rate", "work_add", "work_note", "work_on")
 HAS_WORK, work_rate, work_add, work_note, work_on = slots(*WORK_SLOTS)
-(force, step_end, implicit_kick, pair_kernel, base, extra, extra_energy, nc_accel,
+(force, step_end, pair_kernel, base, extra, extra_energy, nc_accel,
  user_accel, stop_check, tangent_step, record, record_mark) = slots(
-    "force", "step_end", "implicit_kick", "pair_kernel", "base", "extra", "extra_energy",
+    "force", "step_end", "pair_kernel", "base", "extra", "extra_energy",
     "nc_accel", "user_accel", "stop_check", "tangent_step", "record", "record_mark")
 stages, = slots("stages")
 
@@ -744,8 +746,8 @@ class Splitting(NamedTuple):
     coefs: np.ndarray
 
 
-def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent, outputs,
-                    checks, check):
+def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent, kick,
+                    outputs, checks, check):
     # A splitting step is a sequence of drifts (x += c dt v) and kicks
     # (v += c dt a(x)), the method's table (a Splitting record), data of the
     # one loop every method shares.  The acceleration depends only
@@ -753,10 +755,11 @@ def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent,
     # a drift: velocity Verlet's closing kick and the next step's opening kick
     # share one force evaluation.  `fresh` (kept in cache[0] between calls)
     # says whether acc belongs to the current positions.  A velocity-dependent
-    # force is kicked with the implicit midpoint velocity (implicit_kick), so
-    # the kick stays symmetric; vm is its scratch.  A kick v' = v + h a changes
-    # the kinetic energy by exactly h sum m a . (v + v') / 2: the
-    # non-conservative terms' part of it is their work (HAS_WORK).
+    # force is kicked with the implicit midpoint velocity (the pointer kick,
+    # implicit_kick's), so the kick stays symmetric; vm is its scratch.  A
+    # kick v' = v + h a changes the kinetic energy by exactly
+    # h sum m a . (v + v') / 2: the non-conservative terms' part of it is
+    # their work (HAS_WORK).
     kinds, coefs = table
     acc, vm, cache = work
     mon, step0, mon_t, mon_out = outputs
@@ -789,7 +792,7 @@ def _splitting_loop(x, v, t, dt, nsteps, table, work, fargs, velocity_dependent,
                 tx += h
                 fresh = False
             elif velocity_dependent:
-                implicit_kick(x, v, tx, h, fargs, acc, vm)
+                kick(x, v, tx, h, fargs, acc, vm)
                 fresh = False
                 if has_work:
                     # vm is the kick's midpoint velocity (v + v') / 2
@@ -847,23 +850,31 @@ def _implicit_kick(x, v, t, h, fargs, acc, vm):
             v[i, d] += h * acc[i, d]
 
 
-@njit(inline="always")
-def _no_implicit_kick(x, v, t, h, fargs, acc, vm):
-    pass
+_KICK_POINTERS = {}
 
 
-def _implicit_kick_for(force):
-    # Gravity alone never reads velocities: its loops leave the implicit kick
-    # out.  For other forces (whose loops serve velocity-dependent ones and
-    # others alike) the kick is a call: it iterates the force a few times, so
-    # a call costs nothing beside it, and an inlined copy of the force would
-    # cost its compilation again in every loop
-    if force.jit and force.terms is None and force.inner is None and not force.opaque \
-            and not force.velocity_dependent:
-        return _no_implicit_kick
-    kick = specialize(_implicit_kick, force.key, jit=force.jit, cache=force.cache,
-                      inline=True, force=force.kernel)
-    return called(kick, nrt=force.runtime) if force.jit else kick
+def implicit_kick(force, x, fargs, velocity_dependent):
+    """The splitting loop's ``kick`` argument for a run of ``force`` on a state
+    like ``x`` with the force's arguments ``fargs``: the implicit kick
+    (``v' = v + h a(x, (v + v') / 2, t)``) as a C callable, compiled on first
+    use and cached on disk, where the run's force reads velocities; else a
+    pointer of the same type that is never called
+    (:func:`~._jit.idle_pointer`).  So the loop serves both, and a run
+    without velocity-dependent forces compiles no kick.  A force that runs as
+    plain Python gets the kick as plain Python."""
+    if not force.jit:
+        return specialize(_implicit_kick, force.key, jit=False, force=force.kernel)
+    a = numba.typeof(x)
+    signature = nbtypes.none(a, a, nbtypes.float64, nbtypes.float64, numba.typeof(fargs), a, a)
+    if not velocity_dependent:
+        return idle_pointer(signature)
+    key = (force.key, force.cache, force.runtime, signature)
+    found = _KICK_POINTERS.get(key)
+    if found is None:
+        kick = specialize(_implicit_kick, force.key, cache=force.cache, nrt=force.runtime,
+                          force=force.kernel)
+        found = _KICK_POINTERS[key] = pointer(kick, signature, force.cache)
+    return found
 
 
 def splitting_loop(force):
@@ -871,15 +882,15 @@ def splitting_loop(force):
     splitting method.
 
     The loop takes ``(x, v, t, dt, nsteps, table, work, fargs,
-    velocity_dependent, outputs, checks, check)``: the method's
-    :class:`Splitting` table, a :class:`SplittingWork`, the records of
-    :mod:`.records` and the stopping conditions' pointer
-    (:func:`~.stopping.stop_record`).
+    velocity_dependent, kick, outputs, checks, check)``: the method's
+    :class:`Splitting` table, a :class:`SplittingWork`, whether the force
+    reads velocities and the implicit kick's pointer for it
+    (:func:`implicit_kick`), the records of :mod:`.records` and the
+    stopping conditions' pointer (:func:`~.stopping.stop_record`).
     """
     return specialize(_splitting_loop, f"splitting_{force.key}",
                       jit=force.jit, cache=force.cache, nrt=force.runtime, force=force.kernel,
-                      step_end=step_epilogue(force),
-                      implicit_kick=_implicit_kick_for(force), **work_kernels(force))
+                      step_end=step_epilogue(force), **work_kernels(force))
 
 
 # -- explicit Runge-Kutta ---------------------------------------------------------------

@@ -54,6 +54,7 @@ import warnings
 
 import numpy as np
 
+from .._compiling import TERMS
 from .._integrator_options import Option
 from .._kernels import gravity
 from .._kernels import records
@@ -222,6 +223,14 @@ class Integrator:
     def _check_options(self):
         """Subclasses check here what their options' declarations cannot say
         (a value that one method of a family refuses, a pair of options)."""
+
+    def parts_ahead(self, force, x, fargs):
+        """What a run of ``force`` (with its arguments ``fargs``, on a state
+        like ``x``) compiles besides the loop, as ``(label, make)`` pairs:
+        the run calls each ``make()`` before the loop, so that a first
+        compile is announced as the part's (the notice's label, a value of
+        :data:`orbits._compiling.TERMS`) and not as the loop's.  None here."""
+        return ()
 
     # contract, parts 3-5
     def workspace(self, n):
@@ -430,15 +439,26 @@ class SplittingMethod(Integrator):
         return {"acc": np.zeros((n, 3)), "vm": np.zeros((n, 3)),
                 "cache": np.zeros(1, dtype=np.int64)}
 
+    def parts_ahead(self, force, x, fargs):
+        """The implicit kick of a force that reads velocities
+        (:func:`~orbits._kernels.stepping.implicit_kick`), compiled once for
+        every splitting method and only for runs with such a force."""
+        if not (force.jit and force.velocity_dependent):
+            return ()
+        fargs = stepping.work_bound(force, fargs, {})
+        return ((TERMS["kick"], lambda: stepping.implicit_kick(force, x, fargs, True)),)
+
     def advance(self, ws, x, v, t, dt, nsteps, force, fargs, mon, step0, mon_t, mon_out,
                 velocity_dependent=False, check_every=1, stop=None):
         """Apply the operator table ``nsteps`` times in the compiled loop (see
         :meth:`Integrator.advance`)."""
         sargs, check = stop_record(stop)
+        fargs = stepping.work_bound(force, fargs, ws)
+        velocity_dependent = bool(velocity_dependent or force.velocity_dependent)
         return with_status(*loop_for(stepping.splitting_loop, force)(
             x, v, t, dt, nsteps, self._table,
-            stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"]),
-            stepping.work_bound(force, fargs, ws), velocity_dependent or force.velocity_dependent,
+            stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"]), fargs, velocity_dependent,
+            stepping.implicit_kick(force, x, fargs, velocity_dependent),
             outputs(mon, step0, mon_t, mon_out), checks(check_every, sargs), check))
 
     def invalidate(self, ws):

@@ -121,3 +121,32 @@ def test_wisdom_holman_takes_terms_as_data_in_its_scalar_loop():
     assert plain._force.key != terms._force.key and plain._eargs is None
     assert wh.terms_as_data and not wh.table_in_force
     assert wh.loop(plain) is wh.loop(terms)
+
+
+def test_the_splitting_loop_compiles_the_implicit_kick_only_for_terms_that_read_velocities():
+    # the splitting methods' loop takes the implicit kick as a pointer: a run
+    # whose terms read no velocities hands it one of the same type that is
+    # never called (nothing compiled), one with GR the kick's C callable, which
+    # the run compiles before its loop and announces as itself
+    from orbits._compiling import TERMS
+    from orbits._kernels import stepping
+    from orbits.integrators._loops import loop_for
+
+    bodies = orbits.scenes.outer_solar_system()
+    runs = [orbits.Simulation(bodies, "leapfrog", dt=20 * u.day, forces=forces)
+            for forces in ([], [orbits.forces.GRPotential("Sun")], [orbits.forces.GR("Sun")])]
+    x = np.zeros((len(bodies), 3))
+    parts = [sim.integrator.parts_ahead(sim._force, x, sim._fargs) for sim in runs]
+    assert parts[0] == () and parts[1] == ()
+    (label, make), = parts[2]
+    assert label == TERMS["kick"]
+    kick = make()
+    idle = stepping.implicit_kick(runs[0]._force, x, runs[0]._fargs, False)
+    assert kick.cfunc is not None and idle.cfunc is None
+    assert kick._numba_type_ == idle._numba_type_
+    # and one loop, of one signature, serves the three runs
+    before = [sim.run(200 * u.day).max_energy_error() for sim in runs]
+    assert all(np.isfinite(before))
+    loop = loop_for(stepping.splitting_loop, runs[0]._force)
+    assert {loop_for(stepping.splitting_loop, sim._force) for sim in runs} == {loop}
+    assert len(loop.signatures) == 1
