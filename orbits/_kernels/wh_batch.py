@@ -1024,7 +1024,7 @@ def _synchronize_lane(xj, vj, gm, eta, owed, n_active, b, sc, ge, corr, x, v):
         g[i] = gm[i, b]
         e[i] = eta[i, b]
     synchronize(sc[0], sc[1], g, e, owed[b], sc[2], sc[3], x, v, sc[5], n_active, corr,
-                0.0, ())
+                0.0, (), 0)
 
 
 @njit

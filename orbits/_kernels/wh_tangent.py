@@ -103,8 +103,8 @@ from .stepping import epilogue, terms_recorder, work_kernels
 from .terms import table_rows
 from .variational import (chaos_update, renormalise, tangent_product, varied_recorder,
                           variational_work_kernels)
-from .wisdom_holman import (_apply_corrector, _heliocentric_term_kick, _jacobi_term_kick,
-                            _synchronize, _wh_loop, escape_kernels, escape_pointer,
+from .wisdom_holman import (_apply_corrector, _correct_compiled, _heliocentric_term_kick,
+                            _jacobi_term_kick, _synchronize, _wh_loop, escape_kernels, escape_pointer,
                             heliocentric_interaction_kick, jump,
                             short_step_anomalies)
 
@@ -650,17 +650,17 @@ def _carrying(targs, k):
 
 def _tangent_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
     # the monitors' recorder: the bodies alone synchronised, then recorded
-    mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs) = mon
+    mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct) = mon
     synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
-                _carrying(targs, 0))
+                _carrying(targs, 0), correct)
     record(x, v, t, mon_args, n_mon, mon_t, mon_out)
 
 
 def _tangent_bodies(xj, vj, sync):
     # the bodies alone synchronised into x, v (for the escape check)
-    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct = sync
     synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
-                _carrying(targs, 0))
+                _carrying(targs, 0), correct)
 
 
 def _chaos_step(xj, vj, t, sync):
@@ -669,7 +669,7 @@ def _chaos_step(xj, vj, t, sync):
     # the step's internal point (before the deferred half drift and the
     # corrector: see the module notes), and the vector's internal rows scaled
     # back when it has grown large
-    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct = sync
     tp = targs[1]
     if not tp[7]:
         return False
@@ -720,8 +720,12 @@ def _kernels(coordinates, terms, key, cache):
         perturbation = specialize(pert, key, cache=cache, nrt=nrt, TERMS=True,
                                   term_kick=kick, term_tangent=tangent)
     # the corrector and the synchronisation call the drift (see wisdom_holman._kernels)
-    corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
-                           drift=called(_drift, nrt), perturbation=perturbation)
+    # compiled in: the tangent loop's corrector carries the tangent vectors,
+    # and the loop ignores the pointer of the loops without variations
+    corrector = specialize(_correct_compiled, f"corrector_{key}", cache=cache, inline=True,
+                           nrt=nrt, corrector=specialize(
+                               _apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
+                               drift=called(_drift, nrt), perturbation=perturbation))
     sync = specialize(_synchronize, f"synchronize_{key}", cache=cache, nrt=nrt,
                       drift=called(_drift, nrt), from_internal=from_internal,
                       corrector_kernel=corrector)

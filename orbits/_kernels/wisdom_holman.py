@@ -124,10 +124,10 @@ from .wh_lanes import resident_drift as resident_drift_rows
 # the names the templates below are written against, bound by specialize
 (HELIOCENTRIC, convert, drift, extra, from_internal, owed_drift,
  perturbation, step, step_end, synchronize_bodies, term_kick, to_internal, sync_kernel,
- corrector_kernel, record) = slots(
+ corrector_kernel, record, corrector) = slots(
     "HELIOCENTRIC", "convert", "drift", "extra",
     "from_internal", "owed_drift", "perturbation", "step", "step_end", "synchronize_bodies",
-    "term_kick", "to_internal", "sync_kernel", "corrector_kernel", "record")
+    "term_kick", "to_internal", "sync_kernel", "corrector_kernel", "record", "corrector")
 
 __all__ = ["wh_loop", "synchronizer", "interaction_kick", "jacobi_velocity_kick", "jump",
            "heliocentric_interaction_kick", "jump_interaction_kick", "kepler_drift_all",
@@ -312,11 +312,13 @@ def _apply_corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
         drift(xj, vj, eta, a, x, acc, targs)
 
 
-def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs):
+def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct):
     """Inertial ``x``, ``v`` at the current time: the internal state with the
     deferred drift ``owed`` and then the corrector ``corr`` for the step ``h``
     (none if it has no rows) applied to a copy (``xs``, ``vs``); ``acc`` is
-    scratch."""
+    scratch.  ``correct``: the loop's corrector pointer
+    (:func:`corrector_pointer`), which the loops' synchronisation calls
+    (:func:`_correct_through`); others ignore it."""
     for i in range(xj.shape[0]):
         for d in range(3):
             xs[i, d] = xj[i, d]
@@ -324,8 +326,21 @@ def _synchronize(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, ta
     if owed != 0.0:
         drift(xs, vs, eta, owed, x, acc, targs)
     if corr.shape[0] > 0:
-        corrector_kernel(xs, vs, x, acc, gm, eta, n_active, corr, h, FORWARD, targs)
+        corrector_kernel(xs, vs, x, acc, gm, eta, n_active, corr, h, FORWARD, targs, correct)
     from_internal(xs, vs, gm, eta, x, v, targs)
+
+
+@njit(inline="always")
+def _correct_through(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs, correct):
+    # the corrector of the loops without variations: through the loop's
+    # pointer, compiled only for a run with a corrector (corrector_pointer)
+    correct(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
+
+
+def _correct_compiled(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs, correct):
+    # the corrector compiled into its caller (the tangent loop's, the batch's
+    # synchronisation), which ignores the pointer
+    corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
 
 
 # An output of the lanes' loop (no added terms, four bodies or more) is noted
@@ -350,7 +365,7 @@ def _no_output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
 
 @njit(inline="always")
 def _no_make_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
-                corr, h, targs):
+                corr, h, targs, correct):
     pass
 
 
@@ -460,7 +475,7 @@ def _resident_output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
 
 
 def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
-                  corr, h, targs):
+                  corr, h, targs, correct):
     # the noted output, by the usual synchronisation of the state xa, va that
     # still owes the drift owed: the loop's state when it returns, or the copy
     # that output_drift already drifted (owed 0; xa, va are then xs, vs),
@@ -472,7 +487,7 @@ def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
         from_internal(xa, va, gm, eta, x, v, targs)
     else:
         sync_kernel(xa, va, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
-                    targs)
+                    targs, correct)
     record(x, v, S[PENDING, 2], mon, int(S[PENDING, 1]), mon_t, mon_out)
 
 
@@ -519,7 +534,8 @@ class Work(NamedTuple):
 class Sync(NamedTuple):
     """What the synchronisation takes besides the internal state: the
     system, the drift owed, scratch, the inertial state to write, the
-    corrector and its step, and the loop's ``targs``."""
+    corrector and its step, the loop's ``targs`` and its corrector's
+    pointer (:func:`corrector_pointer`; 0 where the loop ignores it)."""
     gm: np.ndarray
     eta: np.ndarray
     owed: float
@@ -532,6 +548,7 @@ class Sync(NamedTuple):
     corr: np.ndarray
     h: float
     targs: tuple
+    correct: object
 
 
 class Recording(NamedTuple):
@@ -541,12 +558,14 @@ class Recording(NamedTuple):
     sync: Sync
 
 
-def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, targs):
+def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, correct,
+             targs):
     # system: a System record, work: a Work record; checks, check: the Checks
     # record (orbits._kernels.records) and the stopping conditions' pointer,
     # whose escape conditions the loops without lanes check through the
     # escape pointer (see escape_kernels; the lanes' loop takes 0 and reads
-    # neither)
+    # neither); correct: the corrector's pointer (corrector_pointer), which
+    # the loops without variations call where the system has a corrector
     gm, eta, n_active, corr, kinds, coefs = system
     xj, vj, acc, xs, vs, state, owed_box, cdt = work
     mon, step0, mon_t, mon_out = outputs
@@ -560,7 +579,8 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, 
         state[0] = 1
         owed_box[0] = 0.0
         if corrected:
-            corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
+            corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs,
+                             correct)
             cdt[0] = abs(dt)
     elif corrected and cdt[0] != abs(dt):
         # a new step size (a shorter last step): through the true state to the
@@ -568,8 +588,10 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, 
         if owed_box[0] != 0.0:
             owed_drift(xj, vj, eta, owed_box[0], xs, vs, targs)
             owed_box[0] = 0.0
-        corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], FORWARD, targs)
-        corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs)
+        corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, cdt[0], FORWARD, targs,
+                         correct)
+        corrector_kernel(xj, vj, xs, acc, gm, eta, n_active, corr, abs(dt), INVERSE, targs,
+                         correct)
         cdt[0] = abs(dt)
     owed = owed_box[0]
     lanes_in(xj, vj, gm, eta, targs)
@@ -587,7 +609,7 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, 
                         # (the lanes' loop): its drift beside this one
                         output_drift(xj, vj, eta, h + owed, xs, vs, owed, x, acc, targs)
                         make_output(xs, vs, 0.0, mon, mon_t, mon_out, gm, eta, xs, vs, x, v,
-                                    acc, n_active, corr, cdt[0], targs)
+                                    acc, n_active, corr, cdt[0], targs, correct)
                         owed = 0.0
                         continue
                     h += owed
@@ -606,7 +628,7 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, 
         # synchronises first, so the monitors see the inertial state at the
         # time; the synchronisation's arguments are also its fargs, for the
         # chaos indicators of a run with variations (orbits._kernels.wh_tangent)
-        sync = Sync(gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs)
+        sync = Sync(gm, eta, owed, xs, vs, x, v, acc, n_active, corr, cdt[0], targs, correct)
         finite, until_check = lanes_check(xj, vj, k, nsteps, until_check, check_every,
                                           until_record, targs)
         if finite:
@@ -621,13 +643,13 @@ def _wh_loop(x, v, t, dt, nsteps, system, work, outputs, checks, check, escape, 
             # an output still noted is made before the loop returns
             if output_pending(targs):
                 make_output(xj, vj, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc,
-                            n_active, corr, cdt[0], targs)
+                            n_active, corr, cdt[0], targs, correct)
             owed_box[0] = owed
             return status, done, n_mon
     lanes_out(xj, vj, targs)
     if output_pending(targs):
         make_output(xj, vj, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
-                    corr, cdt[0], targs)
+                    corr, cdt[0], targs, correct)
     owed_box[0] = owed
     return Status.OK, nsteps, n_mon
 
@@ -724,9 +746,9 @@ def _escape_check(xj, vj, t, stopping, sync):
 
 
 def _synchronize_bodies(xj, vj, sync):
-    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs = sync
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct = sync
     sync_kernel(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h,
-                targs)
+                targs, correct)
 
 
 def escape_kernels(key, cache=True, nrt=False):
@@ -771,8 +793,8 @@ def escape_pointer(key, synchronize_bodies, stopping, sync, conditions, cache=Tr
 def _wh_record(xj, vj, t, mon, n_mon, mon_t, mon_out):
     # the recorder the Wisdom-Holman loop hands the shared step epilogue:
     # mon is a Recording
-    mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs) = mon
-    sync_kernel(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs)
+    mon_args, (gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct) = mon
+    sync_kernel(xj, vj, gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct)
     record(x, v, t, mon_args, n_mon, mon_t, mon_out)
 
 
@@ -935,11 +957,14 @@ COORDINATE_SYSTEMS = {
 }
 
 
-def _kernels(coordinates, terms=None, lanes=False):
+def _kernels(coordinates, terms=None, lanes=False, through=True):
     """``terms``: a :class:`~orbits._kernels.terms.TermKernel` of position-only
     terms added to the interaction step, or None; ``lanes``: the
     synchronisation's owed drift with the planets in vector lanes (the
-    loop's ``targs`` then hold the lanes' scratch)."""
+    loop's ``targs`` then hold the lanes' scratch); ``through``: the
+    synchronisation calls the corrector through the loop's pointer (else it
+    compiles the corrector in).  Returns (to internal, perturbation step,
+    corrector, synchronisation, from internal, the corrector's call)."""
     to_internal, from_internal, step, term_kick, _ = COORDINATE_SYSTEMS[coordinates]
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
@@ -982,10 +1007,50 @@ def _kernels(coordinates, terms=None, lanes=False):
         perturbation_call = called(perturbation, nrt)
     corrector = specialize(_apply_corrector, f"corrector_{key}", cache=cache, nrt=nrt,
                            drift=drift, perturbation=perturbation_call)
-    sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else ""),
+    # the loops call the corrector through a pointer (corrector_pointer): a
+    # run without a corrector, the default, compiles none
+    correct = _correct_through if through else specialize(
+        _correct_compiled, f"corrector_{key}", cache=cache, inline=True, nrt=nrt,
+        corrector=corrector)
+    sync = specialize(_synchronize, f"synchronize_{key}" + ("_lanes" if lanes else "")
+                      + ("" if through else "_compiled"),
                       cache=cache, nrt=nrt, drift=drift, from_internal=from_internal,
-                      corrector_kernel=corrector)
-    return to_internal, perturbation, corrector, sync, from_internal
+                      corrector_kernel=correct)
+    return to_internal, perturbation, corrector, sync, from_internal, correct
+
+
+_CORRECTORS = {}
+
+
+def corrector_signature(xj, gm, eta, corr, targs):
+    """The type of the corrector's pointer (:func:`corrector_pointer`) that a
+    loop takes, from the values it hands the corrector: the internal state
+    ``xj`` (and arrays like it), ``gm``, ``eta``, the stages ``corr`` and the
+    loop's ``targs``."""
+    a = numba.typeof(xj)
+    return nbtypes.none(a, a, a, a, numba.typeof(gm), numba.typeof(eta), nbtypes.int64,
+                        numba.typeof(corr), nbtypes.float64, nbtypes.float64,
+                        numba.typeof(targs))
+
+
+def corrector_pointer(coordinates, terms, lanes, signature, corrected):
+    """The ``correct`` argument of :func:`wh_loop`'s loop for ``coordinates``,
+    ``terms`` and ``lanes``, and of its synchronisation: the symplectic
+    corrector (:func:`_apply_corrector`) as a C callable of ``signature``
+    (:func:`corrector_signature`), compiled on first use and cached on
+    disk, for a run whose method has a corrector (``corrected``); else a
+    pointer of the same type that is never called
+    (:func:`~._jit.idle_pointer`).  So one loop serves runs with and
+    without a corrector, and a run without one compiles none."""
+    if not corrected:
+        return idle_pointer(signature)
+    cache = terms is None or terms.cache
+    key = (coordinates, None if terms is None else terms.key, bool(lanes), signature, cache)
+    found = _CORRECTORS.get(key)
+    if found is None:
+        found = _CORRECTORS[key] = pointer(_kernels(coordinates, terms, lanes)[2], signature,
+                                           cache)
+    return found
 
 
 def synchronizer(coordinates, terms=None, lanes=False):
@@ -1005,19 +1070,20 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     the loop's ``targs`` are then ``(wh_lanes.lanes_scratch(N),)``.  The
     corrector and the synchronisation stay scalar (they run once a call or
     an output).  The loop takes ``(x, v, t, dt, nsteps, system, work,
-    outputs, checks, check, escape, targs)``: a :class:`System`, a
+    outputs, checks, check, escape, correct, targs)``: a :class:`System`, a
     :class:`Work`, the records of :mod:`orbits._kernels.records`, the
     stopping conditions' pointer (:func:`~orbits._kernels.stopping.stop_record`),
-    the escape check's (:func:`loop_escape`) and the terms' arguments or the
-    lanes' scratch; without ``lanes`` it checks the escape conditions of
+    the escape check's (:func:`loop_escape`), the corrector's
+    (:func:`corrector_pointer`) and the terms' arguments or the lanes'
+    scratch; without ``lanes`` it checks the escape conditions of
     :mod:`orbits._kernels.stopping` after every step on the synchronised
     state where the record has conditions (:func:`escape_kernels`); the
     lanes' loop checks none, calls neither pointer and takes 0 for the
     escape check's."""
     if lanes and terms is not None:
         raise ValueError("wh_loop: the lanes' loop takes no added terms")
-    to_internal, perturbation, corrector, sync, from_internal = _kernels(coordinates, terms,
-                                                                         lanes)
+    to_internal, perturbation, _, sync, from_internal, correct = _kernels(coordinates, terms,
+                                                                          lanes)
     key = coordinates if terms is None else f"{coordinates}_{terms.key}"
     cache = terms is None or terms.cache
     nrt = not cache
@@ -1068,7 +1134,7 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
                       owed_drift=called(drift, nrt) if lanes else _plain_call(
                           _plain_drift, "drift", nrt, terms is None),
                       perturbation=perturbation,
-                      corrector_kernel=corrector,
+                      corrector_kernel=correct,
                       step_end=epilogue(recorder, f"wh_{key}", cache=cache, stop=stop),
                       **outputs)
 
@@ -1088,6 +1154,7 @@ def loop_escape(coordinates, terms, stopping, sync, conditions):
     return escape_pointer(key, bodies, stopping, sync, conditions, cache)
 
 
-#: the Jacobi versions, compiled on first use
-apply_corrector = _kernels("jacobi")[2]
-synchronize = _kernels("jacobi")[3]
+#: the Jacobi versions with the corrector compiled in (the batch's
+#: synchronisation, which hands 0 for the pointer), compiled on first use
+apply_corrector = _kernels("jacobi", through=False)[2]
+synchronize = _kernels("jacobi", through=False)[3]

@@ -230,6 +230,7 @@ CORRECTORS = {
 
 
 _ESCAPES = {}
+_CORRECTORS = {}
 
 
 def _loop_escape(loop, conditions, make):
@@ -246,11 +247,11 @@ def _loop_escape(loop, conditions, make):
     return found
 
 
-def _sync_of(system, ws, x, v, targs):
+def _sync_of(system, ws, x, v, targs, correct):
     # the synchronisation's arguments as the loop hands them on (their
     # types; the drift owed and the corrector's step are the loop's own)
     return _wh.Sync(system.gm, system.eta, 0.0, ws["xs"], ws["vs"], x, v, ws["acc"],
-                    system.n_active, system.corrector, 0.0, targs)
+                    system.n_active, system.corrector, 0.0, targs, correct)
 
 
 def refuse_unkickable(integ, terms):
@@ -620,17 +621,33 @@ class WisdomHolman(Integrator):
         loop, terms, targs, mon = self._loop(ws, force, x.shape[0], lanes, mon)
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"], int(n_active), self._corr, self._kinds, self._coefs)
+        correct = self._corrector(ws, loop, terms, lanes, gm, targs)
         # the lanes' loop checks no escapes: it takes a number it never reads
         escape = 0 if lanes else _loop_escape(
             loop, stop is not None, lambda conditions: _wh.loop_escape(
                 self.config["coordinates"], terms, (sargs, check),
-                _sync_of(system, ws, x, v, targs), conditions))
+                _sync_of(system, ws, x, v, targs, correct), conditions))
         out = loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
                    records.outputs(mon, step0, mon_t, mon_out),
-                   records.checks(check_every, sargs), check, escape, targs)
+                   records.checks(check_every, sargs), check, escape, correct, targs)
         if lanes:
             note_lanes_ready(loop)
         return with_status(*out)
+
+    def _corrector(self, ws, loop, terms, lanes, gm, targs):
+        # the loop's corrector pointer (orbits._kernels.wisdom_holman's
+        # corrector_pointer: compiled only where the method has a corrector),
+        # once a loop and process, as the escape check's; kept in the
+        # workspace (not an array: neither saved nor restored) for the
+        # synchronisation outside the loop
+        corrected = self._corr.shape[0] > 0
+        found = _CORRECTORS.get((loop, corrected))
+        if found is None:
+            found = _CORRECTORS[loop, corrected] = _wh.corrector_pointer(
+                self.config["coordinates"], terms, lanes, _wh.corrector_signature(
+                    ws["xj"], gm, ws["eta"], self._corr, targs), corrected)
+        ws["corrector"] = found
+        return found
 
     def _loop(self, ws, force, n, lanes, mon=None):
         # (the compiled loop, the terms' kernel, the loop's targs, the
@@ -724,12 +741,14 @@ class WisdomHolman(Integrator):
         sargs, check = stop_record(stop)
         system = _wh.System(gm, ws["eta"][:n], int(n_active), self._corr, self._kinds,
                             self._coefs)
+        # (the tangent loop compiles its corrector in, and takes 0 for the
+        # pointer of the loops without variations)
         escape = _loop_escape(loop, stop is not None, lambda conditions: _wht.tangent_loop_escape(
             self.config["coordinates"], terms, force, (sargs, check),
-            _sync_of(system, ws, x, v, (targs, tp)), conditions))
+            _sync_of(system, ws, x, v, (targs, tp), 0), conditions))
         return with_status(*loop(x, v, t, dt, nsteps, system, records.work(_wh.Work, ws),
                                  records.outputs(mon, step0, mon_t, mon_out),
-                                 records.checks(check_every, sargs), check, escape,
+                                 records.checks(check_every, sargs), check, escape, 0,
                                  (targs, tp)))
 
     def synchronize(self, ws, x, v):
@@ -741,13 +760,21 @@ class WisdomHolman(Integrator):
             sync = _wht.tangent_synchronizer(self.config["coordinates"], terms, force)
             sync(ws["xj"], ws["vj"], ws["gm"][:n], ws["eta"][:n], ws["owed"][0], ws["xs"],
                  ws["vs"], x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0],
-                 (targs, tp))
+                 (targs, tp), 0)
         elif ws["state"][0]:
             lanes = ws.get("lanes_taken", False)
             terms, targs = self._loop_terms(ws, x.shape[0], lanes)
             sync = _wh.synchronizer(self.config["coordinates"], terms, lanes)
+            correct = ws.get("corrector")
+            if correct is None:
+                # a workspace read back from a file: the pointer of the loop
+                # it steps in (which that loop will take too)
+                correct = self._corrector(ws, _wh.wh_loop(self.config["coordinates"], terms,
+                                                          lanes=lanes), terms, lanes,
+                                          ws["gm"], targs)
             sync(ws["xj"], ws["vj"], ws["gm"], ws["eta"], ws["owed"][0], ws["xs"], ws["vs"],
-                 x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0], targs)
+                 x, v, ws["acc"], int(ws["n_active"][0]), self._corr, ws["cdt"][0], targs,
+                 correct)
 
     def invalidate(self, ws):
         """The state was changed from outside: start again from ``x``, ``v``."""

@@ -635,7 +635,9 @@ def test_the_escape_filter_never_passes_over_a_body_beyond_the_distance(coordina
         # of mass's offset is what the other bodies' pull adds), or a drift
         owed = 0.0 if trial % 3 == 0 else float(rng.uniform(-30.0, 30.0))
         xs, vs, xo, vo, acc = (np.empty((n, 3)) for _ in range(5))
-        sync(xj, vj, gm, eta, owed, xs, vs, xo, vo, acc, n, no_corrector, 0.0, ())
+        none = kwh.corrector_pointer(coordinates, None, False, kwh.corrector_signature(
+            xj, gm, eta, no_corrector, ()), False)
+        sync(xj, vj, gm, eta, owed, xs, vs, xo, vo, acc, n, no_corrector, 0.0, (), none)
         far = np.linalg.norm(xo - gm @ xo / gm.sum(), axis=1).max()
         assert kwh.may_escape(xj, vj, gm, eta, owed, no_corrector, (far * (1 - 1e-12)) ** 2)
         passed += not kwh.may_escape(xj, vj, gm, eta, owed, no_corrector, (1e3 * far) ** 2)
@@ -693,8 +695,30 @@ def test_one_loop_serves_runs_with_and_without_terms():
 
     assert calls(glob["owed_drift"]) is kwh.plain_drift_call
     assert calls(glob["drift"]) is kwh.plain_drift_call
-    corrector = glob["corrector_kernel"].py_func.__globals__
+    # the corrector, which the loop calls through a pointer (its kernel here)
+    from orbits.integrators.wisdom_holman import table_bound
+    terms = table_bound(sim._ws, len(sim._m))[0]
+    corrector = kwh._kernels(DH, terms)[2].py_func.__globals__
     assert calls(corrector["drift"]) is kwh.plain_drift_call
     # and trace's segments with flags call the same compiled drift
     assert trace._kepler_drift_all_call.py_func.__globals__["plain_drift_call"] \
         is kwh.plain_drift_call
+
+
+@pytest.mark.parametrize("coordinates", ["jacobi", DH])
+def test_the_corrector_is_a_pointer_compiled_only_for_a_run_with_a_corrector(coordinates):
+    # wh's loop calls the symplectic corrector through a pointer it takes:
+    # a run without a corrector (the default) hands it one of the same type
+    # that is never called, so that nothing of the corrector compiles; one
+    # loop, of one signature, serves both
+    bodies = orbits.scenes.outer_solar_system()
+    runs = [orbits.Simulation(bodies, orbits.integrators.get(
+                "wh", lanes="off", corrector=c, coordinates=coordinates), dt=216.6 * u.day)
+            for c in (0, 11)]
+    for sim in runs:
+        sim.run(sim.time + 10 * 216.6 * u.day, progress=False)
+    plain, corrected = (sim._ws["corrector"] for sim in runs)
+    assert plain.cfunc is None and corrected.cfunc is not None
+    assert plain._numba_type_ == corrected._numba_type_
+    loop = runs[0].integrator.loop(runs[0])
+    assert runs[1].integrator.loop(runs[1]) is loop and len(loop.signatures) == 1
