@@ -669,7 +669,7 @@ def _chaos_step(xj, vj, t, sync):
     # the step's internal point (before the deferred half drift and the
     # corrector: see the module notes), and the vector's internal rows scaled
     # back when it has grown large
-    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, correct = sync
+    gm, eta, owed, xs, vs, x, v, acc, n_active, corr, h, targs, _ = sync
     tp = targs[1]
     if not tp[7]:
         return False
