@@ -86,17 +86,20 @@ def _compile(func, options):
     return dispatcher
 
 
-def cfunc(signature, func, cache=True):
+def cfunc(signature, func, cache=True, nrt=True):
     """``func`` compiled as a C callable of the declared ``signature``, with the
     package's options: a pointer that compiled loops take as an argument of
     that type (numba's first-class functions), so that one loop serves every
     function of the signature.  Cached on disk (unless ``cache`` is False)
     under ``func``'s qualified name and :data:`KERNEL_STAMP`, as :func:`njit`
-    caches (a pointer compiles the kernels it calls into itself)."""
+    caches (a pointer compiles the kernels it calls into itself).  ``nrt``
+    as in :func:`specialize` (and in the name, as :func:`called` names it)."""
     options = {k: v for k, v in NUMBA_OPTIONS.items() if k != "nogil"}
     options["cache"] = cache
+    if not nrt:
+        options["_nrt"] = False
     qualname = func.__qualname__
-    func.__qualname__ = f"{qualname}__{KERNEL_STAMP}"
+    func.__qualname__ = f"{qualname}{'' if nrt else '__bare'}__{KERNEL_STAMP}"
     try:
         return numba.cfunc(signature, **options)(func)
     finally:
@@ -132,7 +135,7 @@ class Pointer:
         return self.cfunc(*args)
 
 
-def pointer(kernel, signature, cache=True):
+def pointer(kernel, signature, cache=True, nrt=True):
     """``kernel`` (a compiled function, or a plain one) compiled as a C
     callable of ``signature`` (:func:`cfunc`), as a :class:`Pointer`.  A
     compiled kernel's own code is compiled, cached under its name, not a
@@ -140,16 +143,17 @@ def pointer(kernel, signature, cache=True):
     arguments over once (a wrapper would hand them on again, which shows
     beside the stopping conditions' 16 arguments, nine of them arrays).
     ``cache``: False where the kernel cannot be cached (it binds a user's
-    function)."""
+    function); ``nrt``: False for a kernel that allocates nothing, compiled
+    without numba's reference counts (see :func:`specialize`)."""
     py = getattr(kernel, "py_func", None)
     if py is None:
-        return Pointer(cfunc(signature, kernel, cache))
+        return Pointer(cfunc(signature, kernel, cache, nrt))
     name = f"{py.__name__}__pointer"
     func = types.FunctionType(py.__code__, py.__globals__, name, py.__defaults__,
                               py.__closure__)
     func.__qualname__ = name
     func.__module__ = py.__module__
-    return Pointer(cfunc(signature, func, cache))
+    return Pointer(cfunc(signature, func, cache, nrt))
 
 
 #: a C callable that takes nothing and returns 0, for :func:`idle_pointer`

@@ -873,7 +873,7 @@ def implicit_kick(force, x, fargs, velocity_dependent):
     if found is None:
         kick = specialize(_implicit_kick, force.key, cache=force.cache, nrt=force.runtime,
                           force=force.kernel)
-        found = _KICK_POINTERS[key] = pointer(kick, signature, force.cache)
+        found = _KICK_POINTERS[key] = pointer(kick, signature, force.cache, nrt=force.runtime)
     return found
 
 

@@ -1048,8 +1048,10 @@ def corrector_pointer(coordinates, terms, lanes, signature, corrected):
     key = (coordinates, None if terms is None else terms.key, bool(lanes), signature, cache)
     found = _CORRECTORS.get(key)
     if found is None:
+        # without numba's runtime where its kernels have none (a user's
+        # term may allocate: see _kernels)
         found = _CORRECTORS[key] = pointer(_kernels(coordinates, terms, lanes)[2], signature,
-                                           cache)
+                                           cache, nrt=not cache)
     return found
 
 
