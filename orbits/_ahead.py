@@ -110,6 +110,13 @@ def _compile_loop(name, options, lanes, adds=""):
     system, with what ``adds`` names, :data:`ADDS`): ``(its label, the
     seconds spent compiling)``."""
     integ = integrators.get(name, **options)
+    if adds == "terms" and integ.config.get("corrector") == 0:
+        # with a corrector where the method takes one (wh): its loops call it
+        # through a pointer compiled for the runs that have one
+        try:
+            integ = integrators.get(name, **{**options, "corrector": 11})
+        except IntegratorOptionError:
+            pass
     label = loop_label(integ, lanes, adds)
     dt = None if integ.adaptive else _AHEAD_DT_DAYS * u.day
     until = _AHEAD_STEPS * _AHEAD_DT_DAYS * u.day
