@@ -337,6 +337,14 @@ def _correct_through(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs,
     correct(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
 
 
+def _corrector_call(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs):
+    # the body of the corrector's pointer (corrector_pointer): a call of the
+    # compiled corrector, so that compiling it is announced and timed (numba
+    # broadcasts its compile events for compiled functions, not for the C
+    # callables that call them)
+    corrector(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs)
+
+
 def _correct_compiled(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs, correct):
     # the corrector compiled into its caller (the tangent loop's, the batch's
     # synchronisation), which ignores the pointer
@@ -1050,8 +1058,9 @@ def corrector_pointer(coordinates, terms, lanes, signature, corrected):
     if found is None:
         # without numba's runtime where its kernels have none (a user's
         # term may allocate: see _kernels)
-        found = _CORRECTORS[key] = pointer(_kernels(coordinates, terms, lanes)[2], signature,
-                                           cache, nrt=not cache)
+        call = specialize(_corrector_call, f"corrector_{coordinates}", cache=cache,
+                          nrt=not cache, corrector=_kernels(coordinates, terms, lanes)[2])
+        found = _CORRECTORS[key] = pointer(call, signature, cache, nrt=not cache)
     return found
 
 

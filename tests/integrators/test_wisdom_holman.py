@@ -716,7 +716,7 @@ def test_the_corrector_is_a_pointer_compiled_only_for_a_run_with_a_corrector(coo
                 "wh", lanes="off", corrector=c, coordinates=coordinates), dt=216.6 * u.day)
             for c in (0, 11)]
     for sim in runs:
-        sim.run(sim.time + 10 * 216.6 * u.day, progress=False)
+        sim.run(sim.time + 10 * 216.6 * u.day, outputs=2, progress=False)
     plain, corrected = (sim._ws["corrector"] for sim in runs)
     assert plain.cfunc is None and corrected.cfunc is not None
     assert plain._numba_type_ == corrected._numba_type_
