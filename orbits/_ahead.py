@@ -110,9 +110,10 @@ def _compile_loop(name, options, lanes, adds=""):
     system, with what ``adds`` names, :data:`ADDS`): ``(its label, the
     seconds spent compiling)``."""
     integ = integrators.get(name, **options)
-    if adds == "terms" and integ.config.get("corrector") == 0:
+    if (adds == "terms" or lanes) and integ.config.get("corrector") == 0:
         # with a corrector where the method takes one (wh): its loops call it
-        # through a pointer compiled for the runs that have one
+        # through a pointer compiled for the runs that have one (the scalar
+        # loop's with the run with terms, the lanes' loop's with its run)
         try:
             integ = integrators.get(name, **{**options, "corrector": 11})
         except IntegratorOptionError:
