@@ -860,6 +860,15 @@ def _kick_call(x, v, t, h, fargs, acc, vm):
 
 
 _KICK_POINTERS = {}
+#: the forces (key, cache, runtime) whose kick a run of this process has made
+_KICKS_MADE = set()
+
+
+def kick_made(force):
+    """Whether :func:`implicit_kick` has made ``force``'s kick in this
+    process (so that a run need not type the force's arguments to find it
+    again)."""
+    return (force.key, force.cache, force.runtime) in _KICKS_MADE
 
 
 def implicit_kick(force, x, fargs, velocity_dependent):
@@ -885,6 +894,7 @@ def implicit_kick(force, x, fargs, velocity_dependent):
         call = specialize(_kick_call, force.key, cache=force.cache, nrt=force.runtime,
                           kick_kernel=kick)
         found = _KICK_POINTERS[key] = pointer(call, signature, force.cache, nrt=force.runtime)
+        _KICKS_MADE.add((force.key, force.cache, force.runtime))
     return found
 
 

@@ -443,7 +443,7 @@ class SplittingMethod(Integrator):
         """The implicit kick of a force that reads velocities
         (:func:`~orbits._kernels.stepping.implicit_kick`), compiled once for
         every splitting method and only for runs with such a force."""
-        if not (force.jit and force.velocity_dependent):
+        if not (force.jit and force.velocity_dependent) or stepping.kick_made(force):
             return ()
         fargs = stepping.work_bound(force, fargs, {})
         return ((TERMS["kick"], lambda: stepping.implicit_kick(force, x, fargs, True)),)
@@ -455,11 +455,18 @@ class SplittingMethod(Integrator):
         sargs, check = stop_record(stop)
         fargs = stepping.work_bound(force, fargs, ws)
         velocity_dependent = bool(velocity_dependent or force.velocity_dependent)
+        # the kick's pointer, kept in the workspace (not an array: neither
+        # saved nor restored) for the force it was made for: its type is
+        # that of the force's arguments, which numba types in Python in some
+        # hundred microseconds, more than a short call's whole run
+        kick = ws.get("kick")
+        if kick is None or kick[0] != (force.key, velocity_dependent):
+            kick = ws["kick"] = ((force.key, velocity_dependent),
+                                 stepping.implicit_kick(force, x, fargs, velocity_dependent))
         return with_status(*loop_for(stepping.splitting_loop, force)(
             x, v, t, dt, nsteps, self._table,
             stepping.SplittingWork(ws["acc"], ws["vm"], ws["cache"]), fargs, velocity_dependent,
-            stepping.implicit_kick(force, x, fargs, velocity_dependent),
-            outputs(mon, step0, mon_t, mon_out), checks(check_every, sargs), check))
+            kick[1], outputs(mon, step0, mon_t, mon_out), checks(check_every, sargs), check))
 
     def invalidate(self, ws):
         """Drop the cached force: the next kick evaluates it again.
