@@ -115,6 +115,16 @@ def load_point(S, xh, vs, gm, hill):
 
 
 @njit(inline="always")
+def _paired(k, j, n):
+    # whether column k (unsigned) pairs with the source body j (column j -
+    # 1): after it and not padding; compared as signed integers, which the
+    # vector instructions compare directly (unsigned ones take three more
+    # operations a comparison)
+    kk = np.int64(k)
+    return (kk >= j) & (kk < n - 1)
+
+
+@njit(inline="always")
 def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
     """Whether :func:`~orbits._kernels.trace.criterion` could flag a pair or
     a pericentre at the lanes' criterion point of the step ``h``: the
@@ -128,7 +138,6 @@ def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
     fewer operations a pair); only where that may flag are they tested
     again with the relative speeds."""
     kp2, kg2, kv2, kh2 = criterion_scales(h, gm[0], k_hill, k_speed, k_peri)
-    m = np.uint64(n - 1)
     P = np.uint64(lane_columns(n))
     X = S[STATE]
     Y = S[STATE + 1]
@@ -150,17 +159,20 @@ def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
         vi2 = U[k] * U[k] + V[k] * V[k] + W[k] * W[k]
         rv = X[k] * U[k] + Y[k] * V[k] + Z[k] * W[k]
         d = ri2 * ri2 - kp2 * (vi2 * ri2 + 3.0 * rv * rv)
-        hits += (k < m) & ((d <= lo * ri2 * ri2) | (kgm * ri2 > d * d))
+        hits += (np.int64(k) < n - 1) & ((d <= lo * ri2 * ri2) | (kgm * ri2 > d * d))
         SP[k] = math.sqrt(kvm * vi2)
     if hits:
         return True
     khm = MARGIN * kh2
     L = np.uint64(LANE_WIDTH)
+    # the sources with a pair after them: column c = j - 1 pairs with the
+    # columns c < k < n - 1 (the last planet's column has none)
+    sources = min(n_active, n - 1)
     # the looser test: (k_speed h)^2 |V_i - V_j|^2 <= (SP_i + SP_j)^2 (the
     # margin covers the roundings), the pairs (i, j), i > j, as the scalar
     # criterion takes them: the lanes after column c, from the vector
     # register that holds it on
-    for j in range(1, n_active):
+    for j in range(1, sources):
         c = np.uint64(j - 1)
         xj = X[c]
         yj = Y[c]
@@ -175,12 +187,12 @@ def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
             d2 = dx * dx + dy * dy + dz * dz
             s = SP[k] + sj
             reach = max(s * s, khm * max(H2[k], aj) * max(R2[k], rj2))
-            hits += (k > c) & (k < m) & (d2 < reach)
+            hits += _paired(k, j, n) & (d2 < reach)
     if hits == 0:
         return False
     # the same pairs with the relative speeds
     hits = 0
-    for j in range(1, n_active):
+    for j in range(1, sources):
         c = np.uint64(j - 1)
         xj = X[c]
         yj = Y[c]
@@ -199,7 +211,7 @@ def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
             uy = V[k] - vj
             uz = W[k] - wj
             bound = khm * max(H2[k], aj) * max(R2[k], rj2)
-            hits += ((k > c) & (k < m)
+            hits += (_paired(k, j, n)
                      & ((d2 < kvm * (ux * ux + uy * uy + uz * uz)) | (d2 < bound)))
     return hits != 0
 
