@@ -27,14 +27,16 @@ cannot (see "three passes" below).  The passes come in two forms:
 * the medium passes (:func:`medium_columns`), for the steps people take
   with Wisdom-Holman (a twentieth of the innermost period, up to a radian of
   an orbit): up to two iterations, each lane with the four- or the nine-term
-  series (:func:`~orbits._kernels.stumpff.stumpff_medium_lane`), both made
-  in every lane and the scalar path's taken by a select.  The steps' drift
-  of the state kept in the lanes (:func:`resident_drift`) takes them
-  always: a lane whose step is short takes the four-term series and keeps
-  the first iteration's anomaly, as the short passes would, so the loop
-  compiles one drift instead of two (5 s less on a first run) for 7-16 %
-  more time a step at the benchmark's short steps and a little less at the
-  users' steps (benchmarks/RESULTS.md).  The outputs' drifts
+  series (:func:`~orbits._kernels.stumpff.stumpff_medium_lane`), the
+  scalar path's taken by a select; the second iteration is a pass of its
+  own, made in every lane where any column has not converged after the
+  first.  The steps' drift of the state kept in the lanes
+  (:func:`resident_drift`) takes them always: a lane whose step is short
+  takes the four-term series and keeps the first iteration's anomaly, as
+  the short passes would, and at short steps the second pass is left out,
+  so the loop compiles one drift instead of two (5 s less on a first run)
+  and the drift of a short step costs a pass less (benchmarks/RESULTS.md).
+  The outputs' drifts
   (:func:`kepler_drift_lanes`, :func:`resident_drift_twice`) take the short
   passes, and the medium ones, compiled once, where those declined a planet,
   then first for the next :data:`RETRY` drifts (row :data:`MEMO`, column
@@ -282,17 +284,32 @@ def _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t
 
 @njit(inline="always")
 def _iterate_column_medium(T, t, k, h):
-    # the medium passes' second: up to two quartic iterations, as the scalar
-    # path (kepler.short_step_anomaly) takes them, with _stumpff_short's
-    # four- or nine-term series; both are made in every lane, and a lane
-    # converged after the first keeps that anomaly (the scalar path stops
-    # there).  Row t + 8: 1.0 where the anomaly kept has converged with every
-    # Stumpff argument it used within the series
+    # the medium passes' second: the first quartic iteration, as the scalar
+    # path (kepler.short_step_anomaly) takes it, with _stumpff_short's four-
+    # or nine-term series.  Row t + 7: the anomaly; row t + 8: 1.0 where it
+    # has converged with its Stumpff argument within the series (the scalar
+    # path stops there); row t (the starter, no longer read): 1.0 where that
+    # argument is within the series, plus 2.0 where the iteration converged
     s, r0, et, beta, zeta = _started(T, t, k)
     c0, c1, c2, c3, in0 = stumpff_medium_lane(beta * s * s)
     d = quartic_step(s, r0, et, beta, zeta, c0, c1, c2, c3, h)
     s1 = s + d
     done1 = abs(d) <= _SHORT_STEP_TOL * abs(s1)
+    T[t + 7, k] = s1
+    T[t + 8, k] = 1.0 if in0 & done1 else 0.0
+    T[t, k] = (1.0 if in0 else 0.0) + (2.0 if done1 else 0.0)
+
+
+@njit(inline="always")
+def _iterate_again_medium(T, t, k, h):
+    # the medium passes' second iteration, where a column has not converged
+    # after the first (the scalar path's second): row t + 7 gets the anomaly
+    # the scalar path stops at, row t + 8 1.0 where it has converged with
+    # every Stumpff argument it used within the series
+    s1, r0, et, beta, zeta = _started_again(T, t, k)
+    flags = T[t, k]
+    in0 = (flags == 1.0) | (flags == 3.0)
+    done1 = flags >= 2.0
     c0, c1, c2, c3, in1 = stumpff_medium_lane(beta * s1 * s1)
     d = quartic_step(s1, r0, et, beta, zeta, c0, c1, c2, c3, h)
     s2 = s1 + d
@@ -300,6 +317,12 @@ def _iterate_column_medium(T, t, k, h):
     T[t + 7, k] = s1 if done1 else s2
     ok = in0 & (done1 | (in1 & done2))
     T[t + 8, k] = 1.0 if ok else 0.0
+
+
+@njit(inline="always")
+def _started_again(T, t, k):
+    # (s1, r0, eta, beta, zeta) for the second iteration
+    return T[t + 7, k], T[t + 1, k], T[t + 3, k], T[t + 4, k], T[t + 5, k]
 
 
 @njit(inline="always")
@@ -314,8 +337,10 @@ def medium_columns(S, src, mu, dst, take, t, h, column_steps, P):
     of the scratch ``S``: the start ``src .. src + 5`` with ``mu``, the end
     ``dst .. dst + 5``, the verdict ``take``, the passes' ``t .. t + 8``;
     each column's step is row :data:`_H`'s where ``column_steps``, else
-    ``h``.  Returns how many of the ``P`` columns are left to the scalar
-    drift."""
+    ``h``.  The second iteration is a pass of its own, made only where a
+    column has not converged after the first: at short steps every column
+    has, and the drift is a pass shorter.  Returns how many of the ``P``
+    columns are left to the scalar drift."""
     X0, X1, X2, V0, V1, V2 = S[src], S[src + 1], S[src + 2], S[src + 3], S[src + 4], S[src + 5]
     Y0, Y1, Y2, U0, U1, U2 = S[dst], S[dst + 1], S[dst + 2], S[dst + 3], S[dst + 4], S[dst + 5]
     MU = S[mu]
@@ -327,6 +352,16 @@ def medium_columns(S, src, mu, dst, take, t, h, column_steps, P):
     for k in range(P):
         hk = H[k] if column_steps else h
         _iterate_column_medium(S, t, k, hk)
+    # the second iteration, a pass of its own, only where a column has not
+    # converged after the first (at short steps every column has)
+    V = S[t + 8]
+    unsettled = 0
+    for k in range(P):
+        unsettled += V[k] == 0.0
+    if unsettled:
+        for k in range(P):
+            hk = H[k] if column_steps else h
+            _iterate_again_medium(S, t, k, hk)
     rejected = 0
     for k in range(P):
         rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, S,
@@ -342,7 +377,9 @@ def medium_columns(S, src, mu, dst, take, t, h, column_steps, P):
 # loops with shorter bodies, more of them overlap: three passes (the
 # starter, the iteration, the f and g functions) are the quickest from the
 # outer solar system's few columns to many (two are slower from 16 columns
-# on, four at 8 columns; benchmarks/RESULTS.md).  The passes keep nine rows
+# on, four at 8 columns; benchmarks/RESULTS.md).  The medium passes' second
+# iteration is a fourth, only where a column needs it, which costs no time
+# at the steps where one does.  The passes keep nine rows
 # (the start's s, r0, 1 / r0, eta, beta, zeta and verdict, the iterated s
 # and its verdict), the same floats the one pass kept in registers, so the
 # drift is the same bit for bit.

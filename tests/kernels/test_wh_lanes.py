@@ -123,6 +123,37 @@ def test_the_medium_passes_return_to_the_short_ones_bit_for_bit():
         assert S[L.MEMO, 1] == max(L.RETRY - k, 0), k
 
 
+@pytest.mark.parametrize("inner", [None, 0.12])
+def test_the_second_iteration_only_where_a_column_needs_it(inner):
+    # the steps' drift (resident_drift, the medium passes) at a short step
+    # of the outer planets: every column converges after the first iteration
+    # (row _T: 1.0 for a Stumpff argument within the series, plus 2.0 for
+    # converged), and the second pass is left out; with an inner planet whose
+    # step is long against its orbit, that column needs the second, which
+    # is then made in every lane, the converged ones keeping the first's
+    # anomaly.  The scalar drift's bits either way
+    planets = CIRCULAR + ([(inner, 0.1, 1.0)] if inner else [])
+    xj, vj, mu = system(planets)
+    a, b = xj.copy(), vj.copy()
+    e, f = xj.copy(), vj.copy()
+    w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
+    R = L.lanes_scratch(len(xj))
+    L.resident_load(e, f, mu, mu, R)
+    needed = 0
+    for k in range(30):
+        h = 2 * math.pi / 400
+        W.kepler_drift_all(a, b, mu, h, w1, w2)
+        assert L.resident_drift(e, f, mu, h, R) == 0
+        L.resident_store(R, e, f)
+        assert np.array_equal(a, e) and np.array_equal(b, f), k
+        flags = R[L._T, :len(planets)]
+        assert (flags[:len(CIRCULAR)] == 3.0).all(), k
+        needed += flags[-1] == 1.0
+    # the inner planet (a twelfth of its orbit a step) needs the second
+    # iteration on most drifts
+    assert needed >= (10 if inner else 0)
+
+
 @pytest.mark.parametrize("ratio", [1 / 5, 1.0, 7.3])
 def test_longer_steps_are_left_to_the_scalar_drift(ratio):
     # a fifth of the innermost period and beyond: more than a radian of its
