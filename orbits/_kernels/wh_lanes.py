@@ -301,6 +301,13 @@ def _iterate_column_medium(T, t, k, h):
 
 
 @njit(inline="always")
+def _started_again(T, t, k):
+    # (s1, r0, eta, beta, zeta) for the second iteration: the first's
+    # anomaly in place of the starter
+    return T[t + 7, k], T[t + 1, k], T[t + 3, k], T[t + 4, k], T[t + 5, k]
+
+
+@njit(inline="always")
 def _iterate_again_medium(T, t, k, h):
     # the medium passes' second iteration, where a column has not converged
     # after the first (the scalar path's second): row t + 7 gets the anomaly
@@ -317,12 +324,6 @@ def _iterate_again_medium(T, t, k, h):
     T[t + 7, k] = s1 if done1 else s2
     ok = in0 & (done1 | (in1 & done2))
     T[t + 8, k] = 1.0 if ok else 0.0
-
-
-@njit(inline="always")
-def _started_again(T, t, k):
-    # (s1, r0, eta, beta, zeta) for the second iteration
-    return T[t + 7, k], T[t + 1, k], T[t + 3, k], T[t + 4, k], T[t + 5, k]
 
 
 @njit(inline="always")
