@@ -301,19 +301,13 @@ def _iterate_column_medium(T, t, k, h):
 
 
 @njit(inline="always")
-def _started_again(T, t, k):
-    # (s1, r0, eta, beta, zeta) for the second iteration: the first's
-    # anomaly in place of the starter
-    return T[t + 7, k], T[t + 1, k], T[t + 3, k], T[t + 4, k], T[t + 5, k]
-
-
-@njit(inline="always")
 def _iterate_again_medium(T, t, k, h):
     # the medium passes' second iteration, where a column has not converged
     # after the first (the scalar path's second): row t + 7 gets the anomaly
     # the scalar path stops at, row t + 8 1.0 where it has converged with
     # every Stumpff argument it used within the series
-    s1, r0, et, beta, zeta = _started_again(T, t, k)
+    _, r0, et, beta, zeta = _started(T, t, k)
+    s1 = T[t + 7, k]
     flags = T[t, k]
     in0 = (flags == 1.0) | (flags == 3.0)
     done1 = flags >= 2.0
