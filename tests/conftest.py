@@ -53,7 +53,9 @@ def _kernels_compile_once_per_type():
     for obj in gc.get_objects():
         if not issubclass(type(obj), CPUDispatcher):  # (not a weak proxy)
             continue
-        if not getattr(obj.py_func, "__module__", "").startswith("orbits"):
+        # (a function compiled from code run with exec, as the docs' blocks
+        # are, has the module None)
+        if not (getattr(obj.py_func, "__module__", None) or "").startswith("orbits"):
             continue
         seen = {}
         for sig in obj.signatures:
