@@ -34,11 +34,10 @@ import numpy as np
 
 from ._jit import njit
 from .gravity import LANE_WIDTH, lane_columns
-from .wh_lanes import (SCRATCH_ROWS, STATE, SUMS, resident_drift, resident_finite,
-                       resident_jump, resident_load, resident_pulls, resident_store,
-                       resident_velocity_kick)
+from .wh_lanes import (SCRATCH_ROWS, STATE, SUMS, jump_rows, jump_shift, kick_rows, pulls_rows,
+                       resident_drift_into, resident_finite, resident_load, resident_store)
 
-__all__ = ["far_steps", "may_flag", "load_hill", "load_point", "criterion_scales",
+__all__ = ["far_steps", "may_flag", "may_flag_at", "load_hill", "load_point", "criterion_scales",
            "far_scratch_shape", "MARGIN", "FAR_WAIT", "FAR_STEPS"]
 
 #: 2^(1/3): ((m_i + m_j) / 3 m_0)^(1/3) <= 2^(1/3) max(hill_i, hill_j)
@@ -57,14 +56,14 @@ FAR_WAIT = 16
 
 # the rows of the scratch after the lanes' state's (wh_lanes.SCRATCH_ROWS):
 # each column's squared Hill factor, squared distance and half-kicked
-# velocity (3), the step's start (6), the last criterion point (6), each
-# column's scaled speed, and a count of the steps made in the lanes (row
-# FAR_STEPS, column 0)
+# velocity (3), the step's drifted state (6), which holds its criterion
+# point's positions, the last criterion point (6), each column's scaled
+# speed, and a count of the steps made in the lanes (row FAR_STEPS, column 0)
 _HILL2 = SCRATCH_ROWS
 _R2 = _HILL2 + 1
 _VS = _R2 + 1
-_START = _VS + 3
-_POINT = _START + 6
+_DRIFTED = _VS + 3
+_POINT = _DRIFTED + 6
 # each column's speed times k_speed |h| (with the margin)
 _SP = _POINT + 6
 #: the scratch's row whose column 0 counts the steps made in the lanes
@@ -137,14 +136,21 @@ def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
     |V_i| + |V_j|`` in place of the relative speed (each body's speed once,
     fewer operations a pair); only where that may flag are they tested
     again with the relative speeds."""
+    return may_flag_at(S, STATE, _VS, gm, n_active, n, h, k_hill, k_speed, k_peri)
+
+
+@njit(inline="always")
+def may_flag_at(S, pos, vel, gm, n_active, n, h, k_hill, k_speed, k_peri):
+    """:func:`may_flag` of the positions in the three rows from ``pos`` and
+    the velocities in those from ``vel``."""
     kp2, kg2, kv2, kh2 = criterion_scales(h, gm[0], k_hill, k_speed, k_peri)
     P = np.uint64(lane_columns(n))
-    X = S[STATE]
-    Y = S[STATE + 1]
-    Z = S[STATE + 2]
-    U = S[_VS]
-    V = S[_VS + 1]
-    W = S[_VS + 2]
+    X = S[pos]
+    Y = S[pos + 1]
+    Z = S[pos + 2]
+    U = S[vel]
+    V = S[vel + 1]
+    W = S[vel + 2]
     R2 = S[_R2]
     H2 = S[_HILL2]
     SP = S[_SP]
@@ -217,12 +223,40 @@ def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
 
 
 @njit(inline="always")
-def _copy_rows(S, src, dst, rows, P):
-    for r in range(rows):
-        A = S[src + r]
-        B = S[dst + r]
+def _close_step(S, gm, n_active, dt, half, P):
+    # the kick by dt and the closing half jump of a step from its drifted
+    # rows into the state's (wh_lanes.kick_rows, jump_rows: the same
+    # operations), the criterion point (the drifted positions, the
+    # half-kicked velocities) copied into _POINT in the same passes
+    for r in range(3):
+        V = S[_DRIFTED + 3 + r]
+        U = S[STATE + 3 + r]
+        A = S[SUMS + r]
+        Vs = S[_VS + r]
+        Pv = S[_POINT + 3 + r]
         for k in range(P):
-            B[k] = A[k]
+            U[k] = V[k] + dt * A[k]
+            Pv[k] = Vs[k]
+    px, py, pz = jump_shift(S, gm, n_active, half, STATE + 3)
+    X = S[_DRIFTED]
+    Y = S[_DRIFTED + 1]
+    Z = S[_DRIFTED + 2]
+    U = S[STATE]
+    V = S[STATE + 1]
+    W = S[STATE + 2]
+    PX = S[_POINT]
+    PY = S[_POINT + 1]
+    PZ = S[_POINT + 2]
+    for k in range(P):
+        x = X[k]
+        y = Y[k]
+        z = Z[k]
+        U[k] = x + px
+        V[k] = y + py
+        W[k] = z + pz
+        PX[k] = x
+        PY[k] = y
+        PZ[k] = z
 
 
 @njit(inline="always")
@@ -238,38 +272,32 @@ def far_steps(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_pe
     point may flag (the state is that step's start), 2 when the state is not
     finite after the last step made."""
     n = xh.shape[0]
-    P = lane_columns(n)
+    P = np.uint64(lane_columns(n))
     half = 0.5 * dt
     seg = half + half
     resident_load(xh, vb, gm, eta, S)
     load_hill(S, hill, n)
     done = 0
     why = 0
+    # a step drifts the state into rows of its own and makes its criterion
+    # point there, so that a step that may flag leaves the state at its
+    # start; the closing kick and half jump write the state's rows from
+    # them, and keep the criterion point in the same passes (_close_step)
     while done < m:
-        _copy_rows(S, STATE, _START, 6, P)
         b0 = xh[0, 0]
         b1 = xh[0, 1]
         b2 = xh[0, 2]
-        resident_drift(xh, vb, eta, seg, S)
-        resident_jump(S, gm, n_active, half, n)
-        resident_pulls(S, gm, n_active, n)
-        for r in range(3):
-            V = S[STATE + 3 + r]
-            A = S[SUMS + r]
-            Vs = S[_VS + r]
-            for k in range(P):
-                Vs[k] = V[k] + half * A[k]
-        if may_flag(S, gm, n_active, n, dt, k_hill, k_speed, k_peri):
-            _copy_rows(S, _START, STATE, 6, P)
+        resident_drift_into(xh, vb, eta, seg, S, _DRIFTED)
+        jump_rows(S, gm, n_active, half, P, _DRIFTED, _DRIFTED)
+        pulls_rows(S, gm, n_active, n, _DRIFTED)
+        kick_rows(S, half, P, _DRIFTED + 3, _VS)
+        if may_flag_at(S, _DRIFTED, _VS, gm, n_active, n, dt, k_hill, k_speed, k_peri):
             xh[0, 0] = b0
             xh[0, 1] = b1
             xh[0, 2] = b2
             why = 1
             break
-        _copy_rows(S, STATE, _POINT, 3, P)
-        _copy_rows(S, _VS, _POINT + 3, 3, P)
-        resident_velocity_kick(S, dt, n)
-        resident_jump(S, gm, n_active, half, n)
+        _close_step(S, gm, n_active, dt, half, P)
         done += 1
         until_check -= 1
         if until_check == 0:

@@ -126,7 +126,8 @@ __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns
            "drift_columns", "column_start", "SCRATCH_ROWS", "lanes_scratch_shape", "resident_load",
            "resident_store", "resident_drift_twice", "resident_drift", "resident_finite",
            "resident_kick", "resident_jump_kick", "resident_jump", "resident_pulls",
-           "resident_velocity_kick", "STATE", "SUMS"]
+           "resident_velocity_kick", "resident_drift_into", "jump_shift", "jump_rows", "kick_rows",
+           "pulls_rows", "STATE", "SUMS"]
 
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
@@ -453,12 +454,13 @@ def _medium_scratch(S, h0, column_steps, P):
 
 
 @njit(inline="always")
-def _medium_resident(S, h, P):
-    # medium_columns over the rows of the state kept in the lanes (_RX ..,
-    # _RMU, _RY .., _RTAKE), inlined into the steps' drift: called there, it
+def _medium_resident(S, h, P, dst):
+    # medium_columns from the rows of the state kept in the lanes (_RX ..,
+    # _RMU, _RTAKE) into the rows from dst (_RY .., or others), inlined into
+    # the steps' drift: called there, it
     # made the outer solar system's step at 216.6 days 0.36 us against 0.23
     # (benchmarks/RESULTS.md); the outputs' drifts call _medium_scratch
-    return medium_columns(S, _RX, _RMU, _RY, _RTAKE, _T, h, False, P)
+    return medium_columns(S, _RX, _RMU, dst, _RTAKE, _T, h, False, P)
 
 
 @njit(inline="always")
@@ -608,18 +610,28 @@ def resident_drift(xj, vj, eta, h, S):
     straight line), by the medium passes alone (see the module notes); a
     declined planet goes to the scalar drift, with its row of ``xj``, ``vj``
     as scratch.  Returns how many planets were declined."""
-    straight_drift(xj, vj, 0, h)
-    n = xj.shape[0]
-    P = lane_columns(n)
-    rejected = _medium_resident(S, h, np.uint64(P))
-    declined = 0
-    if rejected:
-        declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)
+    declined = resident_drift_into(xj, vj, eta, h, S, _RY)
+    P = np.uint64(lane_columns(xj.shape[0]))
     for r in range(6):
         X = S[_RX + r]
         Y = S[_RY + r]
-        for k in range(np.uint64(P)):
+        for k in range(P):
             X[k] = Y[k]
+    return declined
+
+
+@njit(inline="always")
+def resident_drift_into(xj, vj, eta, h, S, dst):
+    """:func:`resident_drift` of the lanes' state into the six rows from
+    ``dst`` (the drift's end rows, or others of the scratch), the state's
+    own rows left as they were; row 0 of ``xj`` drifts in place.  Returns
+    how many planets were declined."""
+    straight_drift(xj, vj, 0, h)
+    P = lane_columns(xj.shape[0])
+    rejected = _medium_resident(S, h, np.uint64(P), dst)
+    declined = 0
+    if rejected:
+        declined = _resident_declined(xj, vj, eta, h, S, _RX, dst, _RTAKE, P)
     return declined
 
 
@@ -750,33 +762,63 @@ def _zero_sums(S, P):
 @njit(inline="always")
 def _resident_jump(S, gm, n_active, h, P):
     # wisdom_holman.jump on the lanes' state: the same sums in the same order
+    jump_rows(S, gm, n_active, h, P, _RX, _RX)
+
+
+@njit(inline="always")
+def jump_shift(S, gm, n_active, h, vel):
+    """The shift ``(px, py, pz)`` of every position in
+    :func:`~orbits._kernels.wisdom_holman.jump` by ``h``, the velocities in
+    the three rows from ``vel``: the same sums in the same order."""
     px = 0.0
     py = 0.0
     pz = 0.0
     for i in range(1, n_active):
-        px += gm[i] * S[_RX + 3, i - 1]
-        py += gm[i] * S[_RX + 4, i - 1]
-        pz += gm[i] * S[_RX + 5, i - 1]
+        px += gm[i] * S[vel, i - 1]
+        py += gm[i] * S[vel + 1, i - 1]
+        pz += gm[i] * S[vel + 2, i - 1]
     s = h / gm[0]
     px *= s
     py *= s
     pz *= s
-    X = S[_RX]
-    Y = S[_RX + 1]
-    Z = S[_RX + 2]
+    return px, py, pz
+
+
+@njit(inline="always")
+def jump_rows(S, gm, n_active, h, P, src, dst):
+    """:func:`~orbits._kernels.wisdom_holman.jump` by ``h`` of the state in
+    the six rows from ``dst`` (its velocities there), its positions from
+    the three rows from ``src`` (``src = dst``: in place): the same sums in
+    the same order, over the ``P`` columns."""
+    px, py, pz = jump_shift(S, gm, n_active, h, dst + 3)
+    X = S[src]
+    Y = S[src + 1]
+    Z = S[src + 2]
+    U = S[dst]
+    V = S[dst + 1]
+    W = S[dst + 2]
     for k in range(P):
-        X[k] += px
-        Y[k] += py
-        Z[k] += pz
+        U[k] = X[k] + px
+        V[k] = Y[k] + py
+        W[k] = Z[k] + pz
 
 
 @njit(inline="always")
 def _resident_velocity_kick(S, h, P):
+    kick_rows(S, h, P, _RX + 3, _RX + 3)
+
+
+@njit(inline="always")
+def kick_rows(S, h, P, src, dst):
+    """The velocities in the three rows from ``src`` kicked by ``h`` times
+    the pulls' sums (:data:`SUMS`), into the three rows from ``dst``
+    (``src = dst``: in place), over the ``P`` columns."""
     for r in range(3):
-        V = S[_RX + 3 + r]
+        V = S[src + r]
+        U = S[dst + r]
         A = S[_RA + r]
         for k in range(P):
-            V[k] += h * A[k]
+            U[k] = V[k] + h * A[k]
 
 
 @njit(inline="always")
@@ -793,11 +835,17 @@ def resident_pulls(S, gm, n_active, n):
     the sources in ascending order (:func:`~orbits._kernels.gravity.pull_rows`):
     bit for bit :func:`~orbits._kernels.gravity.pair_accelerations` from
     body 1."""
+    pulls_rows(S, gm, n_active, n, _RX)
+
+
+@njit(inline="always")
+def pulls_rows(S, gm, n_active, n, src):
+    """:func:`resident_pulls` of the positions in the three rows from ``src``."""
     Pu = np.uint64(lane_columns(n))
     _zero_sums(S, Pu)
-    X = S[_RX]
-    Y = S[_RX + 1]
-    Z = S[_RX + 2]
+    X = S[src]
+    Y = S[src + 1]
+    Z = S[src + 2]
     for j in range(1, n_active):
         pull_rows(X, Y, Z, S[_RA], S[_RA + 1], S[_RA + 2], Pu, X[j - 1], Y[j - 1], Z[j - 1],
                   gm[j], np.uint64(j - 1), 0.0, np.uint64(n - 1))
