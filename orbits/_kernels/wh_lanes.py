@@ -109,7 +109,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit, slots, specialize, value
+from ._jit import njit, slots, specialize
 # the planets' columns, padded to a multiple of the lane width (shared with the
 # gravity kernels' lanes)
 from .gravity import (LANE_WIDTH, aligned_zeros, lane_columns, pull_factors, pull_rows,
@@ -119,7 +119,7 @@ from .kepler import (_SHORT_STEP, _SHORT_STEP_TOL, advanced_state, f_and_g, kepl
 from .stumpff import _STUMPFF_MEDIUM_Z, _STUMPFF_SHORT_Z, stumpff_lane, stumpff_medium_lane
 
 # the names the templates below are written against, bound by specialize
-step_of, short_passes, own_steps = slots("step_of", "short_passes", "own_steps")
+step_of, short_passes = slots("step_of", "short_passes")
 
 __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns",
            "lanes_scratch", "kepler_drift_lanes",
@@ -436,21 +436,14 @@ def _one_step(H, k, h):
     return h
 
 
-@njit(inline="always")
-def _column_step(H, k, h):
-    # each column takes its own step (resident_drift_twice)
-    return H[k]
-
-
 _pass_rows_one = specialize(_pass_rows, "one_step", inline=True, step_of=_one_step)
-_pass_rows_steps = specialize(_pass_rows, "column_steps", inline=True, step_of=_column_step)
 
 
 @njit
-def _medium_scratch(S, h0, column_steps, P):
+def _medium_scratch(S, h0, P):
     # medium_columns over the drift's rows of the scratch (_X .., _MU, _Y ..,
     # _TAKE); not inlined, so that one compilation serves every loop
-    return medium_columns(S, _X, _MU, _Y, _TAKE, _T, h0, column_steps, P)
+    return medium_columns(S, _X, _MU, _Y, _TAKE, _T, h0, False, P)
 
 
 @njit(inline="always")
@@ -552,27 +545,22 @@ SCRATCH_ROWS = _R + 33
 
 
 def _scratch_pass(S, h0, P):
-    # every column of the scratch by the step h0 (by its own, row _H, where
-    # own_steps): the short-step passes (short_passes, the _pass_rows of
-    # that step), and the medium ones where those declined a planet
-    # (_medium_first); specialised here, after the rows it names (_T).  The
-    # flag goes as a value (not the constant it is here), so that both
-    # copies call one compilation of _medium_scratch
+    # every column of the scratch by the step h0: the short-step passes
+    # (short_passes, the _pass_rows of that step), and the medium ones where
+    # those declined a planet (_medium_first); specialised here, after the
+    # rows it names (_T)
     if _medium_first(S):
-        return _medium_scratch(S, h0, value(own_steps), P)
+        return _medium_scratch(S, h0, P)
     rejected = short_passes(S[_X], S[_X + 1], S[_X + 2], S[_X + 3], S[_X + 4], S[_X + 5],
                             S[_MU], S[_Y], S[_Y + 1], S[_Y + 2], S[_Y + 3], S[_Y + 4],
                             S[_Y + 5], S[_TAKE], S, _T, S[_H], h0, np.uint64(0), P)
     if rejected:
         S[MEMO, 1] = RETRY
-        rejected = _medium_scratch(S, h0, value(own_steps), P)
+        rejected = _medium_scratch(S, h0, P)
     return rejected
 
 
-_single_pass = specialize(_scratch_pass, "one_step", inline=True, short_passes=_pass_rows_one,
-                          own_steps=False)
-_single_pass_steps = specialize(_scratch_pass, "column_steps", inline=True,
-                                short_passes=_pass_rows_steps, own_steps=True)
+_single_pass = specialize(_scratch_pass, "one_step", inline=True, short_passes=_pass_rows_one)
 
 
 def lanes_scratch_shape(n):
@@ -665,72 +653,59 @@ def _resident_declined(xj, vj, eta, h, S, src, dst, take, P):
 @njit(inline="always")
 def resident_drift_twice(xj, vj, eta, h, xs, vs, h2, S):
     """:func:`resident_drift` of the lanes' state by ``h``, and a copy of it
-    drifted by ``h2`` into ``xs``, ``vs`` (shape (N, 3)), in one pass, each
-    bit for bit the scalar drift.  The Wisdom-Holman loop's output: the copy
-    is the state synchronised by the owed drift ``h2``, made beside the next
+    drifted by ``h2`` into ``xs``, ``vs`` (shape (N, 3)), in the same
+    passes, each bit for bit the scalar drift (with ``h2 = 0`` the copy is
+    the state as it is).  The Wisdom-Holman loop's output: the copy is the
+    state synchronised by the owed drift ``h2``, made beside the next
     step's first drift, whose long chains of dependent operations it
     overlaps (an output's drift made on its own added its whole latency to
-    the step).  The copy's columns follow the state's padding, or, where
-    that takes fewer lanes, the state's planets (columns ``N - 1 ..
-    2 N - 3``), padded to a multiple of :data:`LANE_WIDTH`: with lanes of
-    8, four planets take the lanes of one drift instead of two, and with
-    lanes of 4, five planets take 12 columns instead of 16; the pass is
-    bound by its operations, so fewer columns are quicker
-    (benchmarks/RESULTS.md).  Returns how many planets of the state were
-    declined."""
+    the step).  The copy's columns follow the state's padding in the
+    state's rows, so that every row is copied and read whole: a vector load
+    of columns stored one by one just before waits for those stores, which
+    cost the copy packed after the state's planets more than its fewer
+    columns saved (benchmarks/RESULTS.md).  Each column's step goes in row
+    :data:`_H`.  Returns how many planets of the state were declined."""
     n = xj.shape[0]
-    m = n - 1
     P = lane_columns(n)
-    # the copy's first column: packed after the state's planets where that
-    # saves lanes, else after the state's padding (the whole rows then
-    # align, which a pass over 2 P columns needs to be as fast)
-    c = m if lane_columns(2 * m + 1) < 2 * P else P
-    Q = lane_columns(c + m + 1)
+    if h2 == 0.0:
+        for d in range(3):
+            xs[0, d] = xj[0, d]
+            vs[0, d] = vj[0, d]
+        resident_store(S, xs, vs)
+        return resident_drift(xj, vj, eta, h, S)
     for d in range(3):
         xs[0, d] = xj[0, d] + h2 * vj[0, d]
         vs[0, d] = vj[0, d]
-        xj[0, d] += h * vj[0, d]
-    # the start in both halves of the drift's rows, each half with its step:
-    # the state's columns with their padding, then the copy's, from column
-    # c on, with its own (a copy of the first planet), in whole rows that
-    # LLVM vectorises (a vector load waits for scalar stores to the same
-    # place to complete)
+    Pu = np.uint64(P)
     for r in range(6):
         A = S[_RX + r]
-        B = S[_X + r]
-        for k in range(P):
-            B[k] = A[k]
-        for k in range(P):
-            B[c + k] = A[k]
-    M = S[_MU]
+        for k in range(Pu):
+            A[Pu + k] = A[k]
+    M = S[_RMU]
     H = S[_H]
-    R = S[_RMU]
-    for k in range(P):
-        M[k] = R[k]
+    for k in range(Pu):
+        M[Pu + k] = M[k]
         H[k] = h
-    for k in range(P):
-        M[c + k] = R[k]
-        H[c + k] = h2
-    _single_pass_steps(S, h, np.uint64(Q))
-    # the copy (its declined planets start from the state, so the state first)
+        H[Pu + k] = h2
+    straight_drift(xj, vj, 0, h)
+    rejected = medium_columns(S, _RX, _RMU, _RY, _RTAKE, _T, h, True, Pu + Pu)
+    # the copy: a declined planet by the scalar drift from its start
     for i in range(1, n):
+        k = P + i - 1
+        row = _RY if S[_RTAKE, k] != 0.0 else _RX
         for d in range(3):
-            xs[i, d] = S[_RX + d, i - 1]
-            vs[i, d] = S[_RX + 3 + d, i - 1]
-    _store(S, xs, vs, eta, c)
-    # the state (packed: its padding a copy of its first planet again)
+            xs[i, d] = S[row + d, k]
+            vs[i, d] = S[row + 3 + d, k]
+        if row == _RX:
+            kepler_drift(eta[i], xs, vs, i, h2)
+    declined = 0
+    if rejected:
+        declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)
     for r in range(6):
-        A = S[_RX + r]
-        B = S[_Y + r]
-        for k in range(P):
-            A[k] = B[k]
-    if c == P:
-        return _resident_declined(xj, vj, eta, h, S, _X, _RX, _TAKE, P)
-    declined = _resident_declined(xj, vj, eta, h, S, _X, _RX, _TAKE, m)
-    for r in range(6):
-        A = S[_RX + r]
-        for k in range(m, P):
-            A[k] = A[0]
+        X = S[_RX + r]
+        Y = S[_RY + r]
+        for k in range(Pu):
+            X[k] = Y[k]
     return declined
 
 

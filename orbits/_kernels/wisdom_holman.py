@@ -353,13 +353,17 @@ def _correct_compiled(xj, vj, x, acc, gm, eta, n_active, corr, h, inverse, targs
 
 # An output of the lanes' loop (no added terms, four bodies or more) is noted
 # at the end of its step and made at the start of the next one: the copy's
-# owed drift beside that step's first drift, in one pass over the lanes
-# (wh_lanes.resident_drift_twice), so that the processor overlaps their
-# chains of dependent operations; on its own, the output's drift would add
-# its whole latency to the step (benchmarks/RESULTS.md).  The loop
-# makes a noted output before it returns, whatever the reason.  The results
-# are those of the immediate synchronisation, bit for bit.  Other loops bind
-# none of this: the defaults below do nothing.
+# owed drift beside that step's first drift, in the same passes over the
+# lanes (wh_lanes.resident_drift_twice), so that the processor overlaps
+# their chains of dependent operations; on its own, the output's drift would
+# add its whole latency to the step (benchmarks/RESULTS.md).  That drift is
+# inlined into the loop: compiled as a function of its own, its passes took
+# their scalar loops at the outer solar system's few columns (LLVM's vector
+# loops there start at 12 or 16), which cost 0.2 us more an output
+# (benchmarks/RESULTS.md).  The loop makes a noted output before it returns,
+# whatever the reason.  The results are those of the immediate
+# synchronisation, bit for bit.  Other loops bind none of this: the defaults
+# below do nothing.
 
 @njit(inline="always")
 def _no_output_pending(targs):
@@ -467,19 +471,13 @@ def _lanes_pending(targs):
 
 def _resident_output_drift(xj, vj, eta, h, xs, vs, owed, x, acc, targs):
     # the step's first drift h of the state kept in the lanes and the noted
-    # output's owed drift of a copy into xs, vs (both from the same state),
-    # as the lanes' drift and _synchronize would make them one after the
-    # other, in one pass over the lanes (wh_lanes.resident_drift_twice)
+    # output's owed drift of a copy into xs, vs (both from the same state;
+    # with nothing owed the copy is the state), as the lanes' drift and
+    # _synchronize would make them one after the other, in the same passes
+    # over the lanes (wh_lanes.resident_drift_twice)
     S = targs[0]
     S[PENDING, 0] = 0.0
-    if owed != 0.0:
-        resident_drift_twice(xj, vj, eta, h, xs, vs, owed, S)
-        return
-    for d in range(3):
-        xs[0, d] = xj[0, d]
-        vs[0, d] = vj[0, d]
-    resident_store(S, xs, vs)
-    resident_drift_rows(xj, vj, eta, h, S)
+    resident_drift_twice(xj, vj, eta, h, xs, vs, owed, S)
 
 
 def _lanes_output(xa, va, owed, mon, mon_t, mon_out, gm, eta, xs, vs, x, v, acc, n_active,
@@ -1112,7 +1110,7 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
         key = f"{key}_lanes"
         # the kernels that work on the lanes alone are the same for both
         # coordinate systems (each row's Kepler G M is data): named without
-        # them, they compile once for both (the outputs' drift takes some 15 s)
+        # them, those it calls compile once for both
         lanes = "lanes"
         recorder = specialize(_lanes_note, lanes, cache=cache, nrt=nrt)
         outputs = dict(
@@ -1127,8 +1125,8 @@ def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
                                         nrt=nrt), nrt),
             lanes_check=specialize(_resident_check, lanes, cache=cache, inline=True, nrt=nrt),
             output_pending=specialize(_lanes_pending, lanes, cache=cache, inline=True, nrt=nrt),
-            output_drift=called(specialize(_resident_output_drift, lanes, cache=cache,
-                                           inline=True, nrt=nrt), nrt),
+            output_drift=specialize(_resident_output_drift, lanes, cache=cache, inline=True,
+                                    nrt=nrt),
             make_output=specialize(_lanes_output, key, cache=cache, nrt=nrt,
                                    sync_kernel=sync, from_internal=from_internal,
                                    record=record))

@@ -206,18 +206,19 @@ def test_two_drifts_in_one_pass_are_each_the_scalar_drift(f):
     L.resident_store(S, xj, vj)
     assert np.array_equal(xj, a) and np.array_equal(vj, b)
     assert np.array_equal(xs, c) and np.array_equal(vs, d)
-    m = len(xj) - 1                       # the copy's columns follow the state's
-    took, took2 = S[L._TAKE, :m] != 0.0, S[L._TAKE, m:2 * m] != 0.0
+    m, c = len(xj) - 1, L.lane_columns(len(xj))   # the copy after the state's padding
+    took, took2 = S[L._RTAKE, :m] != 0.0, S[L._RTAKE, c:c + m] != 0.0
     assert declined == np.sum(~took) and 1 <= declined < len(xj) - 1
     assert np.sum(~took2) >= 1            # the copy had declined planets too
 
 
 @pytest.mark.parametrize("owed", [0.0, math.pi / 170])
 def test_the_outputs_drift_of_the_loop_with_and_without_a_drift_owed(owed):
-    # the lanes' loop's output drift (as wh_loop compiles it): the state
+    # the lanes' loop's output drift (as wh_loop binds it): the state
     # drifted by h in the lanes, and the output's copy, drifted by what it
-    # owes, in xs, vs; with nothing owed the copy is the state itself.  Each
-    # bit for bit the scalar drift, with declined planets among them
+    # owes, in xs, vs, in the same passes; with nothing owed
+    # the copy is the state itself.  Each bit for bit the scalar drift, with
+    # declined planets among them
     drift = W.called(W.specialize(W._resident_output_drift, "lanes", inline=True, nrt=False),
                      False)
     xj, vj, mu = system(CIRCULAR[:2] + [(1.0, 0.99, 0.0)] + CIRCULAR[2:])
@@ -230,26 +231,28 @@ def test_the_outputs_drift_of_the_loop_with_and_without_a_drift_owed(owed):
         W.kepler_drift_all(c, d, mu, owed, w1, w2)
     S = L.lanes_scratch(len(xj))
     L.resident_load(xj, vj, mu, mu, S)
-    S[W.PENDING, 0] = 1.0
     xs, vs = np.full_like(xj, np.nan), np.full_like(xj, np.nan)
+    S[W.PENDING, 0] = 1.0
     x, acc = np.zeros_like(xj), np.zeros_like(xj)
     drift(xj, vj, mu, h, xs, vs, owed, x, acc, (S,))
     assert S[W.PENDING, 0] == 0.0
     L.resident_store(S, xj, vj)
     assert np.array_equal(xj, a) and np.array_equal(vj, b)
     assert np.array_equal(xs, c) and np.array_equal(vs, d)
-    # the e = 0.99 planet declined (the verdicts of the pass over both, or,
-    # with nothing owed, of the state's own drift)
-    verdicts = S[L._TAKE if owed else L._RTAKE, :len(xj) - 1]
-    assert np.sum(verdicts == 0.0) == 1
+    # the e = 0.99 planet declined, in the state and (with a drift owed) in
+    # the copy: the verdicts of the pass over both
+    m, c = len(xj) - 1, L.lane_columns(len(xj))   # the copy after the state's padding
+    assert np.sum(S[L._RTAKE, :m] == 0.0) == 1
+    if owed:
+        assert np.sum(S[L._RTAKE, c:c + m] == 0.0) == 1
 
 
 @pytest.mark.parametrize("planets", [1, 3, 4, 5, 8, 9])
-def test_two_drifts_packed_side_by_side_for_every_size(planets):
-    # the state's planets and the copy's share the lanes (four planets or
-    # fewer: one lane width for both; five to eight: two): each column bit
-    # for bit the scalar drift, over repeated outputs, and the state's
-    # padding left a copy of its first planet, as resident_load makes it
+def test_two_drifts_side_by_side_for_every_size(planets):
+    # the copy's columns after the state's padding, for every number of
+    # planets: each column bit for bit the scalar drift, over repeated
+    # outputs, and the state's padding left a copy of its first planet, as
+    # resident_load makes it
     orbits_ = [(1.0 + 0.45 * k, 0.03 * (k % 4), 0.7 * k) for k in range(planets)]
     xj, vj, mu = system(orbits_)
     w1, w2 = np.zeros_like(xj), np.zeros_like(xj)
