@@ -667,37 +667,40 @@ def resident_drift_twice(xj, vj, eta, h, xs, vs, h2, S):
     :data:`_H`.  Returns how many planets of the state were declined."""
     n = xj.shape[0]
     P = lane_columns(n)
-    if h2 == 0.0:
-        for d in range(3):
-            xs[0, d] = xj[0, d]
-            vs[0, d] = vj[0, d]
-        resident_store(S, xs, vs)
-        return resident_drift(xj, vj, eta, h, S)
-    for d in range(3):
-        xs[0, d] = xj[0, d] + h2 * vj[0, d]
-        vs[0, d] = vj[0, d]
     Pu = np.uint64(P)
-    for r in range(6):
-        A = S[_RX + r]
-        for k in range(Pu):
-            A[Pu + k] = A[k]
-    M = S[_RMU]
+    copy = h2 != 0.0
+    for d in range(3):
+        xs[0, d] = xj[0, d] + h2 * vj[0, d] if copy else xj[0, d]
+        vs[0, d] = vj[0, d]
     H = S[_H]
     for k in range(Pu):
-        M[Pu + k] = M[k]
         H[k] = h
-        H[Pu + k] = h2
+    if copy:
+        for r in range(6):
+            A = S[_RX + r]
+            for k in range(Pu):
+                A[Pu + k] = A[k]
+        M = S[_RMU]
+        for k in range(Pu):
+            M[Pu + k] = M[k]
+            H[Pu + k] = h2
+    else:
+        # nothing owed: the copy is the state as it is
+        resident_store(S, xs, vs)
     straight_drift(xj, vj, 0, h)
-    rejected = medium_columns(S, _RX, _RMU, _RY, _RTAKE, _T, h, True, Pu + Pu)
-    # the copy: a declined planet by the scalar drift from its start
-    for i in range(1, n):
-        k = P + i - 1
-        row = _RY if S[_RTAKE, k] != 0.0 else _RX
-        for d in range(3):
-            xs[i, d] = S[row + d, k]
-            vs[i, d] = S[row + 3 + d, k]
-        if row == _RX:
-            kepler_drift(eta[i], xs, vs, i, h2)
+    # (one pass over both, or over the state alone: the loop inlines one)
+    rejected = medium_columns(S, _RX, _RMU, _RY, _RTAKE, _T, h, True,
+                              Pu + Pu if copy else Pu)
+    if copy:
+        # the copy: a declined planet by the scalar drift from its start
+        for i in range(1, n):
+            k = P + i - 1
+            row = _RY if S[_RTAKE, k] != 0.0 else _RX
+            for d in range(3):
+                xs[i, d] = S[row + d, k]
+                vs[i, d] = S[row + 3 + d, k]
+            if row == _RX:
+                kepler_drift(eta[i], xs, vs, i, h2)
     declined = 0
     if rejected:
         declined = _resident_declined(xj, vj, eta, h, S, _RX, _RY, _RTAKE, P)

@@ -154,10 +154,13 @@ def test_a_state_that_turns_non_finite_stops_as_the_scalar_loop_does(
 
 
 def test_lanes_are_chosen_by_the_number_of_bodies(monkeypatch):
-    # the loop records its scratch in the workspace when it runs with lanes
+    # the loop records its scratch in the workspace when it runs with lanes;
+    # lanes="on" asks for them, and still not below LANES_FROM_BODIES (the
+    # default "auto" also depends on whether an earlier test compiled them)
     for bodies, lanes in ((orbits.scenes.outer_solar_system(), True),
                           (orbits.scenes.kepler(e=0.1), False)):
-        sim = orbits.Simulation(bodies, integrator="wh", dt=1 * u.day, monitors=())
+        sim = orbits.Simulation(bodies, integrator=orbits.integrators.get("wh", lanes="on"),
+                                dt=1 * u.day, monitors=())
         sim.run(until=10 * u.day, outputs=2, progress=False)
         assert ("lanes" in sim._ws) == lanes
 
