@@ -450,9 +450,10 @@ def _medium_scratch(S, h0, P):
 def _medium_resident(S, h, P, dst):
     # medium_columns from the rows of the state kept in the lanes (_RX ..,
     # _RMU, _RTAKE) into the rows from dst (_RY .., or others), inlined into
-    # the steps' drift: called there, it
-    # made the outer solar system's step at 216.6 days 0.36 us against 0.23
-    # (benchmarks/RESULTS.md); the outputs' drifts call _medium_scratch
+    # the steps' drift: called there, it made the outer solar system's step
+    # at 216.6 days 0.36 us against 0.23 (benchmarks/RESULTS.md); the
+    # synchronisation's and the corrector's drifts (kepler_drift_lanes) call
+    # _medium_scratch
     return medium_columns(S, _RX, _RMU, dst, _RTAKE, _T, h, False, P)
 
 
