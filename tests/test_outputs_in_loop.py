@@ -285,3 +285,31 @@ def test_an_adaptive_runs_output_times_are_those_of_output_time_to_the_bit():
         count = int(rng.integers(1, outputs - first + 2))
         expected = [plan.output_time(k) for k in range(first, first + count)]
         assert plan.output_times(first, count).tolist() == expected
+
+
+@pytest.mark.parametrize("scene, dt", [("outer", 216.6 * u.day), ("sun8", 4.398 * u.day)])
+@pytest.mark.parametrize("coordinates", ["jacobi", "democratic-heliocentric"])
+@pytest.mark.parametrize("k", [1, 10.4])
+def test_wh_lanes_outputs_at_the_step_people_use(scene, dt, coordinates, k):
+    # a twentieth of the innermost period (Jupiter's, Mercury's): the lanes'
+    # medium passes drift the outputs' copies beside the next step's drift,
+    # their second iteration included; in the loop every step and every
+    # 10.4 steps (each output on the step nearest its time), between calls,
+    # and the scalar loop's, all the same to the bit
+    from orbits.integrators import get
+    bodies = (orbits.scenes.outer_solar_system() if scene == "outer"
+              else orbits.scenes.solar_system(moon=False))
+    until = 40 * k * dt
+
+    def run(lanes, every=None):
+        sim = orbits.Simulation(bodies, get("wh", lanes=lanes, coordinates=coordinates),
+                                dt=dt, monitors=["energy", "angular_momentum"])
+        if every:
+            sim.monitor_every = every
+        return sim.run(until=until, outputs=41, progress=False)
+
+    inloop = run("on")
+    _same(inloop, run("on", every=10 ** 9))
+    _same(inloop, run("off"))
+    steps = np.round(inloop.times.value / dt.to_value(inloop.times.unit))
+    assert set(np.diff(steps)) == ({1} if k == 1 else {10, 11})
