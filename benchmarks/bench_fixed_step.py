@@ -20,7 +20,10 @@ spheres it adds pair interactions per second, ``N (N - 1) / 2 / t_step``.
 
 A second table gives the cost of one ``run`` call of a single step (and of
 REBOUND's ``steps(1)``): the fixed price per call that the long runs above
-amortise.
+amortise, and what a loop of ``run`` calls pays for each (REBOUND's habit of
+a Python loop of ``integrate`` calls): two bodies with ``leapfrog``, and the
+outer solar system with ``wh`` and ``trace`` at the users' step (a twentieth
+of Jupiter's period, 216.6 d), default options.
 
 Start-up is measured in fresh processes with ``NUMBA_CACHE_DIR`` set to a new
 empty directory: the first-call compile time is the time of the first short
@@ -142,6 +145,10 @@ def measure_call_overhead(repeats, calls):
         "  default monitors, every field read": (orbits.Simulation(bodies, "leapfrog",
                                                                    dt=dt), True),
     }
+    outer = orbits.scenes.outer_solar_system()
+    for name in ("wh", "trace"):
+        ours[f"orbits run(1 step), {name}, outer solar system"] = (
+            orbits.Simulation(outer, name, dt=216.6 * u.day), False)
     reb = rebound_sim(bodies, 1.0)
     out = {"REBOUND steps(1)": [], **{k: [] for k in ours}}
     for sim, read in ours.values():
@@ -273,9 +280,9 @@ def main(argv=None):
 
     calls = 200 if args.quick else 1000
     overhead = measure_call_overhead(repeats, calls)
-    print("Fixed cost of one call (two bodies, one step)")
+    print("Fixed cost of one call (one step; two bodies but where the row says)")
     for name, t in overhead.items():
-        print(f"  {name:<40} {t * 1e6:>9.2f} us")
+        print(f"  {name:<47} {t * 1e6:>9.2f} us")
     print()
 
     startup = None

@@ -36,6 +36,7 @@ compilation options are the same everywhere and can be changed once.
 """
 
 import ctypes
+import functools
 import hashlib
 import pathlib
 import types
@@ -223,9 +224,16 @@ def cpu_name():
     >>> isinstance(cpu_name(), str) and cpu_name() != ""
     True
     """
-    import llvmlite.binding as llvm
     from numba.core import config
-    return config.CPU_NAME or llvm.get_host_cpu_name()
+    return config.CPU_NAME or _host_cpu_name()
+
+
+@functools.lru_cache(maxsize=None)
+def _host_cpu_name():
+    # LLVM's name of this processor: asked once (a run's call asks for it
+    # where a lanes' loop may have been compiled by another process)
+    import llvmlite.binding as llvm
+    return llvm.get_host_cpu_name()
 
 
 @intrinsic

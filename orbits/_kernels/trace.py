@@ -67,6 +67,7 @@ References
    Differential Equations I", section II.10 (DOP853).
 """
 
+import functools
 import math
 from typing import NamedTuple
 
@@ -847,6 +848,9 @@ def _far(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_peri, m
                            k_peri, m, until_check, check_every, targs[0])
 
 
+# asked at every call of the loop and where the lanes may be compiled (twice
+# a run's call): each answer is kept, as wh's loops are
+@functools.lru_cache(maxsize=None)
 def trace_loop(record=_record, terms=None, lanes=False):
     """The ``trace`` loop, ``record`` recording the monitors, and ``terms`` (the
     :class:`~orbits._kernels.terms.TermKernel` of a table of position-only

@@ -98,6 +98,7 @@ References
    comparisons", MNRAS 468, 2614.
 """
 
+import functools
 import math
 from typing import NamedTuple
 
@@ -963,6 +964,12 @@ COORDINATE_SYSTEMS = {
 }
 
 
+# The getters of the compiled kernels below are asked at every call of the
+# loop and of the synchronisation (a run's call asks four or five times):
+# each answer is kept, as specialize would find the same copies again at some
+# 40 us a loop (benchmarks/RESULTS.md)
+
+@functools.lru_cache(maxsize=None)
 def _kernels(coordinates, terms=None, lanes=False, through=True):
     """``terms``: a :class:`~orbits._kernels.terms.TermKernel` of position-only
     terms added to the interaction step, or None; ``lanes``: the
@@ -1068,6 +1075,7 @@ def synchronizer(coordinates, terms=None, lanes=False):
     return _kernels(coordinates, terms, lanes)[3]
 
 
+@functools.lru_cache(maxsize=None)
 def wh_loop(coordinates="jacobi", terms=None, record=_record, lanes=False):
     """The Wisdom-Holman loop compiled for ``coordinates`` (a key of
     :data:`COORDINATE_SYSTEMS`), for every table of Kepler drifts (DRIFT) and
