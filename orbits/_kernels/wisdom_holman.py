@@ -966,8 +966,8 @@ COORDINATE_SYSTEMS = {
 
 # The getters of the compiled kernels below are asked at every call of the
 # loop and of the synchronisation (a run's call asks four or five times):
-# each answer is kept, as specialize would find the same copies again at some
-# 40 us a loop (benchmarks/RESULTS.md)
+# each answer is kept, instead of being put together again from some twenty
+# lookups of specialize's (benchmarks/RESULTS.md)
 
 @functools.lru_cache(maxsize=None)
 def _kernels(coordinates, terms=None, lanes=False, through=True):
