@@ -11,7 +11,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ._compiling import CHECKS, CompileClock, loop_label
-from ._kernels.invariants import MONITOR_WIDTH
+from ._kernels.invariants import MONITOR_WIDTH, fill_monitors
 from ._kernels.status import Status
 from ._kernels.stepping import USER_FORCE_SIZE
 from .errors import ForceTermError, RunInterrupted, WallTimeExceeded
@@ -23,6 +23,15 @@ __all__ = ["advance_checked", "restored_on_error", "Signals", "CHECK_EVERY", "Dr
 #: (a test is a dependent chain of 6N additions, as dear as the force for a few
 #: bodies); a failure is then located exactly by re-running from a copy.
 CHECK_EVERY = 16
+
+
+def _filled(mon, rows):
+    """``rows``, outputs a compiled loop recorded with the bodies' state, with
+    their monitors made from that state (``mon``: the loop's monitor
+    arguments; see :func:`orbits._kernels.invariants.fill_monitors`)."""
+    if mon[1]:
+        fill_monitors(rows, mon[2], mon[3], mon[4], mon[5], mon[1])
+    return rows
 
 
 def advance_checked(integ, ws, x, v, t, dt, n, force, fargs, mon, step0, mon_t, mon_out,
@@ -477,14 +486,15 @@ class Driven:
         t0 = _time.perf_counter()
         guard = (restored_on_error(self._rows_x, self._rows_v, self._ws)
                  if self._loop_may_raise else contextlib.nullcontext())
+        mon = self._mon(0)
         with guard, self._compile_clock.loop():
             status, t_reached, acc, rej, fev, n_mon = integ.advance_to(
                 self._ws, self._rows_x, self._rows_v, self._t_base, marks[-1], self._force,
-                self._fargs, self._mon(0), self.steps, mon_t, rows, self._stop, self._chunk,
+                self._fargs, mon, self.steps, mon_t, rows, self._stop, self._chunk,
                 marks, steps)
         elapsed = _time.perf_counter() - t0
         if n_mon:
-            rec.output_rows(self, steps[:n_mon], mon_t[:n_mon], rows[:n_mon])
+            rec.output_rows(self, steps[:n_mon], mon_t[:n_mon], _filled(mon, rows[:n_mon]))
             bar.update(n_mon)
         self._t_base = float(t_reached)
         self.steps += int(acc)
@@ -655,7 +665,7 @@ class Driven:
                     ahead = ahead[:n_mon]
                 rec.output_rows(self, self.steps + ahead,
                                 self._t_base + (self._steps_since_base + self._sign * ahead)
-                                * self._dt, mon_out[:n_mon])
+                                * self._dt, _filled(mon, mon_out[:n_mon]))
             elif n_mon:
                 rec.monitor_rows(mon_t[:n_mon], self._offset_rows(mon_out[:n_mon]))
             resolve = status == Status.COLLISION and self._resolves_collisions

@@ -106,6 +106,30 @@ def test_with_terms_work_and_chaos_monitors():
     assert inloop.work[-1].value != 0.0 and inloop.megno[-1] > 0
 
 
+@pytest.mark.parametrize("integrator, dt", [("leapfrog", 10 * u.day), ("wh", 216.6 * u.day)])
+def test_monitors_with_terms_that_carry_energy(integrator, dt):
+    # an output recorded in the loop gets its monitors after the loop, from
+    # the state in its row, the terms' energy (here GR's potential and the
+    # Sun's J2) added to the bodies': the values of the monitors taken
+    # between calls, to the bit, for every monitor computed from the state
+    scene = orbits.scenes.outer_solar_system()
+
+    def make():
+        return orbits.Simulation(
+            scene, integrator, dt=dt,
+            monitors=["energy", "angular_momentum", "momentum", "center_of_mass"],
+            forces=[forces.GRPotential("Sun"),
+                    forces.ZonalHarmonics("Sun", 0.00465 * u.au, J2=2e-7)])
+    until = 300 * 3 * dt
+    inloop = make().run(until=until, outputs=301, progress=False)
+    sim = make()
+    sim.monitor_every = 10 ** 9
+    between = sim.run(until=until, outputs=301, progress=False)
+    _same(inloop, between)
+    for name in ("momentum", "center_of_mass"):
+        assert np.array_equal(getattr(inloop, name).value, getattr(between, name).value)
+
+
 def test_uneven_outputs_and_a_shortened_last_step():
     # 10.55 steps an output: the outputs before the last on the steps nearest
     # their times (recorded in the loop), the last after a shortened step

@@ -7,11 +7,12 @@ the sum to about one rounding error whatever N is.
 
 import math
 
+import numpy as np
 
 from ._jit import njit
 
 __all__ = ["energy", "angular_momentum", "momentum", "center_of_mass",
-           "monitor_row", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
+           "monitor_row", "fill_monitors", "holds_state", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
            "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS", "relative_errors",
            "vector_errors", "error_kernels"]
 
@@ -136,6 +137,108 @@ def monitor_row(x, v, m, G, n_active, eps2, which, row):
         momentum(v, m, row[4:7])
     if which & CENTER_OF_MASS:
         center_of_mass(x, m, row[7:10])
+
+
+@njit(inline="always")
+def holds_state(row, m):
+    """Whether an output row is wide enough to hold the bodies' positions and
+    velocities after the monitors (``6 N`` columns more, N = ``len(m)``)."""
+    return row.shape[0] >= MONITOR_WIDTH + 6 * m.shape[0]
+
+
+# Rows that hold the state (outputs recorded in a loop) get their monitors
+# after the loop, by fill_monitors, a block of rows at a time: the energy's
+# square roots and divisions, and the angular momentum's products, then go
+# through the vector lanes a row a lane, where monitor_row, a row at a time,
+# makes them one by one (the momentum and the centre of mass, which are not
+# default monitors, still go a row at a time).  The sums are monitor_row's,
+# term by term in the same order, so the values are the same to the bit
+# (tests/kernels/test_invariants.py).
+
+#: rows a block of :func:`fill_monitors` (its scratch: ``6 N`` of these);
+#: LLVM makes vector loops of 12 or 16 iterations and more, so 8 stays scalar
+FILL_BLOCK = 16
+
+
+@njit(inline="always")
+def _lane_add(s, c, lane, term):
+    # _add on lane ``lane`` of the sums s and compensations c
+    a = s[lane]
+    t = a + term
+    big = (a - t) + term
+    small = (term - t) + a
+    c[lane] = c[lane] + (big if abs(a) >= abs(term) else small)
+    s[lane] = t
+
+
+@njit
+def fill_monitors(rows, m, G, n_active, eps2, which):
+    """The monitors of output rows that hold the state (:func:`holds_state`),
+    filled in from each row's positions and velocities: the values
+    :func:`monitor_row` gives for them, to the bit, the energy plus what
+    column 0 held (the force terms' energy; 0 without terms).  The work and
+    chaos columns are left as they are."""
+    w = MONITOR_WIDTH
+    n = m.shape[0]
+    B = FILL_BLOCK
+    X = np.zeros((6 * n, B))
+    s = np.empty((3, B))
+    c = np.empty((3, B))
+    for r0 in range(0, rows.shape[0], B):
+        k = min(B, rows.shape[0] - r0)
+        for lane in range(k):
+            row = rows[r0 + lane]
+            for q in range(6 * n):
+                X[q, lane] = row[w + q]
+        if which & ENERGY:
+            s[0, :] = 0.0
+            c[0, :] = 0.0
+            s0 = s[0]
+            c0 = c[0]
+            for i in range(n):
+                vx = X[3 * (n + i)]
+                vy = X[3 * (n + i) + 1]
+                vz = X[3 * (n + i) + 2]
+                for lane in range(B):
+                    _lane_add(s0, c0, lane, 0.5 * m[i] * (vx[lane] * vx[lane] + vy[lane] * vy[lane]
+                                                          + vz[lane] * vz[lane]))
+            for i in range(n_active):
+                for j in range(i):
+                    gm = -G * m[i] * m[j]
+                    for lane in range(B):
+                        dx = X[3 * i, lane] - X[3 * j, lane]
+                        dy = X[3 * i + 1, lane] - X[3 * j + 1, lane]
+                        dz = X[3 * i + 2, lane] - X[3 * j + 2, lane]
+                        _lane_add(s0, c0, lane,
+                                  gm / math.sqrt(dx * dx + dy * dy + dz * dz + eps2))
+            for lane in range(k):
+                rows[r0 + lane, 0] = (s0[lane] + c0[lane]) + rows[r0 + lane, 0]
+        if which & ANGULAR_MOMENTUM:
+            s[:, :] = 0.0
+            c[:, :] = 0.0
+            for i in range(n):
+                x0 = X[3 * i]
+                x1 = X[3 * i + 1]
+                x2 = X[3 * i + 2]
+                v0 = X[3 * (n + i)]
+                v1 = X[3 * (n + i) + 1]
+                v2 = X[3 * (n + i) + 2]
+                for lane in range(B):
+                    _lane_add(s[0], c[0], lane, m[i] * (x1[lane] * v2[lane] - x2[lane] * v1[lane]))
+                    _lane_add(s[1], c[1], lane, m[i] * (x2[lane] * v0[lane] - x0[lane] * v2[lane]))
+                    _lane_add(s[2], c[2], lane, m[i] * (x0[lane] * v1[lane] - x1[lane] * v0[lane]))
+            for d in range(3):
+                for lane in range(k):
+                    rows[r0 + lane, 1 + d] = s[d, lane] + c[d, lane]
+        if which & (MOMENTUM | CENTER_OF_MASS):
+            for lane in range(k):
+                row = rows[r0 + lane]
+                xr = row[w:w + 3 * n].reshape((n, 3))
+                vr = row[w + 3 * n:w + 6 * n].reshape((n, 3))
+                if which & MOMENTUM:
+                    momentum(vr, m, row[4:7])
+                if which & CENTER_OF_MASS:
+                    center_of_mass(xr, m, row[7:10])
 
 
 # The relative errors of a run's monitor rows, one pass over the rows each.

@@ -32,7 +32,9 @@ counted from the start of the simulation (``step0``), into ``mon_t`` and
 Outputs use the same mechanism: rows ``6 N`` wider than the monitors' also
 take the bodies' state (:func:`record_state`), so that a run's evenly
 spaced outputs are recorded inside the loop, ``step0`` then counting from
-the run's start (:meth:`orbits._driver.Driven.execute`).  Outputs that do not
+the run's start (:meth:`orbits._driver.Driven.execute`); such a row's
+monitors are made after the loop, from the state it holds, a block of rows
+at a time (:func:`~.invariants.fill_monitors`).  Outputs that do not
 fall a whole number of steps apart are recorded in the fixed-step loops too:
 with ``every = -1``, ``mon_t`` holds on entry the steps after which to record
 (:func:`first_record`).
@@ -66,7 +68,7 @@ from ._jit import idle_pointer, njit, pointer, slots, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
                       accelerate_pairwise_parallel, accelerate_pairwise_rebound,
                       accelerate_pairwise_small)
-from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, monitor_row
+from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, holds_state, monitor_row
 from .status import Status
 from .stopping import call_check
 from .terms import table_rows
@@ -135,23 +137,28 @@ def flat_stages(a, b):
 @njit(inline="always")
 def record_state(x, v, m, row):
     """Outputs recorded in the loop: a row wider than :data:`MONITOR_WIDTH` by
-    ``6 N`` (N = ``len(m)``, the bodies) also takes their positions and
-    velocities after the monitors."""
+    ``6 N`` (N = ``len(m)``, the bodies; :func:`~.invariants.holds_state`)
+    takes their positions and velocities after the monitors."""
     w = MONITOR_WIDTH
     n = m.shape[0]
-    if row.shape[0] >= w + 6 * n:
-        for i in range(n):
-            for d in range(3):
-                row[w + 3 * i + d] = x[i, d]
-                row[w + 3 * (n + i) + d] = v[i, d]
+    for i in range(n):
+        for d in range(3):
+            row[w + 3 * i + d] = x[i, d]
+            row[w + 3 * (n + i) + d] = v[i, d]
 
 
 @njit
 def _record(x, v, t, mon, n_mon, mon_t, mon_out):
+    # a row that holds the state gets its monitors after the loop, from that
+    # state (invariants.fill_monitors: column 0 is added to the energy)
     every, which, m, G, n_active, eps2 = mon
     mon_t[n_mon] = t
-    monitor_row(x, v, m, G, n_active, eps2, which, mon_out[n_mon])
-    record_state(x, v, m, mon_out[n_mon])
+    row = mon_out[n_mon]
+    if holds_state(row, m):
+        row[0] = 0.0
+        record_state(x, v, m, row)
+    else:
+        monitor_row(x, v, m, G, n_active, eps2, which, row)
 
 
 #: the status of a step epilogue (:func:`step_epilogue`) that lets a loop carry on
@@ -516,10 +523,14 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
     every, which, m, G, n_active, eps2, eargs = mon
     mon_t[n_mon] = t
     row = mon_out[n_mon]
-    monitor_row(x, v, m, G, n_active, eps2, which, row)
-    if which & ENERGY:
-        row[0] += extra_energy(x, v, eargs)
-    record_state(x, v, m, row)
+    if holds_state(row, m):
+        # the terms' energy, to which fill_monitors adds the bodies' after the loop
+        row[0] = extra_energy(x, v, eargs) if which & ENERGY else 0.0
+        record_state(x, v, m, row)
+    else:
+        monitor_row(x, v, m, G, n_active, eps2, which, row)
+        if which & ENERGY:
+            row[0] += extra_energy(x, v, eargs)
 
 
 def terms_recorder(terms):
