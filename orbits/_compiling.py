@@ -27,6 +27,7 @@ from ._kernels import stepping
 from ._kernels._jit import cpu_name
 
 __all__ = ["CompileClock", "FIRST_COMPILE_SECONDS", "NOTICE_FROM", "COMMON", "ADDED", "CHECKS",
+           "OUTPUT_MONITORS",
            "TERMS",
            "loop_label",
            "notice", "cache_dir", "cpu_name", "stderr_is_terminal"]
@@ -58,6 +59,8 @@ FIRST_COMPILE_SECONDS = {
     # the splitting methods' kick of velocity-dependent terms (:data:`TERMS`):
     # 1.4-2.1 s on the Zen 3 (2026-11-30)
     "implicit kick of the force terms": 2.0,
+    # the outputs' monitors (:data:`OUTPUT_MONITORS`): 2.1-2.4 s on the Zen 3 (2026-12-01)
+    "monitors of the outputs": 2.0,
 }
 
 #: The check a run's stopping conditions take (a kind of
@@ -67,6 +70,12 @@ FIRST_COMPILE_SECONDS = {
 #: integrator, and announced by itself (:meth:`CompileClock.part`).
 CHECKS = {"escapes": "check of the escape conditions", "all": "check of the stopping conditions",
           "ahead": "look-ahead of the stopping conditions"}
+
+#: The monitors of the outputs a loop records
+#: (:func:`orbits._kernels.invariants.fill_kernel`), as the notice names
+#: them and :data:`FIRST_COMPILE_SECONDS` keys them: compiled once for every
+#: integrator, before the loop of a first run that records outputs in it.
+OUTPUT_MONITORS = "monitors of the outputs"
 
 #: The C callables of the force terms' table
 #: (:func:`orbits._kernels.terms.table_pointer`), as the notice names them:

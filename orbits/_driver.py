@@ -10,8 +10,8 @@ import _signal as _csignal
 import numpy as np
 from tqdm.auto import tqdm
 
-from ._compiling import CHECKS, CompileClock, loop_label
-from ._kernels.invariants import MONITOR_WIDTH, fill_monitors
+from ._compiling import CHECKS, OUTPUT_MONITORS, CompileClock, loop_label
+from ._kernels.invariants import MONITOR_WIDTH, fill_kernel
 from ._kernels.status import Status
 from ._kernels.stepping import USER_FORCE_SIZE
 from .errors import ForceTermError, RunInterrupted, WallTimeExceeded
@@ -30,7 +30,7 @@ def _filled(mon, rows):
     their monitors made from that state (``mon``: the loop's monitor
     arguments; see :func:`orbits._kernels.invariants.fill_monitors`)."""
     if mon[1]:
-        fill_monitors(rows, mon[2], mon[3], mon[4], mon[5], mon[1])
+        fill_kernel()(rows, mon[2], mon[3], mon[4], mon[5], mon[1])
     return rows
 
 
@@ -384,6 +384,7 @@ class Driven:
             # the last output before the final one
             last = (plan.outputs - 2) * k if k > 0 else next(plan.marks(plan.outputs - 3))
             if done < last:
+                self._fill_ahead()
                 self._in_loop = (k, plan.start_step, plan)
                 try:
                     done = self._advance_to(done, last, rec, bar, wall0)
@@ -425,6 +426,7 @@ class Driven:
         first = first_mark + 1
         if self._marks_in_loop(plan, rec):
             # the outputs before the last, recorded inside the compiled loop
+            self._fill_ahead()
             last = plan.outputs - 1
             while first < last:
                 first = self._advance_marks(plan, first, last, rec, bar, wall0)
@@ -435,6 +437,13 @@ class Driven:
         if plan.outputs == 1:
             self._advance_adaptive(plan.until, rec, wall0)
             rec.output(self, final=True)
+
+    def _fill_ahead(self):
+        # the outputs' monitors (orbits._kernels.invariants.fill_kernel),
+        # compiled or loaded before a loop that records outputs, announced as
+        # themselves
+        with self._compile_clock.part(OUTPUT_MONITORS):
+            fill_kernel()
 
     def _compile_check(self):
         # the stopping conditions' check, one compiled C callable for every

@@ -12,7 +12,7 @@ import numpy as np
 from ._jit import njit
 
 __all__ = ["energy", "angular_momentum", "momentum", "center_of_mass",
-           "monitor_row", "fill_monitors", "holds_state", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
+           "monitor_row", "fill_monitors", "fill_kernel", "holds_state", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
            "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS", "relative_errors",
            "vector_errors", "error_kernels"]
 
@@ -151,7 +151,7 @@ def holds_state(row, m):
 # square roots and divisions, and the angular momentum's products, then go
 # through the vector lanes a row a lane, where monitor_row, a row at a time,
 # makes them one by one (the momentum and the centre of mass, which are not
-# default monitors, still go a row at a time).  The sums are monitor_row's,
+# default monitors, go a row at a time).  The sums are monitor_row's,
 # term by term in the same order, so the values are the same to the bit
 # (tests/kernels/test_invariants.py).
 
@@ -230,15 +230,27 @@ def fill_monitors(rows, m, G, n_active, eps2, which):
             for d in range(3):
                 for lane in range(k):
                     rows[r0 + lane, 1 + d] = s[d, lane] + c[d, lane]
-        if which & (MOMENTUM | CENTER_OF_MASS):
+        # the momentum and the centre of mass (not default monitors), a row at
+        # a time as momentum and center_of_mass make them
+        if which & MOMENTUM:
             for lane in range(k):
-                row = rows[r0 + lane]
-                xr = row[w:w + 3 * n].reshape((n, 3))
-                vr = row[w + 3 * n:w + 6 * n].reshape((n, 3))
-                if which & MOMENTUM:
-                    momentum(vr, m, row[4:7])
-                if which & CENTER_OF_MASS:
-                    center_of_mass(xr, m, row[7:10])
+                for d in range(3):
+                    sm = 0.0
+                    cm = 0.0
+                    for i in range(n):
+                        sm, cm = _add(sm, cm, m[i] * X[3 * (n + i) + d, lane])
+                    rows[r0 + lane, 4 + d] = sm + cm
+        if which & CENTER_OF_MASS:
+            mt = 0.0
+            for i in range(n):
+                mt += m[i]
+            for lane in range(k):
+                for d in range(3):
+                    sm = 0.0
+                    cm = 0.0
+                    for i in range(n):
+                        sm, cm = _add(sm, cm, m[i] * X[3 * i + d, lane])
+                    rows[r0 + lane, 7 + d] = (sm + cm) / mt
 
 
 # The relative errors of a run's monitor rows, one pass over the rows each.
@@ -272,6 +284,19 @@ def vector_errors(values, reference, denom, out):
 _ERROR_SIGNATURES = (
     (relative_errors, "void(float64[:], float64[:], float64, float64, float64[:])"),
     (vector_errors, "void(float64[:, :], float64[:], float64, float64[:])"))
+
+_FILL_SIGNATURE = "void(float64[:, :], float64[:], float64, int64, float64, int64)"
+
+
+def fill_kernel():
+    """:func:`fill_monitors`, compiled (or loaded from the disk cache) once for
+    rows of any layout and then closed to new compilations, as
+    :func:`error_kernels`: a run that records its outputs in the loop loads
+    it before the loop, whether or not the loop gets to an output."""
+    if not fill_monitors.signatures:
+        fill_monitors.compile(_FILL_SIGNATURE)
+        fill_monitors.disable_compile()
+    return fill_monitors
 
 
 def error_kernels():

@@ -88,7 +88,7 @@ def test_fill_monitors_gives_monitor_rows_values_to_the_bit(rng):
             m[0] = 1.0
             expected = rows.copy()
             _row_by_row(expected, m, 0.3, n_active, eps2, which)
-            inv.fill_monitors(rows, m, 0.3, n_active, eps2, which)
+            inv.fill_kernel()(rows, m, 0.3, n_active, eps2, which)
             np.testing.assert_array_equal(rows, expected, err_msg=f"{(n, k, which)}")
 
 
@@ -97,7 +97,7 @@ def test_fill_monitors_leaves_what_it_does_not_monitor(rng):
     w, n = inv.MONITOR_WIDTH, 3
     rows = rng.normal(size=(5, w + 6 * n))
     before = rows.copy()
-    inv.fill_monitors(rows, np.ones(n), 1.0, n, 0.0, inv.ANGULAR_MOMENTUM)
+    inv.fill_kernel()(rows, np.ones(n), 1.0, n, 0.0, inv.ANGULAR_MOMENTUM)
     np.testing.assert_array_equal(rows[:, 0], before[:, 0])
     np.testing.assert_array_equal(rows[:, 4:], before[:, 4:])
     assert not np.array_equal(rows[:, 1:4], before[:, 1:4])
