@@ -161,7 +161,8 @@ def notice(label):
         about = f"about {ADDED_ESTIMATE}"
     else:
         about = UNKNOWN_ESTIMATE
-    what = label if label in CHECKS.values() or label in TERMS.values() else f"{label} loop"
+    parts = (*CHECKS.values(), *TERMS.values(), OUTPUT_MONITORS)
+    what = label if label in parts else f"{label} loop"
     return (f"orbits: compiling the {what} for this CPU, once ({about}; "
             f"`orbits compile` does it ahead)")
 

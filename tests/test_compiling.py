@@ -24,7 +24,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: a fresh process that runs ``euler`` on the Kepler problem twice, with the
 #: default progress (no terminal: no bar), and prints each run's compile
 #: seconds and the first run's summary.  Euler's loop is the cheapest to
-#: compile (about 4 s on an empty cache on the reference machine).
+#: compile (about 4 s on an empty cache on the reference machine).  Its six
+#: outputs are recorded in the loop, so the first run also compiles their
+#: monitors (:data:`orbits._compiling.OUTPUT_MONITORS`, about 2 s).
 RUN_TWICE = """
 import json
 import astropy.units as u
@@ -32,7 +34,7 @@ import orbits
 results = []
 for _ in range(2):
     sim = orbits.Simulation(orbits.scenes.kepler(), "euler", dt=1 * u.day)
-    results.append(sim.run(until=5 * u.day, outputs=2))
+    results.append(sim.run(until=5 * u.day, outputs=6))
 print(json.dumps([r.compile_time for r in results]))
 print(results[0].summary())
 """
@@ -52,9 +54,13 @@ def test_a_first_compile_is_announced_once_and_measured(tmp_path):
     proc = _python(["-c", RUN_TWICE], tmp_path / "cache")
     assert proc.returncode == 0, proc.stderr
     first, second = json.loads(proc.stdout.splitlines()[0])
-    # one line, on a stderr that is not a terminal, for the loop the first
-    # run compiled; the second run of the process compiles nothing
-    assert _notices(proc.stderr) == [notice("euler")], proc.stderr
+    # one line, on a stderr that is not a terminal, for each part the first
+    # run compiled: its outputs' monitors, then its loop; the second run of
+    # the process compiles nothing
+    assert _notices(proc.stderr) == [notice(_compiling.OUTPUT_MONITORS),
+                                     notice("euler")], proc.stderr
+    assert notice(_compiling.OUTPUT_MONITORS).startswith(
+        "orbits: compiling the monitors of the outputs for this CPU, once (about 2 s")
     assert first > 0 and second == 0
     assert "compiling" in proc.stdout and "stepping" in proc.stdout
 
