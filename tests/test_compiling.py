@@ -26,7 +26,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: seconds and the first run's summary.  Euler's loop is the cheapest to
 #: compile (about 4 s on an empty cache on the reference machine).  Its six
 #: outputs are recorded in the loop, so the first run also compiles their
-#: monitors (:data:`orbits._compiling.OUTPUT_MONITORS`, about 2 s).
+#: monitors (:data:`orbits._compiling.OUTPUT_MONITORS`, about 1.3 s).
 RUN_TWICE = """
 import json
 import astropy.units as u
@@ -60,7 +60,7 @@ def test_a_first_compile_is_announced_once_and_measured(tmp_path):
     assert _notices(proc.stderr) == [notice(_compiling.OUTPUT_MONITORS),
                                      notice("euler")], proc.stderr
     assert notice(_compiling.OUTPUT_MONITORS).startswith(
-        "orbits: compiling the monitors of the outputs for this CPU, once (about 2 s")
+        "orbits: compiling the monitors of the outputs for this CPU, once (about 1.3 s")
     assert first > 0 and second == 0
     assert "compiling" in proc.stdout and "stepping" in proc.stdout
 

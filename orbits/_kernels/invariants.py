@@ -12,7 +12,7 @@ import numpy as np
 from ._jit import njit
 
 __all__ = ["energy", "angular_momentum", "momentum", "center_of_mass",
-           "monitor_row", "fill_monitors", "fill_kernel", "holds_state", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
+           "monitor_row", "fill_monitors", "fill_kernel", "holds_state", "FILLED", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
            "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS", "relative_errors",
            "vector_errors", "error_kernels"]
 
@@ -146,14 +146,19 @@ def holds_state(row, m):
     return row.shape[0] >= MONITOR_WIDTH + 6 * m.shape[0]
 
 
-# Rows that hold the state (outputs recorded in a loop) get their monitors
-# after the loop, by fill_monitors, a block of rows at a time: the energy's
-# square roots and divisions, and the angular momentum's products, then go
-# through the vector lanes a row a lane, where monitor_row, a row at a time,
-# makes them one by one (the momentum and the centre of mass, which are not
-# default monitors, go a row at a time).  The sums are monitor_row's,
-# term by term in the same order, so the values are the same to the bit
-# (tests/kernels/test_invariants.py).
+# Rows that hold the state (outputs recorded in a loop) get their energy and
+# angular momentum, the default monitors, after the loop, by fill_monitors,
+# a block of rows at a time: the energy's square roots and divisions, and
+# the angular momentum's products, then go through the vector lanes a row a
+# lane, where monitor_row, a row at a time, makes them one by one.  The sums
+# are monitor_row's, term by term in the same order, so the values are the
+# same to the bit (tests/kernels/test_invariants.py).  The momentum and the
+# centre of mass stay with monitor_row in the loop: in the pass they would
+# add a third to its compile time (1.4 -> 1.7 s) for monitors a run asks for
+# by name only.
+
+#: the monitors :func:`fill_monitors` makes after the loop
+FILLED = ENERGY | ANGULAR_MOMENTUM
 
 #: rows a block of :func:`fill_monitors` (its scratch: ``6 N`` of these);
 #: LLVM makes vector loops of 12 or 16 iterations and more, so 8 stays scalar
@@ -173,11 +178,12 @@ def _lane_add(s, c, lane, term):
 
 @njit
 def fill_monitors(rows, m, G, n_active, eps2, which):
-    """The monitors of output rows that hold the state (:func:`holds_state`),
+    """The energy and angular momentum (:data:`FILLED`, as far as ``which``
+    asks for them) of output rows that hold the state (:func:`holds_state`),
     filled in from each row's positions and velocities: the values
     :func:`monitor_row` gives for them, to the bit, the energy plus what
-    column 0 held (the force terms' energy; 0 without terms).  The work and
-    chaos columns are left as they are."""
+    column 0 held (the force terms' energy; 0 without terms).  The other
+    columns are left as they are."""
     w = MONITOR_WIDTH
     n = m.shape[0]
     B = FILL_BLOCK
@@ -230,27 +236,6 @@ def fill_monitors(rows, m, G, n_active, eps2, which):
             for d in range(3):
                 for lane in range(k):
                     rows[r0 + lane, 1 + d] = s[d, lane] + c[d, lane]
-        # the momentum and the centre of mass (not default monitors), a row at
-        # a time as momentum and center_of_mass make them
-        if which & MOMENTUM:
-            for lane in range(k):
-                for d in range(3):
-                    sm = 0.0
-                    cm = 0.0
-                    for i in range(n):
-                        sm, cm = _add(sm, cm, m[i] * X[3 * (n + i) + d, lane])
-                    rows[r0 + lane, 4 + d] = sm + cm
-        if which & CENTER_OF_MASS:
-            mt = 0.0
-            for i in range(n):
-                mt += m[i]
-            for lane in range(k):
-                for d in range(3):
-                    sm = 0.0
-                    cm = 0.0
-                    for i in range(n):
-                        sm, cm = _add(sm, cm, m[i] * X[3 * i + d, lane])
-                    rows[r0 + lane, 7 + d] = (sm + cm) / mt
 
 
 # The relative errors of a run's monitor rows, one pass over the rows each.

@@ -33,8 +33,8 @@ Outputs use the same mechanism: rows ``6 N`` wider than the monitors' also
 take the bodies' state (:func:`record_state`), so that a run's evenly
 spaced outputs are recorded inside the loop, ``step0`` then counting from
 the run's start (:meth:`orbits._driver.Driven.execute`); such a row's
-monitors are made after the loop, from the state it holds, a block of rows
-at a time (:func:`~.invariants.fill_monitors`).  Outputs that do not
+energy and angular momentum are made after the loop, from the state it
+holds, a block of rows at a time (:func:`~.invariants.fill_monitors`).  Outputs that do not
 fall a whole number of steps apart are recorded in the fixed-step loops too:
 with ``every = -1``, ``mon_t`` holds on entry the steps after which to record
 (:func:`first_record`).
@@ -68,7 +68,7 @@ from ._jit import idle_pointer, njit, pointer, slots, specialize
 from .gravity import (accelerate_pairwise, accelerate_pairwise_lanes,
                       accelerate_pairwise_parallel, accelerate_pairwise_rebound,
                       accelerate_pairwise_small)
-from .invariants import ENERGY, MONITOR_WIDTH, WORK_COLUMN, holds_state, monitor_row
+from .invariants import ENERGY, FILLED, MONITOR_WIDTH, WORK_COLUMN, holds_state, monitor_row
 from .status import Status
 from .stopping import call_check
 from .terms import table_rows
@@ -149,13 +149,16 @@ def record_state(x, v, m, row):
 
 @njit
 def _record(x, v, t, mon, n_mon, mon_t, mon_out):
-    # a row that holds the state gets its monitors after the loop, from that
-    # state (invariants.fill_monitors: column 0 is added to the energy)
+    # a row that holds the state gets its energy and angular momentum after
+    # the loop, from that state (invariants.fill_monitors: column 0 is added
+    # to the energy), its other monitors here
     every, which, m, G, n_active, eps2 = mon
     mon_t[n_mon] = t
     row = mon_out[n_mon]
     if holds_state(row, m):
         row[0] = 0.0
+        if which & ~FILLED:
+            monitor_row(x, v, m, G, n_active, eps2, which & ~FILLED, row)
         record_state(x, v, m, row)
     else:
         monitor_row(x, v, m, G, n_active, eps2, which, row)
@@ -526,6 +529,8 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
     if holds_state(row, m):
         # the terms' energy, to which fill_monitors adds the bodies' after the loop
         row[0] = extra_energy(x, v, eargs) if which & ENERGY else 0.0
+        if which & ~FILLED:
+            monitor_row(x, v, m, G, n_active, eps2, which & ~FILLED, row)
         record_state(x, v, m, row)
     else:
         monitor_row(x, v, m, G, n_active, eps2, which, row)

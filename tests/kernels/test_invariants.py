@@ -63,10 +63,11 @@ def _row_by_row(rows, m, G, n_active, eps2, which):
 
 
 def test_fill_monitors_gives_monitor_rows_values_to_the_bit(rng):
-    # outputs recorded in a loop get their monitors after it, a block of rows
-    # at a time: the same sums in the same order, so the same bits, on rows
-    # fewer than a block, a block, one more, with test particles (n_active <
-    # N), softening, every monitor bit, and rows with NaN and inf
+    # outputs recorded in a loop get their energy and angular momentum after
+    # it, a block of rows at a time: the same sums in the same order, so the
+    # same bits, on rows fewer than a block, a block, one more, with test
+    # particles (n_active < N), softening, and rows with NaN and inf; the
+    # other monitors' bits (made in the loop) leave their columns alone
     w = inv.MONITOR_WIDTH
     B = inv.FILL_BLOCK
     cases = [(6, 6, 0.0, inv.ENERGY | inv.ANGULAR_MOMENTUM),
@@ -87,17 +88,19 @@ def test_fill_monitors_gives_monitor_rows_values_to_the_bit(rng):
             m = rng.uniform(1e-6, 1e-3, size=n)
             m[0] = 1.0
             expected = rows.copy()
-            _row_by_row(expected, m, 0.3, n_active, eps2, which)
+            _row_by_row(expected, m, 0.3, n_active, eps2, which & inv.FILLED)
             inv.fill_kernel()(rows, m, 0.3, n_active, eps2, which)
             np.testing.assert_array_equal(rows, expected, err_msg=f"{(n, k, which)}")
 
 
 def test_fill_monitors_leaves_what_it_does_not_monitor(rng):
-    # without the energy bit, column 0 (the terms' energy) stays as it was
+    # without the energy bit, column 0 (the terms' energy) stays as it was;
+    # the momentum and centre of mass are the loop's
     w, n = inv.MONITOR_WIDTH, 3
     rows = rng.normal(size=(5, w + 6 * n))
     before = rows.copy()
-    inv.fill_kernel()(rows, np.ones(n), 1.0, n, 0.0, inv.ANGULAR_MOMENTUM)
+    inv.fill_kernel()(rows, np.ones(n), 1.0, n, 0.0,
+                      inv.ANGULAR_MOMENTUM | inv.MOMENTUM | inv.CENTER_OF_MASS)
     np.testing.assert_array_equal(rows[:, 0], before[:, 0])
     np.testing.assert_array_equal(rows[:, 4:], before[:, 4:])
     assert not np.array_equal(rows[:, 1:4], before[:, 1:4])
