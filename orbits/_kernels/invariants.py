@@ -154,8 +154,8 @@ def holds_state(row, m):
 # are monitor_row's, term by term in the same order, so the values are the
 # same to the bit (tests/kernels/test_invariants.py).  The momentum and the
 # centre of mass stay with monitor_row in the loop: in the pass they would
-# add a third to its compile time (1.4 -> 1.7 s) for monitors a run asks for
-# by name only.
+# add a fifth to its compile time (benchmarks/RESULTS.md, bench_outputs) for
+# monitors a run asks for by name only.
 
 #: the monitors :func:`fill_monitors` makes after the loop
 FILLED = ENERGY | ANGULAR_MOMENTUM
