@@ -11,7 +11,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ._compiling import CHECKS, OUTPUT_MONITORS, CompileClock, loop_label
-from ._kernels.invariants import MONITOR_WIDTH, fill_kernel
+from ._kernels.invariants import FILLED, MONITOR_WIDTH, fill_kernel
 from ._kernels.status import Status
 from ._kernels.stepping import USER_FORCE_SIZE
 from .errors import ForceTermError, RunInterrupted, WallTimeExceeded
@@ -27,9 +27,10 @@ CHECK_EVERY = 16
 
 def _filled(mon, rows):
     """``rows``, outputs a compiled loop recorded with the bodies' state, with
-    their monitors made from that state (``mon``: the loop's monitor
-    arguments; see :func:`orbits._kernels.invariants.fill_monitors`)."""
-    if mon[1]:
+    their energy and angular momentum made from that state (``mon``: the
+    loop's monitor arguments; see
+    :func:`orbits._kernels.invariants.fill_monitors`)."""
+    if mon[1] & FILLED:
         fill_kernel()(rows, mon[2], mon[3], mon[4], mon[5], mon[1])
     return rows
 
