@@ -441,10 +441,11 @@ class Driven:
 
     def _fill_ahead(self):
         # the outputs' monitors (orbits._kernels.invariants.fill_kernel),
-        # compiled or loaded before a loop that records outputs, announced as
-        # themselves
-        with self._compile_clock.part(OUTPUT_MONITORS):
-            fill_kernel()
+        # compiled or loaded before a loop that records outputs, where the
+        # run asks for them (see _filled), announced as themselves
+        if self._mon(0)[1] & FILLED:
+            with self._compile_clock.part(OUTPUT_MONITORS):
+                fill_kernel()
 
     def _compile_check(self):
         # the stopping conditions' check, one compiled C callable for every
