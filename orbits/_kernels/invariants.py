@@ -12,7 +12,8 @@ import numpy as np
 from ._jit import njit
 
 __all__ = ["energy", "angular_momentum", "momentum", "center_of_mass",
-           "monitor_row", "fill_monitors", "fill_kernel", "holds_state", "FILLED", "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
+           "monitor_row", "fill_monitors", "fill_kernel", "holds_state", "FILLED",
+           "MONITOR_COLUMNS", "MONITOR_WIDTH", "WORK_COLUMN", "ENERGY",
            "ANGULAR_MOMENTUM", "MOMENTUM", "CENTER_OF_MASS", "relative_errors",
            "vector_errors", "error_kernels"]
 

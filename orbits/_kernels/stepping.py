@@ -34,10 +34,10 @@ take the bodies' state (:func:`record_state`), so that a run's evenly
 spaced outputs are recorded inside the loop, ``step0`` then counting from
 the run's start (:meth:`orbits._driver.Driven.execute`); such a row's
 energy and angular momentum are made after the loop, from the state it
-holds, a block of rows at a time (:func:`~.invariants.fill_monitors`).  Outputs that do not
-fall a whole number of steps apart are recorded in the fixed-step loops too:
-with ``every = -1``, ``mon_t`` holds on entry the steps after which to record
-(:func:`first_record`).
+holds, a block of rows at a time (:func:`~.invariants.fill_monitors`).
+Outputs that do not fall a whole number of steps apart are recorded in the
+fixed-step loops too: with ``every = -1``, ``mon_t`` holds on entry the steps
+after which to record (:func:`first_record`).
 
 The work of non-conservative force terms.  A force built by :func:`with_terms`
 carries a third item in ``fargs``, the work arguments ``(their args, m,
@@ -147,21 +147,29 @@ def record_state(x, v, m, row):
             row[w + 3 * (n + i) + d] = v[i, d]
 
 
-@njit
-def _record(x, v, t, mon, n_mon, mon_t, mon_out):
-    # a row that holds the state gets its energy and angular momentum after
-    # the loop, from that state (invariants.fill_monitors: column 0 is added
-    # to the energy), its other monitors here
-    every, which, m, G, n_active, eps2 = mon
-    mon_t[n_mon] = t
-    row = mon_out[n_mon]
+@njit(inline="always")
+def _record_row(x, v, m, G, n_active, eps2, which, row, e_terms):
+    # one row of monitors, e_terms (the force terms' energy, 0 without terms)
+    # added to its energy.  A row that holds the state gets its energy and
+    # angular momentum after the loop, from that state
+    # (invariants.fill_monitors, which adds column 0 to the energy), its
+    # other monitors here
     if holds_state(row, m):
-        row[0] = 0.0
+        row[0] = e_terms
         if which & ~FILLED:
             monitor_row(x, v, m, G, n_active, eps2, which & ~FILLED, row)
         record_state(x, v, m, row)
     else:
         monitor_row(x, v, m, G, n_active, eps2, which, row)
+        if which & ENERGY:
+            row[0] += e_terms
+
+
+@njit
+def _record(x, v, t, mon, n_mon, mon_t, mon_out):
+    every, which, m, G, n_active, eps2 = mon
+    mon_t[n_mon] = t
+    _record_row(x, v, m, G, n_active, eps2, which, mon_out[n_mon], 0.0)
 
 
 #: the status of a step epilogue (:func:`step_epilogue`) that lets a loop carry on
@@ -525,17 +533,8 @@ def _record_terms(x, v, t, mon, n_mon, mon_t, mon_out):
     # mon carries the terms' energy arguments as its seventh item
     every, which, m, G, n_active, eps2, eargs = mon
     mon_t[n_mon] = t
-    row = mon_out[n_mon]
-    if holds_state(row, m):
-        # the terms' energy, to which fill_monitors adds the bodies' after the loop
-        row[0] = extra_energy(x, v, eargs) if which & ENERGY else 0.0
-        if which & ~FILLED:
-            monitor_row(x, v, m, G, n_active, eps2, which & ~FILLED, row)
-        record_state(x, v, m, row)
-    else:
-        monitor_row(x, v, m, G, n_active, eps2, which, row)
-        if which & ENERGY:
-            row[0] += extra_energy(x, v, eargs)
+    e_terms = extra_energy(x, v, eargs) if which & ENERGY else 0.0
+    _record_row(x, v, m, G, n_active, eps2, which, mon_out[n_mon], e_terms)
 
 
 def terms_recorder(terms):
