@@ -248,6 +248,85 @@ def test_a_run_continued_into_its_file_does_not_repeat_its_first_output(tmp_path
     assert again.resume_point.finished and again.resume_point.rows == 21
 
 
+# -- readers that hold HDF5's lock ---------------------------------------------------------
+
+HOLD = textwrap.dedent("""
+    import sys, h5py
+    f = h5py.File(sys.argv[1], "r", swmr=sys.argv[2] == "swmr")
+    print(f["particles/bodies/names"].shape[0], flush=True)
+    sys.stdin.readline()
+""")
+
+
+class Holder:
+    """Another process that opens ``path`` with plain h5py and holds it (and
+    HDF5's lock, where it takes one) until :meth:`close`."""
+
+    def __init__(self, path, mode):
+        self.proc = subprocess.Popen([sys.executable, "-c", HOLD, str(path), mode],
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     text=True)
+        self.bodies = self.proc.stdout.readline().strip()
+
+    def close(self):
+        if self.proc.poll() is None:
+            self.proc.stdin.close()
+        self.proc.wait(CHILD_SECONDS)
+
+
+def test_a_reader_that_opens_a_new_file_as_it_appears_does_not_stop_its_writer(
+        tmp_path, monkeypatch):
+    # a script polling for the file opens it the moment it takes its name (as
+    # test_file_reliability's live-writer test did, once in CI): the writer
+    # must not need a lock that reader holds
+    from orbits.io.h5md import layout
+    path, readers = tmp_path / "run.h5", []
+    real = os.replace
+
+    def replace(src, dst):
+        real(src, dst)
+        if os.fspath(dst) == os.fspath(path):
+            readers.append(Holder(path, "swmr"))
+    monkeypatch.setattr(layout.os, "replace", replace)
+    try:
+        kepler().run(until=100 * u.day, outputs=11, output=path, progress=False)
+    finally:
+        for r in readers:
+            r.close()
+    assert [r.bodies for r in readers] == ["2"]
+    np.testing.assert_array_equal(orbits.load(path).times.to_value(u.day),
+                                  np.arange(0, 101, 10.0))
+
+
+def test_an_append_waits_for_a_reader_and_then_says_what_holds_the_file(tmp_path,
+                                                                        monkeypatch):
+    import threading
+
+    from orbits.io.h5md import writer
+    path = tmp_path / "run.h5"
+    sim = kepler()
+    sim.run(until=100 * u.day, outputs=11, output=path, progress=False)
+    # a reader that closes the file within the wait: the run goes on
+    reader = Holder(path, "plain")
+    threading.Timer(0.5, reader.close).start()
+    sim.run(until=200 * u.day, outputs=11, output=path, progress=False)
+    assert reader.proc.returncode == 0
+    np.testing.assert_array_equal(orbits.load(path).times.to_value(u.day),
+                                  np.arange(0, 201, 10.0))
+    # one that keeps it: a named error, and the file as it was
+    before = path.read_bytes()
+    monkeypatch.setattr(writer, "READER_WAIT_SECONDS", 0.2)
+    reader = Holder(path, "plain")
+    try:
+        with pytest.raises(OrbitsFileError, match="open in another program, which holds "
+                                                  "HDF5's lock"):
+            sim.run(until=300 * u.day, outputs=11, output=path, progress=False)
+    finally:
+        reader.close()
+    assert path.read_bytes() == before
+    assert sim.time.to_value(u.day) == 200
+
+
 def test_repeated_times_are_named_without_advice_about_dt():
     t = np.array([0.0, 10, 20, 20, 30, 40, 50, 60, 70]) * u.day
     with pytest.raises(ValueError, match=r"times\[3\] = 20 is not after times\[2\] = 20") as info:

@@ -318,24 +318,25 @@ def _create(path, desc, state):
     appending in SWMR mode.
 
     It is written whole as ``<path>.creating`` (made exclusively, see
-    :func:`_new_file`) and then renamed to ``path``, which replaces a file or
-    a link there, never what a link names.  Where that fails (a full disk),
-    the temporary is removed and ``path`` is left as it was.
+    :func:`_new_file`), put in SWMR mode and then renamed to ``path``, which
+    replaces a file or a link there, never what a link names.  It stays open
+    throughout: a reader that opens ``path`` at any moment finds either what
+    was there before or this file with its writer in SWMR mode, and never
+    holds a lock the writer would need to open it again.  Where that fails (a
+    full disk), the temporary is removed and ``path`` is left as it was.
     """
     tmp = path.with_name(path.name + ".creating")
     f = _new_file(tmp)
     try:
         _write_layout(f, desc, state)
+        f.swmr_mode = True
+        os.replace(tmp, path)
     except BaseException as exc:
         _close_written(f)
         tmp.unlink(missing_ok=True)
         if isinstance(exc, (OSError, RuntimeError)) and not isinstance(exc, OrbitsError):
             raise _write_error(path, exc, " when making it; nothing was written") from None
         raise
-    f.close()
-    os.replace(tmp, path)
-    f = h5py.File(path, "a", libver="latest")
-    f.swmr_mode = True
     return f
 
 

@@ -20,6 +20,7 @@ written, so even a run stopped before its first periodic checkpoint resumes;
 compiled chunks (a signal handler does).
 """
 
+import errno
 import os
 import pathlib
 import time as _time
@@ -46,6 +47,34 @@ __all__ = ["FileRecorder", "CHECKPOINT_SECONDS", "BUFFER_ROWS"]
 CHECKPOINT_SECONDS = 60.0
 #: outputs held in memory before they are written as one block
 BUFFER_ROWS = 256
+
+
+#: seconds an append waits for readers that hold HDF5's lock on the file
+READER_WAIT_SECONDS = 5.0
+
+
+def _open_to_append(path):
+    """``path`` opened to append to.  A reader that opened it without SWMR
+    writing under way (plain ``h5py.File(path, "r")``, or ``swmr=True``
+    between two runs) holds HDF5's lock on it, which a writer needs to open
+    it: the open is tried again for :data:`READER_WAIT_SECONDS`, then
+    refused with an :class:`OrbitsFileError` that says so."""
+    deadline = _time.monotonic() + READER_WAIT_SECONDS
+    while True:
+        try:
+            return h5py.File(path, "a", libver="latest")
+        except OSError as exc:
+            if _error_number(exc) == errno.EAGAIN and _time.monotonic() < deadline:
+                _time.sleep(0.02)
+                continue
+            if _error_number(exc) == errno.EAGAIN:
+                raise OrbitsFileError(
+                    f"{path}: open in another program, which holds HDF5's lock on it "
+                    f"(waited {READER_WAIT_SECONDS:g} s); close it there, or read it with "
+                    f"orbits.load, which takes no lock") from None
+            raise OrbitsFileError(
+                f"{path}: cannot be opened to append to ({exc}); if the run writing it "
+                f"was killed, finish that run first with resume() (orbits resume)") from None
 
 
 class FileRecorder:
@@ -143,13 +172,7 @@ class FileRecorder:
             self.wall0 = _time.perf_counter()
             self.wall_before = 0.0
             if self.path.exists() and mine and not overwrite:
-                try:
-                    self.f = h5py.File(self.path, "a", libver="latest")
-                except OSError as exc:
-                    raise OrbitsFileError(
-                        f"{self.path}: cannot be opened to append to ({exc}); if the run "
-                        f"writing it was killed, finish that run first with resume() "
-                        f"(orbits resume)") from None
+                self.f = _open_to_append(self.path)
                 self._check_same_layout()
                 # a file written before the work was kept goes on without it
                 self.work = self.work and "work" in self.f["observables"]
