@@ -308,8 +308,10 @@ def test_an_append_waits_for_a_reader_and_then_says_what_holds_the_file(tmp_path
     sim.run(until=100 * u.day, outputs=11, output=path, progress=False)
     # a reader that closes the file within the wait: the run goes on
     reader = Holder(path, "plain")
-    threading.Timer(0.5, reader.close).start()
+    timer = threading.Timer(0.5, reader.close)
+    timer.start()
     sim.run(until=200 * u.day, outputs=11, output=path, progress=False)
+    timer.join()
     assert reader.proc.returncode == 0
     np.testing.assert_array_equal(orbits.load(path).times.to_value(u.day),
                                   np.arange(0, 201, 10.0))
