@@ -35,7 +35,7 @@ __all__ = ["accelerate_pairwise", "accelerate_pairwise_parallel", "accelerate_re
            "aligned_zeros", "zero_rows", "pull_with_sums", "pull_pair", "add_pulls",
            "accelerate_pairwise_lanes", "pair_accelerations_lanes", "lane_columns",
            "LANE_WIDTH", "LANE_ROWS", "LANES_FROM", "serial_kind", "pull_rows", "vector_doubles",
-           "pull_factors", "pull_rows_factored"]
+           "pull_factors", "pull_rows_factored", "pull_column"]
 
 
 #: Up to this many massive bodies the plain double loop
@@ -278,17 +278,26 @@ def _factor(dx, dy, dz, skip, eps2):
 
 
 @njit(inline="always")
+def pull_column(X, Y, Z, AX, AY, AZ, k, xs, ys, zs, ms, own, eps2, real):
+    """The pull of :func:`pull_rows` on the column ``k`` alone, added to its
+    sums; returns the squared separation (without ``eps2``), so that a pass
+    that also tests the pair's distance shares its arithmetic."""
+    dx, dy, dz, skip = _separation(X, Y, Z, k, xs, ys, zs, own, real)
+    s = (0.0 if skip else ms) * _factor(dx, dy, dz, skip, eps2)
+    AX[k] = AX[k] + s * dx
+    AY[k] = AY[k] + s * dy
+    AZ[k] = AZ[k] + s * dz
+    return dx * dx + dy * dy + dz * dz
+
+
+@njit(inline="always")
 def pull_rows(X, Y, Z, AX, AY, AZ, P, xs, ys, zs, ms, own, eps2, real):
     """The pull of a source at ``(xs, ys, zs)`` of ``G m = ms`` on the
     columns ``k < P`` of the rows ``X``, ``Y``, ``Z``, added to the sums
     ``AX``, ``AY``, ``AZ``; the column ``own`` and those from ``real`` on
     (padding) add an exact zero (see the notes above)."""
     for k in range(P):
-        dx, dy, dz, skip = _separation(X, Y, Z, k, xs, ys, zs, own, real)
-        s = (0.0 if skip else ms) * _factor(dx, dy, dz, skip, eps2)
-        AX[k] = AX[k] + s * dx
-        AY[k] = AY[k] + s * dy
-        AZ[k] = AZ[k] + s * dz
+        pull_column(X, Y, Z, AX, AY, AZ, k, xs, ys, zs, ms, own, eps2, real)
 
 
 @njit(inline="always")

@@ -23,9 +23,20 @@ point before it, both kept in the lanes: it evaluates the criterion and
 flags, redoes or goes on as it would have.  So the run is the scalar loop's
 bit for bit, whatever the lanes' criterion says; only the time differs.
 
-Each pair of planets is tested once per source body in the lanes (both
-orders, the same squared numbers), and only the pairs that the scalar
-criterion tests (an active source); the padding columns are left out.
+The pairs go first through a looser test, ``max(SP_i + SP_j, bound on the
+Hill radius)`` with ``SP = k_speed |h| |V|`` in place of the relative
+speed, made inside the pass that sums the planets' pulls
+(:func:`pulls_tested`): that pass already has each pair's squared
+separation, and its square roots and divisions leave room for the test's
+few operations.  Its speeds are taken before the kick that makes the
+criterion point's velocities (the kick needs the pulls), widened by a
+margin (:data:`_GROW`) far above what a half kick far from encounters
+changes; :func:`criterion_end` checks that no kicked speed outgrew its
+reach.  Only where a pair passes the looser test, or a speed outgrew its
+reach, are the pairs tested again with the relative speeds.  Each pair is
+tested once per source body in the lanes (both orders, the same squared
+numbers), and only the pairs that the scalar criterion tests (an active
+source); the padding columns are left out.
 """
 
 import math
@@ -33,12 +44,14 @@ import math
 import numpy as np
 
 from ._jit import njit
-from .gravity import LANE_WIDTH, lane_columns
-from .wh_lanes import (SCRATCH_ROWS, STATE, SUMS, jump_rows, jump_shift, kick_rows, pulls_rows,
-                       resident_drift_into, resident_finite, resident_load, resident_store)
+from .gravity import LANE_WIDTH, lane_columns, pull_column
+from .wh_lanes import (SCRATCH_ROWS, STATE, SUMS, jump_rows, jump_shift, kick_rows,
+                       resident_drift_into, resident_finite, resident_load, resident_store,
+                       zero_sums)
 
 __all__ = ["far_steps", "may_flag", "may_flag_at", "load_hill", "load_point", "criterion_scales",
-           "far_scratch_shape", "MARGIN", "FAR_WAIT", "FAR_STEPS"]
+           "criterion_start", "pulls_tested", "criterion_end", "far_scratch_shape", "MARGIN",
+           "FAR_WAIT", "FAR_STEPS"]
 
 #: 2^(1/3): ((m_i + m_j) / 3 m_0)^(1/3) <= 2^(1/3) max(hill_i, hill_j)
 _CBRT2 = 1.2599210498948732
@@ -47,6 +60,12 @@ _CBRT2 = 1.2599210498948732
 #: notes): it takes the same operations as the scalar criterion, so the
 #: margin only guards the bound against a difference of rounding.
 MARGIN = 1.0 + 1e-12
+
+# A speed reach of criterion_start's, taken before the kick of the
+# criterion point, widened for it: a half kick of the planets' pulls changes
+# a speed far from encounters by a millionth or less (Venus's on Mercury at
+# the users' step), and criterion_end checks the widened reach held.
+_GROW = 1.0 + 1.0 / 1024.0
 
 #: Steps the scalar loop takes after the lanes' criterion stopped a run of
 #: steps, before it tries the lanes again: a pair near its switching radius
@@ -64,7 +83,7 @@ _R2 = _HILL2 + 1
 _VS = _R2 + 1
 _DRIFTED = _VS + 3
 _POINT = _DRIFTED + 6
-# each column's speed times k_speed |h| (with the margin)
+# each column's speed reach k_speed |h| |V| (with the margin, widened)
 _SP = _POINT + 6
 #: the scratch's row whose column 0 counts the steps made in the lanes
 FAR_STEPS = _SP + 1
@@ -128,21 +147,89 @@ def may_flag(S, gm, n_active, n, h, k_hill, k_speed, k_peri):
     """Whether :func:`~orbits._kernels.trace.criterion` could flag a pair or
     a pericentre at the lanes' criterion point of the step ``h``: the
     positions in the lanes' state, the velocities in the rows ``_VS`` (see
-    the module notes).  A pair is taken within the speed radius where ``d^2
-    < (k_speed h)^2 |V_i - V_j|^2`` alone: the scalar criterion asks that
-    and a bound (``d^2 < 4 (k_speed h)^2 max |V|^2``) which it implies but
-    for rounding, so leaving the bound out takes a few more pairs, never
-    fewer.  The pairs go first through a looser test, ``|V_i - V_j| <=
-    |V_i| + |V_j|`` in place of the relative speed (each body's speed once,
-    fewer operations a pair); only where that may flag are they tested
-    again with the relative speeds."""
+    the module notes); the pulls' sums (:data:`SUMS`) are overwritten."""
     return may_flag_at(S, STATE, _VS, gm, n_active, n, h, k_hill, k_speed, k_peri)
 
 
 @njit(inline="always")
 def may_flag_at(S, pos, vel, gm, n_active, n, h, k_hill, k_speed, k_peri):
     """:func:`may_flag` of the positions in the three rows from ``pos`` and
-    the velocities in those from ``vel``."""
+    the velocities in those from ``vel``: :func:`criterion_start`,
+    :func:`pulls_tested` and :func:`criterion_end` with no kick between."""
+    criterion_start(S, pos, vel, n, k_speed * abs(h))
+    hits = pulls_tested(S, gm, n_active, n, pos, k_hill)
+    return criterion_end(S, pos, vel, gm, n_active, n, h, k_hill, k_speed, k_peri, hits)
+
+
+@njit(inline="always")
+def criterion_start(S, pos, vel, n, kv):
+    """What :func:`pulls_tested` reads besides the positions in the three
+    rows from ``pos``: each column's squared heliocentric distance, and its
+    speed reach ``kv |V|`` (``kv = k_speed |h|``, with the margin) from the
+    velocities in the three rows from ``vel`` (before the kick that makes
+    the criterion point's), widened by :data:`_GROW` for that kick."""
+    P = np.uint64(lane_columns(n))
+    X = S[pos]
+    Y = S[pos + 1]
+    Z = S[pos + 2]
+    U = S[vel]
+    V = S[vel + 1]
+    W = S[vel + 2]
+    R2 = S[_R2]
+    SP = S[_SP]
+    kvm = MARGIN * kv * kv
+    for k in range(P):
+        R2[k] = X[k] * X[k] + Y[k] * Y[k] + Z[k] * Z[k]
+        SP[k] = _GROW * math.sqrt(kvm * (U[k] * U[k] + V[k] * V[k] + W[k] * W[k]))
+
+
+@njit(inline="always")
+def pulls_tested(S, gm, n_active, n, pos, k_hill):
+    """:func:`~orbits._kernels.wh_lanes.pulls_rows` of the positions in the
+    three rows from ``pos`` (the same sums, bit for bit), and in the same
+    passes each pair's looser test: the pairs within ``max(SP_i + SP_j,
+    bound on the Hill radius)`` (rows from :func:`criterion_start`), counted
+    (see the module notes)."""
+    P = np.uint64(lane_columns(n))
+    zero_sums(S, P)
+    X = S[pos]
+    Y = S[pos + 1]
+    Z = S[pos + 2]
+    AX = S[SUMS]
+    AY = S[SUMS + 1]
+    AZ = S[SUMS + 2]
+    R2 = S[_R2]
+    H2 = S[_HILL2]
+    SP = S[_SP]
+    khm = MARGIN * (k_hill * _CBRT2) ** 2
+    real = np.uint64(n - 1)
+    hits = 0
+    # each source's pull on every column, and its test of the columns it
+    # pairs with (those after its own, but padding), on the same separation
+    for j in range(1, n_active):
+        c = np.uint64(j - 1)
+        xs = X[c]
+        ys = Y[c]
+        zs = Z[c]
+        sj = SP[c]
+        aj = H2[c]
+        rj2 = R2[c]
+        ms = gm[j]
+        for k in range(P):
+            d2 = pull_column(X, Y, Z, AX, AY, AZ, k, xs, ys, zs, ms, c, 0.0, real)
+            s = SP[k] + sj
+            reach = max(s * s, khm * max(H2[k], aj) * max(R2[k], rj2))
+            hits += _paired(k, j, n) & (d2 < reach)
+    return hits
+
+
+@njit(inline="always")
+def criterion_end(S, pos, vel, gm, n_active, n, h, k_hill, k_speed, k_peri, hits):
+    """The rest of :func:`may_flag_at` once the velocities in the three rows
+    from ``vel`` are the criterion point's: the pericentre test, the check
+    that no speed outgrew its reach in :func:`pulls_tested` (whose count is
+    ``hits``), and the pairs again with their relative speeds where the
+    looser test may flag."""
     kp2, kg2, kv2, kh2 = criterion_scales(h, gm[0], k_hill, k_speed, k_peri)
     P = np.uint64(lane_columns(n))
     X = S[pos]
@@ -157,46 +244,28 @@ def may_flag_at(S, pos, vel, gm, n_active, n, h, k_hill, k_speed, k_peri):
     lo = MARGIN - 1.0
     kgm = MARGIN * kg2
     kvm = MARGIN * kv2
-    hits = 0
+    peri = 0
+    grown = 0
     # (whole rows of lanes, the padding masked: loops that LLVM vectorises)
     for k in range(P):
-        ri2 = X[k] * X[k] + Y[k] * Y[k] + Z[k] * Z[k]
-        R2[k] = ri2
+        ri2 = R2[k]
         vi2 = U[k] * U[k] + V[k] * V[k] + W[k] * W[k]
         rv = X[k] * U[k] + Y[k] * V[k] + Z[k] * W[k]
         d = ri2 * ri2 - kp2 * (vi2 * ri2 + 3.0 * rv * rv)
-        hits += (np.int64(k) < n - 1) & ((d <= lo * ri2 * ri2) | (kgm * ri2 > d * d))
-        SP[k] = math.sqrt(kvm * vi2)
-    if hits:
+        real = np.int64(k) < n - 1
+        peri += real & ((d <= lo * ri2 * ri2) | (kgm * ri2 > d * d))
+        grown += real & (kvm * vi2 > SP[k] * SP[k])
+    if peri:
         return True
+    if hits == 0 and grown == 0:
+        return False
     khm = MARGIN * kh2
     L = np.uint64(LANE_WIDTH)
     # the sources with a pair after them: column c = j - 1 pairs with the
-    # columns c < k < n - 1 (the last planet's column has none)
+    # columns c < k < n - 1 (the last planet's column has none), the pairs
+    # (i, j), i > j, as the scalar criterion takes them: the lanes after
+    # column c, from the vector register that holds it on
     sources = min(n_active, n - 1)
-    # the looser test: (k_speed h)^2 |V_i - V_j|^2 <= (SP_i + SP_j)^2 (the
-    # margin covers the roundings), the pairs (i, j), i > j, as the scalar
-    # criterion takes them: the lanes after column c, from the vector
-    # register that holds it on
-    for j in range(1, sources):
-        c = np.uint64(j - 1)
-        xj = X[c]
-        yj = Y[c]
-        zj = Z[c]
-        sj = SP[c]
-        aj = H2[c]
-        rj2 = R2[c]
-        for k in range((c + np.uint64(1)) // L * L, P):
-            dx = X[k] - xj
-            dy = Y[k] - yj
-            dz = Z[k] - zj
-            d2 = dx * dx + dy * dy + dz * dz
-            s = SP[k] + sj
-            reach = max(s * s, khm * max(H2[k], aj) * max(R2[k], rj2))
-            hits += _paired(k, j, n) & (d2 < reach)
-    if hits == 0:
-        return False
-    # the same pairs with the relative speeds
     hits = 0
     for j in range(1, sources):
         c = np.uint64(j - 1)
@@ -275,6 +344,7 @@ def far_steps(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_pe
     P = np.uint64(lane_columns(n))
     half = 0.5 * dt
     seg = half + half
+    kv = k_speed * abs(dt)
     resident_load(xh, vb, gm, eta, S)
     load_hill(S, hill, n)
     done = 0
@@ -289,9 +359,11 @@ def far_steps(xh, vb, xc, vc, gm, eta, hill, n_active, dt, k_hill, k_speed, k_pe
         b2 = xh[0, 2]
         resident_drift_into(xh, vb, eta, seg, S, _DRIFTED)
         jump_rows(S, gm, n_active, half, P, _DRIFTED, _DRIFTED)
-        pulls_rows(S, gm, n_active, n, _DRIFTED)
+        criterion_start(S, _DRIFTED, _DRIFTED + 3, n, kv)
+        hits = pulls_tested(S, gm, n_active, n, _DRIFTED, k_hill)
         kick_rows(S, half, P, _DRIFTED + 3, _VS)
-        if may_flag_at(S, _DRIFTED, _VS, gm, n_active, n, dt, k_hill, k_speed, k_peri):
+        if criterion_end(S, _DRIFTED, _VS, gm, n_active, n, dt, k_hill, k_speed, k_peri,
+                         hits):
             xh[0, 0] = b0
             xh[0, 1] = b1
             xh[0, 2] = b2

@@ -127,7 +127,7 @@ __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns
            "resident_store", "resident_drift_twice", "resident_drift", "resident_finite",
            "resident_kick", "resident_jump_kick", "resident_jump", "resident_pulls",
            "resident_velocity_kick", "resident_drift_into", "jump_shift", "jump_rows", "kick_rows",
-           "pulls_rows", "STATE", "SUMS"]
+           "pulls_rows", "zero_sums", "STATE", "SUMS"]
 
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
@@ -731,7 +731,8 @@ def resident_finite(xj, vj, S):
 
 
 @njit(inline="always")
-def _zero_sums(S, P):
+def zero_sums(S, P):
+    """The pulls' sums (:data:`SUMS`) of the ``P`` columns set to zero."""
     for r in range(3):
         A = S[_RA + r]
         for k in range(P):
@@ -821,7 +822,7 @@ def resident_pulls(S, gm, n_active, n):
 def pulls_rows(S, gm, n_active, n, src):
     """:func:`resident_pulls` of the positions in the three rows from ``src``."""
     Pu = np.uint64(lane_columns(n))
-    _zero_sums(S, Pu)
+    zero_sums(S, Pu)
     X = S[src]
     Y = S[src + 1]
     Z = S[src + 2]
@@ -905,7 +906,7 @@ def resident_kick(xj, vj, gm, n_active, h, S):
         KX[k] = s * rx
         KY[k] = s * ry
         KZ[k] = s * rz
-    _zero_sums(S, Pu)
+    zero_sums(S, Pu)
     real = np.uint64(n - 1)
     # the central body pulls every lane but body 1's (the pair (0, 1) is left
     # out); its factors 1 / r^3 kept for its own sums below

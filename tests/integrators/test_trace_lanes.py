@@ -215,6 +215,49 @@ def test_the_lanes_criterion_bounds_the_scalar_one(which):
     assert flagged > 50
 
 
+@njit
+def _both_kicked(xh, v0, vs, gm, hill, n_active, h, k_hill, k_speed, k_peri, S, enc, r2):
+    # as _both, with the lanes' criterion in far_steps' order: its speed
+    # reaches from the velocities v0 before the kick, its pericentre test
+    # and its pairs' second pass on the kicked velocities vs
+    npairs, peri = _trace.criterion(xh, vs, gm, hill, r2, n_active, k_hill, k_speed, h,
+                                    k_peri, enc)
+    n = xh.shape[0]
+    _tl.load_point(S, xh, v0, gm, hill)
+    _tl.criterion_start(S, _tl.STATE, _tl.STATE + 3, n, k_speed * abs(h))
+    hits = _tl.pulls_tested(S, gm, n_active, n, _tl.STATE, k_hill)
+    for k in range(_tl.lane_columns(n)):
+        i = k + 1 if k + 1 < n else 1
+        for d in range(3):
+            S[_tl._VS + d, k] = vs[i, d]
+    return npairs, peri, _tl.criterion_end(S, _tl.STATE, _tl._VS, gm, n_active, n, h, k_hill,
+                                           k_speed, k_peri, hits)
+
+
+@pytest.mark.parametrize("which", ["speed", "hill"])
+def test_the_lanes_criterion_bounds_the_scalar_one_after_a_kick(which):
+    # the speed reaches are taken before the criterion point's kick (in the
+    # pulls' pass, which the kick needs): where the kick makes a body faster
+    # than its reach, the pairs are tested again with the kicked speeds.
+    # The velocities before the kick are the kicked ones scaled by 0.5 to 1
+    # (a kick far larger than any of a run far from encounters), so that
+    # the reaches alone would miss pairs at the speed radius
+    rng = np.random.default_rng(29)
+    flagged = 0
+    for trial in range(300):
+        n = int(rng.integers(3, 11))
+        xh, vs, gm, hill, h = _edge_states(rng, n, which)
+        v0 = vs * rng.uniform(0.5, 1.0, (n, 1))
+        n_active = n if trial % 4 else n - 1
+        S = aligned_zeros(_tl.far_scratch_shape(n))
+        npairs, peri, may = _both_kicked(xh, v0, vs, gm, hill, n_active, h, 3.0, 1.0, 1.0, S,
+                                         np.zeros((n, n), dtype=np.uint8), np.zeros(n))
+        if npairs > 0 or peri:
+            flagged += 1
+            assert may, (trial, which)
+    assert flagged > 40
+
+
 def test_the_lanes_criterion_passes_the_planets_far_from_encounters():
     # the solar system's planets at the users' step: no flag, no stop
     b = orbits.scenes.solar_system(moon=False)
