@@ -47,7 +47,7 @@ select, never a branch per lane:
   system).  The passes, three loops (starter, iteration, f and g; see
   ``wh_lanes``) inlined into the step, make the usual drift quicker than
   the masked form's iterations (benchmarks/RESULTS.md).  The masked form:
-  the third-order Taylor starter of the universal anomaly and Danby's quartic
+  the fifth-order Taylor starter of the universal anomaly and Danby's quartic
   iteration, repeated until every lane has converged (at most
   ``_SHORT_STEP_ITER`` times; a lane that has converged keeps its anomaly
   while the others go on, as the scalar loop would have stopped there).

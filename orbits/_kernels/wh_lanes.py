@@ -14,7 +14,7 @@ result back.
 :func:`kepler_drift_lanes` drifts every planet, bit for bit as
 :func:`~orbits._kernels.wisdom_holman.kepler_drift_all` does, in three
 passes over the columns: the scalar drift's short-step path
-(:func:`~orbits._kernels.kepler.kepler_drift`: the third-order starter of
+(:func:`~orbits._kernels.kepler.kepler_drift`: the fifth-order starter of
 the universal anomaly, Danby's quartic iterations, the f and g functions),
 and passes over all the planets let the processor overlap their long chains
 of dependent operations, which the scalar drift, one planet after another,
@@ -23,19 +23,21 @@ cannot (see "three passes" below).  The passes come in two forms:
 * the short-step passes (:func:`drift_columns`): one iteration and the
   four-term Stumpff series (:func:`~orbits._kernels.stumpff.stumpff_lane`),
   the whole drift of a short step (a few hundredths of a radian of anomaly,
-  where the starter is good to 1e-6 and one iteration converges);
+  where the starter is good to a few 1e-9 and one iteration converges);
 * the medium passes (:func:`medium_columns`), for the steps people take
   with Wisdom-Holman (a twentieth of the innermost period, up to a radian of
   an orbit): up to two iterations, each lane with the four- or the nine-term
   series (:func:`~orbits._kernels.stumpff.stumpff_medium_lane`), the
   scalar path's taken by a select; the second iteration is a pass of its
   own, made in every lane where any column has not converged after the
-  first.  The steps' drift of the state kept in the lanes
+  first (up to a twentieth of an orbit of e <= 0.2 none has: the starter is
+  of fifth order).  The steps' drift of the state kept in the lanes
   (:func:`resident_drift`) takes them always: a lane whose step is short
   takes the four-term series and keeps the first iteration's anomaly, as
-  the short passes would, and at short steps the second pass is left out,
-  so the loop compiles one drift instead of two (5 s less on a first run)
-  and the drift of a short step costs a pass less (benchmarks/RESULTS.md).
+  the short passes would, and where no column needs it the second pass is
+  left out, so the loop compiles one drift instead of two (5 s less on a
+  first run) and the drift of a short step costs a pass less
+  (benchmarks/RESULTS.md).
   The outputs' drifts
   (:func:`kepler_drift_lanes`, :func:`resident_drift_twice`) take the short
   passes, and the medium ones, compiled once, where those declined a planet,

@@ -123,7 +123,7 @@ def test_the_medium_passes_return_to_the_short_ones_bit_for_bit():
         assert S[L.MEMO, 1] == max(L.RETRY - k, 0), k
 
 
-@pytest.mark.parametrize("inner", [None, 0.12])
+@pytest.mark.parametrize("inner", [None, 0.08])
 def test_the_second_iteration_only_where_a_column_needs_it(inner):
     # the steps' drift (resident_drift, the medium passes) at a short step
     # of the outer planets: every column converges after the first iteration
@@ -151,8 +151,9 @@ def test_the_second_iteration_only_where_a_column_needs_it(inner):
         if inner:
             needed += flags[-1] == 1.0
     if inner:
-        # the inner planet (a twelfth of its orbit a step) needs the second
-        # iteration on most drifts
+        # the inner planet (a ninth of its orbit a step, beyond the reach of
+        # the fifth-order starter's one iteration) needs the second iteration
+        # on most drifts
         assert needed >= 10
 
 
