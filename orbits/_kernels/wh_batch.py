@@ -44,7 +44,12 @@ select, never a branch per lane:
   decline go to the scalar drift where they are few (at most one in
   :data:`FEW`), else to the masked form below, which takes them all with
   their iterations (the Sun and eight planets at a day: Mercury in every
-  system).  The passes, three loops (starter, iteration, f and g; see
+  system).  After a drift whose passes declined more than that, the next
+  :data:`~orbits._kernels.wh_lanes.RETRY` drifts go straight to the medium
+  passes (:func:`orbits._kernels.wh_lanes.medium_rows`: the nine-term
+  Stumpff series and a second iteration where a column needs it), which
+  take the steps people use, a twentieth of the innermost period, in every
+  element at once; what they decline goes on as above.  The passes, three loops (starter, iteration, f and g; see
   ``wh_lanes``) inlined into the step, make the usual drift quicker than
   the masked form's iterations (benchmarks/RESULTS.md).  The masked form:
   the fifth-order Taylor starter of the universal anomaly and Danby's quartic
@@ -103,7 +108,7 @@ from .stumpff import _STUMPFF_SHORT_Z
 from .stumpff import stumpff_lane as _stumpff_lane
 from .invariants import MONITOR_WIDTH, monitor_row
 from .status import Status
-from .wh_lanes import column_start, drift_columns
+from .wh_lanes import RETRY, column_start, drift_columns, medium_rows
 from .wisdom_holman import synchronize
 
 # the names the templates below are written against, bound by specialize
@@ -126,10 +131,12 @@ FEW = 8
 
 #: rows of the scratch ``d``: the drift's end state (0-5), the kick's
 #: weights (6), the masked drift's lanes (7), the written-out kick's masses
-#: (8-9; its positions and live flags in 0-3 between drifts), and the rows
-#: the drift's passes keep for the next (_DT on, nine)
+#: (8-9; its positions and live flags in 0-3 between drifts), the rows the
+#: drift's passes keep for the next (_DT on, nine), and in column 0 of row
+#: _MEMO the drifts left that go straight to the medium passes
 _DT = 10
-SCRATCH_ROWS = _DT + 9
+_MEMO = _DT + 9
+SCRATCH_ROWS = _MEMO + 1
 
 
 class Lanes(NamedTuple):
@@ -350,7 +357,7 @@ def kepler_drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     nb : int
         B, the systems.
     d, fl : ndarray, shapes (:data:`SCRATCH_ROWS`, N B) and (3, N B)
-        Scratch (the drift uses rows 0 to 5 and 10 to 18 of ``d``).
+        Scratch (the drift uses rows 0 to 5 and 10 to 19 of ``d``).
     one_x, one_v : ndarray, shape (1, 3)
         Scratch for the scalar drift of an element outside the lanes' domain.
 
@@ -386,36 +393,74 @@ def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
     U2 = d[5]
     take = fl[0]
     alone = fl[2]
+    # after the short passes declined many elements, the next RETRY drifts
+    # go straight to the medium passes (in _declined_drifts): the short
+    # passes then run over no column, and every live element is left to them
+    medium = d[_MEMO, 0] > 0.0
+    k0 = np.uint64(m) if medium else np.uint64(nb)
     declined = drift_columns(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, take, d, _DT,
-                             h, np.uint64(nb), np.uint64(m))
+                             h, k0, np.uint64(m))
     for k in range(np.uint64(nb), np.uint64(m)):
-        keep = take[k] * LF[k] != 0.0
+        keep = (take[k] * LF[k] != 0.0) & (not medium)
         X0[k] = Y0[k] if keep else X0[k]
         X1[k] = Y1[k] if keep else X1[k]
         X2[k] = Y2[k] if keep else X2[k]
         V0[k] = U0[k] if keep else V0[k]
         V1[k] = U1[k] if keep else V1[k]
         V2[k] = U2[k] if keep else V2[k]
-        alone[k] = 1.0 if (LF[k] != 0.0) & (take[k] == 0.0) else 0.0
+        alone[k] = 1.0 if (LF[k] != 0.0) & ((take[k] == 0.0) | medium) else 0.0
     # the live elements the passes declined (a step long against an orbit,
     # more than one iteration), in a function of its own: inlined at both of
     # the loop's steps, with the scalar drift's solver inlined in it twice,
     # they would take most of the batch loop's compilation
-    if declined:
-        _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v)
+    if declined or medium:
+        _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v, medium)
 
 
 @njit
-def _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
-    # the elements of fl[2] that the passes declined: few, the scalar drift,
-    # from the same start; more than one in FEW, the masked short-step path
-    # in every element with its iterations (the Sun and eight planets at a
-    # day: Mercury in every system)
+def _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v, medium):
+    # the elements of fl[2] that the passes declined (with medium, every
+    # live element: the short passes ran over none).  Where they are more
+    # than one in FEW, the medium passes (wh_lanes.medium_rows: the
+    # nine-term Stumpff series, a second iteration where a column needs
+    # it; the steps people use) take those they can, and the next RETRY
+    # drifts go straight to them; the rest: few, the scalar drift from the
+    # same start; more, the masked short-step path in every element with
+    # its iterations
     m = X.shape[1]
     alone = fl[2]
     n_alone = 0
     for k in range(np.uint64(nb), np.uint64(m)):
         n_alone += 1 if alone[k] != 0.0 else 0
+    if medium:
+        d[_MEMO, 0] -= 1.0
+    elif FEW * n_alone > m - nb:
+        d[_MEMO, 0] = RETRY
+        medium = True
+    if medium:
+        X0, X1, X2 = _components(X)
+        V0, V1, V2 = _components(V)
+        Y0, Y1, Y2 = _components(d)
+        U0 = d[3]
+        U1 = d[4]
+        U2 = d[5]
+        take = fl[0]
+        medium_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, take, d, _DT, MU, False,
+                    h, np.uint64(nb), np.uint64(m))
+        n_alone = 0
+        for k in range(np.uint64(nb), np.uint64(m)):
+            keep = (alone[k] != 0.0) & (take[k] != 0.0)
+            X0[k] = Y0[k] if keep else X0[k]
+            X1[k] = Y1[k] if keep else X1[k]
+            X2[k] = Y2[k] if keep else X2[k]
+            V0[k] = U0[k] if keep else V0[k]
+            V1[k] = U1[k] if keep else V1[k]
+            V2[k] = U2[k] if keep else V2[k]
+            left = (alone[k] != 0.0) & (take[k] == 0.0)
+            alone[k] = 1.0 if left else 0.0
+            n_alone += 1 if left else 0
+        if n_alone == 0:
+            return
     if FEW * n_alone > m - nb:
         mask = d[7]
         for k in range(np.uint64(nb), np.uint64(m)):

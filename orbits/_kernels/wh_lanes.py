@@ -129,7 +129,7 @@ __all__ = ["LANE_WIDTH", "DRIFT_ROWS", "MEMO", "PENDING", "RETRY", "lane_columns
            "resident_store", "resident_drift_twice", "resident_drift", "resident_finite",
            "resident_kick", "resident_jump_kick", "resident_jump", "resident_pulls",
            "resident_velocity_kick", "resident_drift_into", "jump_shift", "jump_rows", "kick_rows",
-           "pulls_rows", "zero_sums", "STATE", "SUMS"]
+           "pulls_rows", "zero_sums", "medium_rows", "STATE", "SUMS"]
 
 
 #: rows of the drift's scratch: the start (6) and mu, the end state (6),
@@ -339,30 +339,39 @@ def medium_columns(S, src, mu, dst, take, t, h, column_steps, P):
     column has not converged after the first: at short steps every column
     has, and the drift is a pass shorter.  Returns how many of the ``P``
     columns are left to the scalar drift."""
-    X0, X1, X2, V0, V1, V2 = S[src], S[src + 1], S[src + 2], S[src + 3], S[src + 4], S[src + 5]
-    Y0, Y1, Y2, U0, U1, U2 = S[dst], S[dst + 1], S[dst + 2], S[dst + 3], S[dst + 4], S[dst + 5]
-    MU = S[mu]
-    H = S[_H]
-    tk_ = S[take]
-    for k in range(P):
+    return medium_rows(S[src], S[src + 1], S[src + 2], S[src + 3], S[src + 4], S[src + 5],
+                       S[mu], S[dst], S[dst + 1], S[dst + 2], S[dst + 3], S[dst + 4],
+                       S[dst + 5], S[take], S, t, S[_H], column_steps, h, np.uint64(0), P)
+
+
+@njit(inline="always")
+def medium_rows(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T, t, H,
+                column_steps, h, k0, P):
+    """:func:`medium_columns` of the columns ``k0 .. P - 1`` of rows laid out
+    as :func:`drift_columns` has them (the start ``X``, ``V`` with ``MU``,
+    the end ``Y``, ``U``, the verdict ``tk_``, the passes' rows ``t .. t +
+    8`` of ``T``; each column's step from ``H`` where ``column_steps``);
+    the medium drift of :mod:`orbits._kernels.wh_batch`, whose columns are
+    the bodies of many systems."""
+    for k in range(k0, P):
         hk = H[k] if column_steps else h
-        _start_column(X0, X1, X2, V0, V1, V2, MU, S, t, k, hk, _STUMPFF_MEDIUM_Z)
-    for k in range(P):
+        _start_column(X0, X1, X2, V0, V1, V2, MU, T, t, k, hk, _STUMPFF_MEDIUM_Z)
+    for k in range(k0, P):
         hk = H[k] if column_steps else h
-        _iterate_column_medium(S, t, k, hk)
+        _iterate_column_medium(T, t, k, hk)
     # the second iteration, a pass of its own, only where a column has not
     # converged after the first (at short steps every column has)
-    V = S[t + 8]
+    V = T[t + 8]
     unsettled = 0
-    for k in range(P):
+    for k in range(k0, P):
         unsettled += V[k] == 0.0
     if unsettled:
-        for k in range(P):
+        for k in range(k0, P):
             hk = H[k] if column_steps else h
-            _iterate_again_medium(S, t, k, hk)
+            _iterate_again_medium(T, t, k, hk)
     rejected = 0
-    for k in range(P):
-        rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, S,
+    for k in range(k0, P):
+        rejected += _finish_column(X0, X1, X2, V0, V1, V2, MU, Y0, Y1, Y2, U0, U1, U2, tk_, T,
                                    t, k, True)
     return rejected
 

@@ -186,16 +186,16 @@ def test_the_medium_lanes_stumpff_functions_are_the_scalar_ones_bit_for_bit(sign
     assert not stumpff_medium_lane(np.nan)[-1]
 
 
-def systems(b, scale=1e-7, monitors=()):
+def systems(b, scale=1e-7, monitors=(), dt=10 * u.day):
     """b perturbed outer solar systems with masses scaled differently, as
-    simulations (wh, 10 days) and as lanes."""
+    simulations (wh, 10 days unless said) and as lanes."""
     sims = []
     for k in range(b):
         bodies = orbits.scenes.outer_solar_system()
         rng = np.random.default_rng(k)
         bodies._x = bodies._x * (1 + scale * rng.standard_normal(bodies._x.shape))
         bodies._m = bodies._m * (1 + 0.1 * k * np.r_[0, np.ones(len(bodies) - 1)])
-        sims.append(orbits.Simulation(bodies, "wh", dt=10 * u.day, monitors=monitors))
+        sims.append(orbits.Simulation(bodies, "wh", dt=dt, monitors=monitors))
     return sims
 
 
@@ -211,16 +211,16 @@ def lanes_of(sims):
     return xj, vj, gm, eta
 
 
-def advance(xj, vj, gm, eta, n_active, dt, steps, owed=None, unrolled=False):
+def advance(xj, vj, gm, eta, n_active, dt, steps, owed=None, unrolled=False, ws=None):
     # unrolled: the loop of advance_loop, whose kick is written out for the
     # systems' size (the same steps bit for bit), else advance_lanes
     n, _, nb = xj.shape
+    ws = W.lanes_workspace(n, nb) if ws is None else ws
     owed = np.zeros(nb) if owed is None else owed
     live = np.ones(nb)
     status, good = np.zeros(nb, dtype=np.int64), np.zeros(nb, dtype=np.int64)
     loop = W.advance_loop(n, n_active, nb) if unrolled else W.advance_lanes
-    failed = loop(W.Lanes(xj, vj, gm, eta, owed, live, status, good), n_active, dt, steps,
-                  W.lanes_workspace(n, nb))
+    failed = loop(W.Lanes(xj, vj, gm, eta, owed, live, status, good), n_active, dt, steps, ws)
     return failed, owed, live, status, good
 
 
@@ -270,6 +270,31 @@ def test_advance_lanes_is_wh_bit_for_bit(nb, unrolled):
         assert ws["owed"][0] == owed[b]
         x, v = W.lane_inertial(xj, vj, gm, eta, owed, n, b)
         assert np.array_equal(x, sim.state.x) and np.array_equal(v, sim.state.v)
+
+
+@pytest.mark.parametrize("unrolled", [False, True])
+def test_the_step_people_use_goes_to_the_medium_passes_bit_for_bit(unrolled):
+    # at a twentieth of Jupiter's period the short passes decline every
+    # planet (their four-term Stumpff series does not reach); the medium
+    # passes take them, and the next RETRY drifts go straight to those,
+    # then the short passes are tried again: over 200 steps both ways are
+    # taken several times, and every system is wh's bit for bit
+    dt = 216.6
+    sims = systems(4, dt=dt * u.day)
+    xj, vj, gm, eta = lanes_of(sims)
+    n = xj.shape[0]
+    ws = W.lanes_workspace(n, 4)
+    failed, owed, live, status, good = advance(xj, vj, gm, eta, n, dt, 200, unrolled=unrolled,
+                                               ws=ws)
+    assert failed == 0 and live.all() and (good == 200).all()
+    # (a drift a step: 200 drifts, the last RETRY-long run of medium ones
+    # still going)
+    assert 0 < ws.d[W._MEMO, 0] < W.RETRY
+    for b, sim in enumerate(sims):
+        sim.run(until=200 * dt * u.day, outputs=2, progress=False)
+        ws_b = sim.state.workspace
+        assert np.array_equal(ws_b["xj"], xj[:, :, b])
+        assert np.array_equal(ws_b["vj"], vj[:, :, b])
 
 
 @pytest.mark.parametrize("unrolled", [False, True])
