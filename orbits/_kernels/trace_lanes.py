@@ -133,6 +133,19 @@ def load_point(S, xh, vs, gm, hill):
 
 
 @njit(inline="always")
+def _rows(S, r):
+    # the three rows from r (x, y, z of positions or velocities)
+    return S[r], S[r + 1], S[r + 2]
+
+
+@njit(inline="always")
+def _hill_bound(khm, H2, R2, k, aj, rj2):
+    # the bound on the squared Hill switching radius of column k and a source
+    # whose squared Hill factor and distance are aj, rj2 (see criterion)
+    return khm * max(H2[k], aj) * max(R2[k], rj2)
+
+
+@njit(inline="always")
 def _paired(k, j, n):
     # whether column k (unsigned) pairs with the source body j (column j -
     # 1): after it and not padding; compared as signed integers, which the
@@ -169,12 +182,8 @@ def criterion_start(S, pos, vel, n, kv):
     velocities in the three rows from ``vel`` (before the kick that makes
     the criterion point's), widened by :data:`_GROW` for that kick."""
     P = np.uint64(lane_columns(n))
-    X = S[pos]
-    Y = S[pos + 1]
-    Z = S[pos + 2]
-    U = S[vel]
-    V = S[vel + 1]
-    W = S[vel + 2]
+    X, Y, Z = _rows(S, pos)
+    U, V, W = _rows(S, vel)
     R2 = S[_R2]
     SP = S[_SP]
     kvm = MARGIN * kv * kv
@@ -192,12 +201,8 @@ def pulls_tested(S, gm, n_active, n, pos, k_hill):
     (see the module notes)."""
     P = np.uint64(lane_columns(n))
     zero_sums(S, P)
-    X = S[pos]
-    Y = S[pos + 1]
-    Z = S[pos + 2]
-    AX = S[SUMS]
-    AY = S[SUMS + 1]
-    AZ = S[SUMS + 2]
+    X, Y, Z = _rows(S, pos)
+    AX, AY, AZ = _rows(S, SUMS)
     R2 = S[_R2]
     H2 = S[_HILL2]
     SP = S[_SP]
@@ -218,7 +223,7 @@ def pulls_tested(S, gm, n_active, n, pos, k_hill):
         for k in range(P):
             d2 = pull_column(X, Y, Z, AX, AY, AZ, k, xs, ys, zs, ms, c, 0.0, real)
             s = SP[k] + sj
-            reach = max(s * s, khm * max(H2[k], aj) * max(R2[k], rj2))
+            reach = max(s * s, _hill_bound(khm, H2, R2, k, aj, rj2))
             hits += _paired(k, j, n) & (d2 < reach)
     return hits
 
@@ -232,12 +237,8 @@ def criterion_end(S, pos, vel, gm, n_active, n, h, k_hill, k_speed, k_peri, hits
     looser test may flag."""
     kp2, kg2, kv2, kh2 = criterion_scales(h, gm[0], k_hill, k_speed, k_peri)
     P = np.uint64(lane_columns(n))
-    X = S[pos]
-    Y = S[pos + 1]
-    Z = S[pos + 2]
-    U = S[vel]
-    V = S[vel + 1]
-    W = S[vel + 2]
+    X, Y, Z = _rows(S, pos)
+    U, V, W = _rows(S, vel)
     R2 = S[_R2]
     H2 = S[_HILL2]
     SP = S[_SP]
@@ -285,7 +286,7 @@ def criterion_end(S, pos, vel, gm, n_active, n, h, k_hill, k_speed, k_peri, hits
             ux = U[k] - uj
             uy = V[k] - vj
             uz = W[k] - wj
-            bound = khm * max(H2[k], aj) * max(R2[k], rj2)
+            bound = _hill_bound(khm, H2, R2, k, aj, rj2)
             hits += (_paired(k, j, n)
                      & ((d2 < kvm * (ux * ux + uy * uy + uz * uz)) | (d2 < bound)))
     return hits != 0
