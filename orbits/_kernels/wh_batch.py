@@ -42,14 +42,14 @@ select, never a branch per lane:
   iteration and the f and g functions in passes over every body of every
   system), which takes the usual planetary step; the elements those passes
   decline go to the scalar drift where they are few (at most one in
-  :data:`FEW`), else to the masked form below, which takes them all with
-  their iterations (the Sun and eight planets at a day: Mercury in every
-  system).  After a drift whose passes declined more than that, the next
-  :data:`~orbits._kernels.wh_lanes.RETRY` drifts go straight to the medium
-  passes (:func:`orbits._kernels.wh_lanes.medium_rows`: the nine-term
-  Stumpff series and a second iteration where a column needs it), which
-  take the steps people use, a twentieth of the innermost period, in every
-  element at once; what they decline goes on as above.  The passes, three loops (starter, iteration, f and g; see
+  :data:`FEW`).  Where they are more, the medium passes
+  (:func:`orbits._kernels.wh_lanes.medium_rows`: the nine-term Stumpff
+  series and a second iteration where a column needs it) take them, the
+  steps people use, a twentieth of the innermost period, in every element
+  at once, and the next :data:`~orbits._kernels.wh_lanes.RETRY` drifts go
+  straight to those; what they decline goes to the scalar drift where few,
+  else to the masked form below, which takes them all with their
+  iterations.  The passes, three loops (starter, iteration, f and g; see
   ``wh_lanes``) inlined into the step, make the usual drift quicker than
   the masked form's iterations (benchmarks/RESULTS.md).  The masked form:
   the fifth-order Taylor starter of the universal anomaly and Danby's quartic
@@ -125,8 +125,10 @@ CHECK_EVERY = 16
 
 #: The drift's passes (:func:`orbits._kernels.wh_lanes.drift_columns`)
 #: leaves the elements it declines to the scalar drift while they are at
-#: most one in FEW of all, and to the masked short-step path with its
-#: iterations (:func:`_masked_drift`) when there are more.
+#: most one in FEW of all, and to the medium passes when there are more
+#: (what those decline: the scalar drift again, or the masked short-step
+#: path with its iterations, :func:`_masked_drift`, when more than one in
+#: FEW).
 FEW = 8
 
 #: rows of the scratch ``d``: the drift's end state (0-5), the kick's
