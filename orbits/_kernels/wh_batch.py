@@ -41,8 +41,9 @@ select, never a branch per lane:
   (:func:`orbits._kernels.wh_lanes.drift_columns`: the starter, one
   iteration and the f and g functions in passes over every body of every
   system), which takes the usual planetary step; the elements those passes
-  decline go to the scalar drift where they are few (at most one in
-  :data:`FEW`).  Where they are more, the medium passes
+  decline go to the scalar drift where they are few (fewer than one in
+  :data:`FEW`).  Where they are more (the Sun and eight planets at a day:
+  Mercury in every system, one in eight), the medium passes
   (:func:`orbits._kernels.wh_lanes.medium_rows`: the nine-term Stumpff
   series and a second iteration where a column needs it) take them, the
   steps people use, a twentieth of the innermost period, in every element
@@ -124,8 +125,8 @@ __all__ = ["CHECK_EVERY", "SCRATCH_ROWS", "Lanes", "Scratch", "lanes_workspace",
 CHECK_EVERY = 16
 
 #: The drift's passes (:func:`orbits._kernels.wh_lanes.drift_columns`)
-#: leaves the elements it declines to the scalar drift while they are at
-#: most one in FEW of all, and to the medium passes when there are more
+#: leave the elements they decline to the scalar drift while they are fewer
+#: than one in FEW of all, and to the medium passes when there are more
 #: (what those decline: the scalar drift again, or the masked short-step
 #: path with its iterations, :func:`_masked_drift`, when more than one in
 #: FEW).
@@ -422,8 +423,8 @@ def _drift_lanes(X, V, MU, h, LF, nb, d, fl, one_x, one_v):
 @njit
 def _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v, medium):
     # the elements of fl[2] that the passes declined (with medium, every
-    # live element: the short passes ran over none).  Where they are more
-    # than one in FEW, the medium passes (wh_lanes.medium_rows: the
+    # live element: the short passes ran over none).  Where they are one in
+    # FEW or more, the medium passes (wh_lanes.medium_rows: the
     # nine-term Stumpff series, a second iteration where a column needs
     # it; the steps people use) take those they can, and the next RETRY
     # drifts go straight to them; the rest: few, the scalar drift from the
@@ -436,7 +437,7 @@ def _declined_drifts(X, V, MU, h, LF, nb, d, fl, one_x, one_v, medium):
         n_alone += 1 if alone[k] != 0.0 else 0
     if medium:
         d[_MEMO, 0] -= 1.0
-    elif FEW * n_alone > m - nb:
+    elif FEW * n_alone >= m - nb:
         d[_MEMO, 0] = RETRY
         medium = True
     if medium:

@@ -297,6 +297,24 @@ def test_the_step_people_use_goes_to_the_medium_passes_bit_for_bit(unrolled):
         assert np.array_equal(ws_b["vj"], vj[:, :, b])
 
 
+def test_one_declined_element_in_eight_goes_to_the_medium_passes_bit_for_bit():
+    # the Sun and eight planets at a day: the short passes decline Mercury
+    # alone (its Stumpff argument beyond the four-term series), one element
+    # in W.FEW, in every system; the medium passes take it with the others
+    sims = [orbits.Simulation(orbits.scenes.solar_system(moon=False), "wh", dt=1 * u.day,
+                              monitors=()) for _ in range(2)]
+    xj, vj, gm, eta = lanes_of(sims)
+    n = xj.shape[0]
+    ws = W.lanes_workspace(n, 2)
+    failed, *_ = advance(xj, vj, gm, eta, n, 1.0, 100, ws=ws)
+    assert failed == 0
+    assert 0 < ws.d[W._MEMO, 0] < W.RETRY
+    for b, sim in enumerate(sims):
+        sim.run(until=100 * u.day, outputs=2, progress=False)
+        assert np.array_equal(sim.state.workspace["xj"], xj[:, :, b])
+        assert np.array_equal(sim.state.workspace["vj"], vj[:, :, b])
+
+
 @pytest.mark.parametrize("unrolled", [False, True])
 def test_test_particles_and_a_short_last_step_bit_for_bit(unrolled):
     sims = []
